@@ -1,0 +1,122 @@
+//! Two-body impact relations (THEORY.md §2, seed eqs. 4–18).
+//!
+//! Two bodies on a line (or a body and a wall, `m2 = ∞`) collide through a
+//! contact law. Their relative motion `x = s` obeys
+//! `μ ẍ = -F(x, ẋ)` with the reduced mass `μ = m1 m2 / (m1 + m2)`.
+//!
+//! - [`closed_form`]: Fujita's exact relations for the exponential law: the
+//!   phase trajectory (eq. 8), the coefficient of restitution e(V) (eq. 10),
+//!   the peak force f_max(V) (eqs. 15–17).
+//! - [`direct`]: the same quantities, and contact duration and maximum
+//!   penetration, by direct integration of the relative motion for any
+//!   contact law.
+
+pub mod closed_form;
+// pub mod direct;
+
+use crate::numeric::RootError;
+
+/// Errors of the impact relations.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ImpactError {
+    /// A parameter is out of its domain.
+    #[error("{name} = {value} is invalid: {requirement}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Offending value.
+        value: f64,
+        /// What it must satisfy.
+        requirement: &'static str,
+    },
+    /// A root solver failed.
+    #[error("{what}: {source}")]
+    Solver {
+        /// What was being solved.
+        what: &'static str,
+        /// The solver's error.
+        source: RootError,
+    },
+    /// A fixed-point iteration did not reach its tolerance.
+    #[error("fixed-point iteration for {what} did not converge in {iterations} iterations at V = {v}")]
+    FixedPointNoConvergence {
+        /// What was being iterated.
+        what: &'static str,
+        /// Dimensionless impact velocity.
+        v: f64,
+        /// Iterations performed.
+        iterations: usize,
+    },
+    /// The direct integration failed.
+    #[error("direct integration of the impact failed: {0}")]
+    Integration(String),
+    /// The law is not available for this computation.
+    #[error("{0}")]
+    Unsupported(String),
+}
+
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, ImpactError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ImpactError::InvalidParameter {
+            name,
+            value,
+            requirement: "must be finite and > 0",
+        })
+    }
+}
+
+/// The masses of the two colliding bodies. `m2 = +∞` models a rigid wall
+/// (or a body held by the frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TwoBodies {
+    m1: f64,
+    m2: f64,
+}
+
+impl TwoBodies {
+    /// Two bodies of masses `m1 > 0` and `m2 > 0` (kg); `m2` may be `+∞`.
+    pub fn new(m1: f64, m2: f64) -> Result<Self, ImpactError> {
+        positive("mass1", m1)?;
+        if !(m2 > 0.0) || m2.is_nan() {
+            return Err(ImpactError::InvalidParameter {
+                name: "mass2",
+                value: m2,
+                requirement: "must be > 0 (or infinite for a wall)",
+            });
+        }
+        Ok(Self { m1, m2 })
+    }
+
+    /// A body of mass `m1` against a rigid wall.
+    pub fn against_wall(m1: f64) -> Result<Self, ImpactError> {
+        Self::new(m1, f64::INFINITY)
+    }
+
+    /// Mass of body 1 (kg).
+    pub fn m1(&self) -> f64 {
+        self.m1
+    }
+
+    /// Mass of body 2 (kg), `+∞` for a wall.
+    pub fn m2(&self) -> f64 {
+        self.m2
+    }
+
+    /// Reduced mass `μ = m1 m2 / (m1 + m2)` (`m1` against a wall). The seed's
+    /// equal masses give `μ = m/2` (its eq. 4).
+    pub fn reduced_mass(&self) -> f64 {
+        if self.m2.is_infinite() {
+            self.m1
+        } else {
+            self.m1 * self.m2 / (self.m1 + self.m2)
+        }
+    }
+
+    /// Peak accelerations `F/m1`, `F/m2` of the two bodies for a force `F`
+    /// (the seed's "impact acceleration"); 0 for a wall.
+    pub fn accelerations(&self, force: f64) -> [f64; 2] {
+        [force / self.m1, force / self.m2]
+    }
+}

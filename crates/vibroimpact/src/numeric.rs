@@ -1,0 +1,298 @@
+//! Scalar numerics shared by the physics modules: cancellation-free special
+//! functions and safeguarded root finders that report non-convergence.
+
+/// Error of a scalar root finder.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RootError {
+    /// The function values at the bracket ends do not have opposite signs.
+    #[error("root not bracketed: f({lo}) = {f_lo}, f({hi}) = {f_hi}")]
+    NotBracketed {
+        /// Lower end of the bracket.
+        lo: f64,
+        /// Upper end of the bracket.
+        hi: f64,
+        /// Function value at `lo`.
+        f_lo: f64,
+        /// Function value at `hi`.
+        f_hi: f64,
+    },
+    /// The function returned a non-finite value.
+    #[error("function is not finite at x = {x}")]
+    NonFinite {
+        /// Where the function was evaluated.
+        x: f64,
+    },
+    /// The iteration limit was reached before the tolerance.
+    #[error("no convergence after {iterations} iterations (bracket [{lo}, {hi}])")]
+    NoConvergence {
+        /// Iterations performed.
+        iterations: usize,
+        /// Final bracket, lower end.
+        lo: f64,
+        /// Final bracket, upper end.
+        hi: f64,
+    },
+}
+
+/// `e^{-p} - 1 + p`, accurate to a few ulps for every `p >= 0`.
+///
+/// For small `p` the direct formula cancels (the value is ~p²/2); the
+/// alternating Taylor series `Σ_{k≥2} (-p)^k / k!` is used for `p < 1`.
+pub fn exp_neg_minus_one_plus(p: f64) -> f64 {
+    if p.abs() < 1.0 {
+        let mut term = p * p / 2.0;
+        let mut sum = term;
+        let mut k = 2.0;
+        while term.abs() > 1e-18 * sum.abs() {
+            k += 1.0;
+            term *= -p / k;
+            sum += term;
+        }
+        sum
+    } else {
+        (-p).exp_m1() + p
+    }
+}
+
+/// `u - ln(1 + u)` for `u > -1`, accurate to a few ulps (the direct formula
+/// cancels for small `u`, where the value is ~u²/2).
+pub fn x_minus_log1p(u: f64) -> f64 {
+    if u.abs() < 0.25 {
+        // Σ_{k≥2} (-1)^k u^k / k
+        let mut pow = u * u;
+        let mut sum = 0.0;
+        let mut k = 2.0;
+        let mut sign = 1.0;
+        loop {
+            let term = sign * pow / k;
+            sum += term;
+            if term.abs() <= 1e-18 * sum.abs() {
+                break;
+            }
+            pow *= u;
+            k += 1.0;
+            sign = -sign;
+        }
+        sum
+    } else {
+        u - u.ln_1p()
+    }
+}
+
+/// Newton's method safeguarded by bisection on a bracket `[lo, hi]` with
+/// `f(lo)` and `f(hi)` of opposite signs. `f_df` returns `(f(x), f'(x))`.
+///
+/// Converges when the step is below `xtol * max(|x|, tiny)` or `f(x) == 0`.
+/// Reports non-convergence after `max_iter` iterations instead of returning a
+/// poor value.
+pub fn newton_bracketed<F>(
+    mut f_df: F,
+    mut lo: f64,
+    mut hi: f64,
+    xtol: f64,
+    max_iter: usize,
+) -> Result<f64, RootError>
+where
+    F: FnMut(f64) -> (f64, f64),
+{
+    let (f_lo, _) = f_df(lo);
+    let (f_hi, _) = f_df(hi);
+    if !f_lo.is_finite() {
+        return Err(RootError::NonFinite { x: lo });
+    }
+    if !f_hi.is_finite() {
+        return Err(RootError::NonFinite { x: hi });
+    }
+    if f_lo == 0.0 {
+        return Ok(lo);
+    }
+    if f_hi == 0.0 {
+        return Ok(hi);
+    }
+    if f_lo.signum() == f_hi.signum() {
+        return Err(RootError::NotBracketed {
+            lo,
+            hi,
+            f_lo,
+            f_hi,
+        });
+    }
+    let lo_negative = f_lo < 0.0;
+    let mut x = 0.5 * (lo + hi);
+    for _ in 0..max_iter {
+        let (fx, dfx) = f_df(x);
+        if !fx.is_finite() {
+            return Err(RootError::NonFinite { x });
+        }
+        if fx == 0.0 {
+            return Ok(x);
+        }
+        if (fx < 0.0) == lo_negative {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let newton = x - fx / dfx;
+        let next = if dfx.is_finite() && dfx != 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        let step = (next - x).abs();
+        x = next;
+        if step <= xtol * x.abs().max(f64::MIN_POSITIVE) || lo == hi {
+            return Ok(x);
+        }
+    }
+    Err(RootError::NoConvergence {
+        iterations: max_iter,
+        lo,
+        hi,
+    })
+}
+
+/// Brent's method (inverse quadratic interpolation, secant and bisection) for
+/// a root of `f` in `[a, b]` given `fa = f(a)` and `fb = f(b)` of opposite
+/// signs. Stops when the bracket is below `xtol` (absolute).
+pub fn brent<F>(
+    mut f: F,
+    mut a: f64,
+    mut b: f64,
+    mut fa: f64,
+    mut fb: f64,
+    xtol: f64,
+    max_iter: usize,
+) -> Result<f64, RootError>
+where
+    F: FnMut(f64) -> f64,
+{
+    if fa == 0.0 {
+        return Ok(a);
+    }
+    if fb == 0.0 {
+        return Ok(b);
+    }
+    if fa.signum() == fb.signum() || !fa.is_finite() || !fb.is_finite() {
+        return Err(RootError::NotBracketed {
+            lo: a,
+            hi: b,
+            f_lo: fa,
+            f_hi: fb,
+        });
+    }
+    let mut c = a;
+    let mut fc = fa;
+    let mut d = b - a;
+    let mut e = d;
+    for _ in 0..max_iter {
+        if fb.signum() == fc.signum() {
+            c = a;
+            fc = fa;
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            a = b;
+            b = c;
+            c = a;
+            fa = fb;
+            fb = fc;
+            fc = fa;
+        }
+        let tol = 2.0 * f64::EPSILON * b.abs() + 0.5 * xtol;
+        let m = 0.5 * (c - b);
+        if m.abs() <= tol || fb == 0.0 {
+            return Ok(b);
+        }
+        if e.abs() >= tol && fa.abs() > fb.abs() {
+            let s = fb / fa;
+            let (mut p, mut q);
+            if a == c {
+                p = 2.0 * m * s;
+                q = 1.0 - s;
+            } else {
+                let qa = fa / fc;
+                let r = fb / fc;
+                p = s * (2.0 * m * qa * (qa - r) - (b - a) * (r - 1.0));
+                q = (qa - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if p > 0.0 {
+                q = -q;
+            } else {
+                p = -p;
+            }
+            if 2.0 * p < (3.0 * m * q - (tol * q).abs()).min((e * q).abs()) {
+                e = d;
+                d = p / q;
+            } else {
+                d = m;
+                e = m;
+            }
+        } else {
+            d = m;
+            e = m;
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol { d } else { tol.copysign(m) };
+        fb = f(b);
+        if !fb.is_finite() {
+            return Err(RootError::NonFinite { x: b });
+        }
+    }
+    Err(RootError::NoConvergence {
+        iterations: max_iter,
+        lo: b.min(c),
+        hi: b.max(c),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exp_neg_minus_one_plus_matches_series_and_direct() {
+        // Small p: leading terms p²/2 - p³/6 + p⁴/24.
+        let p = 1e-4_f64;
+        let series = p * p / 2.0 - p.powi(3) / 6.0 + p.powi(4) / 24.0 - p.powi(5) / 120.0;
+        assert!((exp_neg_minus_one_plus(p) - series).abs() <= 1e-15 * series);
+        // Either side of the switch agrees with the direct formula (no cancellation there).
+        for p in [0.999_999, 1.0, 3.0] {
+            let direct = (-p as f64).exp() - 1.0 + p;
+            assert!((exp_neg_minus_one_plus(p) - direct).abs() <= 4e-16 * direct);
+        }
+    }
+
+    #[test]
+    fn x_minus_log1p_small_and_large() {
+        let u = -1e-5_f64;
+        let series = u * u / 2.0 - u.powi(3) / 3.0 + u.powi(4) / 4.0;
+        assert!((x_minus_log1p(u) - series).abs() <= 1e-15 * series);
+        for u in [0.2499, 0.25, 0.9, -0.5] {
+            let direct = u - (1.0 + u as f64).ln();
+            assert!((x_minus_log1p(u) - direct).abs() <= 1e-14 * direct);
+        }
+    }
+
+    #[test]
+    fn newton_and_brent_find_cube_root_of_two() {
+        let exact = 2f64.cbrt();
+        let x = newton_bracketed(|x| (x * x * x - 2.0, 3.0 * x * x), 0.0, 2.0, 1e-15, 100).unwrap();
+        assert!((x - exact).abs() < 1e-15);
+        let y = brent(|x| x * x * x - 2.0, 0.0, 2.0, -2.0, 6.0, 1e-15, 100).unwrap();
+        assert!((y - exact).abs() < 1e-14);
+    }
+
+    #[test]
+    fn root_finders_report_failures() {
+        assert!(matches!(
+            newton_bracketed(|x| (x * x + 1.0, 2.0 * x), -1.0, 1.0, 1e-12, 50),
+            Err(RootError::NotBracketed { .. })
+        ));
+        assert!(matches!(
+            newton_bracketed(|x| (x - 0.3, 1.0), 0.0, 1.0, 1e-300, 1),
+            Err(RootError::NoConvergence { .. })
+        ));
+    }
+}
