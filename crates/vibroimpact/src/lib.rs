@@ -17,5 +17,7 @@
 //! The library does no I/O: callers hand it numbers and get numbers back.
 
 pub mod contact;
+pub mod identify;
 pub mod impact;
 pub mod numeric;
+pub mod integrate;
