@@ -291,6 +291,11 @@ impl ContactLaw {
         })
     }
 
+    /// The same law in another form.
+    pub fn with_form(self, form: ForceForm) -> Self {
+        Self { form, ..self }
+    }
+
     /// The law's physics.
     pub fn kind(&self) -> &LawKind {
         &self.kind

@@ -12,7 +12,7 @@
 //!   contact law.
 
 pub mod closed_form;
-// pub mod direct;
+pub mod direct;
 
 use crate::numeric::RootError;
 
