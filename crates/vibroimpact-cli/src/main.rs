@@ -1,1 +1,62 @@
-fn main() {}
+//! `vibroimpact`: the command-line interface.
+//!
+//! Without arguments it runs the built-in default study and writes its
+//! report (see [`report`]); subcommands expose the library's computations.
+
+mod data;
+mod error;
+mod format;
+mod identify_cmd;
+mod impact_cmd;
+mod output;
+mod plot;
+mod report;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Vibrating systems with mutual impacts (after T. Fujita 1977).
+#[derive(Parser, Debug)]
+#[command(name = "vibroimpact", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Report folder of the default study (run when no subcommand is given).
+    #[arg(long, default_value = "vibroimpact-report")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Two-body impact relations: restitution, peak force, contact duration.
+    #[command(allow_negative_numbers = true)]
+    Impact(impact_cmd::ImpactArgs),
+    /// Identify a/b and alpha of the exponential law from measured impacts.
+    #[command(allow_negative_numbers = true)]
+    Identify(identify_cmd::IdentifyArgs),
+    /// Run the default study and write its report (same as no subcommand).
+    Report {
+        /// Report folder.
+        #[arg(long, default_value = "vibroimpact-report")]
+        out: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Some(Command::Impact(args)) => impact_cmd::run(args),
+        Some(Command::Identify(args)) => identify_cmd::run(args),
+        Some(Command::Report { out }) => report::run(out),
+        None => report::run(&cli.out),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

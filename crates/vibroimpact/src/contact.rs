@@ -199,7 +199,12 @@ fn power(s: f64, n: f64) -> (f64, f64) {
 
 impl ContactLaw {
     /// Exponential law from a, b, α (all > 0).
-    pub fn exponential(a: f64, b: f64, alpha: f64, form: ForceForm) -> Result<Self, ContactLawError> {
+    pub fn exponential(
+        a: f64,
+        b: f64,
+        alpha: f64,
+        form: ForceForm,
+    ) -> Result<Self, ContactLawError> {
         const L: &str = "exponential";
         check(L, "a", a, a > 0.0, "must be > 0 (N)")?;
         check(L, "b", b, b > 0.0, "must be > 0 (N s/m)")?;
@@ -217,7 +222,13 @@ impl ContactLaw {
         a: f64,
         form: ForceForm,
     ) -> Result<Self, ContactLawError> {
-        check("exponential", "a_over_b", a_over_b, a_over_b > 0.0, "must be > 0 (m/s)")?;
+        check(
+            "exponential",
+            "a_over_b",
+            a_over_b,
+            a_over_b > 0.0,
+            "must be > 0 (m/s)",
+        )?;
         Self::exponential(a, a / a_over_b, alpha, form)
     }
 
@@ -244,7 +255,12 @@ impl ContactLaw {
     }
 
     /// Hunt–Crossley law `k s^n (1 + χ ṡ)`.
-    pub fn hunt_crossley(k: f64, n: f64, chi: f64, form: ForceForm) -> Result<Self, ContactLawError> {
+    pub fn hunt_crossley(
+        k: f64,
+        n: f64,
+        chi: f64,
+        form: ForceForm,
+    ) -> Result<Self, ContactLawError> {
         const L: &str = "hunt-crossley";
         check(L, "k", k, k > 0.0, "must be > 0 (N/m^n)")?;
         check(L, "n", n, n >= 1.0, "must be >= 1")?;
@@ -461,7 +477,12 @@ mod tests {
     #[test]
     fn compact_support_laws_vanish_when_separated() {
         for law in all_laws(ForceForm::Published).into_iter().skip(1) {
-            assert_eq!(law.eval(-1e-9, 1.0, 0.5), ContactForce::default(), "{}", law.name());
+            assert_eq!(
+                law.eval(-1e-9, 1.0, 0.5),
+                ContactForce::default(),
+                "{}",
+                law.name()
+            );
             assert!(law.has_compact_support());
         }
         // Hertz by hand.
@@ -471,7 +492,8 @@ mod tests {
 
     #[test]
     fn lankarani_nikravesh_uses_onset_velocity_with_floor() {
-        let law = ContactLaw::lankarani_nikravesh(1e9, 1.5, 0.6, 1e-3, ForceForm::Published).unwrap();
+        let law =
+            ContactLaw::lankarani_nikravesh(1e9, 1.5, 0.6, 1e-3, ForceForm::Published).unwrap();
         let s: f64 = 1e-5;
         let base = 1e9 * s.powf(1.5);
         let f = law.force(s, 0.5, 2.0);
@@ -515,6 +537,8 @@ mod tests {
         assert!(e.to_string().contains("b = -1"));
         assert!(ContactLaw::hertz(1e9, 0.5).is_err());
         assert!(ContactLaw::exponential(1.0, 1.0, f64::NAN, ForceForm::Published).is_err());
-        assert!(ContactLaw::lankarani_nikravesh(1.0, 1.5, 1.5, 1e-3, ForceForm::Published).is_err());
+        assert!(
+            ContactLaw::lankarani_nikravesh(1.0, 1.5, 1.5, 1e-3, ForceForm::Published).is_err()
+        );
     }
 }

@@ -35,7 +35,8 @@ use crate::impact::{ImpactError, TwoBodies};
 pub struct RestitutionSample {
     /// Impact velocity U (m/s), > 0.
     pub impact_velocity: f64,
-    /// Coefficient of restitution e, in (0, 1].
+    /// Coefficient of restitution e, in (0, 1.5) (noisy measurements may
+    /// exceed 1 a little).
     pub restitution: f64,
 }
 
@@ -139,16 +140,34 @@ pub enum IdentifyError {
 fn validate_restitution(samples: &[RestitutionSample]) -> Result<(), IdentifyError> {
     const W: &str = "restitution";
     for (index, s) in samples.iter().enumerate() {
-        let bad = |reason: String| Err(IdentifyError::InvalidSample { what: W, index, reason });
+        let bad = |reason: String| {
+            Err(IdentifyError::InvalidSample {
+                what: W,
+                index,
+                reason,
+            })
+        };
         if !(s.impact_velocity > 0.0 && s.impact_velocity.is_finite()) {
-            return bad(format!("impact_velocity = {} must be finite and > 0", s.impact_velocity));
+            return bad(format!(
+                "impact_velocity = {} must be finite and > 0",
+                s.impact_velocity
+            ));
         }
-        if !(s.restitution > 0.0 && s.restitution <= 1.0) {
-            return bad(format!("restitution = {} must be in (0, 1]", s.restitution));
+        // Measured values slightly above 1 are measurement noise and are kept;
+        // values of 1.5 or more cannot come from a passive impact.
+        if !(s.restitution > 0.0 && s.restitution < 1.5) {
+            return bad(format!(
+                "restitution = {} must be in (0, 1.5)",
+                s.restitution
+            ));
         }
     }
     if samples.len() < 2 {
-        return Err(IdentifyError::TooFewPoints { what: W, got: samples.len(), need: 2 });
+        return Err(IdentifyError::TooFewPoints {
+            what: W,
+            got: samples.len(),
+            need: 2,
+        });
     }
     Ok(())
 }
@@ -156,16 +175,32 @@ fn validate_restitution(samples: &[RestitutionSample]) -> Result<(), IdentifyErr
 fn validate_acceleration(samples: &[AccelerationSample], need: usize) -> Result<(), IdentifyError> {
     const W: &str = "acceleration";
     for (index, s) in samples.iter().enumerate() {
-        let bad = |reason: String| Err(IdentifyError::InvalidSample { what: W, index, reason });
+        let bad = |reason: String| {
+            Err(IdentifyError::InvalidSample {
+                what: W,
+                index,
+                reason,
+            })
+        };
         if !(s.impact_velocity > 0.0 && s.impact_velocity.is_finite()) {
-            return bad(format!("impact_velocity = {} must be finite and > 0", s.impact_velocity));
+            return bad(format!(
+                "impact_velocity = {} must be finite and > 0",
+                s.impact_velocity
+            ));
         }
         if !(s.peak_acceleration > 0.0 && s.peak_acceleration.is_finite()) {
-            return bad(format!("peak_acceleration = {} must be finite and > 0", s.peak_acceleration));
+            return bad(format!(
+                "peak_acceleration = {} must be finite and > 0",
+                s.peak_acceleration
+            ));
         }
     }
     if samples.len() < need {
-        return Err(IdentifyError::TooFewPoints { what: W, got: samples.len(), need });
+        return Err(IdentifyError::TooFewPoints {
+            what: W,
+            got: samples.len(),
+            need,
+        });
     }
     Ok(())
 }
@@ -218,7 +253,11 @@ pub fn fit_a_over_b(samples: &[RestitutionSample]) -> Result<RestitutionFit, Ide
         }
     }
     if best.0 == 0 || best.0 == grid.len() - 1 {
-        let direction = if best.0 == 0 { "a/b -> 0 (every e near 0)" } else { "a/b -> infinity (every e near 1, perfectly elastic)" };
+        let direction = if best.0 == 0 {
+            "a/b -> 0 (every e near 0)"
+        } else {
+            "a/b -> infinity (every e near 1, perfectly elastic)"
+        };
         return Err(IdentifyError::NotIdentifiable(format!(
             "a/b: the least-squares fit runs off to {direction}"
         )));
@@ -235,7 +274,9 @@ pub fn fit_a_over_b(samples: &[RestitutionSample]) -> Result<RestitutionFit, Ide
             h += de * de;
         }
         if h <= 0.0 {
-            return Err(IdentifyError::NotIdentifiable("a/b: the model does not depend on it at these velocities".into()));
+            return Err(IdentifyError::NotIdentifiable(
+                "a/b: the model does not depend on it at these velocities".into(),
+            ));
         }
         let mut accepted = false;
         for _ in 0..30 {
@@ -318,10 +359,17 @@ fn acceleration_residuals(
 }
 
 /// ln α = mean(ln A_i - ln g_i) at fixed q, with its residual sum of squares.
-fn profile_log_alpha(samples: &[AccelerationSample], q: f64, bodies: &TwoBodies) -> Result<(f64, f64), IdentifyError> {
+fn profile_log_alpha(
+    samples: &[AccelerationSample],
+    q: f64,
+    bodies: &TwoBodies,
+) -> Result<(f64, f64), IdentifyError> {
     let d: Vec<f64> = samples
         .iter()
-        .map(|s| Ok(s.peak_acceleration.ln() - log_acceleration_model(s.impact_velocity, q, mu_over_m1(bodies))?.0))
+        .map(|s| {
+            Ok(s.peak_acceleration.ln()
+                - log_acceleration_model(s.impact_velocity, q, mu_over_m1(bodies))?.0)
+        })
         .collect::<Result<_, ImpactError>>()?;
     let mean = d.iter().sum::<f64>() / d.len() as f64;
     let ssr = d.iter().map(|x| (x - mean).powi(2)).sum();
@@ -337,7 +385,9 @@ pub fn fit_alpha(
 ) -> Result<ExponentialLawFit, IdentifyError> {
     validate_acceleration(samples, 2)?;
     if !(a_over_b > 0.0 && a_over_b.is_finite()) {
-        return Err(IdentifyError::InvalidParameter(format!("a/b = {a_over_b} must be finite and > 0")));
+        return Err(IdentifyError::InvalidParameter(format!(
+            "a/b = {a_over_b} must be finite and > 0"
+        )));
     }
     let (log_alpha, ssr) = profile_log_alpha(samples, a_over_b, &bodies)?;
     let n = samples.len() as f64;
@@ -345,14 +395,23 @@ pub fn fit_alpha(
     let alpha = log_alpha.exp();
     Ok(ExponentialLawFit {
         method: "alpha-given-a-over-b",
-        a_over_b: Estimate { value: a_over_b, std_error: 0.0 },
-        alpha: Estimate { value: alpha, std_error: alpha * s / n.sqrt() },
+        a_over_b: Estimate {
+            value: a_over_b,
+            std_error: 0.0,
+        },
+        alpha: Estimate {
+            value: alpha,
+            std_error: alpha * s / n.sqrt(),
+        },
         correlation: 0.0,
         restitution_residuals: Vec::new(),
         acceleration_residuals: acceleration_residuals(samples, a_over_b, alpha, &bodies)?,
         acceleration_residual_std: s,
     })
 }
+
+/// Weighted sum of squares, JᵀJ and Jᵀr of the joint problem.
+type NormalEquations = (f64, [[f64; 2]; 2], [f64; 2]);
 
 /// Weighted residuals and Jacobian rows of the joint problem at θ = (ln q, ln α).
 struct JointProblem<'a> {
@@ -365,7 +424,7 @@ struct JointProblem<'a> {
 
 impl JointProblem<'_> {
     /// Weighted SSR, gradient-side JᵀJ and Jᵀr at θ.
-    fn normal_equations(&self, theta: [f64; 2]) -> Result<(f64, [[f64; 2]; 2], [f64; 2]), ImpactError> {
+    fn normal_equations(&self, theta: [f64; 2]) -> Result<NormalEquations, ImpactError> {
         let q = theta[0].exp();
         let mut ssr = 0.0;
         let mut jtj = [[0.0; 2]; 2];
@@ -435,7 +494,13 @@ pub fn fit_joint(
         ([r.a_over_b.value.ln(), la], r.residual_std.max(1e-12))
     };
     let (_, ssr_a) = profile_log_alpha(acceleration_samples, theta[0].exp(), &bodies)?;
-    let sigma_a = if acceleration_only { 1.0 } else { (ssr_a / (acceleration_samples.len() - 1) as f64).sqrt().max(1e-12) };
+    let sigma_a = if acceleration_only {
+        1.0
+    } else {
+        (ssr_a / (acceleration_samples.len() - 1) as f64)
+            .sqrt()
+            .max(1e-12)
+    };
     let problem = JointProblem {
         restitution: restitution_samples,
         acceleration: acceleration_samples,
@@ -459,7 +524,8 @@ pub fn fit_joint(
             let trial_theta = [theta[0] + step[0], theta[1] + step[1]];
             let (trial, tj, tr) = problem.normal_equations(trial_theta)?;
             if trial <= cost {
-                let converged = step[0].abs().max(step[1].abs()) < 1e-13 || cost - trial <= 1e-15 * cost;
+                let converged =
+                    step[0].abs().max(step[1].abs()) < 1e-13 || cost - trial <= 1e-15 * cost;
                 theta = trial_theta;
                 cost = trial;
                 jtj = tj;
@@ -478,7 +544,9 @@ pub fn fit_joint(
     let s2 = cost / (n - 2) as f64;
     let inv = |r| solve2(jtj, r);
     let (Some(c0), Some(c1)) = (inv([1.0, 0.0]), inv([0.0, 1.0])) else {
-        return Err(IdentifyError::NotIdentifiable("a/b and alpha jointly: singular covariance".into()));
+        return Err(IdentifyError::NotIdentifiable(
+            "a/b and alpha jointly: singular covariance".into(),
+        ));
     };
     let (var_q, var_a, cov) = (s2 * c0[0], s2 * c1[1], s2 * c0[1]);
     let (q, alpha) = (theta[0].exp(), theta[1].exp());
@@ -488,11 +556,24 @@ pub fn fit_joint(
         finish_restitution_fit(restitution_samples, theta[0], 0.0)?.residuals
     };
     let acceleration_residuals = acceleration_residuals(acceleration_samples, q, alpha, &bodies)?;
-    let ssr_log: f64 = acceleration_residuals.iter().map(|r| r.residual * r.residual).sum();
+    let ssr_log: f64 = acceleration_residuals
+        .iter()
+        .map(|r| r.residual * r.residual)
+        .sum();
     Ok(ExponentialLawFit {
-        method: if acceleration_only { "joint-acceleration-only" } else { "joint" },
-        a_over_b: Estimate { value: q, std_error: q * var_q.sqrt() },
-        alpha: Estimate { value: alpha, std_error: alpha * var_a.sqrt() },
+        method: if acceleration_only {
+            "joint-acceleration-only"
+        } else {
+            "joint"
+        },
+        a_over_b: Estimate {
+            value: q,
+            std_error: q * var_q.sqrt(),
+        },
+        alpha: Estimate {
+            value: alpha,
+            std_error: alpha * var_a.sqrt(),
+        },
         correlation: cov / (var_q * var_a).sqrt(),
         restitution_residuals,
         acceleration_residuals,
@@ -531,13 +612,23 @@ mod tests {
         let (q, alpha) = (1.2, 1.3e5);
         let r: Vec<_> = velocities()
             .iter()
-            .map(|&u| RestitutionSample { impact_velocity: u, restitution: restitution(u / q).unwrap() })
+            .map(|&u| RestitutionSample {
+                impact_velocity: u,
+                restitution: restitution(u / q).unwrap(),
+            })
             .collect();
         let fit = fit_a_over_b(&r).unwrap();
-        assert!((fit.a_over_b.value - q).abs() < 1e-10 * q, "{:?}", fit.a_over_b);
+        assert!(
+            (fit.a_over_b.value - q).abs() < 1e-10 * q,
+            "{:?}",
+            fit.a_over_b
+        );
         let a: Vec<_> = velocities()
             .iter()
-            .map(|&u| AccelerationSample { impact_velocity: u, peak_acceleration: accel(u, q, alpha) })
+            .map(|&u| AccelerationSample {
+                impact_velocity: u,
+                peak_acceleration: accel(u, q, alpha),
+            })
             .collect();
         let fa = fit_alpha(&a, bodies(), fit.a_over_b.value).unwrap();
         assert!((fa.alpha.value - alpha).abs() < 1e-8 * alpha);
@@ -571,12 +662,28 @@ mod tests {
         let e = fit.a_over_b;
         assert!(e.std_error > 0.0 && e.std_error < 0.2 * q);
         assert!((e.value - q).abs() < 3.0 * e.std_error, "{e:?}");
-        assert!((fit.residual_std - 0.01 / 3f64.sqrt()).abs() < 0.004, "{}", fit.residual_std);
+        assert!(
+            (fit.residual_std - 0.01 / 3f64.sqrt()).abs() < 0.004,
+            "{}",
+            fit.residual_std
+        );
         let fa = fit_alpha(&a, bodies(), e.value).unwrap();
-        assert!((fa.alpha.value - alpha).abs() < 0.1 * alpha, "{:?}", fa.alpha);
+        assert!(
+            (fa.alpha.value - alpha).abs() < 0.1 * alpha,
+            "{:?}",
+            fa.alpha
+        );
         let j = fit_joint(&r, &a, bodies()).unwrap();
-        assert!((j.a_over_b.value - q).abs() < 3.0 * j.a_over_b.std_error, "{:?}", j.a_over_b);
-        assert!((j.alpha.value - alpha).abs() < 3.0 * j.alpha.std_error + 0.05 * alpha, "{:?}", j.alpha);
+        assert!(
+            (j.a_over_b.value - q).abs() < 3.0 * j.a_over_b.std_error,
+            "{:?}",
+            j.a_over_b
+        );
+        assert!(
+            (j.alpha.value - alpha).abs() < 3.0 * j.alpha.std_error + 0.05 * alpha,
+            "{:?}",
+            j.alpha
+        );
         assert!(j.correlation.abs() <= 1.0);
         assert_eq!(j.restitution_residuals.len(), r.len());
     }
@@ -584,20 +691,54 @@ mod tests {
     #[test]
     fn unidentifiable_and_invalid_data_are_reported() {
         let elastic: Vec<_> = (1..5)
-            .map(|i| RestitutionSample { impact_velocity: 0.1 * i as f64, restitution: 1.0 })
+            .map(|i| RestitutionSample {
+                impact_velocity: 0.1 * i as f64,
+                restitution: 1.0,
+            })
             .collect();
-        assert!(matches!(fit_a_over_b(&elastic), Err(IdentifyError::NotIdentifiable(_))));
-        let one = [RestitutionSample { impact_velocity: 0.1, restitution: 0.9 }];
-        assert!(matches!(fit_a_over_b(&one), Err(IdentifyError::TooFewPoints { got: 1, need: 2, .. })));
+        assert!(matches!(
+            fit_a_over_b(&elastic),
+            Err(IdentifyError::NotIdentifiable(_))
+        ));
+        let one = [RestitutionSample {
+            impact_velocity: 0.1,
+            restitution: 0.9,
+        }];
+        assert!(matches!(
+            fit_a_over_b(&one),
+            Err(IdentifyError::TooFewPoints {
+                got: 1,
+                need: 2,
+                ..
+            })
+        ));
         let bad = [
-            RestitutionSample { impact_velocity: 0.1, restitution: 0.9 },
-            RestitutionSample { impact_velocity: -0.1, restitution: 0.9 },
+            RestitutionSample {
+                impact_velocity: 0.1,
+                restitution: 0.9,
+            },
+            RestitutionSample {
+                impact_velocity: -0.1,
+                restitution: 0.9,
+            },
         ];
-        assert!(matches!(fit_a_over_b(&bad), Err(IdentifyError::InvalidSample { index: 1, .. })));
+        assert!(matches!(
+            fit_a_over_b(&bad),
+            Err(IdentifyError::InvalidSample { index: 1, .. })
+        ));
         let zero_acc = [
-            AccelerationSample { impact_velocity: 0.1, peak_acceleration: 1.0 },
-            AccelerationSample { impact_velocity: 0.2, peak_acceleration: 0.0 },
+            AccelerationSample {
+                impact_velocity: 0.1,
+                peak_acceleration: 1.0,
+            },
+            AccelerationSample {
+                impact_velocity: 0.2,
+                peak_acceleration: 0.0,
+            },
         ];
-        assert!(matches!(fit_alpha(&zero_acc, bodies(), 1.2), Err(IdentifyError::InvalidSample { index: 1, .. })));
+        assert!(matches!(
+            fit_alpha(&zero_acc, bodies(), 1.2),
+            Err(IdentifyError::InvalidSample { index: 1, .. })
+        ));
     }
 }

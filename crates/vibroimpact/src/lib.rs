@@ -19,5 +19,5 @@
 pub mod contact;
 pub mod identify;
 pub mod impact;
-pub mod numeric;
 pub mod integrate;
+pub mod numeric;

@@ -110,12 +110,7 @@ where
         return Ok(hi);
     }
     if f_lo.signum() == f_hi.signum() {
-        return Err(RootError::NotBracketed {
-            lo,
-            hi,
-            f_lo,
-            f_hi,
-        });
+        return Err(RootError::NotBracketed { lo, hi, f_lo, f_hi });
     }
     let lo_negative = f_lo < 0.0;
     let mut x = 0.5 * (lo + hi);
@@ -258,8 +253,8 @@ mod tests {
         let series = p * p / 2.0 - p.powi(3) / 6.0 + p.powi(4) / 24.0 - p.powi(5) / 120.0;
         assert!((exp_neg_minus_one_plus(p) - series).abs() <= 1e-15 * series);
         // Either side of the switch agrees with the direct formula (no cancellation there).
-        for p in [0.999_999, 1.0, 3.0] {
-            let direct = (-p as f64).exp() - 1.0 + p;
+        for p in [0.999_999_f64, 1.0, 3.0] {
+            let direct = (-p).exp() - 1.0 + p;
             assert!((exp_neg_minus_one_plus(p) - direct).abs() <= 4e-16 * direct);
         }
     }
@@ -269,8 +264,8 @@ mod tests {
         let u = -1e-5_f64;
         let series = u * u / 2.0 - u.powi(3) / 3.0 + u.powi(4) / 4.0;
         assert!((x_minus_log1p(u) - series).abs() <= 1e-15 * series);
-        for u in [0.2499, 0.25, 0.9, -0.5] {
-            let direct = u - (1.0 + u as f64).ln();
+        for u in [0.2499_f64, 0.25, 0.9, -0.5] {
+            let direct = u - (1.0 + u).ln();
             assert!((x_minus_log1p(u) - direct).abs() <= 1e-14 * direct);
         }
     }

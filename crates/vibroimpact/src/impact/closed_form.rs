@@ -86,7 +86,11 @@ pub struct FixedPoint {
 /// `e_{i+1} = 1/V - (1 + 1/V) exp(-V(e_i + 1))`, stopped when
 /// `|e_{i+1} - e_i| <= tol`. Kept as the seed's method and as an independent
 /// check; it is slow for small V and loses digits to cancellation there.
-pub fn restitution_fixed_point(v: f64, tol: f64, max_iter: usize) -> Result<FixedPoint, ImpactError> {
+pub fn restitution_fixed_point(
+    v: f64,
+    tol: f64,
+    max_iter: usize,
+) -> Result<FixedPoint, ImpactError> {
     positive("V", v)?;
     let mut e = 1.0;
     for i in 1..=max_iter {
@@ -127,7 +131,10 @@ pub fn peak_velocity(v: f64) -> Result<f64, ImpactError> {
     let k = |w: f64| {
         let delta = w - v;
         let u = delta / (1.0 + v);
-        (w + delta * v / (1.0 + v) + x_minus_log1p(u), (1.0 + 2.0 * w) / (1.0 + w))
+        (
+            w + delta * v / (1.0 + v) + x_minus_log1p(u),
+            (1.0 + 2.0 * w) / (1.0 + w),
+        )
     };
     newton_bracketed(k, 0.0, v, XTOL, MAX_ITER).map_err(|source| ImpactError::Solver {
         what: "peak-force velocity, seed eq. (17)",
@@ -137,7 +144,11 @@ pub fn peak_velocity(v: f64) -> Result<f64, ImpactError> {
 
 /// The seed's iteration for w*, eq. (18): `w₀ = V`,
 /// `2 w_{i+1} = ln((1 + w_i)/(1 + V)) + V`, stopped at `|Δw| <= tol`.
-pub fn peak_velocity_fixed_point(v: f64, tol: f64, max_iter: usize) -> Result<FixedPoint, ImpactError> {
+pub fn peak_velocity_fixed_point(
+    v: f64,
+    tol: f64,
+    max_iter: usize,
+) -> Result<FixedPoint, ImpactError> {
     positive("V", v)?;
     let mut w = v;
     for i in 1..=max_iter {
@@ -248,8 +259,7 @@ impl ExponentialImpact {
         let w = peak_velocity(v)?;
         let f = w * (1.0 + w);
         let peak_force = f * self.force_scale();
-        let max_penetration =
-            (self.penetration_scale().ln() + x_minus_log1p(v).ln()) / self.alpha;
+        let max_penetration = (self.penetration_scale().ln() + x_minus_log1p(v).ln()) / self.alpha;
         Ok(ClosedFormImpact {
             impact_velocity,
             v,
@@ -267,7 +277,12 @@ impl ExponentialImpact {
     /// relative velocity `y` (m/s) for an impact that starts at `x = -X`
     /// (`start_distance = X > 0`) with velocity `U`. Returns `None` where the
     /// trajectory does not reach `y` (outside `[-eU, U]`).
-    pub fn trajectory_position(&self, impact_velocity: f64, start_distance: f64, y: f64) -> Option<f64> {
+    pub fn trajectory_position(
+        &self,
+        impact_velocity: f64,
+        start_distance: f64,
+        y: f64,
+    ) -> Option<f64> {
         let q = self.a_over_b();
         let v = impact_velocity / q;
         let w = y / q;
@@ -322,6 +337,7 @@ mod tests {
 
     /// The same six roots to 20 digits (mpmath, 40-digit arithmetic:
     /// `findroot(e - 1/V + (1 + 1/V) exp(-V(e + 1)))`, and likewise eq. 17).
+    #[allow(clippy::excessive_precision)] // the digits as computed, for the record
     const HIGH_PRECISION: [(f64, f64, f64); 6] = [
         (0.01, 0.993_377_454_398_767_363_27, 4.967_038_032_356_94e-5),
         (0.1, 0.937_475_579_949_905_060_52, 4.700_800_310_782_12e-3),
@@ -340,13 +356,22 @@ mod tests {
             let tol = if v == 0.01 { 1.5e-12 } else { 1e-12 };
             assert!((e - e_ref).abs() < tol, "e({v}) = {e:.15} vs {e_ref}");
             let f = peak_force_dimensionless(v).unwrap();
-            assert!((f - f_ref).abs() < 1e-9 * f_ref, "f_max({v}) = {f:.12e} vs {f_ref:e}");
+            assert!(
+                (f - f_ref).abs() < 1e-9 * f_ref,
+                "f_max({v}) = {f:.12e} vs {f_ref:e}"
+            );
         }
         for (v, e_ref, f_ref) in HIGH_PRECISION {
             let e = restitution(v).unwrap();
-            assert!((e - e_ref).abs() <= 8.0 * f64::EPSILON, "e({v}) = {e:.17} vs {e_ref}");
+            assert!(
+                (e - e_ref).abs() <= 8.0 * f64::EPSILON,
+                "e({v}) = {e:.17} vs {e_ref}"
+            );
             let f = peak_force_dimensionless(v).unwrap();
-            assert!((f - f_ref).abs() < 1e-14 * f_ref, "f_max({v}) = {f:.15e} vs {f_ref:e}");
+            assert!(
+                (f - f_ref).abs() < 1e-14 * f_ref,
+                "f_max({v}) = {f:.15e} vs {f_ref:e}"
+            );
         }
     }
 
@@ -361,7 +386,10 @@ mod tests {
             let p = v * (e + 1.0);
             let lhs = p;
             let rhs = (1.0 + v) * -(-p).exp_m1();
-            assert!((lhs - rhs).abs() <= 8.0 * f64::EPSILON * lhs, "V={v}: {lhs} vs {rhs}");
+            assert!(
+                (lhs - rhs).abs() <= 8.0 * f64::EPSILON * lhs,
+                "V={v}: {lhs} vs {rhs}"
+            );
             v *= 1.37;
         }
     }
@@ -372,13 +400,19 @@ mod tests {
         for v in [1e-6, 1e-5, 1e-4, 1e-3] {
             let e = restitution(v).unwrap();
             let series = 1.0 - 2.0 * v / 3.0 + 4.0 * v * v / 9.0;
-            assert!((e - series).abs() <= v * v * v + 4e-16, "V={v}: {e} vs {series}");
+            assert!(
+                (e - series).abs() <= v * v * v + 4e-16,
+                "V={v}: {e} vs {series}"
+            );
             assert!(((1.0 - e) / v - 2.0 / 3.0).abs() <= v, "slope at V={v}");
         }
         // f_max ~ V²/2 for small V.
         for v in [1e-6, 1e-4] {
             let f = peak_force_dimensionless(v).unwrap();
-            assert!((f / (v * v / 2.0) - 1.0).abs() < 2.0 * v, "f_max({v}) = {f}");
+            assert!(
+                (f / (v * v / 2.0) - 1.0).abs() < 2.0 * v,
+                "f_max({v}) = {f}"
+            );
         }
     }
 
@@ -396,9 +430,15 @@ mod tests {
     fn newton_matches_seed_fixed_point_iterations() {
         for v in [0.05, 0.3, 1.0, 3.0, 20.0] {
             let fp = restitution_fixed_point(v, 1e-15, 1_000_000).unwrap();
-            assert!((fp.value - restitution(v).unwrap()).abs() < 1e-13, "e at V={v}");
+            assert!(
+                (fp.value - restitution(v).unwrap()).abs() < 1e-13,
+                "e at V={v}"
+            );
             let wp = peak_velocity_fixed_point(v, 1e-16, 10_000).unwrap();
-            assert!((wp.value - peak_velocity(v).unwrap()).abs() < 1e-13 * v, "w* at V={v}");
+            assert!(
+                (wp.value - peak_velocity(v).unwrap()).abs() < 1e-13 * v,
+                "w* at V={v}"
+            );
         }
         // The seed's iteration is slow for small V: it needs ~1/V iterations.
         let slow = restitution_fixed_point(1e-3, 1e-13, 1_000_000).unwrap();
@@ -418,7 +458,8 @@ mod tests {
             let fd = (restitution(v + h).unwrap() - restitution(v - h).unwrap()) / (2.0 * h);
             assert!((restitution_derivative(v, e) - fd).abs() < 1e-6 * fd.abs().max(1e-3));
             let w = peak_velocity(v).unwrap();
-            let fd = (peak_force_dimensionless(v + h).unwrap() - peak_force_dimensionless(v - h).unwrap())
+            let fd = (peak_force_dimensionless(v + h).unwrap()
+                - peak_force_dimensionless(v - h).unwrap())
                 / (2.0 * h);
             assert!((peak_force_dimensionless_derivative(v, w) - fd).abs() < 1e-6 * fd);
         }
@@ -443,14 +484,17 @@ mod tests {
     /// reaches the maximum penetration at y = 0.
     #[test]
     fn trajectory_endpoints_and_peak() {
-        let law = ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
+        let law =
+            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
         let imp = ExponentialImpact::new(&law, TwoBodies::new(0.227, 0.227).unwrap()).unwrap();
         let u = 0.3;
         let x_start = 3e-5;
         let c = imp.impact(u).unwrap();
         let x0 = imp.trajectory_position(u, x_start, u).unwrap();
         assert!((x0 + x_start).abs() < 1e-15);
-        let x1 = imp.trajectory_position(u, x_start, -c.rebound_velocity).unwrap();
+        let x1 = imp
+            .trajectory_position(u, x_start, -c.rebound_velocity)
+            .unwrap();
         assert!((x1 + x_start).abs() < 1e-12, "rebound end at {x1}");
         let xm = imp.trajectory_position(u, x_start, 0.0).unwrap();
         // Far start (e^{-αX} negligible): the maximum is the closed form's.
@@ -461,7 +505,10 @@ mod tests {
         assert!(pts.iter().all(|&(x, _)| x <= xm + 1e-15));
         // Peak force from eq. (14) with μ = m/2 (the seed's equal masses).
         let q: f64 = 1.2;
-        assert!((c.peak_force - c.peak_force_dimensionless * 0.227 / 2.0 * 1.3e5 * q * q).abs() < 1e-9 * c.peak_force);
+        assert!(
+            (c.peak_force - c.peak_force_dimensionless * 0.227 / 2.0 * 1.3e5 * q * q).abs()
+                < 1e-9 * c.peak_force
+        );
     }
 
     #[test]

@@ -128,7 +128,9 @@ fn length_scale(law: &ContactLaw, mu: f64, u: f64) -> f64 {
         LawKind::KelvinVoigt { k, .. } => u * (mu / k).sqrt(),
         LawKind::Hertz { k, n }
         | LawKind::HuntCrossley { k, n, .. }
-        | LawKind::LankaraniNikravesh { k, n, .. } => ((n + 1.0) * mu * u * u / (2.0 * k)).powf(1.0 / (n + 1.0)),
+        | LawKind::LankaraniNikravesh { k, n, .. } => {
+            ((n + 1.0) * mu * u * u / (2.0 * k)).powf(1.0 / (n + 1.0))
+        }
     }
 }
 
@@ -206,7 +208,10 @@ fn walk(
                 200,
             )
             .map_err(|e| ImpactError::Integration(format!("locating the peak force: {e}")))?;
-            let y = [st.dense_component(sys, 0, tp), st.dense_component(sys, 1, tp)];
+            let y = [
+                st.dense_component(sys, 0, tp),
+                st.dense_component(sys, 1, tp),
+            ];
             let f = sys.force(&y);
             if f > w.peak_force {
                 w.peak_force = f;
@@ -224,7 +229,9 @@ fn walk(
                 tol_root * t1.max(1.0),
                 200,
             )
-            .map_err(|e| ImpactError::Integration(format!("locating the maximum penetration: {e}")))?;
+            .map_err(|e| {
+                ImpactError::Integration(format!("locating the maximum penetration: {e}"))
+            })?;
             w.max_sigma = w.max_sigma.max(st.dense_component(sys, 0, tm));
         }
         // Contact indicator crossings.
@@ -243,7 +250,9 @@ fn walk(
                     tol_root * t1.max(1.0),
                     200,
                 )
-                .map_err(|e| ImpactError::Integration(format!("locating the contact boundary: {e}")))?;
+                .map_err(|e| {
+                    ImpactError::Integration(format!("locating the contact boundary: {e}"))
+                })?;
                 w.crossings.push((tc, in_new > 0.0));
             }
             ind_old = Some(in_new);
@@ -284,7 +293,10 @@ pub fn integrate_impact(
     let length = length_scale(law, mu, u);
     let s0 = match *law.kind() {
         LawKind::Exponential { alpha, .. } => {
-            ExponentialImpact::new(law, bodies)?.impact(u)?.max_penetration - 40.0 / alpha
+            ExponentialImpact::new(law, bodies)?
+                .impact(u)?
+                .max_penetration
+                - 40.0 / alpha
         }
         _ => 0.0,
     };
@@ -364,9 +376,22 @@ mod tests {
             let u = v * 1.2;
             let c = cf.impact(u).unwrap();
             let d = integrate_impact(&law, bodies, u, &DirectOptions::default()).unwrap();
-            assert!((d.restitution - c.restitution).abs() < 1e-9, "V={v}: e {} vs {}", d.restitution, c.restitution);
-            assert!((d.peak_force / c.peak_force - 1.0).abs() < 1e-9, "V={v}: F {} vs {}", d.peak_force, c.peak_force);
-            assert!((d.max_penetration - c.max_penetration).abs() < 1e-9 / 1.3e5, "V={v}: x_max");
+            assert!(
+                (d.restitution - c.restitution).abs() < 1e-9,
+                "V={v}: e {} vs {}",
+                d.restitution,
+                c.restitution
+            );
+            assert!(
+                (d.peak_force / c.peak_force - 1.0).abs() < 1e-9,
+                "V={v}: F {} vs {}",
+                d.peak_force,
+                c.peak_force
+            );
+            assert!(
+                (d.max_penetration - c.max_penetration).abs() < 1e-9 / 1.3e5,
+                "V={v}: x_max"
+            );
             let t_peak = d.peak_force_time - d.contact_start_time;
             assert!(t_peak > 0.0 && t_peak < d.contact_duration, "V={v}: {d:?}");
             v *= 10f64.powf(0.25);
@@ -379,10 +404,16 @@ mod tests {
         let law = seed_law();
         let u = 0.5;
         let e_ref = crate::impact::closed_form::restitution(u / 1.2).unwrap();
-        for bodies in [TwoBodies::against_wall(0.2).unwrap(), TwoBodies::new(0.1, 0.9).unwrap()] {
+        for bodies in [
+            TwoBodies::against_wall(0.2).unwrap(),
+            TwoBodies::new(0.1, 0.9).unwrap(),
+        ] {
             let d = integrate_impact(&law, bodies, u, &DirectOptions::default()).unwrap();
             assert!((d.restitution - e_ref).abs() < 1e-9);
-            let c = ExponentialImpact::new(&law, bodies).unwrap().impact(u).unwrap();
+            let c = ExponentialImpact::new(&law, bodies)
+                .unwrap()
+                .impact(u)
+                .unwrap();
             assert!((d.peak_acceleration[0] / c.peak_acceleration[0] - 1.0).abs() < 1e-9);
             assert_eq!(d.peak_acceleration[1] == 0.0, bodies.m2().is_infinite());
         }
@@ -402,7 +433,11 @@ mod tests {
         assert!((d.max_penetration / x_max - 1.0).abs() < 1e-10);
         // ∫₀¹ dx / sqrt(1 - x^{5/2}) = (2/5) B(2/5, 1/2) = 1.4716375921623523.
         let t_ref = 2.0 * 1.471_637_592_162_352_3 * x_max / u;
-        assert!((d.contact_duration / t_ref - 1.0).abs() < 1e-9, "{} vs {t_ref}", d.contact_duration);
+        assert!(
+            (d.contact_duration / t_ref - 1.0).abs() < 1e-9,
+            "{} vs {t_ref}",
+            d.contact_duration
+        );
         let f_max = 5e9 * x_max.powf(1.5);
         assert!((d.peak_force / f_max - 1.0).abs() < 1e-9);
     }
@@ -421,8 +456,15 @@ mod tests {
         let wd = wn * (1.0 - zeta * zeta).sqrt();
         let e_ref = (-zeta * std::f64::consts::PI / (1.0 - zeta * zeta).sqrt()).exp();
         let d = integrate_impact(&law, bodies, 0.2, &DirectOptions::default()).unwrap();
-        assert!((d.restitution - e_ref).abs() < 1e-10, "{} vs {e_ref}", d.restitution);
-        assert!((d.contact_duration * wd / std::f64::consts::PI - 1.0).abs() < 1e-9, "{d:?}");
+        assert!(
+            (d.restitution - e_ref).abs() < 1e-10,
+            "{} vs {e_ref}",
+            d.restitution
+        );
+        assert!(
+            (d.contact_duration * wd / std::f64::consts::PI - 1.0).abs() < 1e-9,
+            "{d:?}"
+        );
         // The clamped form separates earlier (force reaches 0 at s > 0).
         let clamped = ContactLaw::kelvin_voigt(k, c, ForceForm::NonNegative).unwrap();
         let dc = integrate_impact(&clamped, bodies, 0.2, &DirectOptions::default()).unwrap();
@@ -433,8 +475,15 @@ mod tests {
     /// (the law is derived for e near 1).
     #[test]
     fn lankarani_nikravesh_near_target() {
-        let law = ContactLaw::lankarani_nikravesh(5e9, 1.5, 0.9, 1e-6, ForceForm::Published).unwrap();
-        let d = integrate_impact(&law, TwoBodies::new(0.227, 0.227).unwrap(), 0.3, &DirectOptions::default()).unwrap();
+        let law =
+            ContactLaw::lankarani_nikravesh(5e9, 1.5, 0.9, 1e-6, ForceForm::Published).unwrap();
+        let d = integrate_impact(
+            &law,
+            TwoBodies::new(0.227, 0.227).unwrap(),
+            0.3,
+            &DirectOptions::default(),
+        )
+        .unwrap();
         assert!((d.restitution - 0.9).abs() < 0.02, "e = {}", d.restitution);
     }
 
@@ -442,7 +491,10 @@ mod tests {
     fn bad_input() {
         let bodies = TwoBodies::new(1.0, 1.0).unwrap();
         assert!(integrate_impact(&seed_law(), bodies, 0.0, &DirectOptions::default()).is_err());
-        let opts = DirectOptions { duration_level: Some(1.5), ..DirectOptions::default() };
+        let opts = DirectOptions {
+            duration_level: Some(1.5),
+            ..DirectOptions::default()
+        };
         assert!(integrate_impact(&seed_law(), bodies, 0.1, &opts).is_err());
     }
 }

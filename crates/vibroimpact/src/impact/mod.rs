@@ -38,7 +38,9 @@ pub enum ImpactError {
         source: RootError,
     },
     /// A fixed-point iteration did not reach its tolerance.
-    #[error("fixed-point iteration for {what} did not converge in {iterations} iterations at V = {v}")]
+    #[error(
+        "fixed-point iteration for {what} did not converge in {iterations} iterations at V = {v}"
+    )]
     FixedPointNoConvergence {
         /// What was being iterated.
         what: &'static str,
@@ -79,7 +81,7 @@ impl TwoBodies {
     /// Two bodies of masses `m1 > 0` and `m2 > 0` (kg); `m2` may be `+∞`.
     pub fn new(m1: f64, m2: f64) -> Result<Self, ImpactError> {
         positive("mass1", m1)?;
-        if !(m2 > 0.0) || m2.is_nan() {
+        if m2.is_nan() || m2 <= 0.0 {
             return Err(ImpactError::InvalidParameter {
                 name: "mass2",
                 value: m2,

@@ -1,0 +1,88 @@
+//! Printing tables of numbers as aligned text or CSV.
+
+use clap::ValueEnum;
+use std::io::Write;
+
+use crate::error::CliError;
+
+/// Output format of the commands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Aligned columns for reading.
+    Table,
+    /// Comma-separated values with a header row.
+    Csv,
+    /// A JSON document.
+    Json,
+}
+
+/// Formats a number for tables: full precision (shortest round-trip form).
+pub fn number(x: Option<f64>) -> String {
+    match x {
+        Some(v) => format!("{v:e}"),
+        None => String::new(),
+    }
+}
+
+/// CSV text of a numeric table (empty cells for missing values).
+pub fn csv_text(columns: &[&str], rows: &[Vec<Option<f64>>]) -> Result<String, CliError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
+    w.write_record(columns).map_err(io)?;
+    for row in rows {
+        w.write_record(row.iter().map(|x| number(*x))).map_err(io)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| CliError::new(format!("cannot format CSV: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| CliError::new(e.to_string()))
+}
+
+/// Prints a table to standard output as aligned text or CSV.
+pub fn print_rows(
+    format: Format,
+    columns: &[&str],
+    rows: &[Vec<Option<f64>>],
+) -> Result<(), CliError> {
+    let text = match format {
+        Format::Csv | Format::Json => csv_text(columns, rows)?,
+        Format::Table => {
+            let cells: Vec<Vec<String>> = rows
+                .iter()
+                .map(|r| {
+                    r.iter()
+                        .map(|x| x.map_or("-".to_string(), |v| format!("{v:.6e}")))
+                        .collect()
+                })
+                .collect();
+            let widths: Vec<usize> = (0..columns.len())
+                .map(|c| {
+                    cells
+                        .iter()
+                        .map(|r| r[c].len())
+                        .chain([columns[c].len()])
+                        .max()
+                        .unwrap_or(0)
+                })
+                .collect();
+            let mut out = String::new();
+            let line = |items: Vec<&str>, out: &mut String| {
+                let parts: Vec<String> = items
+                    .iter()
+                    .zip(&widths)
+                    .map(|(s, w)| format!("{s:>w$}"))
+                    .collect();
+                out.push_str(parts.join("  ").trim_end());
+                out.push('\n');
+            };
+            line(columns.to_vec(), &mut out);
+            for r in &cells {
+                line(r.iter().map(String::as_str).collect(), &mut out);
+            }
+            out
+        }
+    };
+    std::io::stdout()
+        .write_all(text.as_bytes())
+        .map_err(|e| CliError::new(format!("cannot write to standard output: {e}")))
+}

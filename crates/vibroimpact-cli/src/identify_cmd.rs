@@ -1,0 +1,280 @@
+//! `vibroimpact identify`: a/b and α of the exponential law from measured
+//! impacts (seed §3).
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use serde::Serialize;
+use vibroimpact::identify::{
+    fit_a_over_b, fit_alpha, fit_joint, AccelerationSample, Estimate, ExponentialLawFit,
+    IdentifyError, RestitutionFit, RestitutionSample,
+};
+use vibroimpact::impact::TwoBodies;
+
+use crate::data::{parse_csv, read_csv, Table};
+use crate::error::CliError;
+use crate::format::Format;
+use crate::impact_cmd::parse_mass2;
+
+/// Options of `vibroimpact identify`.
+#[derive(Args, Debug)]
+pub struct IdentifyArgs {
+    /// CSV with columns `impact_velocity` (m/s) and `restitution`.
+    #[arg(long)]
+    restitution: Option<PathBuf>,
+    /// CSV with columns `impact_velocity` (m/s) and `peak_acceleration`
+    /// (m/s², of body 1: peak force / mass1).
+    #[arg(long)]
+    acceleration: Option<PathBuf>,
+    /// Mass of body 1 (kg).
+    #[arg(long, default_value_t = 0.227)]
+    mass1: f64,
+    /// Mass of body 2 (kg), or `wall`.
+    #[arg(long, default_value = "0.227")]
+    mass2: String,
+    /// Hold a/b at this value (m/s) and fit alpha only.
+    #[arg(long)]
+    a_over_b: Option<f64>,
+    /// Fit a/b and alpha jointly from both data sets (default: a/b from the
+    /// restitution data, then alpha given a/b, as in the seed).
+    #[arg(long)]
+    joint: bool,
+    /// Output format (table or json).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// Result of an identification, as written in JSON.
+#[derive(Serialize, Debug)]
+pub struct Identification {
+    /// How it was made.
+    pub method: String,
+    /// a/b (m/s), if determined or given.
+    pub a_over_b: Option<Estimate>,
+    /// α (1/m), if acceleration data were given.
+    pub alpha: Option<Estimate>,
+    /// The a/b fit to the restitution data alone.
+    pub restitution_fit: Option<RestitutionFit>,
+    /// The α (or joint) fit.
+    pub acceleration_fit: Option<ExponentialLawFit>,
+}
+
+/// Measured data sets of an identification, with their sources for messages.
+pub struct Measurements {
+    restitution: Option<(Vec<RestitutionSample>, Table, String)>,
+    acceleration: Option<(Vec<AccelerationSample>, Table, String)>,
+}
+
+impl Measurements {
+    /// Parses the two data sets from CSV text (either may be absent).
+    pub fn parse(
+        restitution: Option<(&str, &str)>,
+        acceleration: Option<(&str, &str)>,
+    ) -> Result<Self, CliError> {
+        let restitution = restitution
+            .map(|(text, source)| {
+                let t = parse_csv(text, source, &["impact_velocity", "restitution"])?;
+                Ok::<_, CliError>((to_restitution(&t), t, source.to_string()))
+            })
+            .transpose()?;
+        let acceleration = acceleration
+            .map(|(text, source)| {
+                let t = parse_csv(text, source, &["impact_velocity", "peak_acceleration"])?;
+                Ok::<_, CliError>((to_acceleration(&t), t, source.to_string()))
+            })
+            .transpose()?;
+        Ok(Self {
+            restitution,
+            acceleration,
+        })
+    }
+
+    fn read(restitution: Option<&Path>, acceleration: Option<&Path>) -> Result<Self, CliError> {
+        let restitution = restitution
+            .map(|p| {
+                let t = read_csv(p, &["impact_velocity", "restitution"])?;
+                Ok::<_, CliError>((to_restitution(&t), t, p.display().to_string()))
+            })
+            .transpose()?;
+        let acceleration = acceleration
+            .map(|p| {
+                let t = read_csv(p, &["impact_velocity", "peak_acceleration"])?;
+                Ok::<_, CliError>((to_acceleration(&t), t, p.display().to_string()))
+            })
+            .transpose()?;
+        Ok(Self {
+            restitution,
+            acceleration,
+        })
+    }
+}
+
+fn to_restitution(t: &Table) -> Vec<RestitutionSample> {
+    t.columns[0]
+        .iter()
+        .zip(&t.columns[1])
+        .map(|(&u, &e)| RestitutionSample {
+            impact_velocity: u,
+            restitution: e,
+        })
+        .collect()
+}
+
+fn to_acceleration(t: &Table) -> Vec<AccelerationSample> {
+    t.columns[0]
+        .iter()
+        .zip(&t.columns[1])
+        .map(|(&u, &a)| AccelerationSample {
+            impact_velocity: u,
+            peak_acceleration: a,
+        })
+        .collect()
+}
+
+impl Measurements {
+    /// The restitution and acceleration samples (empty when absent).
+    pub fn samples(&self) -> (&[RestitutionSample], &[AccelerationSample]) {
+        (
+            self.restitution.as_ref().map_or(&[][..], |r| &r.0),
+            self.acceleration.as_ref().map_or(&[][..], |a| &a.0),
+        )
+    }
+
+    /// Maps a library error to a message naming the file and line.
+    fn locate(&self, e: IdentifyError) -> CliError {
+        let find = |what: &str| match what {
+            "restitution" => self.restitution.as_ref().map(|(_, t, s)| (t, s)),
+            _ => self.acceleration.as_ref().map(|(_, t, s)| (t, s)),
+        };
+        match &e {
+            IdentifyError::InvalidSample {
+                what,
+                index,
+                reason,
+            } => match find(what) {
+                Some((t, source)) => {
+                    CliError::new(format!("{source}:{}: {reason}", t.lines[*index]))
+                }
+                None => CliError::new(e.to_string()),
+            },
+            IdentifyError::TooFewPoints { what, .. } => match find(what) {
+                Some((_, source)) => CliError::new(format!("{source}: {e}")),
+                None => CliError::new(e.to_string()),
+            },
+            _ => CliError::new(e.to_string()),
+        }
+    }
+
+    /// Runs the identification the options ask for.
+    pub fn identify(
+        &self,
+        bodies: TwoBodies,
+        a_over_b: Option<f64>,
+        joint: bool,
+    ) -> Result<Identification, CliError> {
+        let restitution_fit = self
+            .restitution
+            .as_ref()
+            .map(|(s, _, _)| fit_a_over_b(s))
+            .transpose()
+            .map_err(|e| self.locate(e))?;
+        let Some((acc, _, _)) = &self.acceleration else {
+            let Some(fit) = restitution_fit else {
+                return Err(CliError::new(
+                    "nothing to identify: give --restitution and/or --acceleration",
+                ));
+            };
+            return Ok(Identification {
+                method: "a-over-b-from-restitution".into(),
+                a_over_b: Some(fit.a_over_b),
+                alpha: None,
+                restitution_fit: Some(fit),
+                acceleration_fit: None,
+            });
+        };
+        let empty = Vec::new();
+        let rest = self.restitution.as_ref().map_or(&empty, |r| &r.0);
+        let (fit, method) = match (a_over_b, joint, &restitution_fit) {
+            (Some(q), _, _) => (fit_alpha(acc, bodies, q), "alpha-given-a-over-b"),
+            (None, true, _) | (None, false, None) => (fit_joint(rest, acc, bodies), "joint"),
+            (None, false, Some(r)) => (
+                fit_alpha(acc, bodies, r.a_over_b.value),
+                "sequential: a/b from restitution, then alpha given a/b (alpha's std_error excludes a/b's uncertainty; use --joint for both)",
+            ),
+        };
+        let fit = fit.map_err(|e| self.locate(e))?;
+        let a_over_b = match (&restitution_fit, method) {
+            (Some(r), m) if m.starts_with("sequential") => Some(r.a_over_b),
+            _ => Some(fit.a_over_b),
+        };
+        Ok(Identification {
+            method: if method == "joint" {
+                fit.method.to_string()
+            } else {
+                method.to_string()
+            },
+            a_over_b,
+            alpha: Some(fit.alpha),
+            restitution_fit,
+            acceleration_fit: Some(fit),
+        })
+    }
+}
+
+/// Runs `vibroimpact identify`.
+pub fn run(args: &IdentifyArgs) -> Result<(), CliError> {
+    if args.restitution.is_none() && args.acceleration.is_none() {
+        return Err(CliError::new(
+            "nothing to identify: give --restitution and/or --acceleration",
+        ));
+    }
+    if let Some(q) = args.a_over_b {
+        if !(q > 0.0 && q.is_finite()) {
+            return Err(CliError::new(format!("--a-over-b {q}: must be > 0")));
+        }
+    }
+    let bodies = TwoBodies::new(args.mass1, parse_mass2(&args.mass2)?)?;
+    let data = Measurements::read(args.restitution.as_deref(), args.acceleration.as_deref())?;
+    let result = data.identify(bodies, args.a_over_b, args.joint)?;
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&result)?),
+        _ => print!("{}", table_text(&result)),
+    }
+    Ok(())
+}
+
+/// Human-readable summary of an identification.
+pub fn table_text(r: &Identification) -> String {
+    let mut s = format!("method: {}\n", r.method);
+    let est = |name: &str, unit: &str, e: &Option<Estimate>| match e {
+        Some(e) if e.std_error > 0.0 => format!(
+            "{name:<9} = {:.6e} ± {:.2e} {unit} ({:.2}%)\n",
+            e.value,
+            e.std_error,
+            100.0 * e.std_error / e.value
+        ),
+        Some(e) => format!("{name:<9} = {:.6e} {unit} (given)\n", e.value),
+        None => String::new(),
+    };
+    s += &est("a/b", "m/s", &r.a_over_b);
+    s += &est("alpha", "1/m", &r.alpha);
+    if let Some(f) = &r.restitution_fit {
+        s += &format!(
+            "restitution fit: {} points, residual std {:.3e}\n",
+            f.residuals.len(),
+            f.residual_std
+        );
+    }
+    if let Some(f) = &r.acceleration_fit {
+        s += &format!(
+            "acceleration fit: {} points, residual std of ln A {:.3e} ({:.1}%)\n",
+            f.acceleration_residuals.len(),
+            f.acceleration_residual_std,
+            100.0 * f.acceleration_residual_std
+        );
+        if f.correlation != 0.0 {
+            s += &format!("correlation(ln a/b, ln alpha) = {:.3}\n", f.correlation);
+        }
+    }
+    s
+}
