@@ -8,9 +8,11 @@ mod error;
 mod format;
 mod identify_cmd;
 mod impact_cmd;
+mod model_file;
 mod output;
 mod plot;
 mod report;
+mod simulate_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -36,6 +38,9 @@ enum Command {
     /// Identify a/b and alpha of the exponential law from measured impacts.
     #[command(allow_negative_numbers = true)]
     Identify(identify_cmd::IdentifyArgs),
+    /// Simulate a model file: time history, impact log, summary and plots.
+    #[command(allow_negative_numbers = true)]
+    Simulate(simulate_cmd::SimulateArgs),
     /// Run the default study and write its report (same as no subcommand).
     Report {
         /// Report folder.
@@ -49,6 +54,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Some(Command::Impact(args)) => impact_cmd::run(args),
         Some(Command::Identify(args)) => identify_cmd::run(args),
+        Some(Command::Simulate(args)) => simulate_cmd::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

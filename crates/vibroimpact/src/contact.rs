@@ -409,6 +409,33 @@ impl ContactLaw {
         }
     }
 
+    /// Potential energy of the law's elastic part, `P(s) = ∫_{-∞}^s F(σ, 0) dσ`
+    /// (J): `(a/α) e^{αs}` for the exponential law, `k s^{n+1}/(n+1)` for the
+    /// power laws, `k s²/2` for Kelvin–Voigt (0 for `s <= 0` but for the
+    /// exponential law). The rest of the force, `F(s, ṡ) - F(s, 0)`, is the
+    /// dissipative part: its power `(F(s, ṡ) - F(s, 0)) ṡ` is the contact
+    /// dissipation of an energy balance (`F(s, 0) >= 0` for every law, so the
+    /// non-negative form does not change the elastic part).
+    pub fn potential(&self, s: f64) -> f64 {
+        match self.kind {
+            LawKind::Exponential { a, alpha, .. } => {
+                let z = alpha * s;
+                let e = if z <= EXP_ARG_CAP {
+                    z.exp()
+                } else {
+                    let d = z - EXP_ARG_CAP;
+                    EXP_ARG_CAP.exp() * (1.0 + d + 0.5 * d * d)
+                };
+                sat(a / alpha * e)
+            }
+            _ if s <= 0.0 => 0.0,
+            LawKind::KelvinVoigt { k, .. } => sat(0.5 * k * s * s),
+            LawKind::Hertz { k, n }
+            | LawKind::HuntCrossley { k, n, .. }
+            | LawKind::LankaraniNikravesh { k, n, .. } => sat(k * s.powf(n + 1.0) / (n + 1.0)),
+        }
+    }
+
     /// The force alone (see [`ContactLaw::eval`]).
     #[inline]
     pub fn force(&self, s: f64, sdot: f64, impact_velocity: f64) -> f64 {
@@ -528,6 +555,19 @@ mod tests {
         let below = law.force(EXP_ARG_CAP - 1e-9, 0.0, 0.0);
         let above = law.force(EXP_ARG_CAP + 1e-9, 0.0, 0.0);
         assert!((above - below).abs() < 1e-8 * below);
+    }
+
+    /// dP/ds equals the static force F(s, 0).
+    #[test]
+    fn potential_is_integral_of_static_force() {
+        for law in all_laws(ForceForm::Published) {
+            for s in [1e-6, 2e-5] {
+                let h = 1e-4 * s;
+                let dp = (law.potential(s + h) - law.potential(s - h)) / (2.0 * h);
+                let f = law.force(s, 0.0, 1.0);
+                assert!((dp - f).abs() < 1e-6 * f, "{}: {dp} vs {f}", law.name());
+            }
+        }
     }
 
     #[test]

@@ -17,7 +17,10 @@
 //! The library does no I/O: callers hand it numbers and get numbers back.
 
 pub mod contact;
+pub mod dynamics;
 pub mod identify;
 pub mod impact;
 pub mod integrate;
+pub mod model;
 pub mod numeric;
+pub mod simulate;

@@ -1,0 +1,442 @@
+//! The equations of motion of a [`Model`] as a first-order ODE
+//! (THEORY.md §4), for the integrators.
+//!
+//! ## State layout
+//! Interleaved, `y = [u_1, v_1, u_2, v_2, …, u_N, v_N]`, so that a chain whose
+//! couplings and contacts join bodies at most `d` apart has a banded
+//! Jacobian with lower/upper bandwidths `(2d + 1, 2d)` (`(1, 1)` without
+//! couplings). With the energy audit on, three quadratures follow:
+//! `W` (work of the excitation), `D_c` (dissipation of the dampers) and
+//! `D_k` (dissipation of the contacts), so that
+//! `E(t) + D_c + D_k - W = E(0)` with the mechanical energy
+//! `E = Σ ½ m v² + Σ ½ k u² + Σ ½ k_ij Δu² + Σ P_contact(s)`
+//! (see [`ContactLaw::potential`]).
+//!
+//! ## Contacts far apart are not evaluated
+//! Each right-hand side skips a contact whose force is certainly below
+//! `1e-3 ε` (ε = f64::EPSILON) of its force scale `F_ref` (the smaller of
+//! the two bodies' `k g + m max|z̈|`; `a` when that is zero), i.e. far below
+//! rounding of the other forces on those bodies: for the exponential law
+//! when `α s + ln a + b|ṡ|/a < ln(1e-3 ε F_ref)` (a bound of
+//! `ln((a + b|ṡ|) e^{αs})` that needs no exp or ln), for laws with compact
+//! support when `s <= 0`. For the seed's row (R2) this skips a contact while
+//! its gap exceeds about 0.36 mm, so the cost of a right-hand side grows with
+//! the number of contacts actually closing, and linearly with N.
+
+use crate::contact::{ContactLaw, LawKind};
+use crate::integrate::OdeSystem;
+use crate::model::{BaseExcitation, Model};
+
+/// How a contact is screened before evaluation.
+#[derive(Clone, Copy, Debug)]
+enum Screen {
+    /// Skip when `alpha s + b_over_a |ṡ| < limit`.
+    Exponential {
+        alpha: f64,
+        b_over_a: f64,
+        limit: f64,
+    },
+    /// Skip when `s <= 0`.
+    CompactSupport,
+}
+
+#[derive(Clone, Debug)]
+struct ContactTerm {
+    left: Option<usize>,
+    right: Option<usize>,
+    clearance: f64,
+    law: ContactLaw,
+    screen: Screen,
+    absurd: f64,
+}
+
+/// Equations of motion of a model, ready for an integrator.
+#[derive(Clone, Debug)]
+pub struct ChainDynamics {
+    n: usize,
+    mass: Vec<f64>,
+    inv_mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    couplings: Vec<(usize, usize, f64, f64)>,
+    contacts: Vec<ContactTerm>,
+    forces: Vec<(usize, f64, f64, f64)>,
+    base: BaseExcitation,
+    /// Onset approach velocity of each contact's current impact (read by
+    /// laws that need it: Lankarani–Nikravesh).
+    onset_velocity: Vec<f64>,
+    energy: bool,
+    force: Vec<f64>,
+    contact_evaluations: u64,
+    bandwidth: (usize, usize),
+}
+
+impl ChainDynamics {
+    /// The dynamics of `model`; `energy` appends the three energy quadratures.
+    pub fn new(model: &Model, energy: bool) -> Self {
+        let bodies = model.bodies();
+        let n = bodies.len();
+        let base_peak = match model.base() {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
+            BaseExcitation::Record(r) => r.peak(),
+        };
+        let contacts = model
+            .contacts()
+            .iter()
+            .map(|c| {
+                let scale_of =
+                    |i: usize| bodies[i].stiffness * c.clearance + bodies[i].mass * base_peak;
+                let f_ref = [c.pair.left(), c.pair.right()]
+                    .into_iter()
+                    .flatten()
+                    .map(scale_of)
+                    .fold(f64::INFINITY, f64::min);
+                let (screen, absurd) = match *c.law.kind() {
+                    LawKind::Exponential { a, b, alpha } => {
+                        let f_ref = if f_ref > 0.0 && f_ref.is_finite() {
+                            f_ref
+                        } else {
+                            a
+                        };
+                        let limit = (1e-3 * f64::EPSILON * f_ref).ln() - a.ln();
+                        // Beyond α s = 100 the force exceeds a e^100: no physical state.
+                        (
+                            Screen::Exponential {
+                                alpha,
+                                b_over_a: b / a,
+                                limit,
+                            },
+                            100.0 / alpha,
+                        )
+                    }
+                    _ => (Screen::CompactSupport, f64::INFINITY),
+                };
+                ContactTerm {
+                    left: c.pair.left(),
+                    right: c.pair.right(),
+                    clearance: c.clearance,
+                    law: c.law,
+                    screen,
+                    absurd,
+                }
+            })
+            .collect::<Vec<_>>();
+        let mut reach = 0;
+        for c in model.couplings() {
+            reach = reach.max(c.a.abs_diff(c.b));
+        }
+        for c in &contacts {
+            if let (Some(l), Some(r)) = (c.left, c.right) {
+                reach = reach.max(l.abs_diff(r));
+            }
+        }
+        let bandwidth = if reach == 0 {
+            (1, 1)
+        } else {
+            (2 * reach + 1, 2 * reach)
+        };
+        Self {
+            n,
+            mass: bodies.iter().map(|b| b.mass).collect(),
+            inv_mass: bodies.iter().map(|b| 1.0 / b.mass).collect(),
+            stiffness: bodies.iter().map(|b| b.stiffness).collect(),
+            damping: bodies.iter().map(|b| b.damping).collect(),
+            couplings: model
+                .couplings()
+                .iter()
+                .map(|c| (c.a, c.b, c.stiffness, c.damping))
+                .collect(),
+            onset_velocity: vec![0.0; contacts.len()],
+            contacts,
+            forces: model
+                .forces()
+                .iter()
+                .map(|f| (f.body, f.amplitude, f.frequency, f.phase))
+                .collect(),
+            base: model.base().clone(),
+            energy,
+            force: vec![0.0; n],
+            contact_evaluations: 0,
+            bandwidth,
+        }
+    }
+
+    /// Number of bodies.
+    pub fn bodies(&self) -> usize {
+        self.n
+    }
+
+    /// Dimension of the mechanical state (2N).
+    pub fn state_dim(&self) -> usize {
+        2 * self.n
+    }
+
+    /// Lower and upper bandwidths of the mechanical Jacobian.
+    pub fn bandwidth(&self) -> (usize, usize) {
+        self.bandwidth
+    }
+
+    /// Contact law evaluations so far (skipped contacts not counted).
+    pub fn contact_evaluations(&self) -> u64 {
+        self.contact_evaluations
+    }
+
+    /// Sets the onset approach velocity of contact k's current impact.
+    pub fn set_onset_velocity(&mut self, k: usize, v: f64) {
+        self.onset_velocity[k] = v;
+    }
+
+    /// The initial ODE state of a model (interleaved, energy quadratures 0).
+    pub fn initial_state(&self, model: &Model) -> Vec<f64> {
+        let mut y = vec![0.0; self.dim()];
+        for i in 0..self.n {
+            y[2 * i] = model.initial_displacement()[i];
+            y[2 * i + 1] = model.initial_velocity()[i];
+        }
+        y
+    }
+
+    /// Approach coordinate and its rate of contact k in state y.
+    #[inline]
+    pub fn approach(&self, k: usize, y: &[f64]) -> (f64, f64) {
+        let c = &self.contacts[k];
+        let (ul, vl) = c.left.map_or((0.0, 0.0), |l| (y[2 * l], y[2 * l + 1]));
+        let (ur, vr) = c.right.map_or((0.0, 0.0), |r| (y[2 * r], y[2 * r + 1]));
+        (ul - ur - c.clearance, vl - vr)
+    }
+
+    /// State indices of (u_l, v_l, u_r, v_r) of contact k (None for walls).
+    pub fn contact_indices(&self, k: usize) -> [Option<usize>; 4] {
+        let c = &self.contacts[k];
+        [
+            c.left.map(|l| 2 * l),
+            c.left.map(|l| 2 * l + 1),
+            c.right.map(|r| 2 * r),
+            c.right.map(|r| 2 * r + 1),
+        ]
+    }
+
+    /// Force of contact k at approach s and rate ṡ (N), as used in the
+    /// equations of motion.
+    #[inline]
+    pub fn contact_force(&self, k: usize, s: f64, sdot: f64) -> f64 {
+        self.contacts[k].law.force(s, sdot, self.onset_velocity[k])
+    }
+
+    /// Rate dF/dt of contact k's force at (s, ṡ) with s̈ (N/s).
+    #[inline]
+    pub fn contact_force_rate(&self, k: usize, s: f64, sdot: f64, sddot: f64) -> f64 {
+        let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
+        c.d_ds * sdot + c.d_dsdot * sddot
+    }
+
+    /// Clearance of contact k (m).
+    pub fn clearance(&self, k: usize) -> f64 {
+        self.contacts[k].clearance
+    }
+
+    /// The contact law of contact k.
+    pub fn contact_law(&self, k: usize) -> &ContactLaw {
+        &self.contacts[k].law
+    }
+
+    /// Number of contacts.
+    pub fn contacts(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// Mechanical energy E (J) of state y (see the module notes).
+    pub fn mechanical_energy(&self, y: &[f64]) -> f64 {
+        let mut e = 0.0;
+        for i in 0..self.n {
+            let (u, v) = (y[2 * i], y[2 * i + 1]);
+            e += 0.5 * self.mass[i] * v * v + 0.5 * self.stiffness[i] * u * u;
+        }
+        for &(a, b, k, _) in &self.couplings {
+            let du = y[2 * b] - y[2 * a];
+            e += 0.5 * k * du * du;
+        }
+        for (k, c) in self.contacts.iter().enumerate() {
+            let (s, _) = self.approach(k, y);
+            e += c.law.potential(s);
+        }
+        e
+    }
+
+    #[inline]
+    fn skip(screen: Screen, s: f64, sdot: f64) -> bool {
+        match screen {
+            Screen::Exponential {
+                alpha,
+                b_over_a,
+                limit,
+            } => alpha * s + b_over_a * sdot.abs() < limit,
+            Screen::CompactSupport => s <= 0.0,
+        }
+    }
+}
+
+impl OdeSystem for ChainDynamics {
+    fn dim(&self) -> usize {
+        2 * self.n + if self.energy { 3 } else { 0 }
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let zdd = self.base.at(t);
+        let mut input = 0.0;
+        let mut damper = 0.0;
+        let mut contact = 0.0;
+        for i in 0..self.n {
+            let (u, v) = (y[2 * i], y[2 * i + 1]);
+            self.force[i] = -self.stiffness[i] * u - self.damping[i] * v - self.mass[i] * zdd;
+            if self.energy {
+                input -= self.mass[i] * zdd * v;
+                damper += self.damping[i] * v * v;
+            }
+        }
+        for &(body, p, w, phi) in &self.forces {
+            let f = p * (w * t + phi).sin();
+            self.force[body] += f;
+            input += f * y[2 * body + 1];
+        }
+        for &(a, b, k, c) in &self.couplings {
+            let du = y[2 * b] - y[2 * a];
+            let dv = y[2 * b + 1] - y[2 * a + 1];
+            let f = k * du + c * dv;
+            self.force[a] += f;
+            self.force[b] -= f;
+            damper += c * dv * dv;
+        }
+        for (k, c) in self.contacts.iter().enumerate() {
+            let (ul, vl) = c.left.map_or((0.0, 0.0), |l| (y[2 * l], y[2 * l + 1]));
+            let (ur, vr) = c.right.map_or((0.0, 0.0), |r| (y[2 * r], y[2 * r + 1]));
+            let s = ul - ur - c.clearance;
+            let sdot = vl - vr;
+            if Self::skip(c.screen, s, sdot) {
+                continue;
+            }
+            self.contact_evaluations += 1;
+            let f = c.law.force(s, sdot, self.onset_velocity[k]);
+            if let Some(l) = c.left {
+                self.force[l] -= f;
+            }
+            if let Some(r) = c.right {
+                self.force[r] += f;
+            }
+            if self.energy {
+                contact += (f - c.law.force(s, 0.0, self.onset_velocity[k])) * sdot;
+            }
+        }
+        for i in 0..self.n {
+            dydt[2 * i] = y[2 * i + 1];
+            dydt[2 * i + 1] = self.force[i] * self.inv_mass[i];
+        }
+        if self.energy {
+            let m = 2 * self.n;
+            dydt[m] = input;
+            dydt[m + 1] = damper;
+            dydt[m + 2] = contact;
+        }
+    }
+
+    fn admissible(&self, _t: f64, y: &[f64]) -> bool {
+        self.contacts.iter().enumerate().all(|(k, c)| {
+            let (s, _) = self.approach(k, y);
+            s <= c.absurd
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::ForceForm;
+    use crate::model::{Body, Contact, ContactPair, Coupling};
+
+    fn law() -> ContactLaw {
+        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap()
+    }
+
+    /// The right-hand side by hand for two bodies with a coupling, a contact
+    /// and base excitation.
+    #[test]
+    fn rhs_matches_hand_computation() {
+        let bodies = vec![
+            Body::from_frequency("a", 0.2, 7.0, 0.01),
+            Body::from_frequency("b", 0.3, 5.0, 0.02),
+        ];
+        let couplings = vec![Coupling {
+            a: 0,
+            b: 1,
+            stiffness: 3.0,
+            damping: 0.1,
+        }];
+        let contacts = vec![Contact {
+            pair: ContactPair::Bodies { left: 0, right: 1 },
+            clearance: 1e-4,
+            law: law(),
+        }];
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.5,
+            frequency: 6.0,
+            phase: 0.3,
+        };
+        let model = Model::new(
+            bodies.clone(),
+            couplings,
+            contacts,
+            base,
+            vec![],
+            vec![],
+            vec![],
+        )
+        .unwrap();
+        let mut sys = ChainDynamics::new(&model, false);
+        let y = [5e-5, 0.1, -2e-5, -0.05];
+        let mut dy = [0.0; 4];
+        let t = 0.7;
+        sys.rhs(t, &y, &mut dy);
+        let zdd = 0.5 * (6.0 * t + 0.3f64).sin();
+        let s: f64 = 5e-5 + 2e-5 - 1e-4;
+        // (a + b ṡ) e^{αs} with a = 1, b = 1/1.2, ṡ = 0.1 - (-0.05).
+        let f = (1.0 + 0.15 / 1.2) * (1.3e5 * s).exp();
+        let coupling = 3.0 * (-2e-5 - 5e-5) + 0.1 * (-0.05 - 0.1);
+        let fa = -bodies[0].stiffness * 5e-5 - bodies[0].damping * 0.1 - 0.2 * zdd + coupling - f;
+        let fb =
+            -bodies[1].stiffness * -2e-5 - bodies[1].damping * -0.05 - 0.3 * zdd - coupling + f;
+        assert_eq!(dy[0], 0.1);
+        assert!((dy[1] - fa / 0.2).abs() < 1e-12 * (fa / 0.2).abs().max(1.0));
+        assert!((dy[3] - fb / 0.3).abs() < 1e-12 * (fb / 0.3).abs().max(1.0));
+        assert_eq!(sys.bandwidth(), (3, 2));
+    }
+
+    /// A skipped contact's force is below 1e-3 ε of the force scale.
+    #[test]
+    fn far_contacts_are_skipped_only_when_negligible() {
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.05,
+            frequency: 7.0,
+            phase: 0.0,
+        };
+        let model = Model::row(2, 0.227, 12.46, 0.04, 1e-3, law(), (true, true), base).unwrap();
+        let mut sys = ChainDynamics::new(&model, false);
+        let mut dy = [0.0; 4];
+        sys.rhs(0.0, &[0.0; 4], &mut dy);
+        assert_eq!(
+            sys.contact_evaluations(),
+            0,
+            "at rest every 1 mm gap is far"
+        );
+        let f_ref = 12.46 * 1e-3 + 0.227 * 0.05;
+        // Scan s where contacts switch on: below the switch, the force is negligible.
+        for &(s, sdot) in &[(-3.6e-4, 0.0), (-3.0e-4, 0.5), (-2e-4, -1.0)] {
+            let skipped = ChainDynamics::skip(sys.contacts[0].screen, s, sdot);
+            let f = law().force(s, sdot, 0.0).abs();
+            if skipped {
+                assert!(f < 1e-3 * f64::EPSILON * f_ref, "s={s}: F={f} skipped");
+            }
+        }
+        assert!(!ChainDynamics::skip(sys.contacts[0].screen, -1e-4, 0.0));
+    }
+}

@@ -1,0 +1,625 @@
+//! The system model (THEORY.md §4): N bodies on a line with springs and
+//! dampers to the frame and between each other, contact pairs with their
+//! clearances and laws, and the excitation.
+//!
+//! Equations of motion in displacements `u` relative to a frame that moves
+//! with base acceleration `z̈(t)`:
+//!
+//! ```text
+//! m_i ü_i = -k_i u_i - c_i u̇_i - m_i z̈(t) + p_i(t)
+//!           + Σ couplings (k_ij (u_j - u_i) + c_ij (u̇_j - u̇_i))
+//!           + Σ contacts (∓F)
+//! ```
+//!
+//! A contact between a left body l and a right body r has the approach
+//! coordinate `s = u_l - u_r - g` (`g >= 0` the clearance at u = 0); a wall
+//! on the right of body l gives `s = u_l - g`, a wall on the left of body r
+//! `s = -u_r - g`. The contact force F pushes the pair apart: `-F` on the
+//! left body, `+F` on the right one.
+
+use crate::contact::ContactLaw;
+
+/// A rigid body on the line with its spring and damper to the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name used in files and reports.
+    pub name: String,
+    /// Mass m > 0 (kg).
+    pub mass: f64,
+    /// Spring to the frame k >= 0 (N/m).
+    pub stiffness: f64,
+    /// Damper to the frame c >= 0 (N s/m).
+    pub damping: f64,
+}
+
+impl Body {
+    /// A body from natural frequency ω0 (rad/s) and damping ratio ζ:
+    /// `k = m ω0²`, `c = 2 ζ m ω0`.
+    pub fn from_frequency(name: &str, mass: f64, omega0: f64, zeta: f64) -> Self {
+        Self {
+            name: name.to_string(),
+            mass,
+            stiffness: mass * omega0 * omega0,
+            damping: 2.0 * zeta * mass * omega0,
+        }
+    }
+}
+
+/// A spring–damper between two bodies (indices into the body list).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coupling {
+    /// First body.
+    pub a: usize,
+    /// Second body.
+    pub b: usize,
+    /// Stiffness (N/m), >= 0.
+    pub stiffness: f64,
+    /// Damping (N s/m), >= 0.
+    pub damping: f64,
+}
+
+/// The two sides of a contact pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactPair {
+    /// Bodies `left` < `right` along the line.
+    Bodies {
+        /// Left body index.
+        left: usize,
+        /// Right body index.
+        right: usize,
+    },
+    /// A wall fixed to the frame on the left of `body`.
+    LeftWall {
+        /// The body.
+        body: usize,
+    },
+    /// A wall fixed to the frame on the right of `body`.
+    RightWall {
+        /// The body.
+        body: usize,
+    },
+}
+
+impl ContactPair {
+    /// Left body index (None for a left wall).
+    pub fn left(&self) -> Option<usize> {
+        match *self {
+            ContactPair::Bodies { left, .. } => Some(left),
+            ContactPair::RightWall { body } => Some(body),
+            ContactPair::LeftWall { .. } => None,
+        }
+    }
+
+    /// Right body index (None for a right wall).
+    pub fn right(&self) -> Option<usize> {
+        match *self {
+            ContactPair::Bodies { right, .. } => Some(right),
+            ContactPair::LeftWall { body } => Some(body),
+            ContactPair::RightWall { .. } => None,
+        }
+    }
+}
+
+/// A contact pair with its clearance and law.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Contact {
+    /// Which bodies (or walls) touch.
+    pub pair: ContactPair,
+    /// Clearance g >= 0 at u = 0 (m).
+    pub clearance: f64,
+    /// Contact law.
+    pub law: ContactLaw,
+}
+
+/// A base accelerogram: samples (t_k, a_k), linear interpolation, times a
+/// scale factor; zero before the first and after the last sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accelerogram {
+    times: Vec<f64>,
+    values: Vec<f64>,
+    scale: f64,
+}
+
+impl Accelerogram {
+    /// From strictly increasing times and accelerations (m/s²). Errors name
+    /// the first offending sample (0-based).
+    pub fn new(times: Vec<f64>, values: Vec<f64>, scale: f64) -> Result<Self, ModelError> {
+        if times.len() != values.len() || times.len() < 2 {
+            return Err(ModelError::new(
+                "accelerogram: needs at least two (time, acceleration) samples",
+            ));
+        }
+        for (k, (t, a)) in times.iter().zip(&values).enumerate() {
+            if !t.is_finite() || !a.is_finite() {
+                return Err(ModelError::new(format!(
+                    "accelerogram: sample {k} is not finite"
+                )));
+            }
+            if k > 0 && *t <= times[k - 1] {
+                return Err(ModelError::new(format!(
+                    "accelerogram: time is not increasing at sample {k} (t = {t} after {})",
+                    times[k - 1]
+                )));
+            }
+        }
+        if !scale.is_finite() {
+            return Err(ModelError::new("accelerogram: scale must be finite"));
+        }
+        Ok(Self {
+            times,
+            values,
+            scale,
+        })
+    }
+
+    /// Scaled acceleration at time t (m/s²).
+    pub fn at(&self, t: f64) -> f64 {
+        let n = self.times.len();
+        if t < self.times[0] || t > self.times[n - 1] {
+            return 0.0;
+        }
+        let k = self.times.partition_point(|&x| x <= t).clamp(1, n - 1);
+        let (t0, t1) = (self.times[k - 1], self.times[k]);
+        let w = (t - t0) / (t1 - t0);
+        self.scale * (self.values[k - 1] + w * (self.values[k] - self.values[k - 1]))
+    }
+
+    /// Sample times (the interpolant's breakpoints).
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    /// Largest |scaled acceleration|.
+    pub fn peak(&self) -> f64 {
+        self.values.iter().fold(0.0f64, |m, a| m.max(a.abs())) * self.scale.abs()
+    }
+}
+
+/// Base (frame) acceleration z̈(t).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum BaseExcitation {
+    /// No base motion.
+    #[default]
+    None,
+    /// `A sin(Ω t + φ)`.
+    Harmonic {
+        /// A (m/s²).
+        amplitude: f64,
+        /// Ω (rad/s) > 0.
+        frequency: f64,
+        /// φ (rad).
+        phase: f64,
+    },
+    /// A recorded accelerogram.
+    Record(Accelerogram),
+}
+
+impl BaseExcitation {
+    /// z̈(t) (m/s²).
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic {
+                amplitude,
+                frequency,
+                phase,
+            } => amplitude * (frequency * t + phase).sin(),
+            BaseExcitation::Record(r) => r.at(t),
+        }
+    }
+}
+
+/// A harmonic force `P sin(Ω t + φ)` on one body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HarmonicForce {
+    /// Body index.
+    pub body: usize,
+    /// P (N).
+    pub amplitude: f64,
+    /// Ω (rad/s) > 0.
+    pub frequency: f64,
+    /// φ (rad).
+    pub phase: f64,
+}
+
+/// An invalid model, with a message naming the offending item.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct ModelError(pub String);
+
+impl ModelError {
+    /// An error with this message.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self(message.into())
+    }
+}
+
+/// A complete, validated system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    bodies: Vec<Body>,
+    couplings: Vec<Coupling>,
+    contacts: Vec<Contact>,
+    base: BaseExcitation,
+    forces: Vec<HarmonicForce>,
+    initial_displacement: Vec<f64>,
+    initial_velocity: Vec<f64>,
+}
+
+fn nonneg(what: String, v: f64) -> Result<(), ModelError> {
+    if v >= 0.0 && v.is_finite() {
+        Ok(())
+    } else {
+        Err(ModelError(format!("{what} = {v}: must be finite and >= 0")))
+    }
+}
+
+impl Model {
+    /// Builds and validates a model. Initial displacements and velocities
+    /// default to rest when empty.
+    pub fn new(
+        bodies: Vec<Body>,
+        couplings: Vec<Coupling>,
+        contacts: Vec<Contact>,
+        base: BaseExcitation,
+        forces: Vec<HarmonicForce>,
+        initial_displacement: Vec<f64>,
+        initial_velocity: Vec<f64>,
+    ) -> Result<Self, ModelError> {
+        let n = bodies.len();
+        if n == 0 {
+            return Err(ModelError::new("the model has no bodies"));
+        }
+        for b in &bodies {
+            if !(b.mass > 0.0 && b.mass.is_finite()) {
+                return Err(ModelError(format!(
+                    "body {}: mass = {}: must be finite and > 0",
+                    b.name, b.mass
+                )));
+            }
+            nonneg(format!("body {}: stiffness", b.name), b.stiffness)?;
+            nonneg(format!("body {}: damping", b.name), b.damping)?;
+        }
+        for (k, c) in couplings.iter().enumerate() {
+            if c.a >= n || c.b >= n || c.a == c.b {
+                return Err(ModelError(format!(
+                    "spring {k}: must join two different existing bodies"
+                )));
+            }
+            nonneg(format!("spring {k}: stiffness"), c.stiffness)?;
+            nonneg(format!("spring {k}: damping"), c.damping)?;
+        }
+        let name = |i: usize| bodies[i].name.clone();
+        for (k, c) in contacts.iter().enumerate() {
+            match c.pair {
+                ContactPair::Bodies { left, right } => {
+                    if left >= n || right >= n {
+                        return Err(ModelError(format!("contact {k}: unknown body")));
+                    }
+                    if left >= right {
+                        return Err(ModelError(format!(
+                            "contact {k}: bodies must be given left first in their order along the line ({} is not left of {})",
+                            name(left),
+                            name(right)
+                        )));
+                    }
+                }
+                ContactPair::LeftWall { body } | ContactPair::RightWall { body } => {
+                    if body >= n {
+                        return Err(ModelError(format!("contact {k}: unknown body")));
+                    }
+                }
+            }
+            nonneg(format!("contact {k}: clearance"), c.clearance)?;
+        }
+        for f in &forces {
+            if f.body >= n {
+                return Err(ModelError::new("harmonic force on an unknown body"));
+            }
+            if !(f.frequency > 0.0
+                && f.frequency.is_finite()
+                && f.amplitude.is_finite()
+                && f.phase.is_finite())
+            {
+                return Err(ModelError(format!(
+                    "harmonic force on {}: needs finite amplitude and phase and frequency > 0",
+                    name(f.body)
+                )));
+            }
+        }
+        if let BaseExcitation::Harmonic {
+            amplitude,
+            frequency,
+            phase,
+        } = base
+        {
+            if !(frequency > 0.0
+                && frequency.is_finite()
+                && amplitude.is_finite()
+                && phase.is_finite())
+            {
+                return Err(ModelError::new(
+                    "harmonic base excitation: needs finite amplitude and phase and frequency > 0",
+                ));
+            }
+        }
+        let fill = |v: Vec<f64>, what: &str| -> Result<Vec<f64>, ModelError> {
+            if v.is_empty() {
+                Ok(vec![0.0; n])
+            } else if v.len() != n {
+                Err(ModelError(format!(
+                    "initial {what}: {} values for {n} bodies",
+                    v.len()
+                )))
+            } else if v.iter().any(|x| !x.is_finite()) {
+                Err(ModelError(format!("initial {what}: values must be finite")))
+            } else {
+                Ok(v)
+            }
+        };
+        let model = Self {
+            initial_displacement: fill(initial_displacement, "displacement")?,
+            initial_velocity: fill(initial_velocity, "velocity")?,
+            bodies,
+            couplings,
+            contacts,
+            base,
+            forces,
+        };
+        for k in 0..model.contacts.len() {
+            let s = model.approach(k, &model.initial_displacement);
+            if s > 0.0 {
+                return Err(ModelError(format!(
+                    "contact {k} ({}): the bodies overlap at the start by {s:e} m",
+                    model.contact_name(k)
+                )));
+            }
+        }
+        Ok(model)
+    }
+
+    /// The seed's row (reference problem R2): `count` identical bodies named
+    /// `p1..pN` between two walls, every clearance `clearance`, one law.
+    #[allow(clippy::too_many_arguments)]
+    pub fn row(
+        count: usize,
+        mass: f64,
+        stiffness: f64,
+        damping: f64,
+        clearance: f64,
+        law: ContactLaw,
+        walls: (bool, bool),
+        base: BaseExcitation,
+    ) -> Result<Self, ModelError> {
+        if count == 0 {
+            return Err(ModelError::new("row: count must be >= 1"));
+        }
+        let bodies = (1..=count)
+            .map(|i| Body {
+                name: format!("p{i}"),
+                mass,
+                stiffness,
+                damping,
+            })
+            .collect();
+        let mut contacts = Vec::with_capacity(count + 1);
+        if walls.0 {
+            contacts.push(Contact {
+                pair: ContactPair::LeftWall { body: 0 },
+                clearance,
+                law,
+            });
+        }
+        for i in 0..count - 1 {
+            contacts.push(Contact {
+                pair: ContactPair::Bodies {
+                    left: i,
+                    right: i + 1,
+                },
+                clearance,
+                law,
+            });
+        }
+        if walls.1 {
+            contacts.push(Contact {
+                pair: ContactPair::RightWall { body: count - 1 },
+                clearance,
+                law,
+            });
+        }
+        Self::new(
+            bodies,
+            Vec::new(),
+            contacts,
+            base,
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        )
+    }
+
+    /// Replaces the initial state (validated like [`Model::new`]).
+    pub fn with_initial_state(
+        self,
+        displacement: Vec<f64>,
+        velocity: Vec<f64>,
+    ) -> Result<Self, ModelError> {
+        Self::new(
+            self.bodies,
+            self.couplings,
+            self.contacts,
+            self.base,
+            self.forces,
+            displacement,
+            velocity,
+        )
+    }
+
+    /// Replaces the base excitation.
+    pub fn with_base(mut self, base: BaseExcitation) -> Self {
+        self.base = base;
+        self
+    }
+
+    /// Bodies in order along the line.
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+    /// Spring–dampers between bodies.
+    pub fn couplings(&self) -> &[Coupling] {
+        &self.couplings
+    }
+    /// Contact pairs.
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+    /// Base excitation.
+    pub fn base(&self) -> &BaseExcitation {
+        &self.base
+    }
+    /// Harmonic forces.
+    pub fn forces(&self) -> &[HarmonicForce] {
+        &self.forces
+    }
+    /// Initial displacements (m).
+    pub fn initial_displacement(&self) -> &[f64] {
+        &self.initial_displacement
+    }
+    /// Initial velocities (m/s).
+    pub fn initial_velocity(&self) -> &[f64] {
+        &self.initial_velocity
+    }
+
+    /// The forcing frequency Ω (rad/s) if the excitation is periodic with one
+    /// frequency: the harmonic base's, else that shared by all harmonic
+    /// forces. None for no forcing, an accelerogram, or mixed frequencies.
+    pub fn forcing_frequency(&self) -> Option<f64> {
+        let mut freq = match self.base {
+            BaseExcitation::Harmonic { frequency, .. } => Some(frequency),
+            BaseExcitation::Record(_) => return None,
+            BaseExcitation::None => None,
+        };
+        for f in &self.forces {
+            match freq {
+                None => freq = Some(f.frequency),
+                Some(w) if (w - f.frequency).abs() > 1e-12 * w => return None,
+                _ => {}
+            }
+        }
+        freq
+    }
+
+    /// Name of contact k, e.g. `wall|p1`, `p1|p2`, `p3|wall`.
+    pub fn contact_name(&self, k: usize) -> String {
+        let c = &self.contacts[k];
+        let side = |b: Option<usize>| b.map_or("wall".to_string(), |i| self.bodies[i].name.clone());
+        format!("{}|{}", side(c.pair.left()), side(c.pair.right()))
+    }
+
+    /// Approach coordinate s of contact k for displacements u.
+    #[inline]
+    pub fn approach(&self, k: usize, u: &[f64]) -> f64 {
+        let c = &self.contacts[k];
+        c.pair.left().map_or(0.0, |l| u[l]) - c.pair.right().map_or(0.0, |r| u[r]) - c.clearance
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::ForceForm;
+
+    fn law() -> ContactLaw {
+        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap()
+    }
+
+    #[test]
+    fn row_layout_and_names() {
+        let m = Model::row(
+            3,
+            0.227,
+            12.0,
+            0.04,
+            1e-3,
+            law(),
+            (true, true),
+            BaseExcitation::None,
+        )
+        .unwrap();
+        assert_eq!(m.contacts().len(), 4);
+        assert_eq!(m.contact_name(0), "wall|p1");
+        assert_eq!(m.contact_name(1), "p1|p2");
+        assert_eq!(m.contact_name(3), "p3|wall");
+        let u = [1e-4, -2e-4, 5e-4];
+        assert!((m.approach(0, &u) - (-1e-4 - 1e-3)).abs() < 1e-18);
+        assert!((m.approach(1, &u) - (3e-4 - 1e-3)).abs() < 1e-18);
+        assert!((m.approach(3, &u) - (5e-4 - 1e-3)).abs() < 1e-18);
+    }
+
+    #[test]
+    fn invalid_models_are_named() {
+        let e = Model::row(
+            2,
+            -1.0,
+            1.0,
+            0.0,
+            1e-3,
+            law(),
+            (true, true),
+            BaseExcitation::None,
+        )
+        .unwrap_err();
+        assert!(e.0.contains("mass = -1"), "{e}");
+        let e = Model::row(
+            2,
+            1.0,
+            1.0,
+            0.0,
+            -1e-3,
+            law(),
+            (true, true),
+            BaseExcitation::None,
+        )
+        .unwrap_err();
+        assert!(e.0.contains("clearance"), "{e}");
+        let m = Model::row(
+            2,
+            1.0,
+            1.0,
+            0.0,
+            1e-3,
+            law(),
+            (true, true),
+            BaseExcitation::None,
+        )
+        .unwrap();
+        let e = m.with_initial_state(vec![2e-3, 0.0], vec![]).unwrap_err();
+        assert!(e.0.contains("overlap"), "{e}");
+    }
+
+    #[test]
+    fn accelerogram_interpolates_and_validates() {
+        let r = Accelerogram::new(vec![0.0, 1.0, 3.0], vec![0.0, 2.0, -2.0], 0.5).unwrap();
+        assert_eq!(r.at(0.5), 0.5);
+        assert_eq!(r.at(2.0), 0.0);
+        assert_eq!(r.at(3.0), -1.0);
+        assert_eq!(r.at(3.5), 0.0);
+        assert_eq!(r.at(-1.0), 0.0);
+        assert!(Accelerogram::new(vec![0.0, 1.0, 1.0], vec![0.0; 3], 1.0).is_err());
+        assert_eq!(r.peak(), 1.0);
+    }
+
+    #[test]
+    fn forcing_frequency() {
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.05,
+            frequency: 7.0,
+            phase: 0.0,
+        };
+        let m = Model::row(1, 1.0, 1.0, 0.0, 1e-3, law(), (true, true), base).unwrap();
+        assert_eq!(m.forcing_frequency(), Some(7.0));
+        let m = m.with_base(BaseExcitation::None);
+        assert_eq!(m.forcing_frequency(), None);
+    }
+}
