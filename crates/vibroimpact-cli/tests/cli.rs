@@ -348,3 +348,84 @@ fn default_study_report_is_complete_and_deterministic() {
             < 1e-9
     );
 }
+
+#[test]
+fn simulate_example_row_json_and_outputs() {
+    let model = repo_file("examples/fujita-row.toml");
+    let doc = json(&["simulate", &model, "--periods", "5", "--format", "json"]);
+    for key in ["final_time", "impact_count", "rhs_evaluations", "steps", "rejected_steps"] {
+        assert!(doc[key].is_number(), "missing {key}");
+    }
+    assert_eq!(doc["final_displacement"].as_array().unwrap().len(), 3);
+    assert_eq!(doc["final_velocity"].as_array().unwrap().len(), 3);
+    assert!(doc["impact_count"].as_u64().unwrap() > 10);
+    let period = 2.0 * std::f64::consts::PI / 7.0395;
+    assert!((doc["final_time"].as_f64().unwrap() - 5.0 * period).abs() < 1e-9);
+    let dir = temp_dir("simulate-out");
+    let out = run(&["simulate", &model, "--duration", "2", "--out", &dir.display().to_string(), "--energy"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in ["history.csv", "impacts.csv", "summary.json", "displacements.png", "phase_portrait.svg", "impact_velocities.png"] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    assert!(history.starts_with("t,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3\n"));
+    let log = std::fs::read_to_string(dir.join("impacts.csv")).unwrap();
+    assert!(log.starts_with("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration\n"));
+    assert!(log.lines().count() > 5);
+}
+
+fn write_model(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn simulate_bad_models() {
+    let dir = temp_dir("simulate-bad");
+    let good = std::fs::read_to_string(repo_file("examples/fujita-row.toml")).unwrap();
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("unknown.toml", good.replace("count = 3", "count = 3\ncolour = 1"), "unknown field `colour`"),
+        ("missing.toml", good.replace("clearance = 0.001", ""), "missing field `clearance`"),
+        ("mass.toml", good.replace("mass = 0.227", "mass = 0"), "mass = 0"),
+        ("gap.toml", good.replace("clearance = 0.001 ", "clearance = -0.001 "), "clearance"),
+        ("alpha.toml", good.replace("alpha = 1.3e5", "alpha = -1.0"), "alpha"),
+        (
+            "body.toml",
+            "[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"b\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1e9 }\n".into(),
+            "unknown body `b`",
+        ),
+        (
+            "overlap.toml",
+            "[[body]]\nname = \"a\"\nmass = 1.0\ninitial_displacement = 0.002\n[[contact]]\nbetween = [\"a\", \"wall\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1e9 }\n".into(),
+            "overlap",
+        ),
+        (
+            "nofile.toml",
+            "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"missing.csv\"\n".into(),
+            "missing.csv: cannot read the accelerogram",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let path = write_model(&dir, name, &text);
+        let out_dir = dir.join(format!("{name}.out"));
+        assert_clean_error(&["simulate", &path, "--duration", "0.1", "--out", &out_dir.display().to_string()], needle);
+        assert!(!out_dir.exists(), "{name}: output written despite the error");
+    }
+    std::fs::write(dir.join("back.csv"), "0,0\n1,1\n0.5,0\n").unwrap();
+    let path = write_model(
+        &dir,
+        "back.toml",
+        "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"back.csv\"\n",
+    );
+    assert_clean_error(&["simulate", &path, "--duration", "0.1"], "back.csv:3:");
+    std::fs::write(dir.join("fwd.csv"), "0,0\n1,1\n2,0\n").unwrap();
+    let path = write_model(&dir, "fwd.toml", &std::fs::read_to_string(&path).unwrap().replace("back.csv", "fwd.csv"));
+    assert_clean_error(&["simulate", &path, "--periods", "1"], "--periods needs a periodic excitation");
+    let ok = run(&["simulate", &path, "--duration", "3"]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let model = repo_file("examples/fujita-row.toml");
+    assert_clean_error(&["simulate", &model, "--duration", "-1"], "duration");
+    assert_clean_error(&["simulate", &model, "--duration", "1", "--rtol", "0"], "rtol");
+    assert_clean_error(&["simulate", &dir.join("nope.toml").display().to_string(), "--duration", "1"], "cannot read");
+}
