@@ -353,7 +353,13 @@ fn default_study_report_is_complete_and_deterministic() {
 fn simulate_example_row_json_and_outputs() {
     let model = repo_file("examples/fujita-row.toml");
     let doc = json(&["simulate", &model, "--periods", "5", "--format", "json"]);
-    for key in ["final_time", "impact_count", "rhs_evaluations", "steps", "rejected_steps"] {
+    for key in [
+        "final_time",
+        "impact_count",
+        "rhs_evaluations",
+        "steps",
+        "rejected_steps",
+    ] {
         assert!(doc[key].is_number(), "missing {key}");
     }
     assert_eq!(doc["final_displacement"].as_array().unwrap().len(), 3);
@@ -362,9 +368,28 @@ fn simulate_example_row_json_and_outputs() {
     let period = 2.0 * std::f64::consts::PI / 7.0395;
     assert!((doc["final_time"].as_f64().unwrap() - 5.0 * period).abs() < 1e-9);
     let dir = temp_dir("simulate-out");
-    let out = run(&["simulate", &model, "--duration", "2", "--out", &dir.display().to_string(), "--energy"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    for f in ["history.csv", "impacts.csv", "summary.json", "displacements.png", "phase_portrait.svg", "impact_velocities.png"] {
+    let out = run(&[
+        "simulate",
+        &model,
+        "--duration",
+        "2",
+        "--out",
+        &dir.display().to_string(),
+        "--energy",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "history.csv",
+        "impacts.csv",
+        "summary.json",
+        "displacements.png",
+        "phase_portrait.svg",
+        "impact_velocities.png",
+    ] {
         assert!(dir.join(f).exists(), "{f} missing");
     }
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
@@ -409,8 +434,21 @@ fn simulate_bad_models() {
     for (name, text, needle) in cases {
         let path = write_model(&dir, name, &text);
         let out_dir = dir.join(format!("{name}.out"));
-        assert_clean_error(&["simulate", &path, "--duration", "0.1", "--out", &out_dir.display().to_string()], needle);
-        assert!(!out_dir.exists(), "{name}: output written despite the error");
+        assert_clean_error(
+            &[
+                "simulate",
+                &path,
+                "--duration",
+                "0.1",
+                "--out",
+                &out_dir.display().to_string(),
+            ],
+            needle,
+        );
+        assert!(
+            !out_dir.exists(),
+            "{name}: output written despite the error"
+        );
     }
     std::fs::write(dir.join("back.csv"), "0,0\n1,1\n0.5,0\n").unwrap();
     let path = write_model(
@@ -420,12 +458,36 @@ fn simulate_bad_models() {
     );
     assert_clean_error(&["simulate", &path, "--duration", "0.1"], "back.csv:3:");
     std::fs::write(dir.join("fwd.csv"), "0,0\n1,1\n2,0\n").unwrap();
-    let path = write_model(&dir, "fwd.toml", &std::fs::read_to_string(&path).unwrap().replace("back.csv", "fwd.csv"));
-    assert_clean_error(&["simulate", &path, "--periods", "1"], "--periods needs a periodic excitation");
+    let path = write_model(
+        &dir,
+        "fwd.toml",
+        &std::fs::read_to_string(&path)
+            .unwrap()
+            .replace("back.csv", "fwd.csv"),
+    );
+    assert_clean_error(
+        &["simulate", &path, "--periods", "1"],
+        "--periods needs a periodic excitation",
+    );
     let ok = run(&["simulate", &path, "--duration", "3"]);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     let model = repo_file("examples/fujita-row.toml");
     assert_clean_error(&["simulate", &model, "--duration", "-1"], "duration");
-    assert_clean_error(&["simulate", &model, "--duration", "1", "--rtol", "0"], "rtol");
-    assert_clean_error(&["simulate", &dir.join("nope.toml").display().to_string(), "--duration", "1"], "cannot read");
+    assert_clean_error(
+        &["simulate", &model, "--duration", "1", "--rtol", "0"],
+        "rtol",
+    );
+    assert_clean_error(
+        &[
+            "simulate",
+            &dir.join("nope.toml").display().to_string(),
+            "--duration",
+            "1",
+        ],
+        "cannot read",
+    );
 }
