@@ -27,6 +27,31 @@ use crate::contact::{ContactLaw, LawKind};
 use crate::integrate::OdeSystem;
 use crate::model::{BaseExcitation, Model};
 
+/// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
+/// (`-ml F` on the left, `+mr F` on the right; masks 0 for a wall side).
+/// Returns the dissipated power `(F(s, ṡ) - F(s, 0)) ṡ` when `energy`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn apply_contact(
+    law: &ContactLaw,
+    onset_velocity: f64,
+    force: &mut [f64],
+    (l, r): (usize, usize),
+    (ml, mr): (f64, f64),
+    s: f64,
+    sdot: f64,
+    energy: bool,
+) -> f64 {
+    let f = law.force(s, sdot, onset_velocity);
+    force[l] -= ml * f;
+    force[r] += mr * f;
+    if energy {
+        (f - law.force(s, 0.0, onset_velocity)) * sdot
+    } else {
+        0.0
+    }
+}
+
 /// How a contact is screened before evaluation.
 #[derive(Clone, Copy, Debug)]
 enum Screen {
@@ -69,6 +94,30 @@ pub struct ChainDynamics {
     force: Vec<f64>,
     contact_evaluations: u64,
     bandwidth: (usize, usize),
+    screen: ScreenSoA,
+}
+
+/// Contact screening in structure-of-arrays form (the hot loop of every
+/// right-hand side): `s = ml u_l - mr u_r - g`, `ṡ = ml v_l - mr v_r`, with
+/// the masks `ml`, `mr` 0 for a wall side (index 0 then) and 1 otherwise;
+/// contact k is evaluated only if `alpha s + boa |ṡ| >= limit` (exponential
+/// law: see the module notes; compact support: alpha = 1, boa = 0,
+/// limit = 0, i.e. `s >= 0`). Branch-free up to the final test.
+#[derive(Clone, Debug, Default)]
+struct ScreenSoA {
+    /// Contact index of the pair (body 0, body 1) when the contacts between
+    /// neighbours are stored consecutively (a chain: the row); then contact
+    /// `first_pair + i` joins bodies i and i + 1 and the pair loop needs no
+    /// index gathers.
+    chain: Option<usize>,
+    l: Vec<usize>,
+    r: Vec<usize>,
+    ml: Vec<f64>,
+    mr: Vec<f64>,
+    g: Vec<f64>,
+    alpha: Vec<f64>,
+    boa: Vec<f64>,
+    limit: Vec<f64>,
 }
 
 impl ChainDynamics {
@@ -136,6 +185,39 @@ impl ChainDynamics {
         } else {
             (2 * reach + 1, 2 * reach)
         };
+        let mut screen = ScreenSoA::default();
+        for c in &contacts {
+            screen.l.push(c.left.unwrap_or(0));
+            screen.r.push(c.right.unwrap_or(0));
+            screen.ml.push(if c.left.is_some() { 1.0 } else { 0.0 });
+            screen.mr.push(if c.right.is_some() { 1.0 } else { 0.0 });
+            screen.g.push(c.clearance);
+            let (alpha, boa, limit) = match c.screen {
+                Screen::Exponential {
+                    alpha,
+                    b_over_a,
+                    limit,
+                } => (alpha, b_over_a, limit),
+                Screen::CompactSupport => (1.0, 0.0, 0.0),
+            };
+            screen.alpha.push(alpha);
+            screen.boa.push(boa);
+            screen.limit.push(limit);
+        }
+        screen.chain = (n >= 2)
+            .then(|| {
+                contacts
+                    .iter()
+                    .position(|c| c.left == Some(0) && c.right == Some(1))
+                    .filter(|&fp| {
+                        fp + n - 1 <= contacts.len()
+                            && (0..n - 1).all(|i| {
+                                contacts[fp + i].left == Some(i)
+                                    && contacts[fp + i].right == Some(i + 1)
+                            })
+                    })
+            })
+            .flatten();
         Self {
             n,
             mass: bodies.iter().map(|b| b.mass).collect(),
@@ -159,6 +241,7 @@ impl ChainDynamics {
             force: vec![0.0; n],
             contact_evaluations: 0,
             bandwidth,
+            screen,
         }
     }
 
@@ -264,7 +347,7 @@ impl ChainDynamics {
         e
     }
 
-    #[inline]
+    #[cfg(test)]
     fn skip(screen: Screen, s: f64, sdot: f64) -> bool {
         match screen {
             Screen::Exponential {
@@ -284,17 +367,20 @@ impl OdeSystem for ChainDynamics {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let zdd = self.base.at(t);
+        let n = self.n;
+        for ((((f, uv), k), c), m) in self
+            .force
+            .iter_mut()
+            .zip(y[..2 * n].chunks_exact(2))
+            .zip(&self.stiffness)
+            .zip(&self.damping)
+            .zip(&self.mass)
+        {
+            *f = -k * uv[0] - c * uv[1] - m * zdd;
+        }
         let mut input = 0.0;
         let mut damper = 0.0;
         let mut contact = 0.0;
-        for i in 0..self.n {
-            let (u, v) = (y[2 * i], y[2 * i + 1]);
-            self.force[i] = -self.stiffness[i] * u - self.damping[i] * v - self.mass[i] * zdd;
-            if self.energy {
-                input -= self.mass[i] * zdd * v;
-                damper += self.damping[i] * v * v;
-            }
-        }
         for &(body, p, w, phi) in &self.forces {
             let f = p * (w * t + phi).sin();
             self.force[body] += f;
@@ -308,32 +394,79 @@ impl OdeSystem for ChainDynamics {
             self.force[b] -= f;
             damper += c * dv * dv;
         }
-        for (k, c) in self.contacts.iter().enumerate() {
-            let (ul, vl) = c.left.map_or((0.0, 0.0), |l| (y[2 * l], y[2 * l + 1]));
-            let (ur, vr) = c.right.map_or((0.0, 0.0), |r| (y[2 * r], y[2 * r + 1]));
-            let s = ul - ur - c.clearance;
-            let sdot = vl - vr;
-            if Self::skip(c.screen, s, sdot) {
-                continue;
-            }
-            self.contact_evaluations += 1;
-            let f = c.law.force(s, sdot, self.onset_velocity[k]);
-            if let Some(l) = c.left {
-                self.force[l] -= f;
-            }
-            if let Some(r) = c.right {
-                self.force[r] += f;
-            }
-            if self.energy {
-                contact += (f - c.law.force(s, 0.0, self.onset_velocity[k])) * sdot;
+        let (sc, contacts, onset, force) = (
+            &self.screen,
+            &self.contacts,
+            &self.onset_velocity,
+            &mut self.force,
+        );
+        let energy = self.energy;
+        let mut evaluations = 0;
+        let nc = sc.l.len();
+        let (chain_start, chain_end) = match sc.chain {
+            Some(fp) => (fp, fp + n - 1),
+            None => (0, 0),
+        };
+        if chain_end > chain_start {
+            // Neighbour pairs of a chain: contiguous, no gathers.
+            let (g, al, boa, lim) = (
+                &sc.g[chain_start..chain_end],
+                &sc.alpha[chain_start..chain_end],
+                &sc.boa[chain_start..chain_end],
+                &sc.limit[chain_start..chain_end],
+            );
+            for i in 0..n - 1 {
+                let w = &y[2 * i..2 * i + 4];
+                let s = w[0] - w[2] - g[i];
+                let sdot = w[1] - w[3];
+                if al[i] * s + boa[i] * sdot.abs() < lim[i] {
+                    continue;
+                }
+                let k = chain_start + i;
+                evaluations += 1;
+                contact += apply_contact(
+                    &contacts[k].law,
+                    onset[k],
+                    force,
+                    (i, i + 1),
+                    (1.0, 1.0),
+                    s,
+                    sdot,
+                    energy,
+                );
             }
         }
-        for i in 0..self.n {
+        for k in (0..chain_start).chain(chain_end..nc) {
+            let (l, r) = (sc.l[k], sc.r[k]);
+            let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - sc.g[k];
+            let sdot = sc.ml[k] * y[2 * l + 1] - sc.mr[k] * y[2 * r + 1];
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                continue;
+            }
+            evaluations += 1;
+            contact += apply_contact(
+                &contacts[k].law,
+                onset[k],
+                force,
+                (l, r),
+                (sc.ml[k], sc.mr[k]),
+                s,
+                sdot,
+                energy,
+            );
+        }
+        self.contact_evaluations += evaluations;
+        for i in 0..n {
             dydt[2 * i] = y[2 * i + 1];
             dydt[2 * i + 1] = self.force[i] * self.inv_mass[i];
         }
         if self.energy {
-            let m = 2 * self.n;
+            for i in 0..n {
+                let v = y[2 * i + 1];
+                input -= self.mass[i] * zdd * v;
+                damper += self.damping[i] * v * v;
+            }
+            let m = 2 * n;
             dydt[m] = input;
             dydt[m + 1] = damper;
             dydt[m + 2] = contact;

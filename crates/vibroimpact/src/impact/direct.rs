@@ -351,6 +351,7 @@ pub fn integrate_impact(
             rhs_evaluations: stats1.rhs_evaluations + stats2.rhs_evaluations,
             steps: stats1.steps + stats2.steps,
             rejected_steps: stats1.rejected_steps + stats2.rejected_steps,
+            ..Stats::default()
         },
     })
 }

@@ -23,6 +23,17 @@
 //!   `t_bound` (then `t == t_bound` exactly). When the step was shortened to
 //!   reach `t_bound` and accepted without rejection, the proposed next step is
 //!   not smaller than the step size that was planned before shortening.
+//! * **Stiffness detection** (as in `dop853.f`, but tested after *every*
+//!   accepted step instead of every `NSTIFF = 1000`-th): after an accepted
+//!   step, `h·ρ ≈ h·‖f(t+h, y_new) − f(t+h, Y₁₂)‖ / ‖y_new − Y₁₂‖` (Hairer's
+//!   `STNUM/STDEN`, `Y₁₂` the argument of the 12th stage, also at `t + h`)
+//!   estimates `h` times the dominant eigenvalue of the Jacobian. A step with
+//!   `h·ρ > 6.1` (the step size is then limited by the stability region, not
+//!   by accuracy) counts as suspicious; 6 consecutive non-suspicious steps
+//!   clear the count; 15 consecutive suspicious steps mean "stiff" (see
+//!   [`Dop853::stiffness_detected`]). The test only reports: it never changes
+//!   the computed solution. Switched off by
+//!   [`IntegratorOptions::stiffness_check`].
 //! * **Evaluation count**: `f(t0, y0)` on reset (+1 for the automatic
 //!   initial step); per attempt, 11 new stages (stage 0 is the previous
 //!   step's last evaluation, "first same as last"); `f(t + h, y_new)` once
@@ -54,6 +65,13 @@ const STRETCH: f64 = 1.01;
 const FSAL_STAGE: usize = N_STAGES;
 /// Number of dense-output coefficients per component.
 const N_CONT: usize = 8;
+/// Stiffness test: a step with `h·ρ` above this is suspicious (`dop853.f`).
+const STIFF_H_RHO: f64 = 6.1;
+/// Stiffness test: this many consecutive suspicious steps mean "stiff".
+const STIFF_STEPS: u32 = 15;
+/// Stiffness test: this many consecutive non-suspicious steps clear the
+/// count of suspicious ones.
+const NONSTIFF_STEPS: u32 = 6;
 
 /// Adaptive Dormand–Prince 8(5,3) integrator with 7th-order dense output.
 ///
@@ -84,8 +102,16 @@ pub struct Dop853 {
     /// Step size actually used by the last accepted step.
     h_last: f64,
     h_next: f64,
+    /// Gustafsson's predictive controller: size and error of the previous
+    /// accepted step (None right after a reset).
+    previous_accepted: Option<(f64, f64)>,
     steps_since_reset: u64,
     stats: Stats,
+    /// Consecutive suspicious steps of the stiffness test (Hairer's `IASTI`).
+    stiff_count: u32,
+    /// Consecutive non-suspicious steps since the last suspicious one
+    /// (Hairer's `NONSTI`).
+    nonstiff_count: u32,
     y: Vec<f64>,
     dydt: Vec<f64>,
     /// State at `t_prev`.
@@ -105,17 +131,42 @@ pub struct Dop853 {
 
 /// `out = y + h · Σ_j row[j] · k_j`, skipping zero coefficients.
 fn combine(y: &[f64], k: &[f64], row: &[f64], h: f64, out: &mut [f64]) {
+    // One pass over the output: each block of 8 components accumulates all
+    // stages in registers (measured 2x faster at n = 2000 than one axpy pass
+    // per stage, which loads and stores the output once per stage).
+    const B: usize = 8;
     let n = y.len();
-    out.fill(0.0);
-    for (&a, kj) in row.iter().zip(k.chunks_exact(n)) {
-        if a != 0.0 {
-            for (o, &v) in out.iter_mut().zip(kj) {
-                *o += a * v;
+    let stages = row.len().min(k.len() / n.max(1));
+    let mut i = 0;
+    while i + B <= n {
+        let mut acc = [0.0; B];
+        for (j, &a) in row[..stages].iter().enumerate() {
+            if a != 0.0 {
+                let kj = &k[j * n + i..j * n + i + B];
+                for l in 0..B {
+                    acc[l] += a * kj[l];
+                }
             }
         }
+        for l in 0..B {
+            out[i + l] = y[i + l] + h * acc[l];
+        }
+        i += B;
     }
-    for (o, &v) in out.iter_mut().zip(y) {
-        *o = v + h * *o;
+    let rest = n - i;
+    if rest > 0 {
+        let mut acc = [0.0; B];
+        for (j, &a) in row[..stages].iter().enumerate() {
+            if a != 0.0 {
+                let kj = &k[j * n + i..j * n + n];
+                for l in 0..rest {
+                    acc[l] += a * kj[l];
+                }
+            }
+        }
+        for l in 0..rest {
+            out[i + l] = y[i + l] + h * acc[l];
+        }
     }
 }
 
@@ -150,8 +201,11 @@ impl Dop853 {
             t_prev: 0.0,
             h_last: 0.0,
             h_next: 0.0,
+            previous_accepted: None,
             steps_since_reset: 0,
             stats: Stats::default(),
+            stiff_count: 0,
+            nonstiff_count: 0,
             y: vec![0.0; dim],
             dydt: vec![0.0; dim],
             y_prev: vec![0.0; dim],
@@ -169,7 +223,8 @@ impl Dop853 {
     /// Hairer's `HINIT` estimate (one more evaluation of `f`, at `t0 + h`
     /// with `h` an Euler guess). Statistics are *not* reset (they accumulate
     /// over the integrator's lifetime, see [`reset_stats`](Self::reset_stats));
-    /// the step counter for [`IntegratorOptions::max_steps`] is.
+    /// the step counter for [`IntegratorOptions::max_steps`] and the counters
+    /// of the stiffness test are.
     ///
     /// Errors: [`IntegrationError::InvalidOptions`] for a dimension mismatch
     /// or non-finite `t0`; [`IntegrationError::NonFiniteInitialState`] if `y0`
@@ -212,6 +267,9 @@ impl Dop853 {
         self.has_step = false;
         self.dense_ready = false;
         self.steps_since_reset = 0;
+        self.stiff_count = 0;
+        self.nonstiff_count = 0;
+        self.previous_accepted = None;
         self.h_next = match self.opts.h_init {
             Some(h) => h.min(self.opts.h_max),
             None => self.initial_step(sys),
@@ -271,13 +329,26 @@ impl Dop853 {
             };
             match self.attempt(sys, h, t_new) {
                 Ok(err) => {
-                    let fac =
+                    let mut fac =
                         (err.powf(ERROR_EXPONENT) / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                    // Gustafsson's predictive controller (as in Hairer's
+                    // RADAU5/RODAS): when the error grows from step to step
+                    // (an impact approaching: the exponential force steepens
+                    // every step), shrink ahead of the trend instead of
+                    // being rejected once per step.
+                    if let Some((h_acc, err_acc)) = self.previous_accepted {
+                        let gus = (h_acc / h) * (err * err / err_acc).powf(ERROR_EXPONENT) / SAFETY;
+                        fac = fac.max(gus.clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN));
+                    }
+                    self.previous_accepted = Some((h, err.max(1e-2)));
                     let mut h_new = h / fac;
                     if rejected {
                         h_new = h_new.min(h);
                     } else if clipped {
                         h_new = h_new.max(h_planned);
+                    }
+                    if self.opts.stiffness_check {
+                        self.test_stiffness(h);
                     }
                     self.accept(t_new, h, h_new.min(self.opts.h_max));
                     return Ok(());
@@ -321,6 +392,16 @@ impl Dop853 {
     /// step).
     pub fn dydt(&self) -> &[f64] {
         &self.dydt
+    }
+
+    /// Caps the size of the next step at `h` (> 0), e.g. so that it does not
+    /// run deep into an impact the caller sees coming. Unlike `t_bound`, the
+    /// cap is not remembered: the step after it grows from the capped size
+    /// as the error allows.
+    pub fn limit_next_step(&mut self, h: f64) {
+        if h > 0.0 && h < self.h_next {
+            self.h_next = h;
+        }
     }
 
     /// Step size proposed for the next step (before limiting it by the
@@ -390,6 +471,57 @@ impl Dop853 {
     /// The options the integrator was created with.
     pub fn options(&self) -> &IntegratorOptions {
         &self.opts
+    }
+
+    /// Whether the problem looks stiff: the stiffness test (see the module
+    /// documentation and [`IntegratorOptions::stiffness_check`]) has counted
+    /// at least 15 consecutive accepted steps whose size was limited by
+    /// stability (`h·ρ > 6.1`), and not 6 consecutive unsuspicious steps
+    /// since. Cleared by [`reset`](Self::reset); always `false` when the test
+    /// is switched off.
+    ///
+    /// Limit of Hairer's test: at tight tolerances the controller may keep a
+    /// stability-limited step below the threshold (measured on
+    /// `y' = −1e4 (y − cos t)` at rtol = atol = 1e-10: `h·λ ≈ 4.97`), so
+    /// *mildly* stiff problems can go undetected there; strongly stiff ones
+    /// (`λ = 1e6`, tolerance 1e-12) are detected within a few dozen steps.
+    pub fn stiffness_detected(&self) -> bool {
+        self.stiff_count >= STIFF_STEPS
+    }
+
+    /// Number of consecutive suspicious steps counted by the stiffness test
+    /// (Hairer's `IASTI`; reaching 15 means [`stiffness_detected`](Self::stiffness_detected)).
+    pub fn stiff_step_count(&self) -> u32 {
+        self.stiff_count
+    }
+
+    /// Whether a successful [`reset`](Self::reset) has happened (stepping is
+    /// allowed).
+    pub(super) fn is_initialised(&self) -> bool {
+        self.initialised
+    }
+
+    /// Hairer's stiffness test on the attempt just accepted (before
+    /// [`accept`](Self::accept) swaps the buffers): `y_stage` holds the
+    /// argument of stage 11 (`c = 1`), `k` its derivative and `f(t+h, y_new)`.
+    fn test_stiffness(&mut self, h: f64) {
+        let n = self.n;
+        let k12 = &self.k[(N_STAGES - 1) * n..N_STAGES * n];
+        let f_new = &self.k[FSAL_STAGE * n..(FSAL_STAGE + 1) * n];
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..n {
+            num += (f_new[i] - k12[i]).powi(2);
+            den += (self.y_new[i] - self.y_stage[i]).powi(2);
+        }
+        if den > 0.0 && h * (num / den).sqrt() > STIFF_H_RHO {
+            self.nonstiff_count = 0;
+            self.stiff_count = self.stiff_count.saturating_add(1);
+        } else {
+            self.nonstiff_count = self.nonstiff_count.saturating_add(1);
+            if self.nonstiff_count >= NONSTIFF_STEPS {
+                self.stiff_count = 0;
+            }
+        }
     }
 
     fn check_dim<S: OdeSystem>(&self, sys: &S) -> Result<(), IntegrationError> {
@@ -1364,5 +1496,114 @@ mod tests {
             ),
             Err(IntegrationError::InvalidOptions(_))
         ));
+    }
+
+    // ---------------------------------------------------------------------
+    // 8. Stiffness test.
+    // ---------------------------------------------------------------------
+
+    /// y' = −λ (y − cos t).
+    struct StiffLinear(f64);
+    impl OdeSystem for StiffLinear {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, t: f64, y: &[f64], d: &mut [f64]) {
+            d[0] = -self.0 * (y[0] - t.cos());
+        }
+    }
+
+    /// Steps over [0, t_end]; returns the first step number at which
+    /// stiffness was reported, the largest suspicious-step count seen, and
+    /// the final state.
+    fn stiffness_run<S: OdeSystem>(
+        sys: &mut S,
+        y0: &[f64],
+        t_end: f64,
+        opts: IntegratorOptions,
+    ) -> (Option<u64>, u32, Vec<f64>) {
+        let mut s = Dop853::new(sys.dim(), opts).unwrap();
+        s.reset(sys, 0.0, y0).unwrap();
+        let (mut first, mut max_count) = (None, 0);
+        while s.t() < t_end {
+            s.step(sys, t_end).unwrap();
+            max_count = max_count.max(s.stiff_step_count());
+            if first.is_none() && s.stiffness_detected() {
+                first = Some(s.stats().steps);
+            }
+        }
+        (first, max_count, s.y().to_vec())
+    }
+
+    #[test]
+    fn stiffness_test_fires_on_stiff_problems_only() {
+        // y' = −λ (y − cos t) from y = 0 over [0, 0.1] or [0, 1]: after the
+        // initial layer the step size is limited by stability, h·λ ≈ 6.39
+        // (measured), and the test fires after a few dozen steps (measured
+        // first detection at step 27, 28, 46, 212; the predictive controller
+        // approaches the stability limit more cautiously at tol 1e-12).
+        for (lambda, tl, t_end) in [
+            (1e4, 1e-3, 1.0),
+            (1e4, 1e-6, 1.0),
+            (1e6, 1e-10, 0.1),
+            (1e6, 1e-12, 0.1),
+        ] {
+            let (first, _, _) = stiffness_run(&mut StiffLinear(lambda), &[0.0], t_end, tol(tl));
+            let first = first.unwrap_or_else(|| panic!("λ = {lambda:e}, tol {tl:e}: not detected"));
+            assert!(
+                first < 300,
+                "λ = {lambda:e}, tol {tl:e}: detected at step {first}"
+            );
+        }
+        // Mildly stiff at a tight tolerance: the controller keeps h·λ ≈ 4.97
+        // < 6.1 (measured), Hairer's test does not fire (a known limit of
+        // the test, documented at `stiffness_detected`).
+        let (first, _, _) = stiffness_run(&mut StiffLinear(1e4), &[0.0], 1.0, tol(1e-10));
+        assert_eq!(first, None);
+        // Non-stiff problems never come close (measured: at most 2
+        // consecutive suspicious steps, damped oscillator at tol 1e-3).
+        for tl in [1e-3, 1e-6, 1e-9, 1e-12] {
+            for (name, run) in [
+                (
+                    "harmonic",
+                    stiffness_run(&mut Harmonic, &[1.0, 0.0], 100.0, tol(tl)),
+                ),
+                (
+                    "damped",
+                    stiffness_run(&mut Damped, &[1.0, 0.0], 100.0, tol(tl)),
+                ),
+            ] {
+                assert_eq!(run.0, None, "{name}, tol {tl:e}");
+                assert!(run.1 <= 3, "{name}, tol {tl:e}: {} suspicious steps", run.1);
+            }
+        }
+    }
+
+    #[test]
+    fn stiffness_test_never_changes_the_solution() {
+        for (lambda, tl) in [(1e4, 1e-6), (1e2, 1e-9)] {
+            let off = IntegratorOptions {
+                stiffness_check: false,
+                ..tol(tl)
+            };
+            let (f_on, m_on, y_on) = stiffness_run(&mut StiffLinear(lambda), &[0.0], 1.0, tol(tl));
+            let (f_off, m_off, y_off) = stiffness_run(&mut StiffLinear(lambda), &[0.0], 1.0, off);
+            assert_eq!(y_on, y_off, "bitwise identical");
+            assert_eq!((f_off, m_off), (None, 0));
+            if lambda > 1e3 {
+                assert!(f_on.is_some() && m_on >= 15);
+            }
+        }
+        // Reset clears the counters.
+        let mut s = Dop853::new(1, tol(1e-6)).unwrap();
+        let mut sys = StiffLinear(1e4);
+        s.reset(&mut sys, 0.0, &[0.0]).unwrap();
+        while !s.stiffness_detected() {
+            s.step(&mut sys, 1.0).unwrap();
+        }
+        let (t, y) = (s.t(), s.y().to_vec());
+        s.reset(&mut sys, t, &y).unwrap();
+        assert!(!s.stiffness_detected());
+        assert_eq!(s.stiff_step_count(), 0);
     }
 }
