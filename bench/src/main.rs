@@ -1,0 +1,403 @@
+//! `vibroimpact-bench`: the project's performance claims, measured against
+//! peers on the same problem in one run (ratios, not absolute times).
+//!
+//! Problem R2 (THEORY.md §6): N pendulums between walls, exponential law,
+//! base acceleration 0.05 sin(0.95 ω0 t), from rest. Peers (bench/peers):
+//! SUNDIALS 6.4.1 (CVODE, ARKODE explicit tables) with a C right-hand side
+//! and SciPy `solve_ivp` with a vectorised NumPy right-hand side.
+//!
+//! 1. N = 3, 5 periods: work-precision sweep for every solver (rtol 1e-6 …
+//!    1e-12, atol = 1e-3 rtol), error = max |y - y_ref| / max |y_ref| of
+//!    the final state against a tight reference. For each solver the
+//!    *robust* setting is the loosest rtol from which every tighter rtol
+//!    meets error <= 1e-6 (impacts make the error erratic in rtol); the
+//!    ratios compare the times at those settings.
+//! 2. N = 1000, 1 period, rtol 1e-8: time against every ARKODE explicit
+//!    method, with the achieved errors.
+//! 3. Time per period for N = 10, 100, 1000, 10000 at rtol 1e-8.
+//!
+//! Run: `cargo run --release -p vibroimpact-bench [-- --quick] [--no-peers]`.
+//! It builds the peers itself (`bench/peers/build.sh`, which installs
+//! libsundials-dev and a Python venv with NumPy and SciPy if missing).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use clap::Parser;
+use serde_json::{json, Value};
+use vibroimpact::contact::{ContactLaw, ForceForm};
+use vibroimpact::model::{BaseExcitation, Model};
+use vibroimpact::simulate::{simulate, SimulationOptions};
+
+#[derive(Parser, Debug)]
+#[command(about = "Benchmarks of vibroimpact against SUNDIALS and SciPy on reference problem R2")]
+struct Args {
+    /// Fewer repeats, no N = 10000.
+    #[arg(long)]
+    quick: bool,
+    /// Only our own solver (no peers).
+    #[arg(long)]
+    no_peers: bool,
+    /// Write the results as JSON here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+const OMEGA_RATIO: f64 = 0.95;
+const TARGET_ERROR: f64 = 1e-6;
+const ATOL_RATIO: f64 = 1e-3;
+
+fn r2(n: usize) -> Model {
+    let (m, w0, zeta) = (0.227, 7.41, 0.013);
+    let law = ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published)
+        .expect("valid law");
+    let base = BaseExcitation::Harmonic {
+        amplitude: 0.05,
+        frequency: OMEGA_RATIO * w0,
+        phase: 0.0,
+    };
+    Model::row(
+        n,
+        m,
+        m * w0 * w0,
+        2.0 * zeta * m * w0,
+        1e-3,
+        law,
+        (true, true),
+        base,
+    )
+    .expect("valid model")
+}
+
+fn t_end(periods: f64) -> f64 {
+    periods * 2.0 * std::f64::consts::PI / (OMEGA_RATIO * 7.41)
+}
+
+/// One solver run: final state [u.., v..], best wall time, work counters.
+#[derive(Clone, Debug)]
+struct Run {
+    state: Vec<f64>,
+    seconds: f64,
+    rhs: u64,
+    steps: u64,
+}
+
+fn ours(n: usize, periods: f64, rtol: f64, atol: f64, repeats: usize) -> Run {
+    let model = r2(n);
+    let opts = SimulationOptions {
+        t_end: t_end(periods),
+        rtol,
+        atol,
+        ..SimulationOptions::default()
+    };
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        let sim = simulate(&model, &opts).expect("valid options");
+        best = best.min(start.elapsed().as_secs_f64());
+        assert!(
+            sim.error.is_none(),
+            "our integration failed: {:?}",
+            sim.error
+        );
+        last = Some(sim);
+    }
+    let sim = last.expect("at least one run");
+    Run {
+        state: sim
+            .final_displacement
+            .iter()
+            .chain(&sim.final_velocity)
+            .copied()
+            .collect(),
+        seconds: best,
+        rhs: sim.stats.rhs_evaluations,
+        steps: sim.stats.steps,
+    }
+}
+
+struct Peers {
+    dir: PathBuf,
+}
+
+impl Peers {
+    fn build(root: &Path) -> Result<Self, String> {
+        let dir = root.join("bench/peers");
+        let status = Command::new("bash")
+            .arg(dir.join("build.sh"))
+            .status()
+            .map_err(|e| format!("cannot run bench/peers/build.sh: {e}"))?;
+        if !status.success() {
+            return Err("bench/peers/build.sh failed".into());
+        }
+        Ok(Self { dir })
+    }
+
+    fn run(
+        &self,
+        method: &str,
+        n: usize,
+        periods: f64,
+        rtol: f64,
+        atol: f64,
+        repeats: usize,
+    ) -> Result<Run, String> {
+        let args = [
+            n.to_string(),
+            OMEGA_RATIO.to_string(),
+            periods.to_string(),
+            format!("{rtol:e}"),
+            format!("{atol:e}"),
+            repeats.to_string(),
+        ];
+        let output = if let Some(m) = method.strip_prefix("scipy-") {
+            Command::new(self.dir.join("build/venv/bin/python"))
+                .arg(self.dir.join("r2_scipy.py"))
+                .arg(m)
+                .args(&args)
+                .output()
+        } else {
+            Command::new(self.dir.join("build/r2_sundials"))
+                .arg(method)
+                .args(&args)
+                .output()
+        }
+        .map_err(|e| format!("{method}: {e}"))?;
+        if !output.status.success() {
+            return Err(format!(
+                "{method} failed: {}",
+                String::from_utf8_lossy(&output.stderr).trim()
+            ));
+        }
+        let line = String::from_utf8_lossy(&output.stdout);
+        let v: Value =
+            serde_json::from_str(line.trim()).map_err(|e| format!("{method}: bad output: {e}"))?;
+        let state = v["final_state"]
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_f64).collect())
+            .unwrap_or_default();
+        Ok(Run {
+            state,
+            seconds: v["seconds"].as_f64().unwrap_or(f64::NAN),
+            rhs: v["rhs_evaluations"].as_u64().unwrap_or(0),
+            steps: v["steps"].as_u64().unwrap_or(0),
+        })
+    }
+}
+
+fn error(state: &[f64], reference: &[f64]) -> f64 {
+    let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    state
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
+/// The robust setting of a sweep (rtol descending): the loosest rtol from
+/// which every tighter one meets the target.
+fn robust(sweep: &[(f64, f64, Run)]) -> Option<&(f64, f64, Run)> {
+    let mut pick = None;
+    for entry in sweep.iter().rev() {
+        if entry.1 <= TARGET_ERROR {
+            pick = Some(entry);
+        } else {
+            break;
+        }
+    }
+    pick
+}
+
+fn main() {
+    let args = Args::parse();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let peers = if args.no_peers {
+        None
+    } else {
+        match Peers::build(&root) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                eprintln!("error: {e}");
+                std::process::exit(1);
+            }
+        }
+    };
+    let peer_or_exit = |r: Result<Run, String>| match r {
+        Ok(run) => run,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+    };
+    let repeats = if args.quick { 5 } else { 20 };
+    let mut results = serde_json::Map::new();
+
+    // 1. N = 3, 5 periods, work-precision.
+    println!("== R2, N = 3, Omega = 0.95 omega0, 5 periods: work-precision (atol = 1e-3 rtol) ==");
+    let reference = ours(3, 5.0, 1e-13, 1e-16, 1).state;
+    if let Some(p) = &peers {
+        let cvode = peer_or_exit(p.run("cvode-adams", 3, 5.0, 1e-13, 1e-16, 1));
+        let agreement = error(&cvode.state, &reference);
+        println!("reference: ours at rtol 1e-13; CVODE-Adams at 1e-13 agrees to {agreement:.1e}");
+        results.insert("reference_agreement_cvode_adams".into(), json!(agreement));
+    }
+    let rtols: Vec<f64> = (6..=12).map(|k| 10f64.powi(-k)).collect();
+    let mut solvers: Vec<(&str, Vec<(f64, f64, Run)>)> = Vec::new();
+    let mut sweep = Vec::new();
+    for &rtol in &rtols {
+        let run = ours(3, 5.0, rtol, rtol * ATOL_RATIO, repeats);
+        sweep.push((rtol, error(&run.state, &reference), run));
+    }
+    solvers.push(("vibroimpact-dop853", sweep));
+    if let Some(p) = &peers {
+        for method in [
+            "arkode-dp5",
+            "arkode-verner8",
+            "arkode-fehlberg8",
+            "cvode-adams",
+            "scipy-dop853",
+        ] {
+            let mut sweep = Vec::new();
+            let scipy = method.starts_with("scipy");
+            for &rtol in &rtols {
+                if scipy && rtol < 1e-11 {
+                    continue; // minutes per point; its robust setting is found before
+                }
+                let run = peer_or_exit(p.run(
+                    method,
+                    3,
+                    5.0,
+                    rtol,
+                    rtol * ATOL_RATIO,
+                    if scipy { 3 } else { repeats },
+                ));
+                sweep.push((rtol, error(&run.state, &reference), run));
+            }
+            solvers.push((method, sweep));
+        }
+    }
+    println!(
+        "{:<20} {:>8} {:>10} {:>10} {:>9}",
+        "solver", "rtol", "error", "ms", "rhs"
+    );
+    let mut picks = Vec::new();
+    for (name, sweep) in &solvers {
+        for (rtol, err, run) in sweep {
+            println!(
+                "{name:<20} {rtol:>8.0e} {err:>10.2e} {:>10.3} {:>9}",
+                run.seconds * 1e3,
+                run.rhs
+            );
+        }
+        match robust(sweep) {
+            Some((rtol, err, run)) => picks.push((*name, *rtol, *err, run.seconds)),
+            None => {
+                println!("{name}: no robust setting reaches error {TARGET_ERROR:e} in the sweep")
+            }
+        }
+    }
+    let our_time = picks
+        .iter()
+        .find(|p| p.0 == "vibroimpact-dop853")
+        .map_or(f64::NAN, |p| p.3);
+    println!("\nrobust settings (loosest rtol from which all tighter meet error <= 1e-6):");
+    let mut pick_json = Vec::new();
+    for (name, rtol, err, secs) in &picks {
+        let ratio = secs / our_time;
+        println!(
+            "{name:<20} rtol {rtol:.0e}  error {err:.2e}  {:.3} ms  peer/ours = {ratio:.1}",
+            secs * 1e3
+        );
+        pick_json.push(json!({"solver": name, "rtol": rtol, "error": err, "seconds": secs, "ratio_to_ours": ratio}));
+    }
+    results.insert(
+        "r2_n3".into(),
+        json!({
+            "sweep": solvers.iter().map(|(name, s)| json!({"solver": name, "points": s.iter().map(|(r, e, run)| json!({"rtol": r, "error": e, "seconds": run.seconds, "rhs_evaluations": run.rhs, "steps": run.steps})).collect::<Vec<_>>()})).collect::<Vec<_>>(),
+            "robust": pick_json,
+        }),
+    );
+
+    // 2. N = 1000, 1 period, rtol 1e-8.
+    println!("\n== R2, N = 1000, 1 period, rtol 1e-8, atol 1e-11 ==");
+    let reference = ours(1000, 1.0, 1e-12, 1e-15, 1).state;
+    let mine = ours(1000, 1.0, 1e-8, 1e-11, if args.quick { 3 } else { 10 });
+    let mut rows = vec![(
+        "vibroimpact-dop853",
+        error(&mine.state, &reference),
+        mine.clone(),
+    )];
+    if let Some(p) = &peers {
+        for method in [
+            "arkode-dp5",
+            "arkode-verner8",
+            "arkode-fehlberg8",
+            "scipy-dop853",
+        ] {
+            let run = peer_or_exit(p.run(method, 1000, 1.0, 1e-8, 1e-11, 3));
+            rows.push((method, error(&run.state, &reference), run));
+        }
+    }
+    let best_arkode = rows
+        .iter()
+        .filter(|r| r.0.starts_with("arkode"))
+        .map(|r| r.2.seconds)
+        .fold(f64::INFINITY, f64::min);
+    for (name, err, run) in &rows {
+        println!(
+            "{name:<20} {:>9.2} ms  error {err:.2e}  rhs {:>6}  steps {:>5}  time/ours {:.1}",
+            run.seconds * 1e3,
+            run.rhs,
+            run.steps,
+            run.seconds / mine.seconds
+        );
+    }
+    if best_arkode.is_finite() {
+        println!(
+            "fastest ARKODE explicit / ours = {:.1}",
+            best_arkode / mine.seconds
+        );
+    }
+    results.insert(
+        "r2_n1000".into(),
+        json!({"runs": rows.iter().map(|(n, e, r)| json!({"solver": n, "error": e, "seconds": r.seconds, "rhs_evaluations": r.rhs, "steps": r.steps})).collect::<Vec<_>>(),
+               "fastest_arkode_over_ours": best_arkode / mine.seconds}),
+    );
+
+    // 3. Scaling.
+    println!("\n== time per period, rtol 1e-8 ==");
+    let sizes: &[usize] = if args.quick {
+        &[10, 100, 1000]
+    } else {
+        &[10, 100, 1000, 10000]
+    };
+    let mut scaling = Vec::new();
+    for &n in sizes {
+        let run = ours(n, 1.0, 1e-8, 1e-11, if n >= 10000 { 1 } else { 3 });
+        let peer = peers
+            .as_ref()
+            .map(|p| peer_or_exit(p.run("arkode-verner8", n, 1.0, 1e-8, 1e-11, 1)));
+        let per_body_us = run.seconds / n as f64 * 1e6;
+        match &peer {
+            Some(pr) => println!(
+                "N = {n:>6}: ours {:>9.3} ms ({per_body_us:.2} µs per body), ARKODE Verner {:>9.3} ms, ratio {:.1}",
+                run.seconds * 1e3,
+                pr.seconds * 1e3,
+                pr.seconds / run.seconds
+            ),
+            None => println!("N = {n:>6}: ours {:>9.3} ms ({per_body_us:.2} µs per body)", run.seconds * 1e3),
+        }
+        scaling.push(json!({"n": n, "ours_seconds": run.seconds, "ours_rhs": run.rhs, "arkode_verner8_seconds": peer.map(|p| p.seconds)}));
+    }
+    results.insert("scaling".into(), Value::Array(scaling));
+    if let Some(out) = &args.out {
+        let text = serde_json::to_string_pretty(&Value::Object(results)).expect("serialisable");
+        if let Err(e) = std::fs::write(out, text) {
+            eprintln!("error: cannot write {}: {e}", out.display());
+            std::process::exit(1);
+        }
+    }
+}
