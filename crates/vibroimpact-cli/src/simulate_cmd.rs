@@ -2,8 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde::Serialize;
+use vibroimpact::integrate::Method;
 use vibroimpact::model::Model;
 use vibroimpact::simulate::{simulate, Simulation, SimulationOptions};
 
@@ -12,6 +13,28 @@ use crate::format::{csv_text, Format};
 use crate::model_file::{read_model, LoadedModel};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+
+/// Integration method on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodName {
+    /// Explicit 8th-order Dormand–Prince (DOP853): impacts, free flight.
+    Dop853,
+    /// Implicit Rosenbrock (RODAS): bodies pressed together for long times.
+    Rodas,
+    /// DOP853, switching to RODAS when its stiffness test fires.
+    Auto,
+}
+
+impl MethodName {
+    /// The library's method.
+    pub fn method(self) -> Method {
+        match self {
+            MethodName::Dop853 => Method::Dop853,
+            MethodName::Rodas => Method::Rodas,
+            MethodName::Auto => Method::Auto,
+        }
+    }
+}
 
 /// Options of `vibroimpact simulate`.
 #[derive(Args, Debug)]
@@ -46,6 +69,9 @@ pub struct SimulateArgs {
     /// Integrate the energy audit and report it.
     #[arg(long)]
     energy: bool,
+    /// Integration method.
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    method: MethodName,
     /// Force level F_on (N) that delimits impacts of the exponential law
     /// (default: [simulation] impact_force_threshold, else 1e-3 N).
     #[arg(long)]
@@ -185,6 +211,7 @@ fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOption
             .or(loaded.simulation.impact_force_threshold)
             .unwrap_or(1e-3),
         energy: args.energy,
+        method: args.method.method(),
         ..SimulationOptions::default()
     })
 }
@@ -274,7 +301,7 @@ pub fn plot_history(
     render(&fig, &dir.join("displacements"))?;
     let b = phase_body;
     let fig = Figure::new(
-        &format!("Phase portrait of {}", model.bodies()[b].name),
+        format!("Phase portrait of {}", model.bodies()[b].name),
         "displacement u  [mm]",
         "velocity v  [m/s]",
     )

@@ -24,7 +24,7 @@
 //! the number of contacts actually closing, and linearly with N.
 
 use crate::contact::{ContactLaw, LawKind};
-use crate::integrate::OdeSystem;
+use crate::integrate::{BandMatrix, OdeSystem};
 use crate::model::{BaseExcitation, Model};
 
 /// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
@@ -473,6 +473,66 @@ impl OdeSystem for ChainDynamics {
         }
     }
 
+    /// Banded for the mechanical state; dense with the energy quadratures
+    /// (their rows depend on every velocity).
+    fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
+        (!self.energy).then_some(self.bandwidth)
+    }
+
+    /// Analytic ∂f/∂y: springs, dampers, couplings and every contact not
+    /// screened out, with the laws' analytic partial derivatives. The energy
+    /// quadratures' rows are left to finite differences (returns false then).
+    fn jacobian(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        if self.energy {
+            return false;
+        }
+        for i in 0..self.n {
+            let im = self.inv_mass[i];
+            jac.set(2 * i, 2 * i + 1, 1.0);
+            jac.add(2 * i + 1, 2 * i, -self.stiffness[i] * im);
+            jac.add(2 * i + 1, 2 * i + 1, -self.damping[i] * im);
+        }
+        let pair = |jac: &mut BandMatrix, a: usize, b: usize, ds: f64, dv: f64| {
+            // Force +(ds Δu + dv Δv) on a, -(…) on b, with Δ = (b) - (a).
+            let (ia, ib) = (self.inv_mass[a], self.inv_mass[b]);
+            jac.add(2 * a + 1, 2 * a, -ds * ia);
+            jac.add(2 * a + 1, 2 * b, ds * ia);
+            jac.add(2 * a + 1, 2 * a + 1, -dv * ia);
+            jac.add(2 * a + 1, 2 * b + 1, dv * ia);
+            jac.add(2 * b + 1, 2 * a, ds * ib);
+            jac.add(2 * b + 1, 2 * b, -ds * ib);
+            jac.add(2 * b + 1, 2 * a + 1, dv * ib);
+            jac.add(2 * b + 1, 2 * b + 1, -dv * ib);
+        };
+        for &(a, b, k, c) in &self.couplings {
+            pair(jac, a, b, k, c);
+        }
+        let sc = &self.screen;
+        for k in 0..sc.l.len() {
+            let (s, sdot) = self.approach(k, y);
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                continue;
+            }
+            let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
+            match (self.contacts[k].left, self.contacts[k].right) {
+                // -F on l, +F on r, F = F(u_l - u_r - g, v_l - v_r): the same
+                // shape as a coupling of stiffness ∂F/∂s between r and l.
+                (Some(l), Some(r)) => pair(jac, l, r, c.d_ds, c.d_dsdot),
+                (Some(l), None) => {
+                    jac.add(2 * l + 1, 2 * l, -c.d_ds * self.inv_mass[l]);
+                    jac.add(2 * l + 1, 2 * l + 1, -c.d_dsdot * self.inv_mass[l]);
+                }
+                (None, Some(r)) => {
+                    // s = -u_r - g: ∂(+F)/∂u_r = -∂F/∂s.
+                    jac.add(2 * r + 1, 2 * r, -c.d_ds * self.inv_mass[r]);
+                    jac.add(2 * r + 1, 2 * r + 1, -c.d_dsdot * self.inv_mass[r]);
+                }
+                (None, None) => {}
+            }
+        }
+        true
+    }
+
     fn admissible(&self, _t: f64, y: &[f64]) -> bool {
         self.contacts.iter().enumerate().all(|(k, c)| {
             let (s, _) = self.approach(k, y);
@@ -485,6 +545,7 @@ impl OdeSystem for ChainDynamics {
 mod tests {
     use super::*;
     use crate::contact::ForceForm;
+    use crate::integrate::BandMatrix;
     use crate::model::{Body, Contact, ContactPair, Coupling};
 
     fn law() -> ContactLaw {
@@ -542,6 +603,89 @@ mod tests {
         assert!((dy[1] - fa / 0.2).abs() < 1e-12 * (fa / 0.2).abs().max(1.0));
         assert!((dy[3] - fb / 0.3).abs() < 1e-12 * (fb / 0.3).abs().max(1.0));
         assert_eq!(sys.bandwidth(), (3, 2));
+    }
+
+    /// The analytic banded Jacobian equals central differences of the
+    /// right-hand side, with contacts engaged.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let bodies = vec![
+            Body::from_frequency("a", 0.2, 7.0, 0.01),
+            Body::from_frequency("b", 0.3, 5.0, 0.02),
+            Body::from_frequency("c", 0.25, 6.0, 0.03),
+        ];
+        let couplings = vec![Coupling {
+            a: 0,
+            b: 1,
+            stiffness: 3.0,
+            damping: 0.1,
+        }];
+        let contacts = vec![
+            Contact {
+                pair: ContactPair::LeftWall { body: 0 },
+                clearance: 1e-5,
+                law: law(),
+            },
+            Contact {
+                pair: ContactPair::Bodies { left: 0, right: 1 },
+                clearance: 1e-4,
+                law: law(),
+            },
+            Contact {
+                pair: ContactPair::Bodies { left: 1, right: 2 },
+                clearance: 1e-5,
+                law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+            },
+            Contact {
+                pair: ContactPair::RightWall { body: 2 },
+                clearance: 1e-5,
+                law: law(),
+            },
+        ];
+        let model = Model::new(
+            bodies,
+            couplings,
+            contacts,
+            BaseExcitation::None,
+            vec![],
+            vec![],
+            vec![],
+        )
+        .unwrap();
+        let mut sys = ChainDynamics::new(&model, false);
+        // u = (-1e-5, 5e-5, 3e-5): every contact near or in touch.
+        let y = [-1.2e-5, 0.01, 6e-5, -0.02, 1e-5, 0.03];
+        let (kl, ku) = sys.jacobian_bandwidth().unwrap();
+        let mut jac = BandMatrix::new(6, kl, ku);
+        assert!(sys.jacobian(0.0, &y, &mut jac));
+        let mut f0 = [0.0; 6];
+        let mut f1 = [0.0; 6];
+        for j in 0..6 {
+            let h = if j % 2 == 0 { 1e-10 } else { 1e-7 };
+            let mut yp = y;
+            yp[j] += h;
+            sys.rhs(0.0, &yp, &mut f1);
+            let mut ym = y;
+            ym[j] -= h;
+            sys.rhs(0.0, &ym, &mut f0);
+            for i in 0..6 {
+                let fd = (f1[i] - f0[i]) / (2.0 * h);
+                let an = if jac.in_band(i, j) {
+                    jac.get(i, j)
+                } else {
+                    0.0
+                };
+                // Round-off of the differences scales with the row's largest entry.
+                let row = (0..6)
+                    .filter(|&c| jac.in_band(i, c))
+                    .map(|c| jac.get(i, c).abs())
+                    .fold(1.0, f64::max);
+                assert!(
+                    (an - fd).abs() <= 1e-6 * row,
+                    "J[{i}][{j}] = {an} vs {fd} (row scale {row:e})"
+                );
+            }
+        }
     }
 
     /// A skipped contact's force is below 1e-3 ε of the force scale.

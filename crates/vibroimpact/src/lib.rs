@@ -11,7 +11,12 @@
 //!   and by direct integration;
 //! - [`identify`]: identification of a/b and α from measured impacts
 //!   (seed §3);
-//! - [`integrate`]: the ODE integrator shared by every time integration;
+//! - [`model`]: N bodies, springs, contact pairs and excitation (§4);
+//! - [`dynamics`]: the equations of motion with their banded Jacobian;
+//! - [`simulate`]: time histories with an impact log;
+//! - [`variational`]: sensitivities and monodromy matrices (§5);
+//! - [`integrate`]: the integrators (DOP853, RODAS) shared by every time
+//!   integration;
 //! - [`numeric`]: scalar special functions and root finders.
 //!
 //! The library does no I/O: callers hand it numbers and get numbers back.
@@ -24,3 +29,4 @@ pub mod integrate;
 pub mod model;
 pub mod numeric;
 pub mod simulate;
+pub mod variational;

@@ -522,6 +522,15 @@ impl Stepper {
         }
     }
 
+    /// Caps the size of the next step of the active integrator at `h`.
+    pub fn limit_next_step(&mut self, h: f64) {
+        if self.on_rodas {
+            self.ros_mut().limit_next_step(h);
+        } else {
+            self.dop_mut().limit_next_step(h);
+        }
+    }
+
     /// Dense output of the last accepted step, valid in `[t_prev, t]`: 7th
     /// order for DOP853, 3rd order for RODAS.
     ///

@@ -488,6 +488,14 @@ impl Rodas {
         self.h_next
     }
 
+    /// Caps the size of the next step at `h` (> 0); not remembered after it
+    /// (see [`Dop853::limit_next_step`](super::Dop853::limit_next_step)).
+    pub fn limit_next_step(&mut self, h: f64) {
+        if h > 0.0 && h < self.h_next {
+            self.h_next = h;
+        }
+    }
+
     /// Dense output of the last accepted step (3rd order, `rodas.f`'s
     /// `CONTRO`), valid for t in `[t_prev, t]`; writes all components.
     ///
