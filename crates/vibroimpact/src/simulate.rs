@@ -385,7 +385,7 @@ impl StepScan<'_> {
                 self.finish(st, sys, k, te);
             } else if active {
                 self.update_peak(st, sys, k, t0, t1, Some(r0), Some(r1));
-            } else if sd0 > 0.0 && sd1 < 0.0 {
+            } else if g0 <= 0.0 && sd0 > 0.0 && sd1 < 0.0 {
                 // Approach turned to separation inside the step: was s_on
                 // exceeded in between?
                 let tm = brent(
@@ -508,6 +508,15 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
     scan.previous = (0..model.contacts().len())
         .map(|k| contact_end(&sys, k, st.y(), st.dydt()))
         .collect();
+    // Contacts already engaged at the start (s_on < s <= 0) begin an impact
+    // at t = 0.
+    if error.is_none() {
+        for k in 0..model.contacts().len() {
+            if scan.previous[k].0 > scan.trackers[k].s_on {
+                scan.start(&mut st, &mut sys, k, 0.0);
+            }
+        }
+    }
     while error.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
             next_break += 1;
@@ -520,6 +529,18 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         scan.scan(&mut st, &mut sys);
         if let Some(h) = scan.entry_limit(st.h_next()) {
             st.limit_next_step(h);
+        }
+        // Automatic method: free flight is never stiff; leave RODAS as soon
+        // as every contact is open again (the restart costs two evaluations).
+        if opts.method == Method::Auto
+            && st.active() == Method::Rodas
+            && scan.trackers.iter().all(|t| t.active.is_none())
+        {
+            let (t, y) = (st.t(), st.y().to_vec());
+            if let Err(e) = st.reset(&mut sys, t, &y) {
+                error = Some(e);
+                break;
+            }
         }
         if let Some(dt) = opts.output_step {
             loop {
@@ -819,6 +840,96 @@ mod tests {
             }
             assert_eq!(sim.impacts.len(), reference.impacts.len(), "{method:?}");
         }
+    }
+
+    /// A body pressed against a wall for a long time (constant base
+    /// acceleration of 100 m/s² toward it, a strongly damped contact,
+    /// a/b = 0.01 m/s): the contact is a stiff spring-dashpot (α F = 1.3e7
+    /// N/m and F/(a/b) = 1e4 N s/m on 1 kg, eigenvalues -1.5e3 and -8.5e3
+    /// 1/s). RODAS reaches the static equilibrium `a e^{α s} = m a_base` in a
+    /// small fraction of DOP853's steps, and automatic switching finds it.
+    #[test]
+    fn pressed_body_implicit_method_is_efficient() {
+        let law =
+            ContactLaw::exponential_from_ratio(0.01, 1.3e5, 1.0, ForceForm::Published).unwrap();
+        let bodies = vec![Body {
+            name: "b".into(),
+            mass: 1.0,
+            stiffness: 0.0,
+            damping: 0.0,
+        }];
+        let contacts = vec![Contact {
+            pair: ContactPair::RightWall { body: 0 },
+            clearance: 1e-4,
+            law,
+        }];
+        let base = BaseExcitation::Record(
+            crate::model::Accelerogram::new(vec![0.0, 20.0], vec![-100.0, -100.0], 1.0).unwrap(),
+        );
+        let model = Model::new(bodies, vec![], contacts, base, vec![], vec![1e-4], vec![]).unwrap();
+        let run = |method| {
+            let sim = simulate(
+                &model,
+                &SimulationOptions {
+                    t_end: 10.0,
+                    rtol: 1e-8,
+                    atol: 1e-12,
+                    method,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            assert!(sim.error.is_none(), "{method:?}: {:?}", sim.error);
+            sim
+        };
+        let s_eq = 1e-4 + (100.0f64).ln() / 1.3e5;
+        let (dop, ros, auto) = (run(Method::Dop853), run(Method::Rodas), run(Method::Auto));
+        for sim in [&dop, &ros, &auto] {
+            assert_eq!(
+                sim.impacts.len(),
+                1,
+                "one impact, engaged from the start: {:?}",
+                &sim.impacts[..2.min(sim.impacts.len())]
+            );
+            assert_eq!(sim.impacts[0].start_time, 0.0);
+            assert!(
+                (sim.final_displacement[0] - s_eq).abs() < 1e-9,
+                "{} vs {s_eq}",
+                sim.final_displacement[0]
+            );
+        }
+        assert!(
+            ros.stats.steps * 20 < dop.stats.steps,
+            "RODAS {} vs DOP853 {} steps",
+            ros.stats.steps,
+            dop.stats.steps
+        );
+        assert!(
+            auto.stats.steps * 5 < dop.stats.steps,
+            "auto {} vs DOP853 {} steps",
+            auto.stats.steps,
+            dop.stats.steps
+        );
+    }
+
+    /// An integration that cannot finish keeps what it computed and says
+    /// where it stopped.
+    #[test]
+    fn failure_keeps_partial_results() {
+        let omega = 0.95 * W0;
+        let model = r2(3, 1e-3, omega);
+        let opts = SimulationOptions {
+            t_end: 5.0,
+            max_steps: 300,
+            output_step: Some(0.01),
+            ..Default::default()
+        };
+        let sim = simulate(&model, &opts).unwrap();
+        let err = sim.error.as_ref().expect("must stop early");
+        assert!(sim.final_time > 0.0 && sim.final_time < 5.0);
+        assert!(!sim.times.is_empty() && *sim.times.last().unwrap() <= sim.final_time);
+        assert!(err.contact.is_some());
+        assert!(err.to_string().contains("deepest contact"), "{err}");
     }
 
     /// Energy balance: W = ΔE + D_c + D_k to the integrator's tolerance, in
