@@ -28,5 +28,6 @@ pub mod impact;
 pub mod integrate;
 pub mod model;
 pub mod numeric;
+pub mod periodic;
 pub mod simulate;
 pub mod variational;

@@ -53,6 +53,11 @@ pub struct SimulationOptions {
     pub energy: bool,
     /// Step budget.
     pub max_steps: u64,
+    /// Start from this state, `[u_1..u_N, v_1..v_N]`, instead of the model's
+    /// initial state (a state on a trajectory, e.g. of a periodic orbit:
+    /// contacts may be engaged; the overlap check of model files does not
+    /// apply).
+    pub start: Option<Vec<f64>>,
     /// Integration method: DOP853 (default), RODAS (implicit, for bodies
     /// pressed together for long times), or automatic switching on a
     /// stiffness test.
@@ -69,6 +74,7 @@ impl Default for SimulationOptions {
             impact_force_threshold: 1e-3,
             energy: false,
             max_steps: 50_000_000,
+            start: None,
             method: Method::Dop853,
         }
     }
@@ -454,7 +460,21 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
     let mut sys = ChainDynamics::new(model, opts.energy);
-    let y0 = sys.initial_state(model);
+    let mut y0 = sys.initial_state(model);
+    if let Some(start) = &opts.start {
+        let n = model.bodies().len();
+        if start.len() != 2 * n || start.iter().any(|x| !x.is_finite()) {
+            return Err(OptionsError(format!(
+                "start state: needs {} finite values, got {}",
+                2 * n,
+                start.len()
+            )));
+        }
+        for i in 0..n {
+            y0[2 * i] = start[i];
+            y0[2 * i + 1] = start[n + i];
+        }
+    }
     let n2 = sys.state_dim();
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,

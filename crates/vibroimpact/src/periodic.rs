@@ -1,0 +1,553 @@
+//! Periodic solutions by shooting and their Floquet stability (THEORY.md §5;
+//! the seed's parts I–II).
+//!
+//! Under forcing of period `T = 2π/Ω`, a periodic solution of period `nT`
+//! (n = 1 harmonic, n > 1 subharmonic) is a fixed point of the period map
+//! `P(x) = φ(nT; x)` (forcing phase 0 at t = 0). Newton's method on
+//! `G(x) = P(x) - x` uses the monodromy matrix `Φ = ∂P/∂x` from the
+//! variational equations integrated with the orbit ([`Variational`]), not
+//! finite differences:
+//!
+//! ```text
+//! (Φ(x_k) - I) Δ = -(P(x_k) - x_k),   x_{k+1} = x_k + λ Δ
+//! ```
+//!
+//! with a backtracking λ ∈ {1, ½, ¼, …} when the residual does not decrease.
+//! Convergence: `‖P(x) - x‖ <= tol` in the scaled max norm (displacements
+//! over the displacement scale, velocities over the velocity scale; see
+//! [`ShootingOptions`]). The Floquet multipliers are the eigenvalues of
+//! `Φ(nT)` at the solution (Schur decomposition); the orbit is
+//! asymptotically stable when all have modulus < 1.
+//!
+//! States are in body order, `[u_1..u_N, v_1..v_N]`; Φ is returned in the
+//! same order (the integration itself uses the interleaved layout of
+//! [`ChainDynamics`]).
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use crate::dynamics::ChainDynamics;
+use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions};
+use crate::model::Model;
+use crate::simulate::{simulate, OptionsError, SimulationOptions};
+use crate::variational::Variational;
+
+/// Largest Newton step in the scaled norm (displacement scales).
+const TRUST: f64 = 0.5;
+/// Step budget of one period-map integration.
+const MAX_STEPS: u64 = 200_000;
+
+/// Options of the shooting method.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShootingOptions {
+    /// Period multiple n (1 harmonic, 2 period-doubled, …).
+    pub subharmonic: u32,
+    /// Integration tolerance (relative; absolute = rtol × scale).
+    pub rtol: f64,
+    /// Newton tolerance on the scaled residual.
+    pub tol: f64,
+    /// Newton iterations at most.
+    pub max_iterations: usize,
+    /// Displacement scale (m) of the scaled norm; velocity scale = this × Ω.
+    pub displacement_scale: f64,
+}
+
+impl Default for ShootingOptions {
+    fn default() -> Self {
+        Self {
+            subharmonic: 1,
+            rtol: 1e-10,
+            tol: 1e-9,
+            max_iterations: 30,
+            displacement_scale: 1e-3,
+        }
+    }
+}
+
+/// Why shooting could not run.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PeriodicError {
+    /// The model has no single periodic forcing.
+    #[error("the model has no periodic forcing with one frequency (harmonic base or harmonic forces), so it has no periodic solutions of a forcing period")]
+    NoPeriodicForcing,
+    /// The start state has the wrong size.
+    #[error("initial state: needs {expected} values (u then v), got {got}")]
+    BadState {
+        /// Values expected.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+    /// The integration of the period map failed.
+    #[error("integrating the period map from the state at Newton iteration {iteration}: {source}")]
+    Integration {
+        /// Newton iteration.
+        iteration: usize,
+        /// The integrator's error.
+        #[source]
+        source: IntegrationError,
+    },
+    /// Invalid options.
+    #[error("{0}")]
+    Options(String),
+}
+
+/// The period map and its Jacobian at one state.
+#[derive(Clone, Debug)]
+pub struct PeriodMap {
+    /// `P(x)`, body order.
+    pub image: Vec<f64>,
+    /// Monodromy `Φ = ∂P/∂x`, body order.
+    pub monodromy: DMatrix<f64>,
+}
+
+/// Result of shooting.
+#[derive(Clone, Debug)]
+pub struct PeriodicSolution {
+    /// Whether Newton converged.
+    pub converged: bool,
+    /// Period nT (s).
+    pub period: f64,
+    /// The state at t = 0 (body order); the last iterate if not converged.
+    pub initial_state: Vec<f64>,
+    /// Scaled residual ‖P(x) - x‖ of every iterate.
+    pub residual_history: Vec<f64>,
+    /// Monodromy matrix at the solution (body order).
+    pub monodromy: DMatrix<f64>,
+    /// Floquet multipliers, largest modulus first.
+    pub multipliers: Vec<Complex<f64>>,
+}
+
+impl PeriodicSolution {
+    /// Largest |multiplier|.
+    pub fn spectral_radius(&self) -> f64 {
+        self.multipliers.first().map_or(0.0, |m| m.norm())
+    }
+    /// Asymptotically stable: every multiplier inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.spectral_radius() < 1.0
+    }
+}
+
+/// Forcing period T of the model (error if not periodically forced).
+pub fn forcing_period(model: &Model) -> Result<f64, PeriodicError> {
+    model
+        .forcing_frequency()
+        .map(|w| 2.0 * std::f64::consts::PI / w)
+        .ok_or(PeriodicError::NoPeriodicForcing)
+}
+
+/// Scales of the scaled norm: displacement scale for u, × Ω for v.
+fn scales(model: &Model, opts: &ShootingOptions) -> Vec<f64> {
+    let n = model.bodies().len();
+    let w = model.forcing_frequency().unwrap_or(1.0);
+    (0..2 * n)
+        .map(|i| {
+            if i < n {
+                opts.displacement_scale
+            } else {
+                opts.displacement_scale * w
+            }
+        })
+        .collect()
+}
+
+/// Evaluates the period map and its monodromy at `x` (body order).
+pub fn period_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+) -> Result<PeriodMap, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let t = forcing_period(model).unwrap_or(f64::NAN) * f64::from(opts.subharmonic.max(1));
+    let sys = ChainDynamics::new(model, false);
+    let mut var = Variational::new(sys, d);
+    let mut y0 = vec![0.0; d];
+    for i in 0..n {
+        y0[2 * i] = x[i];
+        y0[2 * i + 1] = x[n + i];
+    }
+    let z0 = var.initial_state(&y0);
+    let int_opts = IntegratorOptions {
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps: MAX_STEPS,
+        ..IntegratorOptions::default()
+    };
+    let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+    // Interleaved index of body-order component k.
+    let inter = |k: usize| if k < n { 2 * k } else { 2 * (k - n) + 1 };
+    let image = (0..d).map(|k| z[inter(k)]).collect();
+    let phi = var.sensitivity(&z);
+    let monodromy = DMatrix::from_fn(d, d, |r, c| phi[inter(c) * d + inter(r)]);
+    Ok(PeriodMap { image, monodromy })
+}
+
+/// Floquet multipliers (eigenvalues of the monodromy), largest modulus first.
+pub fn floquet_multipliers(monodromy: &DMatrix<f64>) -> Vec<Complex<f64>> {
+    let mut mu: Vec<Complex<f64>> = monodromy.complex_eigenvalues().iter().copied().collect();
+    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+    mu
+}
+
+fn scaled_norm(r: &[f64], scale: &[f64]) -> f64 {
+    r.iter()
+        .zip(scale)
+        .map(|(x, s)| (x / s).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Finds a periodic solution of period nT near `guess` (body order) by
+/// Newton's method on the period map.
+pub fn shoot(
+    model: &Model,
+    guess: &[f64],
+    opts: &ShootingOptions,
+) -> Result<PeriodicSolution, PeriodicError> {
+    let period = forcing_period(model)? * f64::from(opts.subharmonic.max(1));
+    let d = 2 * model.bodies().len();
+    if guess.len() != d {
+        return Err(PeriodicError::BadState {
+            expected: d,
+            got: guess.len(),
+        });
+    }
+    if !(opts.rtol > 0.0 && opts.tol > 0.0 && opts.displacement_scale > 0.0) {
+        return Err(PeriodicError::Options(
+            "shooting: rtol, tol and displacement scale must be > 0".into(),
+        ));
+    }
+    let scale = scales(model, opts);
+    let mut x = guess.to_vec();
+    let mut history = Vec::new();
+    let eval = |x: &[f64], iteration: usize| {
+        period_map(model, x, opts)
+            .map_err(|source| PeriodicError::Integration { iteration, source })
+    };
+    let mut map = eval(&x, 0)?;
+    let residual = |map: &PeriodMap, x: &[f64]| -> Vec<f64> {
+        map.image.iter().zip(x).map(|(p, x)| p - x).collect()
+    };
+    let mut r = residual(&map, &x);
+    let mut norm = scaled_norm(&r, &scale);
+    history.push(norm);
+    let mut converged = norm <= opts.tol;
+    let mut iteration = 0;
+    while !converged && iteration < opts.max_iterations {
+        iteration += 1;
+        let a = &map.monodromy - DMatrix::<f64>::identity(d, d);
+        let Some(delta) = a
+            .lu()
+            .solve(&DVector::from_iterator(d, r.iter().map(|v| -v)))
+        else {
+            break; // singular Newton matrix (a multiplier at +1): report non-convergence
+        };
+        // Trust region: at most half a displacement scale per iteration (a
+        // full Newton step can land deep inside a contact, where e^{αs}
+        // makes the period map astronomically stiff).
+        let step = scaled_norm(delta.as_slice(), &scale);
+        let mut lambda = (TRUST / step).min(1.0);
+        let mut accepted = false;
+        for _ in 0..12 {
+            let trial: Vec<f64> = x
+                .iter()
+                .zip(delta.iter())
+                .map(|(x, dx)| x + lambda * dx)
+                .collect();
+            let trial_map = match eval(&trial, iteration) {
+                Ok(m) => m,
+                Err(_) if lambda > 1e-3 => {
+                    lambda *= 0.5;
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
+            let tr = residual(&trial_map, &trial);
+            let tn = scaled_norm(&tr, &scale);
+            if tn < norm || tn <= opts.tol {
+                x = trial;
+                map = trial_map;
+                r = tr;
+                norm = tn;
+                accepted = true;
+                break;
+            }
+            lambda *= 0.5;
+        }
+        history.push(norm);
+        if !accepted {
+            break;
+        }
+        converged = norm <= opts.tol;
+    }
+    let multipliers = floquet_multipliers(&map.monodromy);
+    Ok(PeriodicSolution {
+        converged,
+        period,
+        initial_state: x,
+        residual_history: history,
+        monodromy: map.monodromy,
+        multipliers,
+    })
+}
+
+/// A start guess by simulation: the state after `periods` forcing periods
+/// from the model's initial state.
+pub fn guess_by_simulation(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+) -> Result<Vec<f64>, PeriodicError> {
+    let t = forcing_period(model)?;
+    let opts = SimulationOptions {
+        t_end: periods * t,
+        rtol,
+        atol: rtol * 1e-4,
+        ..SimulationOptions::default()
+    };
+    let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;
+    if let Some(e) = sim.error {
+        return Err(PeriodicError::Integration {
+            iteration: 0,
+            source: e.source,
+        });
+    }
+    Ok(sim
+        .final_displacement
+        .iter()
+        .chain(&sim.final_velocity)
+        .copied()
+        .collect())
+}
+
+/// Impacts of one contact over one period of an orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactImpacts {
+    /// Contact index.
+    pub contact: usize,
+    /// Impact velocities (m/s) of the impacts starting within the period.
+    pub impact_velocities: Vec<f64>,
+    /// Their peak forces (N).
+    pub peak_forces: Vec<f64>,
+}
+
+/// Amplitudes and impacts of a periodic orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitSummary {
+    /// max |u_i| over the period, body order (m).
+    pub max_displacement: Vec<f64>,
+    /// max |v_i| over the period (m/s).
+    pub max_velocity: Vec<f64>,
+    /// Impacts per period per contact.
+    pub impacts: Vec<ContactImpacts>,
+    /// Sampled orbit over one period: times and states (body order).
+    pub times: Vec<f64>,
+    /// States at `times`, `[u.., v..]` each.
+    pub states: Vec<f64>,
+}
+
+impl OrbitSummary {
+    /// Total impacts per period.
+    pub fn impacts_per_period(&self) -> usize {
+        self.impacts.iter().map(|c| c.impact_velocities.len()).sum()
+    }
+}
+
+/// Integrates two periods from a periodic state and summarises the second
+/// (impacts are those that start in it, so an impact in progress at t = 0
+/// is counted once, with its true impact velocity). `samples` points per
+/// period are kept for plots and amplitudes; the amplitudes also include the
+/// exact extrema located as impact-free samples allow (use ≥ 200 samples).
+pub fn orbit_summary(
+    model: &Model,
+    state: &[f64],
+    period: f64,
+    samples: usize,
+    rtol: f64,
+) -> Result<OrbitSummary, PeriodicError> {
+    let n = model.bodies().len();
+    let opts = SimulationOptions {
+        t_end: 2.0 * period,
+        rtol,
+        atol: rtol * 1e-4,
+        output_step: Some(period / samples.max(10) as f64),
+        start: Some(state.to_vec()),
+        ..SimulationOptions::default()
+    };
+    let sim = simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))?;
+    if let Some(e) = sim.error {
+        return Err(PeriodicError::Integration {
+            iteration: 0,
+            source: e.source,
+        });
+    }
+    let mut max_u = vec![0.0f64; n];
+    let mut max_v = vec![0.0f64; n];
+    let mut times = Vec::new();
+    let mut states = Vec::new();
+    for (j, &t) in sim.times.iter().enumerate() {
+        if t < period * (1.0 - 1e-12) {
+            continue;
+        }
+        let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
+        for i in 0..n {
+            max_u[i] = max_u[i].max(row[i].abs());
+            max_v[i] = max_v[i].max(row[n + i].abs());
+        }
+        times.push(t - period);
+        states.extend_from_slice(row);
+    }
+    let impacts = (0..model.contacts().len())
+        .map(|k| {
+            let list: Vec<_> = sim
+                .impacts
+                .iter()
+                .filter(|i| i.contact == k && i.start_time >= period && i.start_time < 2.0 * period)
+                .collect();
+            ContactImpacts {
+                contact: k,
+                impact_velocities: list.iter().map(|i| i.impact_velocity).collect(),
+                peak_forces: list.iter().map(|i| i.peak_force).collect(),
+            }
+        })
+        .collect();
+    Ok(OrbitSummary {
+        max_displacement: max_u,
+        max_velocity: max_v,
+        impacts,
+        times,
+        states,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{ContactLaw, ForceForm};
+    use crate::model::BaseExcitation;
+
+    const M: f64 = 0.227;
+    const W0: f64 = 7.41;
+    const ZETA: f64 = 0.013;
+
+    fn r2(n: usize, clearance: f64, omega: f64) -> Model {
+        let law =
+            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.05,
+            frequency: omega,
+            phase: 0.0,
+        };
+        Model::row(
+            n,
+            M,
+            M * W0 * W0,
+            2.0 * ZETA * M * W0,
+            clearance,
+            law,
+            (true, true),
+            base,
+        )
+        .unwrap()
+    }
+
+    /// R3: the periodic solution is the exact steady state to 1e-10 and the
+    /// multipliers are exp(λT), λ = -ζω0 ± iω0 sqrt(1 - ζ²), to 1e-10.
+    #[test]
+    fn r3_linear_limit_is_exact() {
+        let omega = 0.95 * W0;
+        let model = r2(2, 1e3, omega);
+        let sol = shoot(
+            &model,
+            &[0.0; 4],
+            &ShootingOptions {
+                rtol: 1e-12,
+                tol: 1e-12,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(sol.converged, "{:?}", sol.residual_history);
+        let a = 0.05;
+        let d = (W0 * W0 - omega * omega).powi(2) + (2.0 * ZETA * W0 * omega).powi(2);
+        let (b1, b2) = (
+            -a * (W0 * W0 - omega * omega) / d,
+            a * 2.0 * ZETA * W0 * omega / d,
+        );
+        // Steady state u = b1 sin Ωt + b2 cos Ωt at t = 0: u = b2, v = b1 Ω.
+        let amp = (b1 * b1 + b2 * b2).sqrt();
+        for i in 0..2 {
+            assert!(
+                (sol.initial_state[i] - b2).abs() < 1e-10 * amp,
+                "u {} vs {b2}",
+                sol.initial_state[i]
+            );
+            assert!((sol.initial_state[2 + i] - b1 * omega).abs() < 1e-10 * amp * omega);
+        }
+        let t = sol.period;
+        let wd = W0 * (1.0 - ZETA * ZETA).sqrt();
+        let modulus = (-ZETA * W0 * t).exp();
+        let exact = Complex::new(modulus * (wd * t).cos(), modulus * (wd * t).sin());
+        assert_eq!(sol.multipliers.len(), 4);
+        for mu in &sol.multipliers {
+            let err = (mu - exact).norm().min((mu - exact.conj()).norm());
+            assert!(err < 1e-10, "multiplier {mu} vs {exact}");
+        }
+        assert!(sol.stable());
+        let orbit = orbit_summary(&model, &sol.initial_state, t, 400, 1e-12).unwrap();
+        assert!(
+            (orbit.max_displacement[0] / amp - 1.0).abs() < 1e-4,
+            "sampled amplitude"
+        );
+        assert_eq!(orbit.impacts_per_period(), 0);
+    }
+
+    /// An impacting orbit of R2 (N = 2): converges from a simulated guess,
+    /// is a fixed point of the period map to the tolerance, and its
+    /// monodromy agrees with finite differences of the period map.
+    #[test]
+    fn impacting_orbit_converges_and_monodromy_matches_differences() {
+        let model = r2(2, 1e-3, 0.7 * W0);
+        let guess = guess_by_simulation(&model, 100.0, 1e-9).unwrap();
+        let opts = ShootingOptions::default();
+        let sol = shoot(&model, &guess, &opts).unwrap();
+        assert!(sol.converged, "{:?}", sol.residual_history);
+        let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 400, 1e-10).unwrap();
+        assert!(orbit.impacts_per_period() > 0, "an impacting orbit");
+        let x = &sol.initial_state;
+        for j in 0..4 {
+            let h = if j < 2 { 1e-8 } else { 1e-7 };
+            let mut xp = x.clone();
+            xp[j] += h;
+            let mut xm = x.clone();
+            xm[j] -= h;
+            let p = period_map(&model, &xp, &opts).unwrap().image;
+            let m = period_map(&model, &xm, &opts).unwrap().image;
+            let col_scale = (0..4)
+                .map(|i| sol.monodromy[(i, j)].abs())
+                .fold(1.0, f64::max);
+            for i in 0..4 {
+                let fd = (p[i] - m[i]) / (2.0 * h);
+                assert!(
+                    (sol.monodromy[(i, j)] - fd).abs() < 1e-5 * col_scale,
+                    "Φ[{i}][{j}] {} vs {fd}",
+                    sol.monodromy[(i, j)]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn errors() {
+        let model = r2(2, 1e-3, 7.0).with_base(BaseExcitation::None);
+        assert!(matches!(
+            shoot(&model, &[0.0; 4], &ShootingOptions::default()),
+            Err(PeriodicError::NoPeriodicForcing)
+        ));
+        let model = r2(2, 1e-3, 7.0);
+        assert!(matches!(
+            shoot(&model, &[0.0; 3], &ShootingOptions::default()),
+            Err(PeriodicError::BadState { .. })
+        ));
+    }
+}
