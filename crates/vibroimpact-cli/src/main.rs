@@ -3,6 +3,7 @@
 //! Without arguments it runs the built-in default study and writes its
 //! report (see [`report`]); subcommands expose the library's computations.
 
+mod branch_cmd;
 mod data;
 mod error;
 mod format;
@@ -10,9 +11,11 @@ mod identify_cmd;
 mod impact_cmd;
 mod model_file;
 mod output;
+mod parameter;
 mod plot;
 mod report;
 mod simulate_cmd;
+mod sweep_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,6 +44,16 @@ enum Command {
     /// Simulate a model file: time history, impact log, summary and plots.
     #[command(allow_negative_numbers = true)]
     Simulate(simulate_cmd::SimulateArgs),
+    /// Brute-force bifurcation diagram: Poincaré samples against a parameter.
+    #[command(allow_negative_numbers = true)]
+    Sweep(sweep_cmd::SweepArgs),
+    /// Find a periodic solution by shooting, with its Floquet multipliers.
+    #[command(allow_negative_numbers = true)]
+    Periodic(branch_cmd::PeriodicArgs),
+    /// Continue a branch of periodic solutions in a parameter (folds, branch
+    /// points, period doublings, torus and grazing points).
+    #[command(allow_negative_numbers = true)]
+    Continue(branch_cmd::ContinueArgs),
     /// Run the default study and write its report (same as no subcommand).
     Report {
         /// Report folder.
@@ -55,6 +68,9 @@ fn main() -> ExitCode {
         Some(Command::Impact(args)) => impact_cmd::run(args),
         Some(Command::Identify(args)) => identify_cmd::run(args),
         Some(Command::Simulate(args)) => simulate_cmd::run(args),
+        Some(Command::Periodic(args)) => branch_cmd::run_periodic(args),
+        Some(Command::Continue(args)) => branch_cmd::run_continue(args),
+        Some(Command::Sweep(args)) => sweep_cmd::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

@@ -22,6 +22,7 @@
 //! The library does no I/O: callers hand it numbers and get numbers back.
 
 pub mod contact;
+pub mod continuation;
 pub mod dynamics;
 pub mod identify;
 pub mod impact;

@@ -1,0 +1,624 @@
+//! `vibroimpact periodic` (one periodic solution by shooting, with Floquet
+//! stability) and `vibroimpact continue` (a branch of them by
+//! pseudo-arclength continuation, with special points).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use clap::Args;
+use serde::Serialize;
+use serde_json::json;
+use vibroimpact::continuation::{
+    branch_switch_start, continue_branch, period_doubled_start, Branch, ContinuationOptions,
+    SpecialKind,
+};
+use vibroimpact::model::Model;
+use vibroimpact::periodic::{guess_by_simulation, orbit_summary, shoot, ShootingOptions};
+
+use crate::error::CliError;
+use crate::format::{csv_text, Format};
+use crate::model_file::read_model;
+use crate::output::{ensure_dir, write_atomic};
+use crate::parameter::ParameterizedModel;
+use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+
+/// Options of `vibroimpact periodic`.
+#[derive(Args, Debug)]
+pub struct PeriodicArgs {
+    /// Model file (TOML).
+    model: PathBuf,
+    /// Period multiple n: look for a solution of period n T.
+    #[arg(long, default_value_t = 1)]
+    subharmonic: u32,
+    /// Start guess: `simulate` (the state after --guess-periods periods from
+    /// the model's initial state) or a JSON file with `initial_state`
+    /// (e.g. an earlier output).
+    #[arg(long, default_value = "simulate")]
+    guess: String,
+    /// Periods simulated for the guess.
+    #[arg(long, default_value_t = 200.0)]
+    guess_periods: f64,
+    /// Integration tolerance of the period map.
+    #[arg(long, default_value_t = 1e-10)]
+    rtol: f64,
+    /// Newton tolerance (scaled residual).
+    #[arg(long, default_value_t = 1e-9)]
+    tol: f64,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Output folder: orbit.csv, summary.json, orbit figures.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Impacts of one contact per period.
+#[derive(Serialize, Debug)]
+struct ContactImpactsJson {
+    contact: String,
+    count: usize,
+    impact_velocities: Vec<f64>,
+    peak_forces: Vec<f64>,
+}
+
+fn read_guess(spec: &str, model: &Model, periods: f64, rtol: f64) -> Result<Vec<f64>, CliError> {
+    if spec == "simulate" {
+        return guess_by_simulation(model, periods, rtol.max(1e-9))
+            .map_err(|e| CliError::new(format!("guess by simulation: {e}")));
+    }
+    let text = std::fs::read_to_string(spec)
+        .map_err(|e| CliError::new(format!("{spec}: cannot read the guess: {e}")))?;
+    let doc: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| CliError::new(format!("{spec}: not JSON: {e}")))?;
+    let state: Vec<f64> = doc["initial_state"]
+        .as_array()
+        .ok_or_else(|| CliError::new(format!("{spec}: no `initial_state` array")))?
+        .iter()
+        .map(|v| {
+            v.as_f64()
+                .ok_or_else(|| CliError::new(format!("{spec}: `initial_state` must hold numbers")))
+        })
+        .collect::<Result<_, _>>()?;
+    let d = 2 * model.bodies().len();
+    if state.len() != d {
+        return Err(CliError::new(format!(
+            "{spec}: `initial_state` has {} values, the model needs {d} (u then v)",
+            state.len()
+        )));
+    }
+    Ok(state)
+}
+
+/// Runs `vibroimpact periodic`.
+pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
+    let model = read_model(&args.model)?.model;
+    if model.forcing_frequency().is_none() {
+        return Err(CliError::new(format!(
+            "{}: the model has no periodic forcing with one frequency, so it has no periodic solutions",
+            args.model.display()
+        )));
+    }
+    if args.subharmonic == 0 {
+        return Err(CliError::new("--subharmonic must be >= 1"));
+    }
+    let guess = read_guess(&args.guess, &model, args.guess_periods, args.rtol)?;
+    let opts = ShootingOptions {
+        subharmonic: args.subharmonic,
+        rtol: args.rtol,
+        tol: args.tol,
+        ..ShootingOptions::default()
+    };
+    let sol = shoot(&model, &guess, &opts).map_err(|e| CliError::new(e.to_string()))?;
+    let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)
+        .map_err(|e| CliError::new(e.to_string()))?;
+    let impacts: Vec<ContactImpactsJson> = orbit
+        .impacts
+        .iter()
+        .map(|c| ContactImpactsJson {
+            contact: model.contact_name(c.contact),
+            count: c.impact_velocities.len(),
+            impact_velocities: c.impact_velocities.clone(),
+            peak_forces: c.peak_forces.clone(),
+        })
+        .collect();
+    let doc = json!({
+        "converged": sol.converged,
+        "period": sol.period,
+        "subharmonic": args.subharmonic,
+        "initial_state": sol.initial_state,
+        "residual_history": sol.residual_history,
+        "floquet_multipliers": sol.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "spectral_radius": sol.spectral_radius(),
+        "stable": sol.stable(),
+        "max_displacement": orbit.max_displacement,
+        "max_velocity": orbit.max_velocity,
+        "impacts_per_period": orbit.impacts_per_period(),
+        "impacts": impacts,
+    });
+    if let Some(dir) = &args.out {
+        ensure_dir(dir)?;
+        let n = model.bodies().len();
+        let mut cols = vec!["t".to_string()];
+        cols.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
+        cols.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+        let rows: Vec<Vec<Option<f64>>> = orbit
+            .times
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| {
+                std::iter::once(Some(t))
+                    .chain(
+                        orbit.states[j * 2 * n..(j + 1) * 2 * n]
+                            .iter()
+                            .map(|&x| Some(x)),
+                    )
+                    .collect()
+            })
+            .collect();
+        let c: Vec<&str> = cols.iter().map(String::as_str).collect();
+        write_atomic(&dir.join("orbit.csv"), csv_text(&c, &rows)?.as_bytes())?;
+        write_atomic(
+            &dir.join("summary.json"),
+            serde_json::to_string_pretty(&doc)?.as_bytes(),
+        )?;
+        let mut fig = Figure::new(
+            "Periodic orbit",
+            "time over one period  [s]",
+            "displacement u  [mm]",
+        )
+        .legend_at(LegendPosition::Best);
+        let mut phase = Figure::new(
+            "Periodic orbit in the phase plane",
+            "displacement u  [mm]",
+            "velocity v  [m/s]",
+        )
+        .legend_at(LegendPosition::Best);
+        for i in 0..n.min(8) {
+            let name = &model.bodies()[i].name;
+            fig.push(Series::line(
+                format!("u_{name}"),
+                orbit
+                    .times
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &t)| (t, 1e3 * orbit.states[j * 2 * n + i])),
+            ));
+            phase.push(Series::line(
+                name.clone(),
+                (0..orbit.times.len()).map(|j| {
+                    (
+                        1e3 * orbit.states[j * 2 * n + i],
+                        orbit.states[j * 2 * n + n + i],
+                    )
+                }),
+            ));
+        }
+        render(&fig, &dir.join("orbit"))?;
+        render(&phase, &dir.join("orbit_phase"))?;
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        _ => {
+            println!(
+                "{}: period {:.6} s, residual {:.2e} after {} iterations",
+                if sol.converged {
+                    "converged"
+                } else {
+                    "NOT CONVERGED"
+                },
+                sol.period,
+                sol.residual_history.last().copied().unwrap_or(f64::NAN),
+                sol.residual_history.len() - 1
+            );
+            println!(
+                "{} (largest |multiplier| {:.6})",
+                if sol.stable() { "stable" } else { "unstable" },
+                sol.spectral_radius()
+            );
+            for m in &sol.multipliers {
+                println!("  multiplier {:+.6} {:+.6}i  |{:.6}|", m.re, m.im, m.norm());
+            }
+            for (i, b) in model.bodies().iter().enumerate() {
+                println!(
+                    "  {}: max|u| {:.6e} m, max|v| {:.6e} m/s",
+                    b.name, orbit.max_displacement[i], orbit.max_velocity[i]
+                );
+            }
+            println!("  impacts per period: {}", orbit.impacts_per_period());
+        }
+    }
+    if sol.converged {
+        Ok(())
+    } else {
+        Err(CliError::new(format!(
+            "Newton did not converge (residual history {:?})",
+            sol.residual_history
+                .iter()
+                .map(|r| format!("{r:.2e}"))
+                .collect::<Vec<_>>()
+        )))
+    }
+}
+
+/// Options of `vibroimpact continue`.
+#[derive(Args, Debug)]
+pub struct ContinueArgs {
+    /// Model file (TOML).
+    model: PathBuf,
+    /// The parameter: frequency, amplitude, or a dotted numeric key (row.clearance, body.1.mass, …).
+    #[arg(long)]
+    parameter: String,
+    /// Start value (the branch starts from a simulated guess there).
+    #[arg(long)]
+    from: f64,
+    /// End value.
+    #[arg(long)]
+    to: f64,
+    /// Period multiple n of the branch.
+    #[arg(long, default_value_t = 1)]
+    subharmonic: u32,
+    /// After computing the branch, switch at this special point (e.g. BP1,
+    /// PD1) and continue the crossing or period-doubled branch to --to.
+    #[arg(long)]
+    switch_at: Option<String>,
+    /// Points at most (per branch).
+    #[arg(long, default_value_t = 1500)]
+    max_points: usize,
+    /// Largest arclength step (scaled units).
+    #[arg(long, default_value_t = 0.05)]
+    ds_max: f64,
+    /// Periods simulated for the start guess.
+    #[arg(long, default_value_t = 200.0)]
+    guess_periods: f64,
+    /// Output folder: branch.csv, special_points.json, summary.json, figure.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// JSON of a branch (`points`, `special_points`).
+pub fn branch_json(branch: &Branch, model: &Model, name: &str) -> serde_json::Value {
+    json!({
+        "parameter_name": name,
+        "subharmonic": branch.subharmonic,
+        "stop": format!("{:?}", branch.stop),
+        "contacts": (0..model.contacts().len()).map(|k| model.contact_name(k)).collect::<Vec<_>>(),
+        "points": branch.points.iter().map(|p| json!({
+            "parameter": p.parameter,
+            "max_displacement": p.max_displacement,
+            "max_velocity": p.max_velocity,
+            "impacts_per_period": p.impacts_per_period,
+            "stable": p.stable,
+            "spectral_radius": p.spectral_radius(),
+            "floquet_multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+            "initial_state": p.state,
+            "label": p.label,
+        })).collect::<Vec<_>>(),
+        "special_points": branch.special.iter().map(|s| json!({
+            "kind": s.kind.name(),
+            "label": s.label,
+            "parameter": s.parameter,
+            "floquet_multipliers": s.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+            "initial_state": s.state,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// CSV of a branch.
+pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
+    let n = model.bodies().len();
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["parameter".to_string()];
+    header.extend(model.bodies().iter().map(|b| format!("max_u_{}", b.name)));
+    header.extend(model.bodies().iter().map(|b| format!("max_v_{}", b.name)));
+    header.extend(
+        [
+            "impacts_per_period",
+            "largest_multiplier_modulus",
+            "stable",
+            "label",
+        ]
+        .map(String::from),
+    );
+    let err = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
+    w.write_record(&header).map_err(err)?;
+    for p in &branch.points {
+        let mut row = vec![format!("{:e}", p.parameter)];
+        row.extend((0..n).map(|i| format!("{:e}", p.max_displacement[i])));
+        row.extend((0..n).map(|i| format!("{:e}", p.max_velocity[i])));
+        row.push(p.impacts_per_period.to_string());
+        row.push(format!("{:e}", p.spectral_radius()));
+        row.push(p.stable.to_string());
+        row.push(p.label.clone().unwrap_or_default());
+        w.write_record(&row).map_err(err)?;
+    }
+    String::from_utf8(w.into_inner().map_err(|e| CliError::new(e.to_string()))?)
+        .map_err(|e| CliError::new(e.to_string()))
+}
+
+/// Frequency-response figure: max |u| of the first body against the
+/// parameter, stable solid, unstable dashed, special points marked.
+pub fn branch_figure(
+    branches: &[(&Branch, &str)],
+    title: &str,
+    x_label: &str,
+    x_scale: f64,
+    body: usize,
+) -> Figure {
+    let mut fig = Figure::new(title, x_label, "max |u| over the period  [mm]")
+        .legend_at(LegendPosition::Best);
+    for (bi, (branch, name)) in branches.iter().enumerate() {
+        let color = 2 * bi;
+        let mut start = 0;
+        let pts = &branch.points;
+        let (mut stable_labelled, mut unstable_labelled) = (false, false);
+        while start < pts.len() {
+            let stable = pts[start].stable;
+            let mut end = start + 1;
+            while end < pts.len() && pts[end].stable == stable {
+                end += 1;
+            }
+            let seg: Vec<(f64, f64)> = pts[start..(end + 1).min(pts.len())]
+                .iter()
+                .map(|p| (p.parameter * x_scale, 1e3 * p.max_displacement[body]))
+                .collect();
+            let label = match (stable, stable_labelled, unstable_labelled) {
+                (true, false, _) => {
+                    stable_labelled = true;
+                    format!("{name}, stable")
+                }
+                (false, _, false) => {
+                    unstable_labelled = true;
+                    format!("{name}, unstable")
+                }
+                _ => String::new(),
+            };
+            fig.push(
+                if stable {
+                    Series::line(label, seg)
+                } else {
+                    Series::dashed(label, seg)
+                }
+                .with_color(color),
+            );
+            start = end;
+        }
+        for (kind, marker, c) in [
+            (SpecialKind::Fold, Marker::Triangle, 1),
+            (SpecialKind::PeriodDoubling, Marker::Square, 3),
+            (SpecialKind::BranchPoint, Marker::Circle, 4),
+            (SpecialKind::NeimarkSacker, Marker::Triangle, 5),
+        ] {
+            let sp: Vec<(f64, f64)> = branch
+                .special
+                .iter()
+                .filter(|s| s.kind == kind)
+                .filter_map(|s| {
+                    let p = &branch.points[s.after_point.min(pts.len() - 1)];
+                    Some((s.parameter * x_scale, 1e3 * p.max_displacement.get(body)?))
+                })
+                .collect();
+            if !sp.is_empty() && bi == 0 {
+                fig.push(Series::markers(kind.name(), sp, marker).with_color(c));
+            } else if !sp.is_empty() {
+                fig.push(Series::markers("", sp, marker).with_color(c));
+            }
+        }
+    }
+    fig
+}
+
+fn write_branch(
+    dir: &Path,
+    model: &Model,
+    branch: &Branch,
+    name: &str,
+    stem: &str,
+    x_scale: f64,
+    x_label: &str,
+) -> Result<(), CliError> {
+    ensure_dir(dir)?;
+    write_atomic(
+        &dir.join(format!("{stem}.csv")),
+        branch_csv(branch, model)?.as_bytes(),
+    )?;
+    let doc = branch_json(branch, model, name);
+    write_atomic(
+        &dir.join(format!("{stem}_special_points.json")),
+        serde_json::to_string_pretty(&doc["special_points"])?.as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join(format!("{stem}.json")),
+        serde_json::to_string_pretty(&doc)?.as_bytes(),
+    )?;
+    let fig = branch_figure(
+        &[(branch, "branch")],
+        &format!("Response curve in {name}"),
+        x_label,
+        x_scale,
+        0,
+    );
+    render(&fig, &dir.join(format!("{stem}_response")))?;
+    Ok(())
+}
+
+/// Runs `vibroimpact continue`.
+pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
+    let pm = ParameterizedModel::read(&args.model, &args.parameter)?;
+    if !(args.from.is_finite() && args.to.is_finite()) || args.from == args.to {
+        return Err(CliError::new(format!(
+            "--from {} --to {}: the range is empty or not finite",
+            args.from, args.to
+        )));
+    }
+    if args.subharmonic == 0 {
+        return Err(CliError::new("--subharmonic must be >= 1"));
+    }
+    let start_model = pm.model_at(args.from)?;
+    if start_model.forcing_frequency().is_none() {
+        return Err(CliError::new(
+            "the model has no periodic forcing with one frequency at --from: nothing to continue",
+        ));
+    }
+    let opts = ContinuationOptions {
+        max_points: args.max_points,
+        ds_max: args.ds_max,
+        shooting: ShootingOptions {
+            subharmonic: args.subharmonic,
+            ..ContinuationOptions::default().shooting
+        },
+        ..ContinuationOptions::default()
+    };
+    let guess = guess_by_simulation(&start_model, args.guess_periods, 1e-9)
+        .map_err(|e| CliError::new(format!("start guess: {e}")))?;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler registration (tests run many commands in one
+        // process) is not an error worth stopping for.
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let tty = std::io::stderr().is_terminal();
+    let progress = |p: &vibroimpact::continuation::BranchPoint| {
+        if tty {
+            eprint!(
+                "\r{} = {:.8}  max|u| = {:.4e}  {}   ",
+                args.parameter,
+                p.parameter,
+                p.max_displacement[0],
+                if p.stable { "stable  " } else { "unstable" }
+            );
+        }
+        !stop.load(Ordering::SeqCst)
+    };
+    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+    let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)
+        .map_err(|e| CliError::new(e.to_string()))?;
+    let mut branches = vec![branch];
+    if let Some(label) = &args.switch_at {
+        let sp = branches[0]
+            .special
+            .iter()
+            .find(|s| &s.label == label)
+            .ok_or_else(|| {
+                CliError::new(format!(
+                    "--switch-at {label}: no such special point on the branch (found: {})",
+                    branches[0]
+                        .special
+                        .iter()
+                        .map(|s| s.label.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?
+            .clone();
+        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+        let (p1, x1, sub) = match sp.kind {
+            SpecialKind::PeriodDoubling => {
+                let (p, x) = period_doubled_start(family, &sp, &opts)
+                    .map_err(|e| CliError::new(e.to_string()))?;
+                (p, x, args.subharmonic * 2)
+            }
+            SpecialKind::BranchPoint => {
+                let (p, x) = branch_switch_start(family, &sp, args.from, &opts, 0.02)
+                    .map_err(|e| CliError::new(e.to_string()))?;
+                (p, x, args.subharmonic)
+            }
+            other => {
+                return Err(CliError::new(format!(
+                    "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
+                    other.name()
+                )))
+            }
+        };
+        let switched_opts = ContinuationOptions {
+            shooting: ShootingOptions {
+                subharmonic: sub,
+                ..opts.shooting.clone()
+            },
+            ..opts.clone()
+        };
+        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+        let target = if (args.to - p1).abs() > 1e-12 {
+            args.to
+        } else {
+            args.from
+        };
+        let b = continue_branch(family, p1, &x1, target, &switched_opts, progress)
+            .map_err(|e| CliError::new(e.to_string()))?;
+        branches.push(b);
+    }
+    if tty {
+        eprintln!();
+    }
+    let scale = 1.0;
+    if let Some(dir) = &args.out {
+        write_branch(
+            dir,
+            &start_model,
+            &branches[0],
+            &args.parameter,
+            "branch",
+            scale,
+            &args.parameter,
+        )?;
+        if let Some(b) = branches.get(1) {
+            write_branch(
+                dir,
+                &start_model,
+                b,
+                &args.parameter,
+                "switched_branch",
+                scale,
+                &args.parameter,
+            )?;
+        }
+    }
+    let docs: Vec<serde_json::Value> = branches
+        .iter()
+        .map(|b| branch_json(b, &start_model, &args.parameter))
+        .collect();
+    match args.format {
+        Format::Json => {
+            let doc = if docs.len() == 1 {
+                docs[0].clone()
+            } else {
+                let mut first = docs[0].clone();
+                first["switched_branch"] = docs[1].clone();
+                first
+            };
+            println!("{}", serde_json::to_string_pretty(&doc)?);
+        }
+        _ => {
+            for (i, b) in branches.iter().enumerate() {
+                println!(
+                    "{}: {} points from {} to {} ({:?})",
+                    if i == 0 { "branch" } else { "switched branch" },
+                    b.points.len(),
+                    b.points.first().map_or(f64::NAN, |p| p.parameter),
+                    b.points.last().map_or(f64::NAN, |p| p.parameter),
+                    b.stop
+                );
+                for s in &b.special {
+                    println!(
+                        "  {:<5} {:<16} {} = {:.10}",
+                        s.label,
+                        s.kind.name(),
+                        args.parameter,
+                        s.parameter
+                    );
+                }
+            }
+        }
+    }
+    match &branches[0].stop {
+        vibroimpact::continuation::StopReason::CannotContinue(why) => Err(CliError::new(format!(
+            "the branch cannot continue: {why} (the points computed so far are kept)"
+        ))),
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,1030 @@
+//! Pseudo-arclength continuation of periodic solutions in a parameter, with
+//! Floquet stability and detection and location of special points
+//! (THEORY.md §5).
+//!
+//! ## Formulation
+//! Unknowns `z = (x, p)`: the state at t = 0 of an nT-periodic orbit and the
+//! parameter, in scaled variables (`x̂ = x / scale`, displacement scale and
+//! ×Ω for velocities, `p̂ = p / |p0|`). The branch solves `G(x, p) =
+//! P_p(x) - x = 0`; its Jacobian is `[Φ - I, ∂G/∂p]` (Φ from the variational
+//! equations, `∂G/∂p` by a forward difference of the period map).
+//!
+//! - Predictor: `z + ds t` along the unit tangent t.
+//! - Corrector: Newton on `G(z) = 0, t·(z - z_pred) = 0`.
+//! - Tangent: `[J; t_old] t_new = e`, normalised, oriented along t_old.
+//! - Step control: ds grows (×1.6) after easy corrections (<= 2 Newton
+//!   iterations), shrinks (×0.7) after hard ones (>= 5) and halves on
+//!   failure; the branch stops when ds < ds_min.
+//!
+//! ## Special points (test functions between consecutive points)
+//! - fold: the parameter component of the tangent changes sign;
+//! - branch point: `det [J; t]` changes sign (it does not at a fold):
+//!   a multiplier crosses +1 where the parameter does not turn;
+//! - period doubling: `det(Φ + I)` changes sign (a real multiplier
+//!   crosses -1);
+//! - Neimark–Sacker: the number of complex multipliers outside the unit
+//!   circle changes;
+//! - grazing: the number of impacts per period changes.
+//!
+//! Each is located by bisection of the arclength between the two points
+//! (re-correcting from the earlier point), until the parameter is known to
+//! `locate_tol`.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use crate::integrate::{integrate_to, IntegratorOptions};
+use crate::model::Model;
+use crate::periodic::{
+    floquet_multipliers, forcing_period, orbit_summary, period_map, shoot, PeriodicError,
+    ShootingOptions,
+};
+
+/// Kinds of special points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpecialKind {
+    /// Turning point of the branch (saddle-node).
+    Fold,
+    /// A multiplier crosses +1 without a turn: branches cross.
+    BranchPoint,
+    /// A real multiplier crosses -1.
+    PeriodDoubling,
+    /// A complex pair crosses the unit circle (torus).
+    NeimarkSacker,
+    /// The number of impacts per period changes.
+    Grazing,
+}
+
+impl SpecialKind {
+    /// Name used in files: `fold`, `branch-point`, `period-doubling`,
+    /// `neimark-sacker`, `grazing`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpecialKind::Fold => "fold",
+            SpecialKind::BranchPoint => "branch-point",
+            SpecialKind::PeriodDoubling => "period-doubling",
+            SpecialKind::NeimarkSacker => "neimark-sacker",
+            SpecialKind::Grazing => "grazing",
+        }
+    }
+
+    /// Label prefix: LP, BP, PD, NS, GR.
+    pub fn prefix(self) -> &'static str {
+        match self {
+            SpecialKind::Fold => "LP",
+            SpecialKind::BranchPoint => "BP",
+            SpecialKind::PeriodDoubling => "PD",
+            SpecialKind::NeimarkSacker => "NS",
+            SpecialKind::Grazing => "GR",
+        }
+    }
+}
+
+/// Options of a continuation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContinuationOptions {
+    /// Shooting options (subharmonic n, tolerances, scales).
+    pub shooting: ShootingOptions,
+    /// Initial arclength step (scaled units).
+    pub ds: f64,
+    /// Smallest step before giving up.
+    pub ds_min: f64,
+    /// Largest step.
+    pub ds_max: f64,
+    /// Points at most.
+    pub max_points: usize,
+    /// Corrector iterations at most.
+    pub max_corrector: usize,
+    /// Location tolerance of special points in the parameter.
+    pub locate_tol: f64,
+    /// Samples per period for amplitudes.
+    pub orbit_samples: usize,
+}
+
+impl Default for ContinuationOptions {
+    fn default() -> Self {
+        Self {
+            // The period map with impacts is accurate to ~1e-9 (scaled) at
+            // rtol 1e-11; a corrector tolerance above that noise floor.
+            shooting: ShootingOptions {
+                rtol: 1e-11,
+                tol: 1e-7,
+                ..ShootingOptions::default()
+            },
+            ds: 0.01,
+            ds_min: 1e-7,
+            ds_max: 0.05,
+            max_points: 2000,
+            max_corrector: 8,
+            locate_tol: 1e-8,
+            orbit_samples: 256,
+        }
+    }
+}
+
+/// One point of a branch.
+#[derive(Clone, Debug)]
+pub struct BranchPoint {
+    /// Parameter value.
+    pub parameter: f64,
+    /// State at t = 0 (body order).
+    pub state: Vec<f64>,
+    /// Floquet multipliers, largest modulus first.
+    pub multipliers: Vec<Complex<f64>>,
+    /// All multipliers inside the unit circle.
+    pub stable: bool,
+    /// max |u_i| over the period (m).
+    pub max_displacement: Vec<f64>,
+    /// max |v_i| over the period (m/s).
+    pub max_velocity: Vec<f64>,
+    /// Impacts per period (all contacts).
+    pub impacts_per_period: usize,
+    /// Special-point label at this point (e.g. `LP1`), if it is one.
+    pub label: Option<String>,
+}
+
+impl BranchPoint {
+    /// Largest |multiplier|.
+    pub fn spectral_radius(&self) -> f64 {
+        self.multipliers.first().map_or(0.0, |m| m.norm())
+    }
+}
+
+/// A located special point.
+#[derive(Clone, Debug)]
+pub struct SpecialPoint {
+    /// Kind.
+    pub kind: SpecialKind,
+    /// Label, e.g. `PD1`.
+    pub label: String,
+    /// Parameter value (to `locate_tol`).
+    pub parameter: f64,
+    /// State at t = 0 (body order).
+    pub state: Vec<f64>,
+    /// Multipliers there.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Unit tangent of the branch there (scaled variables, x then p).
+    pub tangent: Vec<f64>,
+    /// Index of the branch point after which it lies.
+    pub after_point: usize,
+}
+
+/// Why a continuation ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StopReason {
+    /// The parameter left the requested range.
+    ReachedEnd,
+    /// The point budget was used.
+    MaxPoints,
+    /// The caller asked to stop (e.g. Ctrl-C).
+    Interrupted,
+    /// The corrector failed down to the smallest step: where and why.
+    CannotContinue(String),
+}
+
+/// A computed branch.
+#[derive(Clone, Debug)]
+pub struct Branch {
+    /// Points in order along the branch.
+    pub points: Vec<BranchPoint>,
+    /// Special points in order along the branch.
+    pub special: Vec<SpecialPoint>,
+    /// Why it ended.
+    pub stop: StopReason,
+    /// Period multiple n of the branch.
+    pub subharmonic: u32,
+}
+
+/// Errors before a branch exists.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ContinuationError {
+    /// The family could not build a model at a parameter value.
+    #[error("model at parameter {parameter}: {message}")]
+    Model {
+        /// Parameter value.
+        parameter: f64,
+        /// The model error.
+        message: String,
+    },
+    /// Shooting failed.
+    #[error(transparent)]
+    Periodic(#[from] PeriodicError),
+    /// The start did not converge.
+    #[error("no periodic solution at the start: Newton stopped at scaled residual {0:e}")]
+    StartNotConverged(f64),
+    /// Invalid options or range.
+    #[error("{0}")]
+    Invalid(String),
+    /// An integration failed.
+    #[error("integration failed: {0}")]
+    Integration(#[from] crate::integrate::IntegrationError),
+}
+
+/// A converged point of the extended system with its linearisation.
+#[derive(Clone, Debug)]
+struct Solved {
+    z: Vec<f64>,
+    jac: DMatrix<f64>,
+    monodromy: DMatrix<f64>,
+}
+
+/// The continuation problem in scaled variables.
+struct Problem<'a, F> {
+    family: &'a mut F,
+    opts: &'a ContinuationOptions,
+    scale: Vec<f64>,
+    p_scale: f64,
+    d: usize,
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
+    fn model(&mut self, p: f64) -> Result<Model, ContinuationError> {
+        (self.family)(p).map_err(|message| ContinuationError::Model {
+            parameter: p,
+            message,
+        })
+    }
+
+    fn unscale(&self, z: &[f64]) -> (Vec<f64>, f64) {
+        let x = z[..self.d]
+            .iter()
+            .zip(&self.scale)
+            .map(|(a, s)| a * s)
+            .collect();
+        (x, z[self.d] * self.p_scale)
+    }
+
+    fn scale_state(&self, x: &[f64], p: f64) -> Vec<f64> {
+        let mut z: Vec<f64> = x.iter().zip(&self.scale).map(|(a, s)| a / s).collect();
+        z.push(p / self.p_scale);
+        z
+    }
+
+    /// Ĝ(z) and its Jacobian [Ĵ_x, Ĝ_p] (d × (d+1)), and Φ.
+    fn residual(&mut self, z: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>, DMatrix<f64>)> {
+        let (x, p) = self.unscale(z);
+        let d = self.d;
+        let model = self.model(p).ok()?;
+        let map = period_map(&model, &x, &self.opts.shooting).ok()?;
+        let g: Vec<f64> = (0..d)
+            .map(|i| (map.image[i] - x[i]) / self.scale[i])
+            .collect();
+        let dp = 1e-6 * self.p_scale.max(p.abs());
+        let model_p = self.model(p + dp).ok()?;
+        let image_p = period_image(&model_p, &x, &self.opts.shooting)?;
+        let mut jac = DMatrix::zeros(d, d + 1);
+        for r in 0..d {
+            for c in 0..d {
+                let id = if r == c { 1.0 } else { 0.0 };
+                jac[(r, c)] = (map.monodromy[(r, c)] - id) * self.scale[c] / self.scale[r];
+            }
+            jac[(r, d)] = (image_p[r] - map.image[r]) / dp * self.p_scale / self.scale[r];
+        }
+        Some((g, jac, map.monodromy))
+    }
+
+    /// Newton on [Ĝ(z) = 0, t·(z - z_pred) = 0] from `pred`. Returns the
+    /// solution and the iterations used.
+    fn correct(&mut self, pred: &[f64], t: &[f64]) -> Option<(Solved, usize)> {
+        let d = self.d;
+        let mut z = pred.to_vec();
+        for it in 1..=self.opts.max_corrector {
+            let (g, jac, monodromy) = self.residual(&z)?;
+            let gn = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let mut a = DMatrix::zeros(d + 1, d + 1);
+            a.view_mut((0, 0), (d, d + 1)).copy_from(&jac);
+            for c in 0..=d {
+                a[(d, c)] = t[c];
+            }
+            let mut rhs = DVector::zeros(d + 1);
+            for r in 0..d {
+                rhs[r] = -g[r];
+            }
+            rhs[d] = -(0..=d).map(|c| t[c] * (z[c] - pred[c])).sum::<f64>();
+            if gn <= self.opts.shooting.tol && rhs[d].abs() <= self.opts.shooting.tol {
+                return Some((Solved { z, jac, monodromy }, it));
+            }
+            let delta = a.lu().solve(&rhs)?;
+            let step = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // Stagnation at the period map's noise floor: the correction is
+            // negligible although the residual is a little above tol.
+            if step <= 1e-2 * self.opts.shooting.tol && gn <= 100.0 * self.opts.shooting.tol {
+                return Some((Solved { z, jac, monodromy }, it));
+            }
+            let lambda = (0.5 / step).min(1.0);
+            for c in 0..=d {
+                z[c] += lambda * delta[c];
+            }
+        }
+        None
+    }
+
+    /// Unit tangent at a solution, oriented along `previous`.
+    fn tangent(&self, jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
+        let d = self.d;
+        let mut a = DMatrix::zeros(d + 1, d + 1);
+        a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
+        for c in 0..=d {
+            a[(d, c)] = previous[c];
+        }
+        let mut e = DVector::zeros(d + 1);
+        e[d] = 1.0;
+        let t = a.lu().solve(&e)?;
+        let norm = t.norm();
+        let mut t: Vec<f64> = t.iter().map(|v| v / norm).collect();
+        if t.iter().zip(previous).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+            t.iter_mut().for_each(|v| *v = -*v);
+        }
+        Some(t)
+    }
+}
+
+/// `P(x)` without the variational equations (for ∂G/∂p).
+fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<f64>> {
+    let n = model.bodies().len();
+    let t = forcing_period(model).ok()? * f64::from(opts.subharmonic.max(1));
+    let mut sys = crate::dynamics::ChainDynamics::new(model, false);
+    let mut y0 = vec![0.0; 2 * n];
+    for i in 0..n {
+        y0[2 * i] = x[i];
+        y0[2 * i + 1] = x[n + i];
+    }
+    let int_opts = IntegratorOptions {
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps: 200_000,
+        ..IntegratorOptions::default()
+    };
+    let (y, _) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
+    Some(
+        (0..2 * n)
+            .map(|k| if k < n { y[2 * k] } else { y[2 * (k - n) + 1] })
+            .collect(),
+    )
+}
+
+/// Test-function values at a point.
+#[derive(Clone, Copy, Debug)]
+struct Tests {
+    tangent_p: f64,
+    det_ext: f64,
+    det_pd: f64,
+    ns_count: usize,
+    impacts: usize,
+}
+
+fn tests_at(
+    jac: &DMatrix<f64>,
+    t: &[f64],
+    monodromy: &DMatrix<f64>,
+    multipliers: &[Complex<f64>],
+    impacts: usize,
+) -> Tests {
+    let d = jac.nrows();
+    let mut a = DMatrix::zeros(d + 1, d + 1);
+    a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
+    for c in 0..=d {
+        a[(d, c)] = t[c];
+    }
+    let pd = monodromy + DMatrix::<f64>::identity(d, d);
+    Tests {
+        tangent_p: t[d],
+        det_ext: a.determinant(),
+        det_pd: pd.determinant(),
+        ns_count: multipliers
+            .iter()
+            .filter(|m| m.im.abs() > 1e-9 * m.norm() && m.norm() > 1.0)
+            .count(),
+        impacts,
+    }
+}
+
+fn changed(kind: SpecialKind, a: &Tests, b: &Tests) -> bool {
+    match kind {
+        SpecialKind::Fold => a.tangent_p.signum() != b.tangent_p.signum(),
+        SpecialKind::BranchPoint => {
+            a.det_ext.signum() != b.det_ext.signum() && a.tangent_p.signum() == b.tangent_p.signum()
+        }
+        SpecialKind::PeriodDoubling => a.det_pd.signum() != b.det_pd.signum(),
+        SpecialKind::NeimarkSacker => a.ns_count != b.ns_count,
+        SpecialKind::Grazing => a.impacts != b.impacts,
+    }
+}
+
+const KINDS: [SpecialKind; 5] = [
+    SpecialKind::Fold,
+    SpecialKind::BranchPoint,
+    SpecialKind::PeriodDoubling,
+    SpecialKind::NeimarkSacker,
+    SpecialKind::Grazing,
+];
+
+/// A point in full detail (for test functions and output).
+struct Evaluated {
+    solved: Solved,
+    tangent: Vec<f64>,
+    point: BranchPoint,
+    tests: Tests,
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
+    fn evaluate(&mut self, solved: Solved, previous_tangent: &[f64]) -> Option<Evaluated> {
+        let tangent = self.tangent(&solved.jac, previous_tangent)?;
+        let (x, p) = self.unscale(&solved.z);
+        let model = self.model(p).ok()?;
+        let period =
+            forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
+        let orbit = orbit_summary(
+            &model,
+            &x,
+            period,
+            self.opts.orbit_samples,
+            self.opts.shooting.rtol,
+        )
+        .ok()?;
+        let multipliers = floquet_multipliers(&solved.monodromy);
+        let impacts = orbit.impacts_per_period();
+        let tests = tests_at(
+            &solved.jac,
+            &tangent,
+            &solved.monodromy,
+            &multipliers,
+            impacts,
+        );
+        let point = BranchPoint {
+            parameter: p,
+            state: x,
+            stable: multipliers.first().is_none_or(|m| m.norm() < 1.0),
+            multipliers,
+            max_displacement: orbit.max_displacement,
+            max_velocity: orbit.max_velocity,
+            impacts_per_period: impacts,
+            label: None,
+        };
+        Some(Evaluated {
+            solved,
+            tangent,
+            point,
+            tests,
+        })
+    }
+
+    /// Bisection of the arclength in (0, ds) from `a` for the change of
+    /// `kind` that occurs before `b`; returns the located point.
+    fn locate(
+        &mut self,
+        kind: SpecialKind,
+        a: &Evaluated,
+        b: &Evaluated,
+        ds: f64,
+    ) -> Option<Evaluated> {
+        let (mut lo, mut hi) = (0.0, ds);
+        let (mut p_lo, mut p_hi) = (a.point.parameter, b.point.parameter);
+        let mut best: Option<Evaluated> = None;
+        let mut lo_tests = a.tests;
+        for _ in 0..80 {
+            if (p_hi - p_lo).abs() <= self.opts.locate_tol && best.is_some() {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            let pred: Vec<f64> = a
+                .solved
+                .z
+                .iter()
+                .zip(&a.tangent)
+                .map(|(z, t)| z + mid * t)
+                .collect();
+            let (solved, _) = self.correct(&pred, &a.tangent)?;
+            let e = self.evaluate(solved, &a.tangent)?;
+            if changed(kind, &lo_tests, &e.tests) {
+                hi = mid;
+                p_hi = e.point.parameter;
+            } else {
+                lo = mid;
+                p_lo = e.point.parameter;
+                lo_tests = e.tests;
+            }
+            best = Some(e);
+            if hi - lo < 1e-14 {
+                break;
+            }
+        }
+        best
+    }
+}
+
+/// Continues the branch of nT-periodic solutions from `(x0, p0)` toward
+/// `p_end`. `family(p)` builds the model at parameter p; `on_point` sees
+/// every accepted point and returns false to stop (the branch so far is
+/// returned). `x0` need not be converged: it is refined by shooting first.
+pub fn continue_branch<F, C>(
+    mut family: F,
+    p0: f64,
+    x0: &[f64],
+    p_end: f64,
+    opts: &ContinuationOptions,
+    mut on_point: C,
+) -> Result<Branch, ContinuationError>
+where
+    F: FnMut(f64) -> Result<Model, String>,
+    C: FnMut(&BranchPoint) -> bool,
+{
+    if !(p0.is_finite() && p_end.is_finite()) || p0 == p_end || p0 == 0.0 {
+        return Err(ContinuationError::Invalid(format!(
+            "the range from {p0} to {p_end} is empty or not finite (and the start must be nonzero)"
+        )));
+    }
+    let model = family(p0).map_err(|message| ContinuationError::Model {
+        parameter: p0,
+        message,
+    })?;
+    let start = shoot(&model, x0, &opts.shooting)?;
+    if !start.converged {
+        return Err(ContinuationError::StartNotConverged(
+            *start.residual_history.last().unwrap_or(&f64::NAN),
+        ));
+    }
+    let d = x0.len();
+    let w = model.forcing_frequency().unwrap_or(1.0);
+    let mut problem = Problem {
+        family: &mut family,
+        opts,
+        scale: (0..d)
+            .map(|i| {
+                if i < d / 2 {
+                    opts.shooting.displacement_scale
+                } else {
+                    opts.shooting.displacement_scale * w
+                }
+            })
+            .collect(),
+        p_scale: p0.abs(),
+        d,
+    };
+    let (lo, hi) = (p0.min(p_end), p0.max(p_end));
+    let z0 = problem.scale_state(&start.initial_state, p0);
+    // The start point: corrected with the parameter held (t = e_p).
+    let mut dir = vec![0.0; d + 1];
+    dir[d] = 1.0;
+    let (solved0, _) = problem
+        .correct(&z0, &dir)
+        .ok_or(ContinuationError::StartNotConverged(f64::NAN))?;
+    dir[d] = (p_end - p0).signum();
+    let first = problem
+        .evaluate(solved0, &dir)
+        .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the start point".into()))?;
+    let mut points = vec![first.point.clone()];
+    let mut special: Vec<SpecialPoint> = Vec::new();
+    let mut counts = [0usize; 5];
+    if !on_point(&first.point) {
+        return Ok(Branch {
+            points,
+            special,
+            stop: StopReason::Interrupted,
+            subharmonic: opts.shooting.subharmonic,
+        });
+    }
+    let mut current = first;
+    let mut ds = opts.ds;
+    let stop = loop {
+        if points.len() >= opts.max_points {
+            break StopReason::MaxPoints;
+        }
+        let pred: Vec<f64> = current
+            .solved
+            .z
+            .iter()
+            .zip(&current.tangent)
+            .map(|(z, t)| z + ds * t)
+            .collect();
+        let attempt = problem
+            .correct(&pred, &current.tangent)
+            .and_then(|(s, it)| {
+                // Reject corrections that jump (angle between tangents > ~35°).
+                let e = problem.evaluate(s, &current.tangent)?;
+                let cos: f64 = e
+                    .tangent
+                    .iter()
+                    .zip(&current.tangent)
+                    .map(|(a, b)| a * b)
+                    .sum();
+                (cos > 0.8).then_some((e, it))
+            });
+        let Some((next, iterations)) = attempt else {
+            ds *= 0.5;
+            if ds < opts.ds_min {
+                let p = current.point.parameter;
+                break StopReason::CannotContinue(format!(
+                    "the corrector does not converge beyond parameter {p} even with step {ds:e}"
+                ));
+            }
+            continue;
+        };
+        let p = next.point.parameter;
+        if p < lo - opts.locate_tol || p > hi + opts.locate_tol {
+            break StopReason::ReachedEnd;
+        }
+        for (k, kind) in KINDS.iter().enumerate() {
+            if changed(*kind, &current.tests, &next.tests) {
+                if let Some(loc) = problem.locate(*kind, &current, &next, ds) {
+                    counts[k] += 1;
+                    let label = format!("{}{}", kind.prefix(), counts[k]);
+                    special.push(SpecialPoint {
+                        kind: *kind,
+                        label,
+                        parameter: loc.point.parameter,
+                        state: loc.point.state.clone(),
+                        multipliers: loc.point.multipliers.clone(),
+                        tangent: loc.tangent.clone(),
+                        after_point: points.len() - 1,
+                    });
+                }
+            }
+        }
+        ds = if iterations <= 2 {
+            (ds * 1.6).min(opts.ds_max)
+        } else if iterations >= 5 {
+            (ds * 0.7).max(opts.ds_min)
+        } else {
+            ds
+        };
+        let mut point = next.point.clone();
+        if let Some(sp) = special
+            .iter()
+            .rev()
+            .find(|s| s.after_point == points.len() - 1)
+        {
+            point.label = Some(sp.label.clone());
+        }
+        points.push(point);
+        current = next;
+        if !on_point(points.last().expect("just pushed")) {
+            break StopReason::Interrupted;
+        }
+    };
+    Ok(Branch {
+        points,
+        special,
+        stop,
+        subharmonic: opts.shooting.subharmonic,
+    })
+}
+
+/// A start on the period-2n branch that emanates from a period-doubling
+/// point: shoots the 2nT map from `x* ± ε v` (v the eigenvector of the
+/// multiplier nearest -1) at parameters just beyond and before the point,
+/// and returns the first genuinely period-2n solution `(p, x)`.
+pub fn period_doubled_start<F>(
+    mut family: F,
+    point: &SpecialPoint,
+    opts: &ContinuationOptions,
+) -> Result<(f64, Vec<f64>), ContinuationError>
+where
+    F: FnMut(f64) -> Result<Model, String>,
+{
+    let model = family(point.parameter).map_err(|message| ContinuationError::Model {
+        parameter: point.parameter,
+        message,
+    })?;
+    let map = period_map(&model, &point.state, &opts.shooting)?;
+    let d = point.state.len();
+    let shifted = &map.monodromy + DMatrix::<f64>::identity(d, d);
+    // Null vector of Φ + I: the right singular vector of the smallest singular value.
+    let svd = shifted.svd(false, true);
+    let v_t = svd
+        .v_t
+        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
+    let (imin, _) =
+        svd.singular_values
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |m, (i, &s)| if s < m.1 { (i, s) } else { m },
+            );
+    let v: Vec<f64> = (0..d).map(|j| v_t[(imin, j)]).collect();
+    let mut doubled = opts.shooting.clone();
+    doubled.subharmonic = opts.shooting.subharmonic * 2;
+    let scale = doubled.displacement_scale;
+    for dp in [1e-3, -1e-3, 1e-2, -1e-2] {
+        let p = point.parameter * (1.0 + dp);
+        let model = family(p).map_err(|message| ContinuationError::Model {
+            parameter: p,
+            message,
+        })?;
+        for eps in [0.05, -0.05, 0.2, -0.2] {
+            let guess: Vec<f64> = point
+                .state
+                .iter()
+                .zip(&v)
+                .map(|(x, v)| x + eps * scale * v * (d as f64).sqrt())
+                .collect();
+            let Ok(sol) = shoot(&model, &guess, &doubled) else {
+                continue;
+            };
+            if !sol.converged {
+                continue;
+            }
+            // Genuinely period-2n: the nT map does not fix it.
+            let single = period_map(&model, &sol.initial_state, &opts.shooting)?;
+            let gap = single
+                .image
+                .iter()
+                .zip(&sol.initial_state)
+                .map(|(a, b)| (a - b).abs() / scale)
+                .fold(0.0, f64::max);
+            if gap > 1e3 * opts.shooting.tol {
+                return Ok((p, sol.initial_state));
+            }
+        }
+    }
+    Err(ContinuationError::Invalid(format!(
+        "no period-{} solution found next to the period doubling at {}",
+        2 * opts.shooting.subharmonic,
+        point.parameter
+    )))
+}
+
+/// A start on the other branch through a branch point: steps along the
+/// direction of the 2-D null space of [Φ - I, G_p] orthogonal to the branch
+/// tangent and corrects there. Returns `(p, x)` and the direction's sign
+/// toward increasing parameter is not guaranteed: continue both ways if
+/// needed.
+pub fn branch_switch_start<F>(
+    mut family: F,
+    point: &SpecialPoint,
+    p0: f64,
+    opts: &ContinuationOptions,
+    step: f64,
+) -> Result<(f64, Vec<f64>), ContinuationError>
+where
+    F: FnMut(f64) -> Result<Model, String>,
+{
+    let d = point.state.len();
+    let model = family(point.parameter).map_err(|message| ContinuationError::Model {
+        parameter: point.parameter,
+        message,
+    })?;
+    let w = model.forcing_frequency().unwrap_or(1.0);
+    let mut problem = Problem {
+        family: &mut family,
+        opts,
+        scale: (0..d)
+            .map(|i| {
+                if i < d / 2 {
+                    opts.shooting.displacement_scale
+                } else {
+                    opts.shooting.displacement_scale * w
+                }
+            })
+            .collect(),
+        p_scale: p0.abs(),
+        d,
+    };
+    let z = problem.scale_state(&point.state, point.parameter);
+    let (_, jac, _) = problem
+        .residual(&z)
+        .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the branch point".into()))?;
+    let svd = jac.clone().svd(false, true);
+    let v_t = svd
+        .v_t
+        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
+    // The two right singular vectors of the smallest singular values span the null space.
+    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
+    order.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
+    let mut candidates: Vec<Vec<f64>> = Vec::new();
+    for &i in order.iter().take(2) {
+        candidates.push((0..=d).map(|j| v_t[(i, j)]).collect());
+    }
+    // d × (d+1) Jacobian: its null space always has the extra direction.
+    let null_dir = {
+        let full = jac.transpose() * &jac;
+        let eig = full.symmetric_eigen();
+        let mut idx: Vec<usize> = (0..=d).collect();
+        idx.sort_by(|&a, &b| {
+            eig.eigenvalues[a]
+                .abs()
+                .total_cmp(&eig.eigenvalues[b].abs())
+        });
+        idx.iter()
+            .take(2)
+            .map(|&i| {
+                eig.eigenvectors
+                    .column(i)
+                    .iter()
+                    .copied()
+                    .collect::<Vec<f64>>()
+            })
+            .collect::<Vec<_>>()
+    };
+    let t = &point.tangent;
+    let mut other = Vec::new();
+    for v in null_dir.iter().chain(&candidates) {
+        let proj: f64 = v.iter().zip(t).map(|(a, b)| a * b).sum();
+        let o: Vec<f64> = v.iter().zip(t).map(|(a, b)| a - proj * b).collect();
+        let n = o.iter().map(|a| a * a).sum::<f64>().sqrt();
+        if n > 0.3 {
+            other = o.iter().map(|a| a / n).collect();
+            break;
+        }
+    }
+    if other.is_empty() {
+        return Err(ContinuationError::Invalid(
+            "no second direction at the branch point".into(),
+        ));
+    }
+    for sign in [1.0, -1.0] {
+        let pred: Vec<f64> = z
+            .iter()
+            .zip(&other)
+            .map(|(a, b)| a + sign * step * b)
+            .collect();
+        if let Some((solved, _)) = problem.correct(&pred, &other) {
+            let (x, p) = problem.unscale(&solved.z);
+            return Ok((p, x));
+        }
+    }
+    Err(ContinuationError::Invalid(format!(
+        "the corrector fails on the crossing branch at {}",
+        point.parameter
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{ContactLaw, ForceForm};
+    use crate::model::BaseExcitation;
+    use crate::simulate::{simulate, SimulationOptions};
+
+    const M: f64 = 0.227;
+    const W0: f64 = 7.41;
+    const ZETA: f64 = 0.013;
+
+    fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
+        let law =
+            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.05,
+            frequency: omega,
+            phase: 0.0,
+        };
+        Model::row(
+            n,
+            M,
+            M * W0 * W0,
+            2.0 * ZETA * M * W0,
+            clearance,
+            law,
+            (true, true),
+            base,
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    /// R3 along a branch: amplitude equals the exact steady state, no
+    /// special points, all stable.
+    #[test]
+    fn linear_branch_is_exact() {
+        let family = |w: f64| r2(2, 1e3, w);
+        let opts = ContinuationOptions {
+            shooting: ShootingOptions {
+                rtol: 1e-12,
+                tol: 1e-10,
+                displacement_scale: 1e-2,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let b = continue_branch(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts, |_| true).unwrap();
+        assert_eq!(b.stop, StopReason::ReachedEnd);
+        assert!(
+            b.special.is_empty(),
+            "{:?}",
+            b.special.iter().map(|s| &s.label).collect::<Vec<_>>()
+        );
+        assert!(b.points.len() > 10);
+        for p in &b.points {
+            let w = p.parameter;
+            let exact = 0.05 / ((W0 * W0 - w * w).powi(2) + (2.0 * ZETA * W0 * w).powi(2)).sqrt();
+            // Amplitude sampled 256 times per period: parabolic error < 1e-4.
+            assert!(
+                (p.max_displacement[0] / exact - 1.0).abs() < 1e-4,
+                "at {w}: {} vs {exact}",
+                p.max_displacement[0]
+            );
+            assert!(p.stable);
+        }
+    }
+
+    /// R2, N = 2, from 1.5 ω0 downward: special points exist; a fold is
+    /// confirmed by the change of stability on either side, a period
+    /// doubling by the period-2 orbit next to it, and stable points agree
+    /// with brute-force simulation.
+    #[test]
+    fn r2_branch_special_points_are_confirmed() {
+        let family = |w: f64| r2(2, 1e-3, w);
+        let opts = ContinuationOptions {
+            max_points: 900,
+            ..Default::default()
+        };
+        let start = r2(2, 1e-3, 1.5 * W0).unwrap();
+        let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+        let b = continue_branch(family, 1.5 * W0, &guess, 0.5 * W0, &opts, |_| true).unwrap();
+        let unstable_count =
+            |p: &BranchPoint| p.multipliers.iter().filter(|m| m.norm() > 1.0).count();
+        // Fold: stability changes across it.
+        let fold = b
+            .special
+            .iter()
+            .find(|s| s.kind == SpecialKind::Fold)
+            .expect("a fold");
+        let (a, c) = (
+            &b.points[fold.after_point],
+            &b.points[(fold.after_point + 1).min(b.points.len() - 1)],
+        );
+        assert_ne!(
+            unstable_count(a),
+            unstable_count(c),
+            "fold at {}",
+            fold.parameter
+        );
+        // Period doubling: a multiplier near -1 there, and a period-2 orbit next to it.
+        let pd = b
+            .special
+            .iter()
+            .find(|s| s.kind == SpecialKind::PeriodDoubling)
+            .expect("a period doubling");
+        assert!(
+            pd.multipliers
+                .iter()
+                .any(|m| (m.re + 1.0).abs() < 1e-2 && m.im.abs() < 1e-6),
+            "{:?}",
+            pd.multipliers
+        );
+        let (p2, x2) = period_doubled_start(family, pd, &opts).unwrap();
+        assert!((p2 / pd.parameter - 1.0).abs() < 0.02);
+        let model = r2(2, 1e-3, p2).unwrap();
+        let two = shoot(
+            &model,
+            &x2,
+            &ShootingOptions {
+                subharmonic: 2,
+                ..opts.shooting.clone()
+            },
+        )
+        .unwrap();
+        assert!(two.converged);
+        let one = period_map(&model, &two.initial_state, &opts.shooting).unwrap();
+        let gap = one
+            .image
+            .iter()
+            .zip(&two.initial_state)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            gap > 1e-7,
+            "the period-2 orbit is not period-1 (gap {gap:e})"
+        );
+        // Stable points agree with brute-force simulation from rest.
+        let stable: Vec<&BranchPoint> = b
+            .points
+            .iter()
+            .filter(|p| p.stable && p.spectral_radius() < 0.95)
+            .step_by(20)
+            .take(3)
+            .collect();
+        assert!(!stable.is_empty());
+        for p in stable {
+            let model = r2(2, 1e-3, p.parameter).unwrap();
+            let t = 2.0 * std::f64::consts::PI / p.parameter;
+            let sim = simulate(
+                &model,
+                &SimulationOptions {
+                    t_end: 400.0 * t,
+                    rtol: 1e-11,
+                    atol: 1e-15,
+                    start: Some(p.state.iter().map(|x| x * 0.9).collect()),
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let end: Vec<f64> = sim
+                .final_displacement
+                .iter()
+                .chain(&sim.final_velocity)
+                .copied()
+                .collect();
+            let orbit = orbit_summary(&model, &end, t, 256, 1e-11).unwrap();
+            for i in 0..2 {
+                assert!(
+                    (orbit.max_displacement[i] - p.max_displacement[i]).abs()
+                        < 1e-6 * p.max_displacement[i].max(1e-3),
+                    "at {}: {} vs {}",
+                    p.parameter,
+                    orbit.max_displacement[i],
+                    p.max_displacement[i]
+                );
+            }
+        }
+    }
+}
