@@ -940,7 +940,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
         columns.extend(["largest_multiplier_modulus", "stable", "impacts_per_period"]);
         report.summary(
             &format!("r2_n{n}_branch"),
-            serde_json::json!({"points": branch.points.len(), "seconds": seconds, "stop": format!("{:?}", branch.stop),
+            serde_json::json!({"points": branch.points.len(), "stop": format!("{:?}", branch.stop),
                 "special_points": branch.special.iter().map(|s| serde_json::json!({"label": s.label, "kind": s.kind.name(), "omega_over_omega0": s.parameter / w0})).collect::<Vec<_>>()}),
         );
         for s in &branch.special {
