@@ -104,8 +104,11 @@ def main(argv):
         e="r2n2", s="hom", sv="check", IRS=irs, ICP=f"[1, 11, {ra.ICP_OUT}]", NMX=20000,
         DS=0.002, DSMAX=args.dsmax, SP="['BP0']", UZSTOP="{1: [0.45, 1.5]}",
         UZR="{1: [%s]}" % ", ".join("%.12g" % w for w in grid), **common), "check")
-    sols = [s for s in parse_s(os.path.join(workdir, "s.check")) if s["itp"] in (-4, 9, 4)]
-    mult = ra.parse_d(os.path.join(workdir, "d.check"))
+    # the start orbit (W = 0.5, end of the amplitude homotopy) and the UZR orbits
+    mult_hom = ra.parse_d(os.path.join(workdir, "d.hom"))
+    mult_chk = ra.parse_d(os.path.join(workdir, "d.check"))
+    sols = [dict(s, mult=mult_hom) for s in parse_s(os.path.join(workdir, "s.hom")) if s["lab"] == irs]
+    sols += [dict(s, mult=mult_chk) for s in parse_s(os.path.join(workdir, "s.check")) if s["itp"] == -4]
     scale = np.array([GAP, GAP, GAP * OMEGA0, GAP * OMEGA0])
     worst = {"periodicity": 0.0, "maxu_rel": 0.0, "multiplier_rel": 0.0}
     for s in sols:
@@ -139,7 +142,7 @@ def main(argv):
                            rtol=1e-12, atol=1e-15).y[:, -1] / scale
             Mx[:, j] = (yp - ym) / (2 * h)
         ev = np.linalg.eigvals(Mx)
-        ev_auto = ra.nontrivial(mult.get(s["pt"], (0, []))[1])
+        ev_auto = ra.nontrivial(s["mult"].get(s["pt"], (0, []))[1])
         # drop the oscillator's multiplier exp(-2T) (smallest modulus)
         ev_auto = sorted(ev_auto, key=abs, reverse=True)[:4]
         ev_s = sorted(ev, key=abs, reverse=True)

@@ -184,11 +184,11 @@ def main(argv):
     ap.add_argument("--secondary-nmx", type=int, default=3000)
     args = ap.parse_args(argv[1:])
 
-    exe_src = os.path.join(args.build, "r2n2.exe")
+    exe_src = os.path.join(os.path.abspath(args.build), "r2n2.exe")
     if not os.path.exists(exe_src):
         sys.stderr.write(f"run_auto.py: {exe_src} missing; run build.sh first\n")
         return 2
-    workdir = args.workdir or os.path.join(args.build, "run")
+    workdir = os.path.abspath(args.workdir or os.path.join(args.build, "run"))
     os.makedirs(workdir, exist_ok=True)
     exe = os.path.join(workdir, "r2n2.exe")
     shutil.copy2(exe_src, exe)
@@ -318,7 +318,7 @@ def main(argv):
         for i, bp in enumerate(located_bps):
             if bp["auto_type"] != "BP":
                 continue
-            for sign in (1, -1):
+            for sign in (1,):  # ISW=-1 picks the direction itself; -1 gave the same branch
                 name = f"sec{i}{'p' if sign > 0 else 'm'}"
                 text = constants(e="r2n2", s=bp["run"], sv=name, IRS=bp["label"], ISW=-1,
                                  ICP=f"[1, 11, {ICP_OUT}]", NMX=args.secondary_nmx,

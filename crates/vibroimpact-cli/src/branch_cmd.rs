@@ -15,7 +15,9 @@ use vibroimpact::continuation::{
     SpecialKind,
 };
 use vibroimpact::model::Model;
-use vibroimpact::periodic::{guess_by_simulation, orbit_summary, shoot, ShootingOptions};
+use vibroimpact::periodic::{
+    guess_by_simulation, orbit_summary, shoot, shoot_krylov, ShootingOptions,
+};
 
 use crate::error::CliError;
 use crate::format::{csv_text, Format};
@@ -46,6 +48,16 @@ pub struct PeriodicArgs {
     /// Newton tolerance (scaled residual).
     #[arg(long, default_value_t = 1e-9)]
     tol: f64,
+    /// Matrix-free Newton–Krylov shooting with Arnoldi multipliers (default
+    /// from 200 bodies on; the dense monodromy costs O(N²) memory and work).
+    #[arg(long)]
+    krylov: bool,
+    /// Dense shooting even for large N.
+    #[arg(long, conflicts_with = "krylov")]
+    dense: bool,
+    /// Dominant multipliers computed by Arnoldi (Krylov shooting).
+    #[arg(long, default_value_t = 20)]
+    arnoldi: usize,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -110,7 +122,13 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         tol: args.tol,
         ..ShootingOptions::default()
     };
-    let sol = shoot(&model, &guess, &opts).map_err(|e| CliError::new(e.to_string()))?;
+    let krylov = args.krylov || (!args.dense && model.bodies().len() >= 200);
+    let sol = if krylov {
+        shoot_krylov(&model, &guess, &opts, args.arnoldi)
+    } else {
+        shoot(&model, &guess, &opts)
+    }
+    .map_err(|e| CliError::new(e.to_string()))?;
     let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)
         .map_err(|e| CliError::new(e.to_string()))?;
     let impacts: Vec<ContactImpactsJson> = orbit
@@ -125,6 +143,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         .collect();
     let doc = json!({
         "converged": sol.converged,
+        "method": if krylov { "newton-krylov (dominant multipliers by Arnoldi)" } else { "newton (dense monodromy)" },
         "period": sol.period,
         "subharmonic": args.subharmonic,
         "initial_state": sol.initial_state,

@@ -236,7 +236,21 @@ struct Problem<'a, F> {
     d: usize,
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
+impl<'a, F: FnMut(f64) -> Result<Model, String>> Problem<'a, F> {
+    /// Scales: the displacement scale for u, × Ω of `model` for v, |p0| for p.
+    fn new(family: &'a mut F, opts: &'a ContinuationOptions, model: &Model, p0: f64) -> Self {
+        let d = 2 * model.bodies().len();
+        let w = model.forcing_frequency().unwrap_or(1.0);
+        let u = opts.shooting.displacement_scale;
+        Self {
+            family,
+            opts,
+            scale: (0..d).map(|i| if i < d / 2 { u } else { u * w }).collect(),
+            p_scale: p0.abs(),
+            d,
+        }
+    }
+
     fn model(&mut self, p: f64) -> Result<Model, ContinuationError> {
         (self.family)(p).map_err(|message| ContinuationError::Model {
             parameter: p,
@@ -343,11 +357,7 @@ fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<
     let n = model.bodies().len();
     let t = forcing_period(model).ok()? * f64::from(opts.subharmonic.max(1));
     let mut sys = crate::dynamics::ChainDynamics::new(model, false);
-    let mut y0 = vec![0.0; 2 * n];
-    for i in 0..n {
-        y0[2 * i] = x[i];
-        y0[2 * i + 1] = x[n + i];
-    }
+    let y0 = crate::dynamics::to_interleaved(x);
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,
         atol: opts.rtol * opts.displacement_scale,
@@ -544,22 +554,7 @@ where
         ));
     }
     let d = x0.len();
-    let w = model.forcing_frequency().unwrap_or(1.0);
-    let mut problem = Problem {
-        family: &mut family,
-        opts,
-        scale: (0..d)
-            .map(|i| {
-                if i < d / 2 {
-                    opts.shooting.displacement_scale
-                } else {
-                    opts.shooting.displacement_scale * w
-                }
-            })
-            .collect(),
-        p_scale: p0.abs(),
-        d,
-    };
+    let mut problem = Problem::new(&mut family, opts, &model, p0);
     let (lo, hi) = (p0.min(p_end), p0.max(p_end));
     let z0 = problem.scale_state(&start.initial_state, p0);
     // The start point: corrected with the parameter held (t = e_p).
@@ -764,22 +759,7 @@ where
         parameter: point.parameter,
         message,
     })?;
-    let w = model.forcing_frequency().unwrap_or(1.0);
-    let mut problem = Problem {
-        family: &mut family,
-        opts,
-        scale: (0..d)
-            .map(|i| {
-                if i < d / 2 {
-                    opts.shooting.displacement_scale
-                } else {
-                    opts.shooting.displacement_scale * w
-                }
-            })
-            .collect(),
-        p_scale: p0.abs(),
-        d,
-    };
+    let mut problem = Problem::new(&mut family, opts, &model, p0);
     let z = problem.scale_state(&point.state, point.parameter);
     let (_, jac, _) = problem
         .residual(&z)
@@ -852,33 +832,13 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{ContactLaw, ForceForm};
-    use crate::model::BaseExcitation;
     use crate::simulate::{simulate, SimulationOptions};
 
-    const M: f64 = 0.227;
     const W0: f64 = 7.41;
     const ZETA: f64 = 0.013;
 
     fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
-        let law =
-            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
-        let base = BaseExcitation::Harmonic {
-            amplitude: 0.05,
-            frequency: omega,
-            phase: 0.0,
-        };
-        Model::row(
-            n,
-            M,
-            M * W0 * W0,
-            2.0 * ZETA * M * W0,
-            clearance,
-            law,
-            (true, true),
-            base,
-        )
-        .map_err(|e| e.to_string())
+        Ok(crate::model::seed_row(n, clearance, omega))
     }
 
     /// R3 along a branch: amplitude equals the exact steady state, no

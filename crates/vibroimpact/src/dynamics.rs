@@ -27,6 +27,32 @@ use crate::contact::{ContactLaw, LawKind};
 use crate::integrate::{BandMatrix, OdeSystem};
 use crate::model::{BaseExcitation, Model};
 
+/// Index in the interleaved state `[u_1, v_1, …]` of component k of a
+/// body-order state `[u_1..u_N, v_1..v_N]` of N bodies.
+#[inline]
+pub fn interleaved_index(k: usize, n: usize) -> usize {
+    if k < n {
+        2 * k
+    } else {
+        2 * (k - n) + 1
+    }
+}
+
+/// Body-order `[u.., v..]` to interleaved `[u_1, v_1, …]`.
+pub fn to_interleaved(x: &[f64]) -> Vec<f64> {
+    let n = x.len() / 2;
+    let mut y = vec![0.0; x.len()];
+    for (k, &v) in x.iter().enumerate() {
+        y[interleaved_index(k, n)] = v;
+    }
+    y
+}
+
+/// Interleaved `[u_1, v_1, …]` (first 2N entries of `y`) to body order.
+pub fn from_interleaved(y: &[f64], n: usize) -> Vec<f64> {
+    (0..2 * n).map(|k| y[interleaved_index(k, n)]).collect()
+}
+
 /// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
 /// (`-ml F` on the left, `+mr F` on the right; masks 0 for a wall side).
 /// Returns the dissipated power `(F(s, ṡ) - F(s, 0)) ṡ` when `energy`.

@@ -626,7 +626,6 @@ mod tests {
     use crate::impact::TwoBodies;
     use crate::model::{Body, Contact, ContactPair};
 
-    const M: f64 = 0.227;
     const W0: f64 = 7.41;
     const ZETA: f64 = 0.013;
 
@@ -635,22 +634,7 @@ mod tests {
     }
 
     fn r2(n: usize, clearance: f64, omega: f64) -> Model {
-        let base = BaseExcitation::Harmonic {
-            amplitude: 0.05,
-            frequency: omega,
-            phase: 0.0,
-        };
-        Model::row(
-            n,
-            M,
-            M * W0 * W0,
-            2.0 * ZETA * M * W0,
-            clearance,
-            law(),
-            (true, true),
-            base,
-        )
-        .unwrap()
+        crate::model::seed_row(n, clearance, omega)
     }
 
     /// Exact response of `u'' + 2ζω0 u' + ω0² u = -A sin(Ωt)` from rest.

@@ -85,6 +85,17 @@ impl<S: OdeSystem> Variational<S> {
         z
     }
 
+    /// Extended initial state `[y0, w_1, …, w_p]` with given initial columns
+    /// (directional derivatives `Φ(t) w_j` instead of `Φ(t) e_j`).
+    pub fn initial_state_with(&self, y0: &[f64], columns: &[&[f64]]) -> Vec<f64> {
+        let mut z = vec![0.0; self.dim * (1 + self.columns)];
+        z[..self.dim].copy_from_slice(y0);
+        for (c, w) in columns.iter().enumerate().take(self.columns) {
+            z[self.dim * (1 + c)..self.dim * (2 + c)].copy_from_slice(w);
+        }
+        z
+    }
+
     /// Φ from an extended state, column-major (`dim × columns`).
     pub fn sensitivity<'a>(&self, z: &'a [f64]) -> &'a [f64] {
         &z[self.dim..self.dim * (1 + self.columns)]
@@ -136,34 +147,15 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{ContactLaw, ForceForm};
     use crate::dynamics::ChainDynamics;
     use crate::integrate::{integrate_to, IntegratorOptions};
-    use crate::model::{BaseExcitation, Model};
+    use crate::model::Model;
 
-    const M: f64 = 0.227;
     const W0: f64 = 7.41;
     const ZETA: f64 = 0.013;
 
     fn r2(n: usize, clearance: f64) -> Model {
-        let law =
-            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
-        let base = BaseExcitation::Harmonic {
-            amplitude: 0.05,
-            frequency: 0.95 * W0,
-            phase: 0.0,
-        };
-        Model::row(
-            n,
-            M,
-            M * W0 * W0,
-            2.0 * ZETA * M * W0,
-            clearance,
-            law,
-            (true, true),
-            base,
-        )
-        .unwrap()
+        crate::model::seed_row(n, clearance, 0.95 * W0)
     }
 
     fn opts(tol: f64, error_components: Option<usize>) -> IntegratorOptions {
