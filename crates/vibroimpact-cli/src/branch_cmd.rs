@@ -20,11 +20,12 @@ use vibroimpact::periodic::{
 };
 
 use crate::error::CliError;
-use crate::format::{csv_text, Format};
+use crate::format::Format;
 use crate::model_file::read_model;
 use crate::output::{ensure_dir, write_atomic};
 use crate::parameter::ParameterizedModel;
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use crate::simulate_cmd::history_csv;
 
 /// Options of `vibroimpact periodic`.
 #[derive(Args, Debug)]
@@ -159,25 +160,10 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
         let n = model.bodies().len();
-        let mut cols = vec!["t".to_string()];
-        cols.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
-        cols.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
-        let rows: Vec<Vec<Option<f64>>> = orbit
-            .times
-            .iter()
-            .enumerate()
-            .map(|(j, &t)| {
-                std::iter::once(Some(t))
-                    .chain(
-                        orbit.states[j * 2 * n..(j + 1) * 2 * n]
-                            .iter()
-                            .map(|&x| Some(x)),
-                    )
-                    .collect()
-            })
-            .collect();
-        let c: Vec<&str> = cols.iter().map(String::as_str).collect();
-        write_atomic(&dir.join("orbit.csv"), csv_text(&c, &rows)?.as_bytes())?;
+        write_atomic(
+            &dir.join("orbit.csv"),
+            history_csv(&model, &orbit.times, &orbit.states)?.as_bytes(),
+        )?;
         write_atomic(
             &dir.join("summary.json"),
             serde_json::to_string_pretty(&doc)?.as_bytes(),

@@ -216,6 +216,26 @@ fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOption
     })
 }
 
+/// CSV of sampled states: `t, u_<body>…, v_<body>…` (rows of `states` are
+/// `[u.., v..]` at `times`).
+pub fn history_csv(model: &Model, times: &[f64], states: &[f64]) -> Result<String, CliError> {
+    let n = model.bodies().len();
+    let mut columns: Vec<String> = vec!["t".into()];
+    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
+    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+    let rows: Vec<Vec<Option<f64>>> = times
+        .iter()
+        .enumerate()
+        .map(|(j, &t)| {
+            std::iter::once(Some(t))
+                .chain(states[j * 2 * n..(j + 1) * 2 * n].iter().map(|&x| Some(x)))
+                .collect()
+        })
+        .collect();
+    let cols: Vec<&str> = columns.iter().map(String::as_str).collect();
+    csv_text(&cols, &rows)
+}
+
 /// Writes the time history, impact log, summary and plots into `dir`.
 pub fn write_outputs(
     dir: &Path,
@@ -225,26 +245,10 @@ pub fn write_outputs(
     phase_body: usize,
 ) -> Result<(), CliError> {
     ensure_dir(dir)?;
-    let n = model.bodies().len();
-    let mut columns: Vec<String> = vec!["t".into()];
-    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
-    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
-    let rows: Vec<Vec<Option<f64>>> = sim
-        .times
-        .iter()
-        .enumerate()
-        .map(|(j, &t)| {
-            std::iter::once(Some(t))
-                .chain(
-                    sim.states[j * 2 * n..(j + 1) * 2 * n]
-                        .iter()
-                        .map(|&x| Some(x)),
-                )
-                .collect()
-        })
-        .collect();
-    let cols: Vec<&str> = columns.iter().map(String::as_str).collect();
-    write_atomic(&dir.join("history.csv"), csv_text(&cols, &rows)?.as_bytes())?;
+    write_atomic(
+        &dir.join("history.csv"),
+        history_csv(model, &sim.times, &sim.states)?.as_bytes(),
+    )?;
     let mut log = String::from("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration\n");
     for i in &sim.impacts {
         let f = |x: f64| {
