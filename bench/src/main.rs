@@ -16,6 +16,9 @@
 //! 2. N = 1000, 1 period, rtol 1e-8: time against every ARKODE explicit
 //!    method, with the achieved errors.
 //! 3. Time per period for N = 10, 100, 1000, 10000 at rtol 1e-8.
+//! 4. Cost of one shooting period map with the full monodromy (dense
+//!    variational equations, banded Jacobian) for N = 10 … 160 at rtol
+//!    1e-8, with the fitted growth exponent (issue: no faster than N²).
 //!
 //! Run: `cargo run --release -p vibroimpact-bench [-- --quick] [--no-peers]`.
 //! It builds the peers itself (`bench/peers/build.sh`, which installs
@@ -43,6 +46,9 @@ struct Args {
     /// Write the results as JSON here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Run only one section: n3, n1000, scaling or shooting.
+    #[arg(long)]
+    only: Option<String>,
 }
 
 const OMEGA_RATIO: f64 = 0.95;
@@ -239,160 +245,168 @@ fn main() {
     let repeats = if args.quick { 5 } else { 30 };
     let mut results = serde_json::Map::new();
 
-    // 1. N = 3, 5 periods, work-precision.
-    println!("== R2, N = 3, Omega = 0.95 omega0, 5 periods: work-precision (atol = 1e-3 rtol) ==");
-    let reference = ours(3, 5.0, 1e-13, 1e-16, 1).state;
-    if let Some(p) = &peers {
-        let cvode = peer_or_exit(p.run("cvode-adams", 3, 5.0, 1e-13, 1e-16, 1));
-        let agreement = error(&cvode.state, &reference);
-        println!("reference: ours at rtol 1e-13; CVODE-Adams at 1e-13 agrees to {agreement:.1e}");
-        results.insert("reference_agreement_cvode_adams".into(), json!(agreement));
-    }
-    let rtols: Vec<f64> = (6..=12).map(|k| 10f64.powi(-k)).collect();
-    let mut solvers: Vec<(&str, f64, Sweep)> = Vec::new();
-    for q in ATOL_RATIOS {
-        let sweep = rtols
-            .iter()
-            .map(|&rtol| {
-                let run = ours(3, 5.0, rtol, rtol * q, repeats);
-                (rtol, error(&run.state, &reference), run)
-            })
-            .collect();
-        solvers.push(("vibroimpact-dop853", q, sweep));
-    }
-    if let Some(p) = &peers {
-        for method in [
-            "arkode-dp5",
-            "arkode-verner8",
-            "arkode-fehlberg8",
-            "cvode-adams",
-            "scipy-dop853",
-        ] {
-            let scipy = method.starts_with("scipy");
-            for q in ATOL_RATIOS {
-                let mut sweep = Vec::new();
-                for &rtol in &rtols {
-                    if scipy && rtol < 1e-11 {
-                        continue; // seconds per point; its robust setting is found before
-                    }
-                    let reps = if scipy { 3 } else { repeats };
-                    let run = peer_or_exit(p.run(method, 3, 5.0, rtol, rtol * q, reps));
-                    sweep.push((rtol, error(&run.state, &reference), run));
-                }
-                solvers.push((method, q, sweep));
-            }
-        }
-    }
-    println!(
-        "{:<20} {:>9} {:>8} {:>10} {:>10} {:>9}",
-        "solver", "atol/rtol", "rtol", "error", "ms", "rhs"
-    );
-    // Per solver: the fastest robust setting over the atol ratios.
-    let mut picks: Vec<(&str, f64, f64, f64, f64)> = Vec::new();
-    for (name, q, sweep) in &solvers {
-        for (rtol, err, run) in sweep {
-            println!(
-                "{name:<20} {q:>9.0e} {rtol:>8.0e} {err:>10.2e} {:>10.3} {:>9}",
-                run.seconds * 1e3,
-                run.rhs
-            );
-        }
-        if let Some((rtol, err, run)) = robust(sweep) {
-            match picks.iter_mut().find(|p| p.0 == *name) {
-                Some(p) if p.4 <= run.seconds => {}
-                Some(p) => *p = (name, *q, *rtol, *err, run.seconds),
-                None => picks.push((name, *q, *rtol, *err, run.seconds)),
-            }
-        }
-    }
-    for (name, _, _) in &solvers {
-        if !picks.iter().any(|p| p.0 == *name) {
-            println!("{name}: no robust setting reaches error {TARGET_ERROR:e} in the sweep");
-        }
-    }
-    let our_time = picks
-        .iter()
-        .find(|p| p.0 == "vibroimpact-dop853")
-        .map_or(f64::NAN, |p| p.4);
-    println!("\nrobust settings (loosest rtol from which all tighter meet error <= 1e-6; best atol ratio):");
-    let mut pick_json = Vec::new();
-    for (name, q, rtol, err, secs) in &picks {
-        let ratio = secs / our_time;
+    let run = |name: &str| args.only.as_deref().is_none_or(|o| o == name);
+    if run("n3") {
+        // 1. N = 3, 5 periods, work-precision.
         println!(
+            "== R2, N = 3, Omega = 0.95 omega0, 5 periods: work-precision (atol = 1e-3 rtol) =="
+        );
+        let reference = ours(3, 5.0, 1e-13, 1e-16, 1).state;
+        if let Some(p) = &peers {
+            let cvode = peer_or_exit(p.run("cvode-adams", 3, 5.0, 1e-13, 1e-16, 1));
+            let agreement = error(&cvode.state, &reference);
+            println!(
+                "reference: ours at rtol 1e-13; CVODE-Adams at 1e-13 agrees to {agreement:.1e}"
+            );
+            results.insert("reference_agreement_cvode_adams".into(), json!(agreement));
+        }
+        let rtols: Vec<f64> = (6..=12).map(|k| 10f64.powi(-k)).collect();
+        let mut solvers: Vec<(&str, f64, Sweep)> = Vec::new();
+        for q in ATOL_RATIOS {
+            let sweep = rtols
+                .iter()
+                .map(|&rtol| {
+                    let run = ours(3, 5.0, rtol, rtol * q, repeats);
+                    (rtol, error(&run.state, &reference), run)
+                })
+                .collect();
+            solvers.push(("vibroimpact-dop853", q, sweep));
+        }
+        if let Some(p) = &peers {
+            for method in [
+                "arkode-dp5",
+                "arkode-verner8",
+                "arkode-fehlberg8",
+                "cvode-adams",
+                "scipy-dop853",
+            ] {
+                let scipy = method.starts_with("scipy");
+                for q in ATOL_RATIOS {
+                    let mut sweep = Vec::new();
+                    for &rtol in &rtols {
+                        if scipy && rtol < 1e-11 {
+                            continue; // seconds per point; its robust setting is found before
+                        }
+                        let reps = if scipy { 3 } else { repeats };
+                        let run = peer_or_exit(p.run(method, 3, 5.0, rtol, rtol * q, reps));
+                        sweep.push((rtol, error(&run.state, &reference), run));
+                    }
+                    solvers.push((method, q, sweep));
+                }
+            }
+        }
+        println!(
+            "{:<20} {:>9} {:>8} {:>10} {:>10} {:>9}",
+            "solver", "atol/rtol", "rtol", "error", "ms", "rhs"
+        );
+        // Per solver: the fastest robust setting over the atol ratios.
+        let mut picks: Vec<(&str, f64, f64, f64, f64)> = Vec::new();
+        for (name, q, sweep) in &solvers {
+            for (rtol, err, run) in sweep {
+                println!(
+                    "{name:<20} {q:>9.0e} {rtol:>8.0e} {err:>10.2e} {:>10.3} {:>9}",
+                    run.seconds * 1e3,
+                    run.rhs
+                );
+            }
+            if let Some((rtol, err, run)) = robust(sweep) {
+                match picks.iter_mut().find(|p| p.0 == *name) {
+                    Some(p) if p.4 <= run.seconds => {}
+                    Some(p) => *p = (name, *q, *rtol, *err, run.seconds),
+                    None => picks.push((name, *q, *rtol, *err, run.seconds)),
+                }
+            }
+        }
+        for (name, _, _) in &solvers {
+            if !picks.iter().any(|p| p.0 == *name) {
+                println!("{name}: no robust setting reaches error {TARGET_ERROR:e} in the sweep");
+            }
+        }
+        let our_time = picks
+            .iter()
+            .find(|p| p.0 == "vibroimpact-dop853")
+            .map_or(f64::NAN, |p| p.4);
+        println!("\nrobust settings (loosest rtol from which all tighter meet error <= 1e-6; best atol ratio):");
+        let mut pick_json = Vec::new();
+        for (name, q, rtol, err, secs) in &picks {
+            let ratio = secs / our_time;
+            println!(
             "{name:<20} atol/rtol {q:.0e} rtol {rtol:.0e}  error {err:.2e}  {:.3} ms  peer/ours = {ratio:.1}",
             secs * 1e3
         );
-        pick_json.push(json!({"solver": name, "atol_ratio": q, "rtol": rtol, "error": err, "seconds": secs, "ratio_to_ours": ratio}));
-    }
-    results.insert(
+            pick_json.push(json!({"solver": name, "atol_ratio": q, "rtol": rtol, "error": err, "seconds": secs, "ratio_to_ours": ratio}));
+        }
+        results.insert(
         "r2_n3".into(),
         json!({
             "sweep": solvers.iter().map(|(name, q, s)| json!({"solver": name, "atol_ratio": q, "points": s.iter().map(|(r, e, run)| json!({"rtol": r, "error": e, "seconds": run.seconds, "rhs_evaluations": run.rhs, "steps": run.steps})).collect::<Vec<_>>()})).collect::<Vec<_>>(),
             "robust": pick_json,
         }),
     );
-
-    // 2. N = 1000, 1 period, rtol 1e-8.
-    println!("\n== R2, N = 1000, 1 period, rtol 1e-8, atol 1e-11 ==");
-    let reference = ours(1000, 1.0, 1e-12, 1e-15, 1).state;
-    let mine = ours(1000, 1.0, 1e-8, 1e-11, if args.quick { 3 } else { 10 });
-    let mut rows = vec![(
-        "vibroimpact-dop853",
-        error(&mine.state, &reference),
-        mine.clone(),
-    )];
-    if let Some(p) = &peers {
-        for method in [
-            "arkode-dp5",
-            "arkode-verner8",
-            "arkode-fehlberg8",
-            "scipy-dop853",
-        ] {
-            let run = peer_or_exit(p.run(method, 1000, 1.0, 1e-8, 1e-11, 3));
-            rows.push((method, error(&run.state, &reference), run));
+    }
+    if run("n1000") {
+        // 2. N = 1000, 1 period, rtol 1e-8.
+        println!("\n== R2, N = 1000, 1 period, rtol 1e-8, atol 1e-11 ==");
+        let reference = ours(1000, 1.0, 1e-12, 1e-15, 1).state;
+        let mine = ours(1000, 1.0, 1e-8, 1e-11, if args.quick { 3 } else { 10 });
+        let mut rows = vec![(
+            "vibroimpact-dop853",
+            error(&mine.state, &reference),
+            mine.clone(),
+        )];
+        if let Some(p) = &peers {
+            for method in [
+                "arkode-dp5",
+                "arkode-verner8",
+                "arkode-fehlberg8",
+                "scipy-dop853",
+            ] {
+                let run = peer_or_exit(p.run(method, 1000, 1.0, 1e-8, 1e-11, 3));
+                rows.push((method, error(&run.state, &reference), run));
+            }
         }
-    }
-    let best_arkode = rows
-        .iter()
-        .filter(|r| r.0.starts_with("arkode"))
-        .map(|r| r.2.seconds)
-        .fold(f64::INFINITY, f64::min);
-    for (name, err, run) in &rows {
-        println!(
-            "{name:<20} {:>9.2} ms  error {err:.2e}  rhs {:>6}  steps {:>5}  time/ours {:.1}",
-            run.seconds * 1e3,
-            run.rhs,
-            run.steps,
-            run.seconds / mine.seconds
-        );
-    }
-    if best_arkode.is_finite() {
-        println!(
-            "fastest ARKODE explicit / ours = {:.1}",
-            best_arkode / mine.seconds
-        );
-    }
-    results.insert(
+        let best_arkode = rows
+            .iter()
+            .filter(|r| r.0.starts_with("arkode"))
+            .map(|r| r.2.seconds)
+            .fold(f64::INFINITY, f64::min);
+        for (name, err, run) in &rows {
+            println!(
+                "{name:<20} {:>9.2} ms  error {err:.2e}  rhs {:>6}  steps {:>5}  time/ours {:.1}",
+                run.seconds * 1e3,
+                run.rhs,
+                run.steps,
+                run.seconds / mine.seconds
+            );
+        }
+        if best_arkode.is_finite() {
+            println!(
+                "fastest ARKODE explicit / ours = {:.1}",
+                best_arkode / mine.seconds
+            );
+        }
+        results.insert(
         "r2_n1000".into(),
         json!({"runs": rows.iter().map(|(n, e, r)| json!({"solver": n, "error": e, "seconds": r.seconds, "rhs_evaluations": r.rhs, "steps": r.steps})).collect::<Vec<_>>(),
                "fastest_arkode_over_ours": best_arkode / mine.seconds}),
     );
-
-    // 3. Scaling.
-    println!("\n== time per period, rtol 1e-8 ==");
-    let sizes: &[usize] = if args.quick {
-        &[10, 100, 1000]
-    } else {
-        &[10, 100, 1000, 10000]
-    };
-    let mut scaling = Vec::new();
-    for &n in sizes {
-        let run = ours(n, 1.0, 1e-8, 1e-11, if n >= 10000 { 2 } else { 7 });
-        let peer = peers
-            .as_ref()
-            .map(|p| peer_or_exit(p.run("arkode-verner8", n, 1.0, 1e-8, 1e-11, 1)));
-        let per_body_us = run.seconds / n as f64 * 1e6;
-        match &peer {
+    }
+    if run("scaling") {
+        // 3. Scaling.
+        println!("\n== time per period, rtol 1e-8 ==");
+        let sizes: &[usize] = if args.quick {
+            &[10, 100, 1000]
+        } else {
+            &[10, 100, 1000, 10000]
+        };
+        let mut scaling = Vec::new();
+        for &n in sizes {
+            let run = ours(n, 1.0, 1e-8, 1e-11, if n >= 10000 { 2 } else { 7 });
+            let peer = peers
+                .as_ref()
+                .map(|p| peer_or_exit(p.run("arkode-verner8", n, 1.0, 1e-8, 1e-11, 1)));
+            let per_body_us = run.seconds / n as f64 * 1e6;
+            match &peer {
             Some(pr) => println!(
                 "N = {n:>6}: ours {:>9.3} ms ({per_body_us:.2} µs per body), ARKODE Verner {:>9.3} ms, ratio {:.1}",
                 run.seconds * 1e3,
@@ -401,9 +415,48 @@ fn main() {
             ),
             None => println!("N = {n:>6}: ours {:>9.3} ms ({per_body_us:.2} µs per body)", run.seconds * 1e3),
         }
-        scaling.push(json!({"n": n, "ours_seconds": run.seconds, "ours_rhs": run.rhs, "arkode_verner8_seconds": peer.map(|p| p.seconds)}));
+            scaling.push(json!({"n": n, "ours_seconds": run.seconds, "ours_rhs": run.rhs, "arkode_verner8_seconds": peer.map(|p| p.seconds)}));
+        }
+        results.insert("scaling".into(), Value::Array(scaling));
     }
-    results.insert("scaling".into(), Value::Array(scaling));
+    if run("shooting") {
+        // 4. Shooting cost per period map with the full monodromy.
+        println!("\n== shooting: one period map with the full monodromy, rtol 1e-8 ==");
+        let mut rows = Vec::new();
+        for n in [10usize, 20, 40, 80, 160] {
+            let model = r2(n);
+            let opts = vibroimpact::periodic::ShootingOptions {
+                rtol: 1e-8,
+                ..Default::default()
+            };
+            let x = vec![0.0; 2 * n];
+            let mut best = f64::INFINITY;
+            for _ in 0..if n >= 160 { 1 } else { 3 } {
+                let start = Instant::now();
+                vibroimpact::periodic::period_map(&model, &x, &opts).expect("period map");
+                best = best.min(start.elapsed().as_secs_f64());
+            }
+            println!("N = {n:>4}: {:>10.3} ms", best * 1e3);
+            rows.push((n as f64, best));
+        }
+        // Least-squares slope of log(time) against log(N) over the largest three.
+        let tail = &rows[rows.len() - 3..];
+        let (mx, my) = tail.iter().fold((0.0, 0.0), |a, r| {
+            (a.0 + r.0.ln() / 3.0, a.1 + r.1.ln() / 3.0)
+        });
+        let (sxy, sxx) = tail.iter().fold((0.0, 0.0), |a, r| {
+            (
+                a.0 + (r.0.ln() - mx) * (r.1.ln() - my),
+                a.1 + (r.0.ln() - mx).powi(2),
+            )
+        });
+        let exponent = sxy / sxx;
+        println!("growth exponent (N = 40 … 160): {exponent:.2}");
+        results.insert(
+            "shooting".into(),
+            json!({"rows": rows.iter().map(|r| json!({"n": r.0, "seconds": r.1})).collect::<Vec<_>>(), "exponent": exponent}),
+        );
+    }
     if let Some(out) = &args.out {
         let text = serde_json::to_string_pretty(&Value::Object(results)).expect("serialisable");
         if let Err(e) = std::fs::write(out, text) {

@@ -163,10 +163,13 @@ pub fn period_map(
     let sys = ChainDynamics::new(model, false);
     let mut var = Variational::new(sys, d);
     let z0 = var.initial_state(&to_interleaved(x));
+    // The state controls the steps: Φ rides along on the same steps, so a
+    // period map costs O(N) steps × O(N² · bandwidth) per step.
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,
         atol: opts.rtol * opts.displacement_scale,
         max_steps: MAX_STEPS,
+        error_components: Some(d),
         ..IntegratorOptions::default()
     };
     let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
