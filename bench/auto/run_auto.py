@@ -340,10 +340,12 @@ def main(argv):
                     "omega_range": [min(r["par1"] for r in srows), max(r["par1"] for r in srows)],
                     "end": TYPES.get(srows[-1]["ty"]), "end_omega": srows[-1]["par1"],
                     "special_points": sp,
-                    "branch": [{"omega_over_omega0": r["par1"],
-                                "max_u1": GAP * max(abs(r["maxx1"]), abs(r["minx1"])),
-                                "max_u2": GAP * max(abs(r["maxx2"]), abs(r["minx2"])),
-                                "stable": r["pt"] < 0} for r in srows],
+                    # every 5th point and every labelled one, 7 digits (information only)
+                    "branch": [{"omega_over_omega0": float("%.7g" % r["par1"]),
+                                "max_u1": float("%.7g" % (GAP * max(abs(r["maxx1"]), abs(r["minx1"])))),
+                                "max_u2": float("%.7g" % (GAP * max(abs(r["maxx2"]), abs(r["minx2"])))),
+                                "stable": r["pt"] < 0}
+                               for k, r in enumerate(srows) if k % 5 == 0 or r["lab"] > 0],
                 })
 
     last = rows[-1]

@@ -22,8 +22,9 @@
 //!   a multiplier crosses +1 where the parameter does not turn;
 //! - period doubling: `det(Φ + I)` changes sign (a real multiplier
 //!   crosses -1);
-//! - Neimark–Sacker: the number of complex multipliers outside the unit
-//!   circle changes;
+//! - Neimark–Sacker: the number of multipliers outside the unit circle
+//!   changes while no real multiplier crosses +1 or -1 (a complex pair
+//!   crossed);
 //! - grazing: the number of impacts per period changes.
 //!
 //! Each is located by bisection of the arclength between the two points
@@ -378,7 +379,8 @@ struct Tests {
     tangent_p: f64,
     det_ext: f64,
     det_pd: f64,
-    ns_count: usize,
+    /// Multipliers outside the unit circle.
+    outside: usize,
     impacts: usize,
 }
 
@@ -400,10 +402,7 @@ fn tests_at(
         tangent_p: t[d],
         det_ext: a.determinant(),
         det_pd: pd.determinant(),
-        ns_count: multipliers
-            .iter()
-            .filter(|m| m.im.abs() > 1e-9 * m.norm() && m.norm() > 1.0)
-            .count(),
+        outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
         impacts,
     }
 }
@@ -415,7 +414,16 @@ fn changed(kind: SpecialKind, a: &Tests, b: &Tests) -> bool {
             a.det_ext.signum() != b.det_ext.signum() && a.tangent_p.signum() == b.tangent_p.signum()
         }
         SpecialKind::PeriodDoubling => a.det_pd.signum() != b.det_pd.signum(),
-        SpecialKind::NeimarkSacker => a.ns_count != b.ns_count,
+        // A change of the number of multipliers outside the circle that no
+        // real crossing at +1 (fold, branch point) or -1 (period doubling)
+        // explains: a complex pair crossed. (Two real multipliers that
+        // collide and turn complex outside the circle change nothing.)
+        SpecialKind::NeimarkSacker => {
+            a.outside != b.outside
+                && a.det_pd.signum() == b.det_pd.signum()
+                && a.det_ext.signum() == b.det_ext.signum()
+                && a.tangent_p.signum() == b.tangent_p.signum()
+        }
         SpecialKind::Grazing => a.impacts != b.impacts,
     }
 }
