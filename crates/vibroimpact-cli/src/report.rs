@@ -439,6 +439,15 @@ fn seed_part3(report: &mut Report) -> Result<(), CliError> {
     Ok(())
 }
 
+/// CSV rows (U, measured, fitted, residual) of fit residuals.
+fn residual_rows<'a>(
+    residuals: impl Iterator<Item = &'a vibroimpact::identify::Residual>,
+) -> Vec<Vec<f64>> {
+    residuals
+        .map(|r| vec![r.impact_velocity, r.measured, r.fitted, r.residual])
+        .collect()
+}
+
 fn identification_figures(
     report: &mut Report,
     data: &Measurements,
@@ -549,12 +558,7 @@ fn identification_figures(
             DataFile::new(
                 "fig4_residuals.csv",
                 vec!["impact_velocity", "measured", "fitted", "residual"],
-                sequential
-                    .restitution_fit
-                    .iter()
-                    .flat_map(|f| &f.residuals)
-                    .map(|r| vec![r.impact_velocity, r.measured, r.fitted, r.residual])
-                    .collect(),
+                residual_rows(sequential.restitution_fit.iter().flat_map(|f| &f.residuals)),
             ),
         ],
     )?;
@@ -587,12 +591,7 @@ fn identification_figures(
         vec![DataFile::new(
             "fig5_residuals.csv",
             vec!["impact_velocity", "measured", "fitted", "residual_ln"],
-            sequential
-                .acceleration_fit
-                .iter()
-                .flat_map(|f| &f.acceleration_residuals)
-                .map(|r| vec![r.impact_velocity, r.measured, r.fitted, r.residual])
-                .collect(),
+            residual_rows(sequential.acceleration_fit.iter().flat_map(|f| &f.acceleration_residuals)),
         )],
     )?;
     Ok(())

@@ -194,6 +194,28 @@ fn scaled_norm(r: &[f64], scale: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Backtracking along a Newton direction: tries λ = λ0, λ0/2, … (12 times)
+/// and returns the first trial whose scaled residual `trial(λ)` reports
+/// below `norm` (or below `tol`). `trial` returns `Ok(None)` for a trial to
+/// skip (e.g. an integration that failed at a large λ) and `Err` to stop.
+fn backtrack<S, E>(
+    lambda0: f64,
+    norm: f64,
+    tol: f64,
+    mut trial: impl FnMut(f64) -> Result<Option<(S, f64)>, E>,
+) -> Result<Option<(S, f64)>, E> {
+    let mut lambda = lambda0;
+    for _ in 0..12 {
+        if let Some((state, tn)) = trial(lambda)? {
+            if tn < norm || tn <= tol {
+                return Ok(Some((state, tn)));
+            }
+        }
+        lambda *= 0.5;
+    }
+    Ok(None)
+}
+
 /// Finds a periodic solution of period nT near `guess` (body order) by
 /// Newton's method on the period map.
 pub fn shoot(
@@ -243,9 +265,7 @@ pub fn shoot(
         // full Newton step can land deep inside a contact, where e^{αs}
         // makes the period map astronomically stiff).
         let step = scaled_norm(delta.as_slice(), &scale);
-        let mut lambda = (TRUST / step).min(1.0);
-        let mut accepted = false;
-        for _ in 0..12 {
+        let found = backtrack((TRUST / step).min(1.0), norm, opts.tol, |lambda| {
             let trial: Vec<f64> = x
                 .iter()
                 .zip(delta.iter())
@@ -253,23 +273,19 @@ pub fn shoot(
                 .collect();
             let trial_map = match eval(&trial, iteration) {
                 Ok(m) => m,
-                Err(_) if lambda > 1e-3 => {
-                    lambda *= 0.5;
-                    continue;
-                }
+                Err(_) if lambda > 1e-3 => return Ok(None),
                 Err(e) => return Err(e),
             };
             let tr = residual(&trial_map, &trial);
             let tn = scaled_norm(&tr, &scale);
-            if tn < norm || tn <= opts.tol {
-                x = trial;
-                map = trial_map;
-                r = tr;
-                norm = tn;
-                accepted = true;
-                break;
-            }
-            lambda *= 0.5;
+            Ok(Some(((trial, trial_map, tr), tn)))
+        })?;
+        let accepted = found.is_some();
+        if let Some(((trial, trial_map, tr), tn)) = found {
+            x = trial;
+            map = trial_map;
+            r = tr;
+            norm = tn;
         }
         history.push(norm);
         if !accepted {
@@ -443,24 +459,21 @@ pub fn shoot_krylov(
         let (delta, _, _) = gmres(&mut op, &b, &scale, 60, 1e-3)
             .map_err(|source| PeriodicError::Integration { iteration, source })?;
         let step = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut lambda = (TRUST / step).min(1.0);
-        let mut accepted = false;
-        for _ in 0..12 {
+        let found = backtrack((TRUST / step).min(1.0), norm, opts.tol, |lambda| {
             let trial: Vec<f64> = (0..d)
                 .map(|i| x[i] + lambda * delta[i] * scale[i])
                 .collect();
-            if let Ok(tp) = image(&trial, iteration) {
+            Ok::<_, PeriodicError>(image(&trial, iteration).ok().map(|tp| {
                 let tr: Vec<f64> = (0..d).map(|i| (tp[i] - trial[i]) / scale[i]).collect();
                 let tn = tr.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                if tn < norm || tn <= opts.tol {
-                    x = trial;
-                    r = tr;
-                    norm = tn;
-                    accepted = true;
-                    break;
-                }
-            }
-            lambda *= 0.5;
+                ((trial, tr), tn)
+            }))
+        })?;
+        let accepted = found.is_some();
+        if let Some(((trial, tr), tn)) = found {
+            x = trial;
+            r = tr;
+            norm = tn;
         }
         history.push(norm);
         if !accepted {
