@@ -290,6 +290,7 @@ pub fn branch_json(branch: &Branch, model: &Model, name: &str) -> serde_json::Va
     json!({
         "parameter_name": name,
         "subharmonic": branch.subharmonic,
+        "symmetric": branch.symmetric,
         "stop": format!("{:?}", branch.stop),
         "contacts": (0..model.contacts().len()).map(|k| model.contact_name(k)).collect::<Vec<_>>(),
         "points": branch.points.iter().map(|p| json!({
@@ -307,6 +308,7 @@ pub fn branch_json(branch: &Branch, model: &Model, name: &str) -> serde_json::Va
             "kind": s.kind.name(),
             "label": s.label,
             "parameter": s.parameter,
+            "symmetry_breaking": s.symmetry_breaking,
             "floquet_multipliers": s.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
             "initial_state": s.state,
         })).collect::<Vec<_>>(),
@@ -504,58 +506,13 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)
         .map_err(|e| CliError::new(e.to_string()))?;
     let mut branches = vec![branch];
+    // A failed switch keeps the main branch: it is written, then reported.
+    let mut switch_error = None;
     if let Some(label) = &args.switch_at {
-        let sp = branches[0]
-            .special
-            .iter()
-            .find(|s| &s.label == label)
-            .ok_or_else(|| {
-                CliError::new(format!(
-                    "--switch-at {label}: no such special point on the branch (found: {})",
-                    branches[0]
-                        .special
-                        .iter()
-                        .map(|s| s.label.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })?
-            .clone();
-        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-        let (p1, x1, sub) = match sp.kind {
-            SpecialKind::PeriodDoubling => {
-                let (p, x) = period_doubled_start(family, &sp, &opts)
-                    .map_err(|e| CliError::new(e.to_string()))?;
-                (p, x, args.subharmonic * 2)
-            }
-            SpecialKind::BranchPoint => {
-                let (p, x) = branch_switch_start(family, &sp, args.from, &opts, 0.02)
-                    .map_err(|e| CliError::new(e.to_string()))?;
-                (p, x, args.subharmonic)
-            }
-            other => {
-                return Err(CliError::new(format!(
-                    "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
-                    other.name()
-                )))
-            }
-        };
-        let switched_opts = ContinuationOptions {
-            shooting: ShootingOptions {
-                subharmonic: sub,
-                ..opts.shooting.clone()
-            },
-            ..opts.clone()
-        };
-        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-        let target = if (args.to - p1).abs() > 1e-12 {
-            args.to
-        } else {
-            args.from
-        };
-        let b = continue_branch(family, p1, &x1, target, &switched_opts, progress)
-            .map_err(|e| CliError::new(e.to_string()))?;
-        branches.push(b);
+        match switched_branch(&branches[0], label, args, &opts, &pm, progress) {
+            Ok(b) => branches.push(b),
+            Err(e) => switch_error = Some(e),
+        }
     }
     if tty {
         eprintln!();
@@ -620,10 +577,77 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             }
         }
     }
+    if let Some(e) = switch_error {
+        return Err(e);
+    }
     match &branches[0].stop {
         vibroimpact::continuation::StopReason::CannotContinue(why) => Err(CliError::new(format!(
             "the branch cannot continue: {why} (the points computed so far are kept)"
         ))),
         _ => Ok(()),
     }
+}
+
+/// The branch through special point `label` of `branch` (a branch point's
+/// crossing branch or a period doubling's period-2n branch), continued
+/// within the range of `--from`/`--to`.
+fn switched_branch(
+    branch: &Branch,
+    label: &str,
+    args: &ContinueArgs,
+    opts: &ContinuationOptions,
+    pm: &ParameterizedModel,
+    progress: impl FnMut(&vibroimpact::continuation::BranchPoint) -> bool,
+) -> Result<Branch, CliError> {
+    let sp = branch
+        .special
+        .iter()
+        .find(|s| s.label == label)
+        .ok_or_else(|| {
+            CliError::new(format!(
+                "--switch-at {label}: no such special point on the branch (found: {})",
+                branch
+                    .special
+                    .iter()
+                    .map(|s| s.label.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+    let fail = |e: vibroimpact::continuation::ContinuationError| {
+        CliError::new(format!(
+            "--switch-at {label}: {e} (the main branch is kept)"
+        ))
+    };
+    let (p1, x1, sub) = match sp.kind {
+        SpecialKind::PeriodDoubling => {
+            let (p, x) = period_doubled_start(family, sp, opts).map_err(fail)?;
+            (p, x, args.subharmonic * 2)
+        }
+        SpecialKind::BranchPoint => {
+            let (p, x) = branch_switch_start(family, sp, args.from, opts, 0.02).map_err(fail)?;
+            (p, x, args.subharmonic)
+        }
+        other => {
+            return Err(CliError::new(format!(
+                "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
+                other.name()
+            )))
+        }
+    };
+    let switched_opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            subharmonic: sub,
+            ..opts.shooting.clone()
+        },
+        bounds: Some((args.from, args.to)),
+        ..opts.clone()
+    };
+    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+    // Onward from the start, away from the special point (the branch
+    // stays within --from/--to).
+    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
+    let target = if p1 >= sp.parameter { hi } else { lo };
+    continue_branch(family, p1, &x1, target, &switched_opts, progress).map_err(fail)
 }

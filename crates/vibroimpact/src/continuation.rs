@@ -36,8 +36,8 @@ use nalgebra::{Complex, DMatrix, DVector};
 use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
 use crate::periodic::{
-    floquet_multipliers, forcing_period, orbit_summary, period_map, shoot, PeriodicError,
-    ShootingOptions,
+    forcing_period, map_multipliers, map_time, mirror, orbit_summary, period_map, shoot,
+    PeriodicError, ShootingOptions,
 };
 
 /// Kinds of special points.
@@ -99,6 +99,19 @@ pub struct ContinuationOptions {
     pub locate_tol: f64,
     /// Samples per period for amplitudes.
     pub orbit_samples: usize,
+    /// Largest change of the Floquet multipliers between consecutive points
+    /// ([`spectral_distance`]); a larger change halves the step, so that two
+    /// crossings of the unit circle do not hide in one step.
+    pub max_multiplier_change: f64,
+    /// Parameter interval the branch must stay in (default: between the
+    /// start and the end value).
+    pub bounds: Option<(f64, f64)>,
+    /// Follow symmetric orbits of a mirror-symmetric model on the half map
+    /// (see [`ShootingOptions::symmetric`]) when the start orbit is
+    /// symmetric: half the cost, and symmetry-breaking pitchforks are
+    /// regular points of the half map, found by its eigenvalue -1 instead
+    /// of a singular extended Jacobian.
+    pub use_symmetry: bool,
 }
 
 impl Default for ContinuationOptions {
@@ -118,6 +131,9 @@ impl Default for ContinuationOptions {
             max_corrector: 8,
             locate_tol: 1e-8,
             orbit_samples: 256,
+            max_multiplier_change: 0.25,
+            bounds: None,
+            use_symmetry: true,
         }
     }
 }
@@ -167,6 +183,10 @@ pub struct SpecialPoint {
     pub tangent: Vec<f64>,
     /// Index of the branch point after which it lies.
     pub after_point: usize,
+    /// A branch point where a symmetric orbit loses its symmetry (an
+    /// eigenvalue -1 of the half map's Jacobian): a pitchfork whose
+    /// crossing branch is a pair of mirror-image asymmetric orbits.
+    pub symmetry_breaking: bool,
 }
 
 /// Why a continuation ended.
@@ -193,6 +213,9 @@ pub struct Branch {
     pub stop: StopReason,
     /// Period multiple n of the branch.
     pub subharmonic: u32,
+    /// Whether the branch was followed on the symmetric half map (its
+    /// orbits satisfy `x(t + nT/2) = S x(t)`).
+    pub symmetric: bool,
 }
 
 /// Errors before a branch exists.
@@ -356,7 +379,7 @@ impl<'a, F: FnMut(f64) -> Result<Model, String>> Problem<'a, F> {
 /// `P(x)` without the variational equations (for ∂G/∂p).
 fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<f64>> {
     let n = model.bodies().len();
-    let t = forcing_period(model).ok()? * f64::from(opts.subharmonic.max(1));
+    let t = map_time(model, opts).ok()?;
     let mut sys = crate::dynamics::ChainDynamics::new(model, false);
     let y0 = crate::dynamics::to_interleaved(x);
     let int_opts = IntegratorOptions {
@@ -366,11 +389,12 @@ fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<
         ..IntegratorOptions::default()
     };
     let (y, _) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
-    Some(
-        (0..2 * n)
-            .map(|k| if k < n { y[2 * k] } else { y[2 * (k - n) + 1] })
-            .collect(),
-    )
+    let image = crate::dynamics::from_interleaved(&y, n);
+    Some(if opts.symmetric {
+        mirror(&image)
+    } else {
+        image
+    })
 }
 
 /// Test-function values at a point.
@@ -378,6 +402,9 @@ fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<
 struct Tests {
     tangent_p: f64,
     det_ext: f64,
+    /// det(DG + I) of the symmetric half map (an eigenvalue -1 of DG is a
+    /// symmetry-breaking pitchfork); 1 off the half map.
+    det_sym: f64,
     det_pd: f64,
     /// Multipliers outside the unit circle.
     outside: usize,
@@ -390,6 +417,7 @@ fn tests_at(
     monodromy: &DMatrix<f64>,
     multipliers: &[Complex<f64>],
     impacts: usize,
+    symmetric: bool,
 ) -> Tests {
     let d = jac.nrows();
     let mut a = DMatrix::zeros(d + 1, d + 1);
@@ -397,10 +425,20 @@ fn tests_at(
     for c in 0..=d {
         a[(d, c)] = t[c];
     }
-    let pd = monodromy + DMatrix::<f64>::identity(d, d);
+    let identity = DMatrix::<f64>::identity(d, d);
+    // Φ + I; on the half map Φ = DG².
+    let (det_sym, pd) = if symmetric {
+        (
+            (monodromy + &identity).determinant(),
+            monodromy * monodromy + &identity,
+        )
+    } else {
+        (1.0, monodromy + &identity)
+    };
     Tests {
         tangent_p: t[d],
         det_ext: a.determinant(),
+        det_sym,
         det_pd: pd.determinant(),
         outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
         impacts,
@@ -411,7 +449,9 @@ fn changed(kind: SpecialKind, a: &Tests, b: &Tests) -> bool {
     match kind {
         SpecialKind::Fold => a.tangent_p.signum() != b.tangent_p.signum(),
         SpecialKind::BranchPoint => {
-            a.det_ext.signum() != b.det_ext.signum() && a.tangent_p.signum() == b.tangent_p.signum()
+            (a.det_ext.signum() != b.det_ext.signum()
+                && a.tangent_p.signum() == b.tangent_p.signum())
+                || a.det_sym.signum() != b.det_sym.signum()
         }
         SpecialKind::PeriodDoubling => a.det_pd.signum() != b.det_pd.signum(),
         // A change of the number of multipliers outside the circle that no
@@ -422,6 +462,7 @@ fn changed(kind: SpecialKind, a: &Tests, b: &Tests) -> bool {
             a.outside != b.outside
                 && a.det_pd.signum() == b.det_pd.signum()
                 && a.det_ext.signum() == b.det_ext.signum()
+                && a.det_sym.signum() == b.det_sym.signum()
                 && a.tangent_p.signum() == b.tangent_p.signum()
         }
         SpecialKind::Grazing => a.impacts != b.impacts,
@@ -459,7 +500,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
             self.opts.shooting.rtol,
         )
         .ok()?;
-        let multipliers = floquet_multipliers(&solved.monodromy);
+        let symmetric = self.opts.shooting.symmetric;
+        let multipliers = map_multipliers(&solved.monodromy, symmetric).ok()?;
         let impacts = orbit.impacts_per_period();
         let tests = tests_at(
             &solved.jac,
@@ -467,6 +509,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
             &solved.monodromy,
             &multipliers,
             impacts,
+            symmetric,
         );
         let point = BranchPoint {
             parameter: p,
@@ -562,8 +605,25 @@ where
         ));
     }
     let d = x0.len();
+    let symmetric = opts.shooting.symmetric
+        || (opts.use_symmetry
+            && opts.shooting.subharmonic.max(1) % 2 == 1
+            && model.is_mirror_symmetric()
+            && is_symmetric_orbit(&model, &start.initial_state, &opts.shooting));
+    let local = ContinuationOptions {
+        shooting: ShootingOptions {
+            symmetric,
+            ..opts.shooting.clone()
+        },
+        ..opts.clone()
+    };
+    let opts = &local;
     let mut problem = Problem::new(&mut family, opts, &model, p0);
-    let (lo, hi) = (p0.min(p_end), p0.max(p_end));
+    let (lo, hi) = opts
+        .bounds
+        .map_or((p0.min(p_end), p0.max(p_end)), |(a, b)| {
+            (a.min(b), a.max(b))
+        });
     let z0 = problem.scale_state(&start.initial_state, p0);
     // The start point: corrected with the parameter held (t = e_p).
     let mut dir = vec![0.0; d + 1];
@@ -584,6 +644,7 @@ where
             special,
             stop: StopReason::Interrupted,
             subharmonic: opts.shooting.subharmonic,
+            symmetric,
         });
     }
     let mut current = first;
@@ -612,6 +673,13 @@ where
                     .sum();
                 (cos > 0.8).then_some((e, it))
             });
+        // Step too long for the spectrum: the multipliers moved so far that
+        // two crossings could cancel in the test functions (kept at ds_min).
+        let attempt = attempt.filter(|(next, _)| {
+            0.5 * ds < opts.ds_min
+                || spectral_distance(&current.point.multipliers, &next.point.multipliers)
+                    <= opts.max_multiplier_change
+        });
         let Some((next, iterations)) = attempt else {
             ds *= 0.5;
             if ds < opts.ds_min {
@@ -639,6 +707,8 @@ where
                         multipliers: loc.point.multipliers.clone(),
                         tangent: loc.tangent.clone(),
                         after_point: points.len() - 1,
+                        symmetry_breaking: *kind == SpecialKind::BranchPoint
+                            && current.tests.det_sym.signum() != next.tests.det_sym.signum(),
                     });
                 }
             }
@@ -669,6 +739,39 @@ where
         special,
         stop,
         subharmonic: opts.shooting.subharmonic,
+        symmetric,
+    })
+}
+
+/// Distance between two spectra (each closed under conjugation): the
+/// Hausdorff distance with `d(a, b) = |a - b| / max(1/2, min(|a|, |b|))`,
+/// absolute near and inside the unit circle and relative for large
+/// multipliers.
+pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
+    let d = |x: &Complex<f64>, y: &Complex<f64>| (x - y).norm() / x.norm().min(y.norm()).max(0.5);
+    let one_way = |p: &[Complex<f64>], q: &[Complex<f64>]| {
+        p.iter()
+            .map(|x| q.iter().map(|y| d(x, y)).fold(f64::INFINITY, f64::min))
+            .fold(0.0, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
+}
+
+/// Whether the periodic orbit through `x` is symmetric, `x(t + nT/2) =
+/// S x(t)`: the half map fixes x to 100 × the shooting tolerance.
+fn is_symmetric_orbit(model: &Model, x: &[f64], opts: &ShootingOptions) -> bool {
+    let half = ShootingOptions {
+        symmetric: true,
+        ..opts.clone()
+    };
+    let Some(image) = period_image(model, x, &half) else {
+        return false;
+    };
+    let n = x.len() / 2;
+    let w = model.forcing_frequency().unwrap_or(1.0);
+    image.iter().zip(x).enumerate().all(|(k, (g, x))| {
+        let scale = opts.displacement_scale * if k < n { 1.0 } else { w };
+        (g - x).abs() <= 100.0 * opts.tol * scale
     })
 }
 
@@ -690,21 +793,8 @@ where
     })?;
     let map = period_map(&model, &point.state, &opts.shooting)?;
     let d = point.state.len();
-    let shifted = &map.monodromy + DMatrix::<f64>::identity(d, d);
-    // Null vector of Φ + I: the right singular vector of the smallest singular value.
-    let svd = shifted.svd(false, true);
-    let v_t = svd
-        .v_t
-        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
-    let (imin, _) =
-        svd.singular_values
-            .iter()
-            .enumerate()
-            .fold(
-                (0, f64::INFINITY),
-                |m, (i, &s)| if s < m.1 { (i, s) } else { m },
-            );
-    let v: Vec<f64> = (0..d).map(|j| v_t[(imin, j)]).collect();
+    // Null vector of Φ + I.
+    let v = null_vector(&map.monodromy + DMatrix::<f64>::identity(d, d))?;
     let mut doubled = opts.shooting.clone();
     doubled.subharmonic = opts.shooting.subharmonic * 2;
     let scale = doubled.displacement_scale;
@@ -747,11 +837,31 @@ where
     )))
 }
 
-/// A start on the other branch through a branch point: steps along the
-/// direction of the 2-D null space of [Φ - I, G_p] orthogonal to the branch
-/// tangent and corrects there. Returns `(p, x)` and the direction's sign
-/// toward increasing parameter is not guaranteed: continue both ways if
-/// needed.
+/// Unit right null vector of a square matrix (the right singular vector of
+/// its smallest singular value).
+fn null_vector(m: DMatrix<f64>) -> Result<Vec<f64>, ContinuationError> {
+    let d = m.ncols();
+    let svd = m.svd(false, true);
+    let v_t = svd
+        .v_t
+        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
+    let imin = svd
+        .singular_values
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(0, |(i, _)| i);
+    Ok((0..d).map(|j| v_t[(imin, j)]).collect())
+}
+
+/// A start on the other branch through a branch point. At a
+/// symmetry-breaking point the direction is the eigenvector of the half
+/// map's Jacobian for the eigenvalue -1 (the asymmetric mode) and a
+/// corrected point that is still symmetric is refused; otherwise it is the
+/// direction of the 2-D null space of `[Φ - I, G_p]` orthogonal to the
+/// branch tangent. Steps `step` (then a quarter and 2.5 times it) both ways
+/// and corrects in the full period map. Returns `(p, x)`; the side of the
+/// point it lands on is not guaranteed: continue both ways if needed.
 pub fn branch_switch_start<F>(
     mut family: F,
     point: &SpecialPoint,
@@ -767,67 +877,90 @@ where
         parameter: point.parameter,
         message,
     })?;
+    // The predictor off the branch is poorer than along it: a larger
+    // corrector budget, in the full period map (the crossing branch of a
+    // symmetry-breaking point is asymmetric).
+    let opts = &ContinuationOptions {
+        max_corrector: 4 * opts.max_corrector,
+        shooting: ShootingOptions {
+            symmetric: false,
+            ..opts.shooting.clone()
+        },
+        ..opts.clone()
+    };
     let mut problem = Problem::new(&mut family, opts, &model, p0);
     let z = problem.scale_state(&point.state, point.parameter);
-    let (_, jac, _) = problem
-        .residual(&z)
-        .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the branch point".into()))?;
-    let svd = jac.clone().svd(false, true);
-    let v_t = svd
-        .v_t
-        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
-    // The two right singular vectors of the smallest singular values span the null space.
-    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
-    order.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
-    let mut candidates: Vec<Vec<f64>> = Vec::new();
-    for &i in order.iter().take(2) {
-        candidates.push((0..=d).map(|j| v_t[(i, j)]).collect());
-    }
-    // d × (d+1) Jacobian: its null space always has the extra direction.
-    let null_dir = {
-        let full = jac.transpose() * &jac;
-        let eig = full.symmetric_eigen();
+    let t = &point.tangent;
+    let mut directions: Vec<Vec<f64>> = Vec::new();
+    if point.symmetry_breaking {
+        let half = ShootingOptions {
+            symmetric: true,
+            ..opts.shooting.clone()
+        };
+        let map = period_map(&model, &point.state, &half)?;
+        let v = null_vector(&map.monodromy + DMatrix::<f64>::identity(d, d))?;
+        let mut dir: Vec<f64> = v.iter().zip(&problem.scale).map(|(a, s)| a / s).collect();
+        dir.push(0.0);
+        directions.push(dir);
+    } else {
+        let (_, jac, _) = problem
+            .residual(&z)
+            .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the branch point".into()))?;
+        // The two eigenvectors of JᵀJ of the smallest eigenvalues span the
+        // null space of the d × (d+1) Jacobian at a simple branch point.
+        let eig = (jac.transpose() * &jac).symmetric_eigen();
         let mut idx: Vec<usize> = (0..=d).collect();
         idx.sort_by(|&a, &b| {
             eig.eigenvalues[a]
                 .abs()
                 .total_cmp(&eig.eigenvalues[b].abs())
         });
-        idx.iter()
-            .take(2)
-            .map(|&i| {
-                eig.eigenvectors
-                    .column(i)
-                    .iter()
-                    .copied()
-                    .collect::<Vec<f64>>()
-            })
-            .collect::<Vec<_>>()
-    };
-    let t = &point.tangent;
-    let mut other = Vec::new();
-    for v in null_dir.iter().chain(&candidates) {
+        directions.extend(
+            idx.iter()
+                .take(2)
+                .map(|&i| eig.eigenvectors.column(i).iter().copied().collect()),
+        );
+    }
+    // Predictor along the null vector v; constraint along its part
+    // orthogonal to the tangent, which the old branch satisfies to first
+    // order with zero: the corrector cannot fall back onto it nearby.
+    let mut found = None;
+    for v in &directions {
+        let vn = v.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let v: Vec<f64> = v.iter().map(|a| a / vn).collect();
         let proj: f64 = v.iter().zip(t).map(|(a, b)| a * b).sum();
         let o: Vec<f64> = v.iter().zip(t).map(|(a, b)| a - proj * b).collect();
         let n = o.iter().map(|a| a * a).sum::<f64>().sqrt();
-        if n > 0.3 {
-            other = o.iter().map(|a| a / n).collect();
+        if n > 1e-3 {
+            found = Some((v, o.iter().map(|a| a / n).collect::<Vec<f64>>()));
             break;
         }
     }
-    if other.is_empty() {
-        return Err(ContinuationError::Invalid(
-            "no second direction at the branch point".into(),
-        ));
-    }
-    for sign in [1.0, -1.0] {
-        let pred: Vec<f64> = z
-            .iter()
-            .zip(&other)
-            .map(|(a, b)| a + sign * step * b)
-            .collect();
-        if let Some((solved, _)) = problem.correct(&pred, &other) {
+    let (v, constraint) = found.ok_or_else(|| {
+        ContinuationError::Invalid("no second direction at the branch point".into())
+    })?;
+    for h in [step, 0.25 * step, 2.5 * step] {
+        for sign in [1.0, -1.0] {
+            let pred: Vec<f64> = z.iter().zip(&v).map(|(a, b)| a + sign * h * b).collect();
+            let Some((solved, _)) = problem.correct(&pred, &constraint) else {
+                continue;
+            };
+            // A corrector that wandered off to some other branch far away.
+            let jump = solved
+                .z
+                .iter()
+                .zip(&pred)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            if jump > 5.0 * h {
+                continue;
+            }
             let (x, p) = problem.unscale(&solved.z);
+            if point.symmetry_breaking {
+                let model = problem.model(p)?;
+                if is_symmetric_orbit(&model, &x, &opts.shooting) {
+                    continue; // back on the symmetric branch
+                }
+            }
             return Ok((p, x));
         }
     }
@@ -884,48 +1017,178 @@ mod tests {
         }
     }
 
-    /// R2, N = 2, from 1.5 ω0 downward: special points exist; a fold is
-    /// confirmed by the change of stability on either side, a period
-    /// doubling by the period-2 orbit next to it, and stable points agree
-    /// with brute-force simulation.
-    #[test]
-    fn r2_branch_special_points_are_confirmed() {
+    /// AUTO-07p's special points of the R2, N = 2 branch (bench/auto,
+    /// Ω/ω0): six symmetry-breaking branch points and a torus bifurcation.
+    const AUTO_BP: [f64; 6] = [0.983100, 0.949393, 0.794528, 0.552497, 0.534043, 0.509475];
+    const AUTO_TR: f64 = 0.502479;
+
+    fn r2_branch(from: f64, to: f64) -> Branch {
         let family = |w: f64| r2(2, 1e-3, w);
-        let opts = ContinuationOptions {
-            max_points: 900,
-            ..Default::default()
-        };
-        let start = r2(2, 1e-3, 1.5 * W0).unwrap();
+        let start = r2(2, 1e-3, from * W0).unwrap();
         let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
-        let b = continue_branch(family, 1.5 * W0, &guess, 0.5 * W0, &opts, |_| true).unwrap();
-        let unstable_count =
-            |p: &BranchPoint| p.multipliers.iter().filter(|m| m.norm() > 1.0).count();
-        // Fold: stability changes across it.
-        let fold = b
+        let opts = ContinuationOptions::default();
+        continue_branch(family, from * W0, &guess, to * W0, &opts, |_| true).unwrap()
+    }
+
+    /// R2, N = 2 (a mirror-symmetric row): the branch from 1.5 ω0 down is
+    /// followed on the half map and has exactly AUTO-07p's special points
+    /// (plus grazing, which AUTO does not detect), located from either
+    /// direction to the same values; stable points agree with brute-force
+    /// simulation.
+    #[test]
+    fn r2_symmetric_branch_matches_auto() {
+        let down = r2_branch(1.5, 0.5);
+        assert_eq!(down.stop, StopReason::ReachedEnd);
+        assert!(down.symmetric);
+        let of = |b: &Branch, kind| {
+            b.special
+                .iter()
+                .filter(|s| s.kind == kind)
+                .map(|s| s.parameter / W0)
+                .collect::<Vec<f64>>()
+        };
+        let bps = of(&down, SpecialKind::BranchPoint);
+        assert_eq!(bps.len(), AUTO_BP.len(), "{bps:?}");
+        for (ours, auto) in bps.iter().zip(AUTO_BP) {
+            // AUTO's collocation (NTST 300) agrees to ~5e-6.
+            assert!((ours / auto - 1.0).abs() < 2e-5, "BP {ours} vs AUTO {auto}");
+        }
+        let ns = of(&down, SpecialKind::NeimarkSacker);
+        assert_eq!(ns.len(), 1);
+        assert!((ns[0] / AUTO_TR - 1.0).abs() < 2e-5, "NS {}", ns[0]);
+        assert!(of(&down, SpecialKind::Fold).is_empty());
+        assert!(of(&down, SpecialKind::PeriodDoubling).is_empty());
+        for s in down
             .special
             .iter()
-            .find(|s| s.kind == SpecialKind::Fold)
-            .expect("a fold");
-        let (a, c) = (
-            &b.points[fold.after_point],
-            &b.points[(fold.after_point + 1).min(b.points.len() - 1)],
-        );
-        assert_ne!(
-            unstable_count(a),
-            unstable_count(c),
-            "fold at {}",
-            fold.parameter
-        );
-        // Period doubling: a multiplier near -1 there, and a period-2 orbit next to it.
-        let pd = b
+            .filter(|s| s.kind == SpecialKind::BranchPoint)
+        {
+            assert!(s.symmetry_breaking);
+            let near_one = s
+                .multipliers
+                .iter()
+                .map(|m| (m - Complex::new(1.0, 0.0)).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(near_one < 1e-4, "{}: {:?}", s.label, s.multipliers);
+        }
+        // Every point is symmetric: u1 and u2 have the same amplitude (to
+        // the 256-sample resolution of the maxima, which occur half a period
+        // apart).
+        for p in &down.points {
+            let (a, b) = (p.max_displacement[0], p.max_displacement[1]);
+            assert!((a - b).abs() < 1e-4 * a, "{}: {a} vs {b}", p.parameter);
+        }
+        // The same special points from 0.5 ω0 upward.
+        let up = r2_branch(0.5, 1.5);
+        assert_eq!(up.stop, StopReason::ReachedEnd);
+        let mut a: Vec<(SpecialKind, f64)> =
+            down.special.iter().map(|s| (s.kind, s.parameter)).collect();
+        let b: Vec<(SpecialKind, f64)> = up.special.iter().map(|s| (s.kind, s.parameter)).collect();
+        a.reverse();
+        assert_eq!(a.len(), b.len(), "{a:?} vs {b:?}");
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.0, y.0);
+            let tol = if x.0 == SpecialKind::Grazing {
+                1e-4
+            } else {
+                1e-7
+            };
+            assert!((x.1 / y.1 - 1.0).abs() < tol, "{x:?} vs {y:?}");
+        }
+        // Stable points agree with brute-force simulation.
+        let stable: Vec<&BranchPoint> = down
+            .points
+            .iter()
+            .filter(|p| p.stable && p.spectral_radius() < 0.95)
+            .step_by(15)
+            .take(3)
+            .collect();
+        assert!(stable.len() >= 2);
+        for p in stable {
+            assert_brute_force_agrees(p);
+        }
+    }
+
+    /// Simulation from a 0.1 % perturbation of the orbit settles back on it:
+    /// max |u_i| to 1e-6. (A larger perturbation can leave the basin: below
+    /// 0.51 ω0 the symmetric orbit coexists with other attractors, and a 1 %
+    /// kick lands on one with max |u| 11 % smaller.)
+    fn assert_brute_force_agrees(p: &BranchPoint) {
+        let model = r2(2, 1e-3, p.parameter).unwrap();
+        let t = 2.0 * std::f64::consts::PI / p.parameter;
+        let sim = simulate(
+            &model,
+            &SimulationOptions {
+                t_end: 400.0 * t,
+                rtol: 1e-11,
+                atol: 1e-15,
+                start: Some(p.state.iter().map(|x| x * 0.999).collect()),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let end: Vec<f64> = sim
+            .final_displacement
+            .iter()
+            .chain(&sim.final_velocity)
+            .copied()
+            .collect();
+        let orbit = orbit_summary(&model, &end, t, 256, 1e-11).unwrap();
+        for i in 0..2 {
+            assert!(
+                (orbit.max_displacement[i] - p.max_displacement[i]).abs()
+                    < 1e-6 * p.max_displacement[i].max(1e-3),
+                "at {}: {} vs {}",
+                p.parameter,
+                orbit.max_displacement[i],
+                p.max_displacement[i]
+            );
+        }
+    }
+
+    /// Switching at the first two pitchforks onto the asymmetric branches:
+    /// a period doubling confirmed by the period-2 orbit next to it, a fold
+    /// confirmed by the change of stability on either side.
+    #[test]
+    fn r2_asymmetric_branches_fold_and_period_doubling() {
+        let family = |w: f64| r2(2, 1e-3, w);
+        let main = r2_branch(1.5, 0.9);
+        let opts = ContinuationOptions {
+            max_points: 45,
+            bounds: Some((0.5 * W0, 1.5 * W0)),
+            ..Default::default()
+        };
+        let switched = |label: &str| {
+            let bp = main.special.iter().find(|s| s.label == label).unwrap();
+            let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+            let model = r2(2, 1e-3, p).unwrap();
+            // Off the symmetric branch: the two bodies move differently.
+            let orbit =
+                orbit_summary(&model, &x, 2.0 * std::f64::consts::PI / p, 256, 1e-11).unwrap();
+            let (a, b) = (orbit.max_displacement[0], orbit.max_displacement[1]);
+            assert!((a - b).abs() > 1e-7, "{label}: still symmetric ({a} {b})");
+            let b = continue_branch(family, p, &x, 0.5 * W0, &opts, |_| true).unwrap();
+            assert!(!b.symmetric);
+            b
+        };
+        let unstable_count =
+            |p: &BranchPoint| p.multipliers.iter().filter(|m| m.norm() > 1.0).count();
+        // BP1 (0.9831 ω0): a period doubling at 0.97820 ω0.
+        let b1 = switched("BP1");
+        let pd = b1
             .special
             .iter()
             .find(|s| s.kind == SpecialKind::PeriodDoubling)
             .expect("a period doubling");
         assert!(
+            (pd.parameter / W0 - 0.978202).abs() < 1e-5,
+            "{}",
+            pd.parameter / W0
+        );
+        assert!(
             pd.multipliers
                 .iter()
-                .any(|m| (m.re + 1.0).abs() < 1e-2 && m.im.abs() < 1e-6),
+                .any(|m| (m.re + 1.0).abs() < 1e-3 && m.im.abs() < 1e-6),
             "{:?}",
             pd.multipliers
         );
@@ -949,50 +1212,24 @@ mod tests {
             .zip(&two.initial_state)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        assert!(
-            gap > 1e-7,
-            "the period-2 orbit is not period-1 (gap {gap:e})"
-        );
-        // Stable points agree with brute-force simulation from rest.
-        let stable: Vec<&BranchPoint> = b
-            .points
+        assert!(gap > 1e-7, "the period-2 orbit is period-1 (gap {gap:e})");
+        // BP2 (0.9494 ω0): a fold at 0.91225 ω0, stability changes across it.
+        let b2 = switched("BP2");
+        let fold = b2
+            .special
             .iter()
-            .filter(|p| p.stable && p.spectral_radius() < 0.95)
-            .step_by(20)
-            .take(3)
-            .collect();
-        assert!(!stable.is_empty());
-        for p in stable {
-            let model = r2(2, 1e-3, p.parameter).unwrap();
-            let t = 2.0 * std::f64::consts::PI / p.parameter;
-            let sim = simulate(
-                &model,
-                &SimulationOptions {
-                    t_end: 400.0 * t,
-                    rtol: 1e-11,
-                    atol: 1e-15,
-                    start: Some(p.state.iter().map(|x| x * 0.9).collect()),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
-            let end: Vec<f64> = sim
-                .final_displacement
-                .iter()
-                .chain(&sim.final_velocity)
-                .copied()
-                .collect();
-            let orbit = orbit_summary(&model, &end, t, 256, 1e-11).unwrap();
-            for i in 0..2 {
-                assert!(
-                    (orbit.max_displacement[i] - p.max_displacement[i]).abs()
-                        < 1e-6 * p.max_displacement[i].max(1e-3),
-                    "at {}: {} vs {}",
-                    p.parameter,
-                    orbit.max_displacement[i],
-                    p.max_displacement[i]
-                );
-            }
-        }
+            .find(|s| s.kind == SpecialKind::Fold)
+            .expect("a fold");
+        assert!((fold.parameter / W0 - 0.912249).abs() < 1e-5);
+        let (a, c) = (
+            &b2.points[fold.after_point],
+            &b2.points[fold.after_point + 1],
+        );
+        assert_ne!(
+            unstable_count(a),
+            unstable_count(c),
+            "fold at {}",
+            fold.parameter
+        );
     }
 }

@@ -510,6 +510,57 @@ impl Model {
         freq
     }
 
+    /// Whether the model is equivariant under the spatio-temporal mirror
+    /// symmetry of a symmetric row: `u_i → -u_{N-1-i}` together with the
+    /// time shift of half a forcing period (which flips the sign of every
+    /// harmonic forcing term).
+    ///
+    /// True when mirrored bodies have equal mass, stiffness and damping,
+    /// every coupling and contact has a mirror partner with the same
+    /// constants and law (a left wall of body i mirrors a right wall of body
+    /// N-1-i), the excitation is harmonic (or absent) with one frequency, and
+    /// every harmonic force has a partner of the same amplitude and phase on
+    /// the mirrored body. Then `x(t + T/2) = S x(t)` maps solutions to
+    /// solutions, symmetric periodic orbits exist, and their symmetry can
+    /// only break at a multiplier +1 (a pitchfork, never a period doubling).
+    pub fn is_mirror_symmetric(&self) -> bool {
+        let n = self.bodies.len();
+        let m = |i: usize| n - 1 - i;
+        if self.forcing_frequency().is_none() {
+            return false;
+        }
+        let bodies = (0..n).all(|i| {
+            let (a, b) = (&self.bodies[i], &self.bodies[m(i)]);
+            a.mass == b.mass && a.stiffness == b.stiffness && a.damping == b.damping
+        });
+        let couplings = self.couplings.iter().all(|c| {
+            self.couplings.iter().any(|o| {
+                let same = o.stiffness == c.stiffness && o.damping == c.damping;
+                let ends = (o.a, o.b) == (m(c.a), m(c.b)) || (o.a, o.b) == (m(c.b), m(c.a));
+                same && ends
+            })
+        });
+        let mirror_pair = |p: ContactPair| match p {
+            ContactPair::Bodies { left, right } => ContactPair::Bodies {
+                left: m(right),
+                right: m(left),
+            },
+            ContactPair::LeftWall { body } => ContactPair::RightWall { body: m(body) },
+            ContactPair::RightWall { body } => ContactPair::LeftWall { body: m(body) },
+        };
+        let contacts = self.contacts.iter().all(|c| {
+            self.contacts.iter().any(|o| {
+                o.pair == mirror_pair(c.pair) && o.clearance == c.clearance && o.law == c.law
+            })
+        });
+        let forces = self.forces.iter().all(|f| {
+            self.forces
+                .iter()
+                .any(|o| o.body == m(f.body) && o.amplitude == f.amplitude && o.phase == f.phase)
+        });
+        bodies && couplings && contacts && forces
+    }
+
     /// Name of contact k, e.g. `wall|p1`, `p1|p2`, `p3|wall`.
     pub fn contact_name(&self, k: usize) -> String {
         let c = &self.contacts[k];
@@ -634,6 +685,32 @@ mod tests {
         assert_eq!(r.at(-1.0), 0.0);
         assert!(Accelerogram::new(vec![0.0, 1.0, 1.0], vec![0.0; 3], 1.0).is_err());
         assert_eq!(r.peak(), 1.0);
+    }
+
+    #[test]
+    fn mirror_symmetry() {
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.05,
+            frequency: 7.0,
+            phase: 0.3,
+        };
+        let row = |walls| Model::row(3, 1.0, 1.0, 0.1, 1e-3, law(), walls, base.clone()).unwrap();
+        assert!(row((true, true)).is_mirror_symmetric());
+        assert!(row((false, false)).is_mirror_symmetric());
+        // One wall only: not symmetric.
+        assert!(!row((true, false)).is_mirror_symmetric());
+        // No periodic forcing: no spatio-temporal symmetry.
+        assert!(!row((true, true))
+            .with_base(BaseExcitation::None)
+            .is_mirror_symmetric());
+        // A heavier end body breaks it.
+        let mut m = row((true, true));
+        m.bodies[0].mass = 1.1;
+        assert!(!m.is_mirror_symmetric());
+        // A different clearance at one wall breaks it.
+        let mut m = row((true, true));
+        m.contacts[0].clearance = 2e-3;
+        assert!(!m.is_mirror_symmetric());
     }
 
     #[test]
