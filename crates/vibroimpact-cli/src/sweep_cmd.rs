@@ -968,6 +968,7 @@ mod tests {
             contact_evaluations: 0,
             energy: None,
             error: None,
+            extrema: None,
         };
         let s = handover(&model, &sim, 5, 16, 5 + 32).unwrap();
         assert_eq!(s.u, vec![-5e-4, 1e-4]);

@@ -1007,9 +1007,9 @@ mod tests {
         for p in &b.points {
             let w = p.parameter;
             let exact = 0.05 / ((W0 * W0 - w * w).powi(2) + (2.0 * ZETA * W0 * w).powi(2)).sqrt();
-            // Amplitude sampled 256 times per period: parabolic error < 1e-4.
+            // The exact extremum (located on the dense output).
             assert!(
-                (p.max_displacement[0] / exact - 1.0).abs() < 1e-4,
+                (p.max_displacement[0] / exact - 1.0).abs() < 1e-8,
                 "at {w}: {} vs {exact}",
                 p.max_displacement[0]
             );
@@ -1072,11 +1072,11 @@ mod tests {
             assert!(near_one < 1e-4, "{}: {:?}", s.label, s.multipliers);
         }
         // Every point is symmetric: u1 and u2 have the same amplitude (to
-        // the 256-sample resolution of the maxima, which occur half a period
-        // apart).
+        // 1e-7 where the orbit is unstable with multipliers ~200, 4e-8 on
+        // stable ones: integration at rtol 1e-10 through contact pulses).
         for p in &down.points {
             let (a, b) = (p.max_displacement[0], p.max_displacement[1]);
-            assert!((a - b).abs() < 1e-4 * a, "{}: {a} vs {b}", p.parameter);
+            assert!((a - b).abs() < 1e-6 * a, "{}: {a} vs {b}", p.parameter);
         }
         // The same special points from 0.5 ω0 upward.
         let up = r2_branch(0.5, 1.5);

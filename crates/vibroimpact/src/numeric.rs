@@ -146,6 +146,40 @@ where
     })
 }
 
+/// Golden-section search for the maximum of `f` on `[a, b]` (exact for a
+/// unimodal `f`, a local maximum otherwise), to a bracket of 8 ulps or 60
+/// iterations. Returns `(f(t*), t*)`.
+pub fn golden_max<F>(mut f: F, a: f64, b: f64) -> (f64, f64)
+where
+    F: FnMut(f64) -> f64,
+{
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (a, b);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..60 {
+        if fc > fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+        if b - a <= 8.0 * f64::EPSILON * b.abs().max(1.0) {
+            break;
+        }
+    }
+    let t = 0.5 * (a + b);
+    (f(t), t)
+}
+
 /// Brent's method (inverse quadratic interpolation, secant and bisection) for
 /// a root of `f` in `[a, b]` given `fa = f(a)` and `fb = f(b)` of opposite
 /// signs. Stops when the bracket is below `xtol` (absolute).

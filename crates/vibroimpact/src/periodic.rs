@@ -668,11 +668,16 @@ impl OrbitSummary {
     }
 }
 
-/// Integrates two periods from a periodic state and summarises the second
-/// (impacts are those that start in it, so an impact in progress at t = 0
-/// is counted once, with its true impact velocity). `samples` points per
-/// period are kept for plots and amplitudes; the amplitudes also include the
-/// exact extrema located as impact-free samples allow (use ≥ 200 samples).
+/// Integrates from a periodic state and summarises the first period: the
+/// samples and extrema of [0, T], and the impacts that start in (0, T] (an
+/// impact in progress at t = 0 is the one that starts before T; the
+/// integration runs on to 2T to complete it, so it is counted once, with
+/// its true impact velocity, rebound and peak). The first period, not the
+/// second: on an unstable orbit the state's error grows by the largest
+/// multiplier each period (~500 on R2's symmetric branch near 0.55 ω0). `samples` points per
+/// period are kept for plots; the amplitudes max |u_i|, max |v_i| are the
+/// exact extrema of the second period, located on the dense output (see
+/// [`crate::simulate::Extrema`]), independent of `samples`.
 pub fn orbit_summary(
     model: &Model,
     state: &[f64],
@@ -687,6 +692,7 @@ pub fn orbit_summary(
         atol: rtol * 1e-4,
         output_step: Some(period / samples.max(10) as f64),
         start: Some(state.to_vec()),
+        extrema_window: Some((0.0, period)),
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))?;
@@ -696,20 +702,14 @@ pub fn orbit_summary(
             source: e.source,
         });
     }
-    let mut max_u = vec![0.0f64; n];
-    let mut max_v = vec![0.0f64; n];
     let mut times = Vec::new();
     let mut states = Vec::new();
     for (j, &t) in sim.times.iter().enumerate() {
-        if t < period * (1.0 - 1e-12) {
-            continue;
+        if t > period * (1.0 + 1e-12) {
+            break;
         }
         let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
-        for i in 0..n {
-            max_u[i] = max_u[i].max(row[i].abs());
-            max_v[i] = max_v[i].max(row[n + i].abs());
-        }
-        times.push(t - period);
+        times.push(t);
         states.extend_from_slice(row);
     }
     let impacts = (0..model.contacts().len())
@@ -717,7 +717,7 @@ pub fn orbit_summary(
             let list: Vec<_> = sim
                 .impacts
                 .iter()
-                .filter(|i| i.contact == k && i.start_time >= period && i.start_time < 2.0 * period)
+                .filter(|i| i.contact == k && i.start_time > 0.0 && i.start_time <= period)
                 .collect();
             ContactImpacts {
                 contact: k,
@@ -726,9 +726,12 @@ pub fn orbit_summary(
             }
         })
         .collect();
+    let extrema = sim
+        .extrema
+        .ok_or_else(|| PeriodicError::Options("the orbit's extrema were not tracked".into()))?;
     Ok(OrbitSummary {
-        max_displacement: max_u,
-        max_velocity: max_v,
+        max_displacement: extrema.max_displacement,
+        max_velocity: extrema.max_velocity,
         impacts,
         times,
         states,
@@ -791,9 +794,18 @@ mod tests {
         }
         assert!(sol.stable());
         let orbit = orbit_summary(&model, &sol.initial_state, t, 400, 1e-12).unwrap();
+        // The extrema are located exactly, not sampled (400 samples would
+        // be off by ~3e-5).
         assert!(
-            (orbit.max_displacement[0] / amp - 1.0).abs() < 1e-4,
-            "sampled amplitude"
+            (orbit.max_displacement[0] / amp - 1.0).abs() < 1e-9,
+            "amplitude {} vs {amp}",
+            orbit.max_displacement[0]
+        );
+        assert!(
+            (orbit.max_velocity[0] / (omega * amp) - 1.0).abs() < 1e-9,
+            "velocity amplitude {} vs {}",
+            orbit.max_velocity[0],
+            omega * amp
         );
         assert_eq!(orbit.impacts_per_period(), 0);
     }
@@ -810,6 +822,25 @@ mod tests {
         assert!(sol.converged, "{:?}", sol.residual_history);
         let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 400, 1e-10).unwrap();
         assert!(orbit.impacts_per_period() > 0, "an impacting orbit");
+        // Exact extrema against 200 000 samples per period: never below the
+        // samples, and within their resolution of the contact pulses.
+        let fine = orbit_summary(&model, &sol.initial_state, sol.period, 200_000, 1e-10).unwrap();
+        for i in 0..2 {
+            for (k, exact) in [
+                (i, orbit.max_displacement[i]),
+                (2 + i, orbit.max_velocity[i]),
+            ] {
+                let sampled = fine
+                    .states
+                    .chunks(4)
+                    .map(|row| row[k].abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    sampled <= exact * (1.0 + 1e-9) && sampled >= exact * (1.0 - 1e-6),
+                    "component {k}: exact {exact} vs sampled {sampled}"
+                );
+            }
+        }
         let x = &sol.initial_state;
         for j in 0..4 {
             let h = if j < 2 { 1e-8 } else { 1e-7 };

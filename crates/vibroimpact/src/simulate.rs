@@ -34,7 +34,7 @@ use crate::contact::LawKind;
 use crate::dynamics::ChainDynamics;
 use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
-use crate::numeric::brent;
+use crate::numeric::{brent, golden_max};
 
 /// Options of a simulation.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,6 +62,9 @@ pub struct SimulationOptions {
     /// pressed together for long times), or automatic switching on a
     /// stiffness test.
     pub method: Method,
+    /// Locate the exact extrema of every |u_i| and |v_i| over this time
+    /// window (see [`Extrema`]).
+    pub extrema_window: Option<(f64, f64)>,
 }
 
 impl Default for SimulationOptions {
@@ -76,6 +79,7 @@ impl Default for SimulationOptions {
             max_steps: 50_000_000,
             start: None,
             method: Method::Dop853,
+            extrema_window: None,
         }
     }
 }
@@ -161,6 +165,107 @@ pub struct Simulation {
     pub energy: Option<EnergyBalance>,
     /// The integration failure that stopped the simulation early, if any.
     pub error: Option<SimulationFailure>,
+    /// Exact extrema over the requested window (up to `final_time`).
+    pub extrema: Option<Extrema>,
+}
+
+/// Largest |u_i| and |v_i| of every body over a time window, located on the
+/// integrator's dense output rather than sampled: an interior maximum of
+/// |u_i| lies where v_i changes sign within a step (Brent on the dense
+/// v_i), one of |v_i| where the acceleration changes sign (golden section
+/// on the dense v_i); otherwise the maximum is at a step end. Contact pulses
+/// shorter than any output interval (the deepest penetration, the fastest
+/// approach) are therefore caught to the integration tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Extrema {
+    /// max |u_i| (m), body order.
+    pub max_displacement: Vec<f64>,
+    /// max |v_i| (m/s), body order.
+    pub max_velocity: Vec<f64>,
+}
+
+/// Dense-output values of two components at time t.
+fn dense_pair(
+    st: &mut Stepper,
+    sys: &mut ChainDynamics,
+    (i, j): (usize, usize),
+    t: f64,
+) -> (f64, f64) {
+    (st.dense_component(sys, i, t), st.dense_component(sys, j, t))
+}
+
+/// Running state of the extrema search: the window start and the previous
+/// step end (interleaved state and its derivative).
+struct ExtremaScan {
+    from: f64,
+    to: f64,
+    t: f64,
+    y: Vec<f64>,
+    dydt: Vec<f64>,
+    found: Extrema,
+}
+
+impl ExtremaScan {
+    fn new((from, to): (f64, f64), bodies: usize, st: &Stepper) -> Self {
+        let mut scan = Self {
+            from,
+            to,
+            t: st.t(),
+            y: st.y().to_vec(),
+            dydt: st.dydt().to_vec(),
+            found: Extrema {
+                max_displacement: vec![0.0; bodies],
+                max_velocity: vec![0.0; bodies],
+            },
+        };
+        if from <= scan.t && scan.t <= to {
+            for i in 0..bodies {
+                scan.found.max_displacement[i] = scan.y[2 * i].abs();
+                scan.found.max_velocity[i] = scan.y[2 * i + 1].abs();
+            }
+        }
+        scan
+    }
+
+    /// Processes the accepted step from the previous end to `st.t()`.
+    fn step(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) {
+        let t1 = st.t();
+        let (a, b) = (self.t.max(self.from), t1.min(self.to));
+        if a <= b {
+            for i in 0..self.found.max_displacement.len() {
+                let (iu, iv) = (2 * i, 2 * i + 1);
+                let (ua, va) = if a == self.t {
+                    (self.y[iu], self.y[iv])
+                } else {
+                    dense_pair(st, sys, (iu, iv), a)
+                };
+                let (ub, vb) = if b == t1 {
+                    (st.y()[iu], st.y()[iv])
+                } else {
+                    dense_pair(st, sys, (iu, iv), b)
+                };
+                let mut max_u = ua.abs().max(ub.abs());
+                let mut max_v = va.abs().max(vb.abs());
+                if va * vb < 0.0 {
+                    let xtol = 4.0 * f64::EPSILON * t1.abs().max(1.0);
+                    let v = |t| st.dense_component(sys, iv, t);
+                    if let Ok(t) = brent(v, a, b, va, vb, xtol, ROOT_ITER) {
+                        max_u = max_u.max(st.dense_component(sys, iu, t).abs());
+                    }
+                }
+                if self.dydt[iv] * st.dydt()[iv] < 0.0 {
+                    let speed = |t| st.dense_component(sys, iv, t).abs();
+                    max_v = max_v.max(golden_max(speed, a, b).0);
+                }
+                let f = &mut self.found;
+                f.max_displacement[i] = f.max_displacement[i].max(max_u);
+                f.max_velocity[i] = f.max_velocity[i].max(max_v);
+            }
+        }
+        self.t = t1;
+        self.y.copy_from_slice(st.y());
+        self.dydt.copy_from_slice(st.dydt());
+    }
 }
 
 /// Why and where a simulation stopped early.
@@ -268,33 +373,7 @@ impl StepScan<'_> {
         };
         let mut best = if fa >= fb { (fa, ta) } else { (fb, tb) };
         if interior {
-            // Golden-section search for the interior maximum.
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            let (mut a, mut b) = (ta, tb);
-            let mut c = b - g * (b - a);
-            let mut d = a + g * (b - a);
-            let (mut fc, mut fd) = (force(c), force(d));
-            for _ in 0..60 {
-                if fc > fd {
-                    b = d;
-                    d = c;
-                    fd = fc;
-                    c = b - g * (b - a);
-                    fc = force(c);
-                } else {
-                    a = c;
-                    c = d;
-                    fc = fd;
-                    d = a + g * (b - a);
-                    fd = force(d);
-                }
-                if b - a <= 8.0 * f64::EPSILON * b.abs().max(1.0) {
-                    break;
-                }
-            }
-            let t = 0.5 * (a + b);
-            let f = force(t);
-            for cand in [(f, t), (fm, tm)] {
+            for cand in [golden_max(&mut force, ta, tb), (fm, tm)] {
                 if cand.0 > best.0 {
                     best = cand;
                 }
@@ -537,6 +616,10 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
             }
         }
     }
+    let mut extrema = match (opts.extrema_window, &error) {
+        (Some(window), None) => Some(ExtremaScan::new(window, n2 / 2, &st)),
+        _ => None,
+    };
     while error.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
             next_break += 1;
@@ -547,6 +630,9 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
             break;
         }
         scan.scan(&mut st, &mut sys);
+        if let Some(x) = extrema.as_mut() {
+            x.step(&mut st, &mut sys);
+        }
         if let Some(h) = scan.entry_limit(st.h_next()) {
             st.limit_next_step(h);
         }
@@ -615,6 +701,7 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         contact_evaluations: sys.contact_evaluations(),
         energy,
         error,
+        extrema: extrema.map(|x| x.found),
     })
 }
 
