@@ -531,6 +531,26 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<'_, F> {
 
     /// Bisection of the arclength in (0, ds) from `a` for the change of
     /// `kind` that occurs before `b`; returns the located point.
+    /// The solution at parameter `bound`, between the solutions `a` and
+    /// `b` that bracket it: predicted by linear interpolation and corrected
+    /// with the parameter held.
+    fn end_point(&mut self, a: &Evaluated, b: &Evaluated, bound: f64) -> Option<Evaluated> {
+        let (pa, pb) = (a.point.parameter, b.point.parameter);
+        let theta = (bound - pa) / (pb - pa);
+        let mut pred: Vec<f64> = a
+            .solved
+            .z
+            .iter()
+            .zip(&b.solved.z)
+            .map(|(za, zb)| za + theta * (zb - za))
+            .collect();
+        pred[self.d] = bound / self.p_scale;
+        let mut held = vec![0.0; self.d + 1];
+        held[self.d] = 1.0;
+        let (solved, _) = self.correct(&pred, &held)?;
+        self.evaluate(solved, &a.tangent)
+    }
+
     fn locate(
         &mut self,
         kind: SpecialKind,
@@ -691,12 +711,11 @@ where
             continue;
         };
         let p = next.point.parameter;
-        if p < lo - opts.locate_tol || p > hi + opts.locate_tol {
-            break StopReason::ReachedEnd;
-        }
+        let inside = |q: f64| q >= lo - opts.locate_tol && q <= hi + opts.locate_tol;
         for (k, kind) in KINDS.iter().enumerate() {
             if changed(*kind, &current.tests, &next.tests) {
-                if let Some(loc) = problem.locate(*kind, &current, &next, ds) {
+                let located = problem.locate(*kind, &current, &next, ds);
+                if let Some(loc) = located.filter(|l| inside(l.point.parameter)) {
                     counts[k] += 1;
                     let label = format!("{}{}", kind.prefix(), counts[k]);
                     special.push(SpecialPoint {
@@ -720,6 +739,18 @@ where
         } else {
             ds
         };
+        // A step past the end of the range: the last point is the solution
+        // at the end itself (the parameter held there), if it converges.
+        let beyond = !inside(p);
+        let next = if beyond {
+            let bound = if p > hi { hi } else { lo };
+            match problem.end_point(&current, &next, bound) {
+                Some(end) => end,
+                None => break StopReason::ReachedEnd,
+            }
+        } else {
+            next
+        };
         let mut point = next.point.clone();
         if let Some(sp) = special
             .iter()
@@ -730,6 +761,10 @@ where
         }
         points.push(point);
         current = next;
+        if beyond {
+            on_point(points.last().expect("just pushed"));
+            break StopReason::ReachedEnd;
+        }
         if !on_point(points.last().expect("just pushed")) {
             break StopReason::Interrupted;
         }
@@ -1039,6 +1074,16 @@ mod tests {
     fn r2_symmetric_branch_matches_auto() {
         let down = r2_branch(1.5, 0.5);
         assert_eq!(down.stop, StopReason::ReachedEnd);
+        // The branch runs from one end of the range exactly to the other.
+        let ends = |b: &Branch| {
+            let p = |q: &BranchPoint| q.parameter / W0;
+            (p(&b.points[0]), p(b.points.last().expect("points")))
+        };
+        let (first, last) = ends(&down);
+        assert!(
+            (first - 1.5).abs() < 1e-12 && (last - 0.5).abs() < 1e-12,
+            "{first}..{last}"
+        );
         assert!(down.symmetric);
         let of = |b: &Branch, kind| {
             b.special
@@ -1081,6 +1126,11 @@ mod tests {
         // The same special points from 0.5 ω0 upward.
         let up = r2_branch(0.5, 1.5);
         assert_eq!(up.stop, StopReason::ReachedEnd);
+        let (first, last) = ends(&up);
+        assert!(
+            (first - 0.5).abs() < 1e-12 && (last - 1.5).abs() < 1e-12,
+            "{first}..{last}"
+        );
         let mut a: Vec<(SpecialKind, f64)> =
             down.special.iter().map(|s| (s.kind, s.parameter)).collect();
         let b: Vec<(SpecialKind, f64)> = up.special.iter().map(|s| (s.kind, s.parameter)).collect();
