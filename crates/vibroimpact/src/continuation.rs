@@ -200,6 +200,22 @@ pub enum StopReason {
     Interrupted,
     /// The corrector failed down to the smallest step: where and why.
     CannotContinue(String),
+    /// The branch returned to its first point (a closed loop, e.g. the
+    /// asymmetric branch between two symmetry-breaking points and its
+    /// mirror image); it is not traversed again.
+    ClosedLoop,
+}
+
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::ReachedEnd => write!(f, "reached the end of the range"),
+            Self::MaxPoints => write!(f, "used the point budget"),
+            Self::Interrupted => write!(f, "interrupted"),
+            Self::CannotContinue(why) => write!(f, "cannot continue: {why}"),
+            Self::ClosedLoop => write!(f, "closed loop (back at the first point)"),
+        }
+    }
 }
 
 /// A computed branch.
@@ -667,6 +683,29 @@ where
             symmetric,
         });
     }
+    // Closing the loop: the branch is back at its first point, or (for an
+    // asymmetric branch of a mirror-symmetric row) at the mirror image
+    // S x(nT/2) of a point already traversed, which happens right after it
+    // passes a pitchfork on the symmetric branch; the rest would be the
+    // mirror image of what is known.
+    let mirrored = !symmetric
+        && opts.use_symmetry
+        && opts.shooting.subharmonic.max(1) % 2 == 1
+        && model.is_mirror_symmetric();
+    let half = ShootingOptions {
+        symmetric: true,
+        ..opts.shooting.clone()
+    };
+    let mirror_of = |problem: &mut Problem<'_, F>, z: &[f64]| -> Option<Vec<f64>> {
+        let (x, p) = problem.unscale(z);
+        let model = problem.model(p).ok()?;
+        period_image(&model, &x, &half).map(|image| problem.scale_state(&image, p))
+    };
+    let origin = (first.solved.z.clone(), first.tangent.clone());
+    let mut mirrors: Vec<Vec<f64>> = Vec::new();
+    if mirrored {
+        mirrors.extend(mirror_of(&mut problem, &first.solved.z));
+    }
     let mut current = first;
     let mut ds = opts.ds;
     let stop = loop {
@@ -760,10 +799,22 @@ where
             point.label = Some(sp.label.clone());
         }
         points.push(point);
-        current = next;
+        let previous_z = std::mem::replace(&mut current, next).solved.z;
         if beyond {
             on_point(points.last().expect("just pushed"));
             break StopReason::ReachedEnd;
+        }
+        let closed = points.len() > 4
+            && (returns_to(&origin.0, Some(&origin.1), &previous_z, &current)
+                || mirrors[..mirrors.len().saturating_sub(2)]
+                    .iter()
+                    .any(|m| returns_to(m, None, &previous_z, &current)));
+        if closed {
+            on_point(points.last().expect("just pushed"));
+            break StopReason::ClosedLoop;
+        }
+        if mirrored {
+            mirrors.extend(mirror_of(&mut problem, &current.solved.z));
         }
         if !on_point(points.last().expect("just pushed")) {
             break StopReason::Interrupted;
@@ -776,6 +827,40 @@ where
         subharmonic: opts.shooting.subharmonic,
         symmetric,
     })
+}
+
+/// Whether the step from `previous` to `current` (scaled unknowns) passes
+/// through the point `origin`: within a quarter step of the chord (a chord
+/// of the same curve deviates from it by O(curvature × step²)) and, if the
+/// origin's tangent is given, in the same direction.
+fn returns_to(z0: &[f64], t0: Option<&[f64]>, previous: &[f64], current: &Evaluated) -> bool {
+    let z1 = &current.solved.z;
+    let chord: Vec<f64> = z1.iter().zip(previous).map(|(b, a)| b - a).collect();
+    let len2: f64 = chord.iter().map(|c| c * c).sum();
+    if len2 == 0.0 {
+        return false;
+    }
+    let along: f64 = z0
+        .iter()
+        .zip(previous)
+        .zip(&chord)
+        .map(|((z, a), c)| (z - a) * c)
+        .sum::<f64>()
+        / len2;
+    let dist2: f64 = z0
+        .iter()
+        .zip(previous)
+        .zip(&chord)
+        .map(|((z, a), c)| (z - a - along.clamp(0.0, 1.0) * c).powi(2))
+        .sum();
+    let aligned = t0.is_none_or(|t0| {
+        t0.iter()
+            .zip(&current.tangent)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            > 0.5
+    });
+    (0.0..=1.0).contains(&along) && dist2 <= 0.0625 * len2 && aligned
 }
 
 /// Distance between two spectra (each closed under conjugation): the
@@ -1281,5 +1366,38 @@ mod tests {
             "fold at {}",
             fold.parameter
         );
+    }
+
+    /// The asymmetric branch from BP2 (0.9494 ω0) is a connection: it meets
+    /// the symmetric branch again at BP3 (AUTO: 0.794528 ω0), where it turns
+    /// (a fold of the pitchfork) onto its mirror image; the continuation
+    /// stops there as a closed loop instead of retracing the mirror.
+    #[test]
+    fn r2_asymmetric_branch_connects_bp2_to_bp3() {
+        let family = |w: f64| r2(2, 1e-3, w);
+        let main = r2_branch(1.5, 0.9);
+        let opts = ContinuationOptions {
+            max_points: 3000,
+            bounds: Some((0.5 * W0, 1.5 * W0)),
+            ..Default::default()
+        };
+        let bp = main.special.iter().find(|s| s.label == "BP2").unwrap();
+        let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+        let b = continue_branch(family, p, &x, 0.5 * W0, &opts, |_| true).unwrap();
+        assert_eq!(b.stop, StopReason::ClosedLoop);
+        let last = b.special.last().expect("special points");
+        assert_eq!(last.kind, SpecialKind::Fold);
+        assert!(
+            (last.parameter / W0 / AUTO_BP[2] - 1.0).abs() < 2e-5,
+            "{}",
+            last.parameter / W0
+        );
+        // At the fold the orbit is (nearly) symmetric again.
+        let model = r2(2, 1e-3, last.parameter).unwrap();
+        let period = 2.0 * std::f64::consts::PI / last.parameter;
+        let at = orbit_summary(&model, &last.state, period, 256, 1e-11).unwrap();
+        let (u1, u2) = (at.max_displacement[0], at.max_displacement[1]);
+        assert!((u1 - u2).abs() < 1e-3 * u1, "{u1} vs {u2}");
+        assert!(b.points.len() < 1500, "{} points", b.points.len());
     }
 }
