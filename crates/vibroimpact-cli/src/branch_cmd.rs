@@ -59,6 +59,11 @@ pub struct PeriodicArgs {
     /// Dominant multipliers computed by Arnoldi (Krylov shooting).
     #[arg(long, default_value_t = 20)]
     arnoldi: usize,
+    /// Look for a mirror-symmetric orbit (u_i(t + nT/2) = -u_{N+1-i}(t)) with
+    /// the half map S P_{nT/2}: half the integration per Newton step; needs
+    /// a mirror-symmetric model and an odd --subharmonic.
+    #[arg(long)]
+    symmetric: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -121,8 +126,15 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         subharmonic: args.subharmonic,
         rtol: args.rtol,
         tol: args.tol,
+        symmetric: args.symmetric,
         ..ShootingOptions::default()
     };
+    if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic.is_multiple_of(2)) {
+        return Err(CliError::new(format!(
+            "{}: --symmetric needs a mirror-symmetric model (mirrored bodies, contacts, walls and forcing) and an odd --subharmonic",
+            args.model.display()
+        )));
+    }
     let krylov = args.krylov || (!args.dense && model.bodies().len() >= 200);
     let sol = if krylov {
         shoot_krylov(&model, &guess, &opts, args.arnoldi)
@@ -152,6 +164,8 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         "floquet_multipliers": sol.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
         "spectral_radius": sol.spectral_radius(),
         "stable": sol.stable(),
+        "symmetric_orbit": args.symmetric
+            || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts),
         "max_displacement": orbit.max_displacement,
         "max_velocity": orbit.max_velocity,
         "impacts_per_period": orbit.impacts_per_period(),
@@ -358,6 +372,7 @@ pub fn branch_figure(
 ) -> Figure {
     let mut fig = Figure::new(title, x_label, "max |u| over the period  [mm]")
         .legend_at(LegendPosition::Best);
+    let mut labelled: Vec<SpecialKind> = Vec::new();
     for (bi, (branch, name)) in branches.iter().enumerate() {
         let color = 2 * bi;
         let mut start = 0;
@@ -409,10 +424,15 @@ pub fn branch_figure(
                     Some((s.parameter * x_scale, 1e3 * p.max_displacement.get(body)?))
                 })
                 .collect();
-            if !sp.is_empty() && bi == 0 {
-                fig.push(Series::markers(kind.name(), sp, marker).with_color(c));
-            } else if !sp.is_empty() {
-                fig.push(Series::markers("", sp, marker).with_color(c));
+            if !sp.is_empty() {
+                // Each kind in the legend once, wherever it first appears.
+                let name = if labelled.contains(&kind) {
+                    ""
+                } else {
+                    labelled.push(kind);
+                    kind.name()
+                };
+                fig.push(Series::markers(name, sp, marker).with_color(c));
             }
         }
     }

@@ -213,7 +213,10 @@ impl std::fmt::Display for StopReason {
             Self::MaxPoints => write!(f, "used the point budget"),
             Self::Interrupted => write!(f, "interrupted"),
             Self::CannotContinue(why) => write!(f, "cannot continue: {why}"),
-            Self::ClosedLoop => write!(f, "closed loop (back at the first point)"),
+            Self::ClosedLoop => write!(
+                f,
+                "closed loop (back at its first point or its mirror image)"
+            ),
         }
     }
 }
@@ -878,8 +881,9 @@ pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
 }
 
 /// Whether the periodic orbit through `x` is symmetric, `x(t + nT/2) =
-/// S x(t)`: the half map fixes x to 100 × the shooting tolerance.
-fn is_symmetric_orbit(model: &Model, x: &[f64], opts: &ShootingOptions) -> bool {
+/// S x(t)`: the model is mirror-symmetric and the half map fixes x to
+/// 100 × the shooting tolerance.
+pub fn is_symmetric_orbit(model: &Model, x: &[f64], opts: &ShootingOptions) -> bool {
     let half = ShootingOptions {
         symmetric: true,
         ..opts.clone()
