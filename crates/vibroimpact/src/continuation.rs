@@ -1331,6 +1331,17 @@ mod tests {
             "{:?}",
             pd.multipliers
         );
+        // Its stable points (between the pitchfork and the period doubling)
+        // agree with brute-force simulation as well.
+        let stable: Vec<&BranchPoint> = b1
+            .points
+            .iter()
+            .filter(|p| p.stable && p.spectral_radius() < 0.95)
+            .collect();
+        assert!(!stable.is_empty());
+        for p in stable.iter().step_by(stable.len().div_ceil(2).max(1)) {
+            assert_brute_force_agrees(p);
+        }
         let (p2, x2) = period_doubled_start(family, pd, &opts).unwrap();
         assert!((p2 / pd.parameter - 1.0).abs() < 0.02);
         let model = r2(2, 1e-3, p2).unwrap();
