@@ -116,12 +116,7 @@ fn ours(n: usize, periods: f64, rtol: f64, atol: f64, repeats: usize) -> Run {
     }
     let sim = last.expect("at least one run");
     Run {
-        state: sim
-            .final_displacement
-            .iter()
-            .chain(&sim.final_velocity)
-            .copied()
-            .collect(),
+        state: sim.final_state(),
         seconds: best,
         rhs: sim.stats.rhs_evaluations,
         steps: sim.stats.steps,

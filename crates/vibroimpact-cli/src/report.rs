@@ -913,12 +913,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
                     },
                 )
                 .ok()?;
-                let end: Vec<f64> = sim
-                    .final_displacement
-                    .iter()
-                    .chain(&sim.final_velocity)
-                    .copied()
-                    .collect();
+                let end: Vec<f64> = sim.final_state();
                 let orbit = orbit_summary(&model, &end, 10.0 * t, 2560, 1e-9).ok()?;
                 Some((w / w0, 1e3 * orbit.max_displacement[0]))
             })

@@ -1266,12 +1266,7 @@ mod tests {
             },
         )
         .unwrap();
-        let end: Vec<f64> = sim
-            .final_displacement
-            .iter()
-            .chain(&sim.final_velocity)
-            .copied()
-            .collect();
+        let end: Vec<f64> = sim.final_state();
         let orbit = orbit_summary(&model, &end, t, 256, 1e-11).unwrap();
         for i in 0..2 {
             assert!(

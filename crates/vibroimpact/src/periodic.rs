@@ -639,12 +639,7 @@ pub fn guess_by_simulation(
             source: e.source,
         });
     }
-    Ok(sim
-        .final_displacement
-        .iter()
-        .chain(&sim.final_velocity)
-        .copied()
-        .collect())
+    Ok(sim.final_state())
 }
 
 /// Impacts of one contact over one period of an orbit.

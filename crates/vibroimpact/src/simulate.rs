@@ -169,6 +169,18 @@ pub struct Simulation {
     pub extrema: Option<Extrema>,
 }
 
+impl Simulation {
+    /// The state reached, `[u_1..u_N, v_1..v_N]` (e.g. the start of a
+    /// continuation or of a periodic-orbit summary).
+    pub fn final_state(&self) -> Vec<f64> {
+        self.final_displacement
+            .iter()
+            .chain(&self.final_velocity)
+            .copied()
+            .collect()
+    }
+}
+
 /// Largest |u_i| and |v_i| of every body over a time window, located on the
 /// integrator's dense output rather than sampled: an interior maximum of
 /// |u_i| lies where v_i changes sign within a step (Brent on the dense
@@ -878,12 +890,7 @@ mod tests {
                 },
             )
             .unwrap();
-            let y: Vec<f64> = sim
-                .final_displacement
-                .iter()
-                .chain(&sim.final_velocity)
-                .copied()
-                .collect();
+            let y: Vec<f64> = sim.final_state();
             for reference in [scipy, cvode] {
                 let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 let err = y
