@@ -280,25 +280,6 @@ fn handover(
     })
 }
 
-/// Largest |x| of a sampled signal, refined by a parabola through each
-/// sampled local maximum and its neighbours.
-fn refined_max(values: &[f64]) -> f64 {
-    let y: Vec<f64> = values.iter().map(|x| x.abs()).collect();
-    let mut best = y.iter().copied().fold(f64::NAN, f64::max);
-    for j in 1..y.len().saturating_sub(1) {
-        let (a, b, c) = (y[j - 1], y[j], y[j + 1]);
-        let d = a - 2.0 * b + c;
-        if b >= a && b >= c && d < 0.0 {
-            let delta = 0.5 * (a - c) / d;
-            let peak = b - 0.25 * (a - c) * delta;
-            if peak.is_finite() {
-                best = best.max(peak);
-            }
-        }
-    }
-    best
-}
-
 /// Number of clusters of `points` (greedy, in order): two points are the same
 /// when every displacement differs by at most `tol_u` and every velocity by
 /// at most `tol_v`.
@@ -416,6 +397,7 @@ fn run_value(
     let opts = SimulationOptions {
         t_end: j_end as f64 * dt,
         output_step: Some(dt),
+        extrema_window: Some((j0 as f64 * dt, j_end as f64 * dt)),
         ..settings.opts.clone()
     };
     let sim = match simulate(&m, &opts) {
@@ -433,16 +415,10 @@ fn run_value(
     let window_end = (j0 + point.recorded_periods * FINE).min(samples.saturating_sub(1));
     let mut max_v: f64 = 0.0;
     if window_end > j0 {
-        // One sample either side for the parabolic refinement at the edges.
-        let lo = j0.saturating_sub(1);
-        let hi = (window_end + 1).min(samples - 1);
-        for i in 0..n {
-            let u: Vec<f64> = (lo..=hi).map(|j| row(j)[i]).collect();
-            point.max_displacement[i] = refined_max(&u);
-            let vmax = (j0..=window_end)
-                .map(|j| row(j)[n + i].abs())
-                .fold(0.0, f64::max);
-            max_v = max_v.max(vmax);
+        // The exact extrema over the recorded periods (dense output).
+        if let Some(x) = &sim.extrema {
+            point.max_displacement.clone_from(&x.max_displacement);
+            max_v = x.max_velocity.iter().copied().fold(0.0, f64::max);
         }
     }
     if point.recorded_periods > 0 {
@@ -880,17 +856,6 @@ mod tests {
         assert!((v[3] - 0.4).abs() < 1e-15);
         let v = parameter_values(2.0, 1.0, 2);
         assert_eq!(v, vec![2.0, 1.0]);
-    }
-
-    #[test]
-    fn refined_max_of_a_sampled_sine() {
-        let m = 256;
-        let x: Vec<f64> = (0..=m)
-            .map(|j| 3.0 * (2.0 * std::f64::consts::PI * (j as f64 + 0.37) / m as f64).sin())
-            .collect();
-        let raw = x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        assert!((3.0 - raw) / 3.0 > 1e-6, "the samples miss the peak");
-        assert!((refined_max(&x) - 3.0).abs() / 3.0 < 1e-8);
     }
 
     const ROW: &str = "[row]\ncount = 2\nmass = 0.227\nnatural_frequency = 7.41\ndamping_ratio = 0.013\nclearance = 0.001\ncontact = { law = \"exponential\", a_over_b = 1.2, alpha = 1.3e5 }\n[excitation]\ntype = \"harmonic-base\"\namplitude = 0.5\nfrequency = 7.0\n";
