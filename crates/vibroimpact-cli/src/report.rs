@@ -858,8 +858,9 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
          continuation from 1.5 ω0 downward; stability from the Floquet multipliers. Special points are located to \
          1e-8 in Ω: folds (LP), branch points (BP, symmetry breaking of the in-phase motion), period doublings (PD), \
          Neimark–Sacker points (NS) and grazings (GR, the number of impacts per period changes). Each branch is \
-         checked against a brute-force sweep: simulation from rest for 150 forcing periods at 61 frequencies, \
-         max |u1| over the next 10 periods.</p>\n\
+         checked against brute-force sweeps at 61 frequencies, max |u1| over 10 periods after a transient: from \
+         rest (150 periods), and downward from 1.5 ω0 with each frequency starting from the state the previous one \
+         reached (100 periods), which follows an attractor as long as it exists.</p>\n\
          <p>The rows are mirror-symmetric (u_i → −u_{N+1−i} with a half-period shift), and so is the in-phase \
          branch: it is followed on the symmetric half map S∘P_{T/2}, whose Jacobian's eigenvalue −1 marks a \
          symmetry-breaking pitchfork (BP) as a sign change of det(DG + I), a test the full period map does not \
@@ -897,30 +898,64 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
             "R2 N = {n}: branch of {} points in {seconds:.1} s",
             branch.points.len()
         );
-        let sweep: Vec<(f64, f64)> = (0..61)
-            .into_par_iter()
-            .map(|k| {
+        // Brute force twice: from rest at every frequency (in parallel), and
+        // downward from 1.5 ω0 with each frequency starting from the state
+        // the previous one reached (follows an attractor while it exists).
+        let onward = || {
+            let mut state: Option<Vec<f64>> = None;
+            let mut out = Vec::new();
+            for k in (0..61).rev() {
                 let w = (0.5 + k as f64 / 60.0) * w0;
-                let model = row(n, w).ok()?;
+                let Ok(model) = row(n, w) else { continue };
                 let t = 2.0 * std::f64::consts::PI / w;
-                let sim = simulate(
-                    &model,
-                    &SimulationOptions {
-                        t_end: 150.0 * t,
-                        rtol: 1e-9,
-                        atol: 1e-13,
-                        ..SimulationOptions::default()
-                    },
-                )
-                .ok()?;
-                let end: Vec<f64> = sim.final_state();
-                let orbit = orbit_summary(&model, &end, 10.0 * t, 2560, 1e-9).ok()?;
-                Some((w / w0, 1e3 * orbit.max_displacement[0]))
-            })
-            .collect::<Vec<_>>()
-            .into_iter()
-            .flatten()
-            .collect();
+                let opts = SimulationOptions {
+                    t_end: 100.0 * t,
+                    rtol: 1e-9,
+                    atol: 1e-13,
+                    start: state.clone(),
+                    ..SimulationOptions::default()
+                };
+                let Ok(sim) = simulate(&model, &opts) else {
+                    continue;
+                };
+                if sim.error.is_some() {
+                    continue;
+                }
+                let end = sim.final_state();
+                if let Ok(orbit) = orbit_summary(&model, &end, 10.0 * t, 2560, 1e-9) {
+                    out.push((w / w0, 1e3 * orbit.max_displacement[0]));
+                }
+                state = Some(end);
+            }
+            out
+        };
+        let from_rest = || -> Vec<(f64, f64)> {
+            (0..61)
+                .into_par_iter()
+                .map(|k| {
+                    let w = (0.5 + k as f64 / 60.0) * w0;
+                    let model = row(n, w).ok()?;
+                    let t = 2.0 * std::f64::consts::PI / w;
+                    let sim = simulate(
+                        &model,
+                        &SimulationOptions {
+                            t_end: 150.0 * t,
+                            rtol: 1e-9,
+                            atol: 1e-13,
+                            ..SimulationOptions::default()
+                        },
+                    )
+                    .ok()?;
+                    let end: Vec<f64> = sim.final_state();
+                    let orbit = orbit_summary(&model, &end, 10.0 * t, 2560, 1e-9).ok()?;
+                    Some((w / w0, 1e3 * orbit.max_displacement[0]))
+                })
+                .collect::<Vec<_>>()
+                .into_iter()
+                .flatten()
+                .collect()
+        };
+        let (sweep, sweep_down) = rayon::join(from_rest, onward);
         // N = 2: the asymmetric branches from the first two pitchforks.
         let mut asymmetric: Vec<(Branch, String)> = Vec::new();
         if n == 2 {
@@ -963,13 +998,35 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
             0,
         );
         fig.push(
+            Series::markers("brute force from rest", sweep.clone(), Marker::Circle).with_color(6),
+        );
+        fig.push(
             Series::markers(
-                "brute-force sweep (simulation)",
-                sweep.clone(),
+                "brute force downward, continued state",
+                sweep_down.clone(),
                 Marker::Circle,
             )
-            .with_color(6),
+            .with_color(1),
         );
+        // Head room above the data for the legend: 10 % of the data's span
+        // per entry.
+        let (lo, hi) = fig
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.1))
+            .filter(|y| y.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+                (a.min(y), b.max(y))
+            });
+        let entries = fig
+            .series
+            .iter()
+            .filter(|s| s.label.as_deref().is_some_and(|l| !l.is_empty()))
+            .count();
+        if lo < hi {
+            let span = hi - lo;
+            fig = fig.y_range(lo - 0.05 * span, hi + 0.1 * entries as f64 * span);
+        }
         let stem = format!("fig{}_frequency_response_n{n}", 7 + n);
         let rows = |b: &Branch| -> Vec<Vec<f64>> {
             b.points
@@ -1021,7 +1078,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
         let caption = format!(
             "Largest displacement of pendulum 1 over a period against the forcing frequency, N = {n}: periodic \
              solutions by continuation (solid stable, dashed unstable; symmetric branch: {} points, {} special points, \
-             {}{others}) and the brute-force sweep (circles), which settles on stable branches or wanders where no \
+             {}{others}) and the brute-force sweeps (circles), which settle on stable branches or wander where no \
              stable periodic orbit exists.",
             branch.points.len(),
             branch.special.len(),
@@ -1051,6 +1108,11 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
                 &format!("{stem}_sweep.csv"),
                 vec!["omega_over_omega0", "max_u_p1_mm"],
                 sweep.iter().map(|&(a, b)| vec![a, b]).collect(),
+            )))
+            .chain(std::iter::once(DataFile::new(
+                &format!("{stem}_sweep_down.csv"),
+                vec!["omega_over_omega0", "max_u_p1_mm"],
+                sweep_down.iter().map(|&(a, b)| vec![a, b]).collect(),
             )))
             .collect(),
         )?;
