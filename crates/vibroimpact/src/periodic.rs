@@ -948,20 +948,33 @@ mod tests {
         let wd = W0 * (1.0 - ZETA * ZETA).sqrt();
         let exact = Complex::from_polar((-ZETA * W0 * t).exp(), wd * t);
         let guess = guess_by_simulation(&model, 100.0, 1e-10).unwrap();
-        for symmetric in [false, true] {
-            let opts = ShootingOptions {
-                symmetric,
-                ..Default::default()
-            };
-            let sol = shoot_krylov(&model, &guess, &opts, 20).unwrap();
-            assert!(sol.converged, "{:?}", sol.residual_history);
-            let orbit = orbit_summary(&model, &sol.initial_state, t, 64, 1e-10).unwrap();
+        krylov_on_both_maps(&model, &guess, t, |symmetric, sol, orbit| {
             assert_eq!(orbit.impacts_per_period(), 0);
             assert!(!sol.multipliers.is_empty());
             for mu in &sol.multipliers {
                 let err = (mu - exact).norm().min((mu - exact.conj()).norm());
                 assert!(err < 1e-9, "symmetric {symmetric}: {mu} vs {exact}");
             }
+        });
+    }
+
+    /// Newton–Krylov shooting from `guess` on the full and on the half map;
+    /// each converged solution and its orbit summary go to `check`.
+    fn krylov_on_both_maps(
+        model: &Model,
+        guess: &[f64],
+        period: f64,
+        mut check: impl FnMut(bool, &PeriodicSolution, &OrbitSummary),
+    ) {
+        for symmetric in [false, true] {
+            let opts = ShootingOptions {
+                symmetric,
+                ..Default::default()
+            };
+            let sol = shoot_krylov(model, guess, &opts, 20).unwrap();
+            assert!(sol.converged, "{:?}", sol.residual_history);
+            let orbit = orbit_summary(model, &sol.initial_state, period, 64, 1e-10).unwrap();
+            check(symmetric, &sol, &orbit);
         }
     }
 
@@ -980,25 +993,18 @@ mod tests {
         let linear =
             0.05 / ((W0 * W0 - omega * omega).powi(2) + (2.0 * ZETA * W0 * omega).powi(2)).sqrt();
         let decay = (-ZETA * W0 * t).exp();
-        for symmetric in [false, true] {
-            let opts = ShootingOptions {
-                symmetric,
-                ..Default::default()
-            };
-            let sol = shoot_krylov(&model, &guess, &opts, 20).unwrap();
-            assert!(sol.converged, "{:?}", sol.residual_history);
+        krylov_on_both_maps(&model, &guess, t, |_, sol, orbit| {
             assert!(sol.stable());
             // 1e-3: the linear multiplier has multiplicity ~1000, and Ritz
             // values of such a cluster are only accurate to ~sqrt(rtol).
             for mu in &sol.multipliers {
                 assert!((mu.norm() / decay - 1.0).abs() < 1e-3, "{mu} vs |{decay}|");
             }
-            let orbit = orbit_summary(&model, &sol.initial_state, t, 64, 1e-10).unwrap();
             assert_eq!(orbit.impacts_per_period(), 2);
             assert!(orbit.max_displacement[0] > 1e-3 && orbit.max_displacement[999] > 1e-3);
             let mid = orbit.max_displacement[500];
             assert!((mid / linear - 1.0).abs() < 1e-8, "{mid} vs {linear}");
-        }
+        });
     }
 
     #[test]
