@@ -8,11 +8,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use clap::Args;
-use serde::Serialize;
-use serde_json::json;
 use vibroimpact::continuation::{
-    branch_switch_start, continue_branch, period_doubled_start, Branch, ContinuationOptions,
-    SpecialKind,
+    continue_branch, switch_branch, Branch, ContinuationOptions, SpecialKind,
 };
 use vibroimpact::model::Model;
 use vibroimpact::periodic::{
@@ -21,11 +18,11 @@ use vibroimpact::periodic::{
 
 use crate::error::CliError;
 use crate::format::Format;
-use crate::model_file::read_model;
+use crate::model_io::{read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
-use crate::parameter::ParameterizedModel;
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use crate::simulate_cmd::history_csv;
+use vibroimpact::results::{branch_document, periodic_document};
 
 /// Options of `vibroimpact periodic`.
 #[derive(Args, Debug)]
@@ -70,15 +67,6 @@ pub struct PeriodicArgs {
     /// Output folder: orbit.csv, summary.json, orbit figures.
     #[arg(long)]
     out: Option<PathBuf>,
-}
-
-/// Impacts of one contact per period.
-#[derive(Serialize, Debug)]
-struct ContactImpactsJson {
-    contact: String,
-    count: usize,
-    impact_velocities: Vec<f64>,
-    peak_forces: Vec<f64>,
 }
 
 fn read_guess(spec: &str, model: &Model, periods: f64, rtol: f64) -> Result<Vec<f64>, CliError> {
@@ -144,33 +132,16 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     .map_err(|e| CliError::new(e.to_string()))?;
     let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)
         .map_err(|e| CliError::new(e.to_string()))?;
-    let impacts: Vec<ContactImpactsJson> = orbit
-        .impacts
-        .iter()
-        .map(|c| ContactImpactsJson {
-            contact: model.contact_name(c.contact),
-            count: c.impact_velocities.len(),
-            impact_velocities: c.impact_velocities.clone(),
-            peak_forces: c.peak_forces.clone(),
-        })
-        .collect();
-    let doc = json!({
-        "converged": sol.converged,
-        "method": if krylov { "newton-krylov (dominant multipliers by Arnoldi)" } else { "newton (dense monodromy)" },
-        "period": sol.period,
-        "subharmonic": args.subharmonic,
-        "initial_state": sol.initial_state,
-        "residual_history": sol.residual_history,
-        "floquet_multipliers": sol.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "spectral_radius": sol.spectral_radius(),
-        "stable": sol.stable(),
-        "symmetric_orbit": args.symmetric
-            || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts),
-        "max_displacement": orbit.max_displacement,
-        "max_velocity": orbit.max_velocity,
-        "impacts_per_period": orbit.impacts_per_period(),
-        "impacts": impacts,
-    });
+    let symmetric_orbit = args.symmetric
+        || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts);
+    let doc = periodic_document(
+        &model,
+        &sol,
+        &orbit,
+        args.subharmonic,
+        symmetric_orbit,
+        krylov,
+    );
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
         let n = model.bodies().len();
@@ -299,36 +270,6 @@ pub struct ContinueArgs {
     format: Format,
 }
 
-/// JSON of a branch (`points`, `special_points`).
-pub fn branch_json(branch: &Branch, model: &Model, name: &str) -> serde_json::Value {
-    json!({
-        "parameter_name": name,
-        "subharmonic": branch.subharmonic,
-        "symmetric": branch.symmetric,
-        "stop": format!("{:?}", branch.stop),
-        "contacts": (0..model.contacts().len()).map(|k| model.contact_name(k)).collect::<Vec<_>>(),
-        "points": branch.points.iter().map(|p| json!({
-            "parameter": p.parameter,
-            "max_displacement": p.max_displacement,
-            "max_velocity": p.max_velocity,
-            "impacts_per_period": p.impacts_per_period,
-            "stable": p.stable,
-            "spectral_radius": p.spectral_radius(),
-            "floquet_multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-            "initial_state": p.state,
-            "label": p.label,
-        })).collect::<Vec<_>>(),
-        "special_points": branch.special.iter().map(|s| json!({
-            "kind": s.kind.name(),
-            "label": s.label,
-            "parameter": s.parameter,
-            "symmetry_breaking": s.symmetry_breaking,
-            "floquet_multipliers": s.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-            "initial_state": s.state,
-        })).collect::<Vec<_>>(),
-    })
-}
-
 /// CSV of a branch.
 pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
     let n = model.bodies().len();
@@ -453,7 +394,7 @@ fn write_branch(
         &dir.join(format!("{stem}.csv")),
         branch_csv(branch, model)?.as_bytes(),
     )?;
-    let doc = branch_json(branch, model, name);
+    let doc = branch_document(branch, model, name);
     write_atomic(
         &dir.join(format!("{stem}_special_points.json")),
         serde_json::to_string_pretty(&doc["special_points"])?.as_bytes(),
@@ -475,7 +416,7 @@ fn write_branch(
 
 /// Runs `vibroimpact continue`.
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
-    let pm = ParameterizedModel::read(&args.model, &args.parameter)?;
+    let pm = read_family(&args.model, &args.parameter)?;
     if !(args.from.is_finite() && args.to.is_finite()) || args.from == args.to {
         return Err(CliError::new(format!(
             "--from {} --to {}: the range is empty or not finite",
@@ -529,9 +470,17 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;
     if let Some(label) = &args.switch_at {
-        match switched_branch(&branches[0], label, args, &opts, &pm, progress) {
+        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+        match switch_branch(
+            family,
+            &branches[0],
+            label,
+            (args.from, args.to),
+            &opts,
+            progress,
+        ) {
             Ok(b) => branches.push(b),
-            Err(e) => switch_error = Some(e),
+            Err(e) => switch_error = Some(CliError::new(e.to_string())),
         }
     }
     if tty {
@@ -562,7 +511,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     }
     let docs: Vec<serde_json::Value> = branches
         .iter()
-        .map(|b| branch_json(b, &start_model, &args.parameter))
+        .map(|b| branch_document(b, &start_model, &args.parameter))
         .collect();
     match args.format {
         Format::Json => {
@@ -606,68 +555,4 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         ))),
         _ => Ok(()),
     }
-}
-
-/// The branch through special point `label` of `branch` (a branch point's
-/// crossing branch or a period doubling's period-2n branch), continued
-/// within the range of `--from`/`--to`.
-fn switched_branch(
-    branch: &Branch,
-    label: &str,
-    args: &ContinueArgs,
-    opts: &ContinuationOptions,
-    pm: &ParameterizedModel,
-    progress: impl FnMut(&vibroimpact::continuation::BranchPoint) -> bool,
-) -> Result<Branch, CliError> {
-    let sp = branch
-        .special
-        .iter()
-        .find(|s| s.label == label)
-        .ok_or_else(|| {
-            CliError::new(format!(
-                "--switch-at {label}: no such special point on the branch (found: {})",
-                branch
-                    .special
-                    .iter()
-                    .map(|s| s.label.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ))
-        })?;
-    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-    let fail = |e: vibroimpact::continuation::ContinuationError| {
-        CliError::new(format!(
-            "--switch-at {label}: {e} (the main branch is kept)"
-        ))
-    };
-    let (p1, x1, sub) = match sp.kind {
-        SpecialKind::PeriodDoubling => {
-            let (p, x) = period_doubled_start(family, sp, opts).map_err(fail)?;
-            (p, x, args.subharmonic * 2)
-        }
-        SpecialKind::BranchPoint => {
-            let (p, x) = branch_switch_start(family, sp, args.from, opts, 0.02).map_err(fail)?;
-            (p, x, args.subharmonic)
-        }
-        other => {
-            return Err(CliError::new(format!(
-                "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
-                other.name()
-            )))
-        }
-    };
-    let switched_opts = ContinuationOptions {
-        shooting: ShootingOptions {
-            subharmonic: sub,
-            ..opts.shooting.clone()
-        },
-        bounds: Some((args.from, args.to)),
-        ..opts.clone()
-    };
-    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-    // Onward from the start, away from the special point (the branch
-    // stays within --from/--to).
-    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
-    let target = if p1 >= sp.parameter { hi } else { lo };
-    continue_branch(family, p1, &x1, target, &switched_opts, progress).map_err(fail)
 }

@@ -29,5 +29,7 @@ from_display!(
     vibroimpact::contact::ContactLawError,
     vibroimpact::impact::ImpactError,
     vibroimpact::identify::IdentifyError,
+    vibroimpact::model_file::ModelFileError,
+    vibroimpact::sweep::SweepError,
     serde_json::Error
 );

@@ -4,10 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use serde::Serialize;
+pub use vibroimpact::identify::Identification;
 use vibroimpact::identify::{
-    fit_a_over_b, fit_alpha, fit_joint, AccelerationSample, Estimate, ExponentialLawFit,
-    IdentifyError, RestitutionFit, RestitutionSample,
+    identify, AccelerationSample, Estimate, IdentifyError, RestitutionSample,
 };
 use vibroimpact::impact::TwoBodies;
 
@@ -42,21 +41,6 @@ pub struct IdentifyArgs {
     /// Output format (table or json).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-}
-
-/// Result of an identification, as written in JSON.
-#[derive(Serialize, Debug)]
-pub struct Identification {
-    /// How it was made.
-    pub method: String,
-    /// a/b (m/s), if determined or given.
-    pub a_over_b: Option<Estimate>,
-    /// α (1/m), if acceleration data were given.
-    pub alpha: Option<Estimate>,
-    /// The a/b fit to the restitution data alone.
-    pub restitution_fit: Option<RestitutionFit>,
-    /// The α (or joint) fit.
-    pub acceleration_fit: Option<ExponentialLawFit>,
 }
 
 /// Measured data sets of an identification, with their sources for messages.
@@ -172,52 +156,13 @@ impl Measurements {
         a_over_b: Option<f64>,
         joint: bool,
     ) -> Result<Identification, CliError> {
-        let restitution_fit = self
-            .restitution
-            .as_ref()
-            .map(|(s, _, _)| fit_a_over_b(s))
-            .transpose()
-            .map_err(|e| self.locate(e))?;
-        let Some((acc, _, _)) = &self.acceleration else {
-            let Some(fit) = restitution_fit else {
-                return Err(CliError::new(
-                    "nothing to identify: give --restitution and/or --acceleration",
-                ));
-            };
-            return Ok(Identification {
-                method: "a-over-b-from-restitution".into(),
-                a_over_b: Some(fit.a_over_b),
-                alpha: None,
-                restitution_fit: Some(fit),
-                acceleration_fit: None,
-            });
-        };
-        let empty = Vec::new();
-        let rest = self.restitution.as_ref().map_or(&empty, |r| &r.0);
-        let (fit, method) = match (a_over_b, joint, &restitution_fit) {
-            (Some(q), _, _) => (fit_alpha(acc, bodies, q), "alpha-given-a-over-b"),
-            (None, true, _) | (None, false, None) => (fit_joint(rest, acc, bodies), "joint"),
-            (None, false, Some(r)) => (
-                fit_alpha(acc, bodies, r.a_over_b.value),
-                "sequential: a/b from restitution, then alpha given a/b (alpha's std_error excludes a/b's uncertainty; use --joint for both)",
-            ),
-        };
-        let fit = fit.map_err(|e| self.locate(e))?;
-        let a_over_b = match (&restitution_fit, method) {
-            (Some(r), m) if m.starts_with("sequential") => Some(r.a_over_b),
-            _ => Some(fit.a_over_b),
-        };
-        Ok(Identification {
-            method: if method == "joint" {
-                fit.method.to_string()
-            } else {
-                method.to_string()
-            },
-            a_over_b,
-            alpha: Some(fit.alpha),
-            restitution_fit,
-            acceleration_fit: Some(fit),
-        })
+        if self.restitution.is_none() && self.acceleration.is_none() {
+            return Err(CliError::new(
+                "nothing to identify: give --restitution and/or --acceleration",
+            ));
+        }
+        let (restitution, acceleration) = self.samples();
+        identify(restitution, acceleration, bodies, a_over_b, joint).map_err(|e| self.locate(e))
     }
 }
 

@@ -3,11 +3,10 @@
 //! law).
 
 use clap::{Args, ValueEnum};
-use serde::Serialize;
-use vibroimpact::contact::{ContactLaw, ForceForm, LawKind};
-use vibroimpact::impact::closed_form::ExponentialImpact;
-use vibroimpact::impact::direct::{integrate_impact, DirectOptions};
+use vibroimpact::contact::{ContactLaw, ForceForm};
+use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::TwoBodies;
+use vibroimpact::results::{impact_document, impact_rows, ImpactMethod, IMPACT_COLUMNS};
 
 use crate::error::CliError;
 use crate::format::{print_rows, Format};
@@ -123,28 +122,6 @@ impl LawArgs {
     }
 }
 
-/// JSON description of a contact law: name, form and parameters.
-pub fn law_json(law: &ContactLaw) -> serde_json::Value {
-    let params = match *law.kind() {
-        LawKind::Exponential { a, b, alpha } => {
-            serde_json::json!({"a": a, "b": b, "a_over_b": a / b, "alpha": alpha})
-        }
-        LawKind::Hertz { k, n } => serde_json::json!({"stiffness": k, "exponent": n}),
-        LawKind::KelvinVoigt { k, c } => serde_json::json!({"stiffness": k, "damping": c}),
-        LawKind::HuntCrossley { k, n, chi } => {
-            serde_json::json!({"stiffness": k, "exponent": n, "chi": chi})
-        }
-        LawKind::LankaraniNikravesh {
-            k,
-            n,
-            restitution,
-            min_impact_velocity,
-        } => serde_json::json!({"stiffness": k, "exponent": n, "restitution": restitution,
-            "min_impact_velocity": min_impact_velocity}),
-    };
-    serde_json::json!({"law": law.name(), "form": law.form().name(), "parameters": params})
-}
-
 /// How impacts are computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
@@ -152,6 +129,15 @@ pub enum Method {
     ClosedForm,
     /// Direct integration of the relative motion (any law).
     Integrate,
+}
+
+impl Method {
+    fn method(self) -> ImpactMethod {
+        match self {
+            Method::ClosedForm => ImpactMethod::ClosedForm,
+            Method::Integrate => ImpactMethod::Integrate,
+        }
+    }
 }
 
 /// Options of `vibroimpact impact`.
@@ -247,119 +233,6 @@ pub fn parse_mass2(text: &str) -> Result<f64, CliError> {
     }
 }
 
-/// One row of the output.
-#[derive(Serialize, Debug)]
-pub struct ImpactRow {
-    /// U (m/s).
-    pub impact_velocity: f64,
-    /// V = U/(a/b), exponential law only.
-    pub v: Option<f64>,
-    /// e.
-    pub restitution: f64,
-    /// e U (m/s).
-    pub rebound_velocity: f64,
-    /// f_max = F_max / (μ α (a/b)²), exponential law only.
-    pub peak_force_dimensionless: Option<f64>,
-    /// F_max (N).
-    pub peak_force: f64,
-    /// F_max/m1 (m/s²).
-    pub peak_acceleration1: f64,
-    /// F_max/m2 (m/s²), 0 for a wall.
-    pub peak_acceleration2: f64,
-    /// Maximum approach coordinate (m).
-    pub max_penetration: f64,
-    /// Contact duration (s), integrate only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub contact_duration: Option<f64>,
-}
-
-impl ImpactRow {
-    fn values(&self) -> Vec<Option<f64>> {
-        vec![
-            Some(self.impact_velocity),
-            self.v,
-            Some(self.restitution),
-            Some(self.rebound_velocity),
-            self.peak_force_dimensionless,
-            Some(self.peak_force),
-            Some(self.peak_acceleration1),
-            Some(self.peak_acceleration2),
-            Some(self.max_penetration),
-            self.contact_duration,
-        ]
-    }
-}
-
-const COLUMNS: [&str; 10] = [
-    "impact_velocity",
-    "v",
-    "restitution",
-    "rebound_velocity",
-    "peak_force_dimensionless",
-    "peak_force",
-    "peak_acceleration1",
-    "peak_acceleration2",
-    "max_penetration",
-    "contact_duration",
-];
-
-/// Computes the rows for a law, bodies and velocities.
-pub fn compute_rows(
-    law: &ContactLaw,
-    bodies: TwoBodies,
-    velocities: &[f64],
-    method: Method,
-    opts: &DirectOptions,
-) -> Result<Vec<ImpactRow>, CliError> {
-    let closed = match law.kind() {
-        LawKind::Exponential { .. } => Some(ExponentialImpact::new(law, bodies)?),
-        _ => None,
-    };
-    velocities
-        .iter()
-        .map(|&u| {
-            Ok(match (method, &closed) {
-                (Method::ClosedForm, None) => {
-                    return Err(CliError::new(format!(
-                        "--method closed-form exists only for the exponential law, not for {}; use --method integrate",
-                        law.name()
-                    )))
-                }
-                (Method::ClosedForm, Some(cf)) => {
-                    let c = cf.impact(u)?;
-                    ImpactRow {
-                        impact_velocity: u,
-                        v: Some(c.v),
-                        restitution: c.restitution,
-                        rebound_velocity: c.rebound_velocity,
-                        peak_force_dimensionless: Some(c.peak_force_dimensionless),
-                        peak_force: c.peak_force,
-                        peak_acceleration1: c.peak_acceleration[0],
-                        peak_acceleration2: c.peak_acceleration[1],
-                        max_penetration: c.max_penetration,
-                        contact_duration: None,
-                    }
-                }
-                (Method::Integrate, _) => {
-                    let d = integrate_impact(law, bodies, u, opts)?;
-                    ImpactRow {
-                        impact_velocity: u,
-                        v: closed.map(|cf| u / cf.a_over_b()),
-                        restitution: d.restitution,
-                        rebound_velocity: d.rebound_velocity,
-                        peak_force_dimensionless: closed.map(|cf| d.peak_force / cf.force_scale()),
-                        peak_force: d.peak_force,
-                        peak_acceleration1: d.peak_acceleration[0],
-                        peak_acceleration2: d.peak_acceleration[1],
-                        max_penetration: d.max_penetration,
-                        contact_duration: Some(d.contact_duration),
-                    }
-                }
-            })
-        })
-        .collect()
-}
-
 /// Runs `vibroimpact impact`.
 pub fn run(args: &ImpactArgs) -> Result<(), CliError> {
     let law = args.law.build()?;
@@ -375,28 +248,23 @@ pub fn run(args: &ImpactArgs) -> Result<(), CliError> {
         duration_level: args.duration_level,
         ..DirectOptions::default()
     };
-    let rows = compute_rows(&law, bodies, &velocities, method, &opts)?;
-    let method_name = match method {
-        Method::ClosedForm => "closed-form",
-        Method::Integrate => "integrate",
-    };
+    if method == Method::ClosedForm && law.has_compact_support() {
+        return Err(CliError::new(format!(
+            "--method closed-form exists only for the exponential law, not for {}; use --method integrate",
+            law.name()
+        )));
+    }
+    let rows = impact_rows(&law, bodies, &velocities, method.method(), &opts)?;
     match args.format {
         Format::Json => {
-            let doc = serde_json::json!({
-                "method": method_name,
-                "contact_law": law_json(&law),
-                "mass1": bodies.m1(),
-                "mass2": if bodies.m2().is_infinite() { serde_json::json!("wall") } else { serde_json::json!(bodies.m2()) },
-                "reduced_mass": bodies.reduced_mass(),
-                "rows": rows,
-            });
+            let doc = impact_document(&law, bodies, method.method(), &rows);
             println!("{}", serde_json::to_string_pretty(&doc)?);
         }
         format => {
             let ncol = if method == Method::Integrate { 10 } else { 9 };
             let table: Vec<Vec<Option<f64>>> =
                 rows.iter().map(|r| r.values()[..ncol].to_vec()).collect();
-            print_rows(format, &COLUMNS[..ncol], &table)?;
+            print_rows(format, &IMPACT_COLUMNS[..ncol], &table)?;
         }
     }
     Ok(())

@@ -22,7 +22,6 @@ use crate::format::csv_text;
 use crate::identify_cmd::{Identification, Measurements};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
-use crate::simulate_cmd;
 
 /// The example impact data shipped in `examples/seed-impacts/` (embedded so
 /// the default study runs from any directory).
@@ -633,7 +632,7 @@ fn seed_row_time_history(report: &mut Report) -> Result<(), CliError> {
     if let Some(e) = &sim.error {
         return Err(CliError::new(format!("default study, R2 simulation: {e}")));
     }
-    let summary = simulate_cmd::summary(&model, &sim);
+    let summary = vibroimpact::results::simulation_summary(&model, &sim);
     report.summary("r2_n3_simulation", serde_json::to_value(&summary)?);
     let energy = summary.energy.as_ref().map_or(0.0, |e| e.residual);
     let mut counts = Vec::new();

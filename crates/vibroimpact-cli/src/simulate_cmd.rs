@@ -3,16 +3,17 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use serde::Serialize;
 use vibroimpact::integrate::Method;
 use vibroimpact::model::Model;
 use vibroimpact::simulate::{simulate, Simulation, SimulationOptions};
 
 use crate::error::CliError;
 use crate::format::{csv_text, Format};
-use crate::model_file::{read_model, LoadedModel};
+use crate::model_io::read_model;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use vibroimpact::model_file::LoadedModel;
+use vibroimpact::results::{simulation_summary, SimulationSummary};
 
 /// Integration method on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -78,106 +79,6 @@ pub struct SimulateArgs {
     impact_force_threshold: Option<f64>,
 }
 
-/// The summary of a simulation (JSON).
-#[derive(Serialize, Debug)]
-pub struct Summary {
-    /// Whether the simulation reached the end time.
-    pub completed: bool,
-    /// The integration error that stopped it, if any.
-    pub error: Option<String>,
-    /// Time reached (s).
-    pub final_time: f64,
-    /// Final displacements in body order (m).
-    pub final_displacement: Vec<f64>,
-    /// Final velocities in body order (m/s).
-    pub final_velocity: Vec<f64>,
-    /// Number of logged impacts.
-    pub impact_count: usize,
-    /// Impacts per contact, in contact order.
-    pub impacts_per_contact: Vec<ContactCount>,
-    /// Right-hand side evaluations.
-    pub rhs_evaluations: u64,
-    /// Accepted steps.
-    pub steps: u64,
-    /// Rejected steps.
-    pub rejected_steps: u64,
-    /// Contact-law evaluations (far contacts are skipped).
-    pub contact_evaluations: u64,
-    /// The contact laws and their force forms.
-    pub contact_laws: Vec<String>,
-    /// Energy audit (J), with --energy.
-    pub energy: Option<EnergySummary>,
-}
-
-/// Impacts of one contact.
-#[derive(Serialize, Debug)]
-pub struct ContactCount {
-    /// Contact name, e.g. `p1|p2`.
-    pub contact: String,
-    /// Number of impacts.
-    pub impacts: usize,
-}
-
-/// Energy audit (J).
-#[derive(Serialize, Debug)]
-pub struct EnergySummary {
-    /// Mechanical energy at the start.
-    pub initial: f64,
-    /// Mechanical energy at the end.
-    pub mechanical: f64,
-    /// Work of the excitation.
-    pub input_work: f64,
-    /// Dissipated in dampers.
-    pub damping_dissipation: f64,
-    /// Dissipated in contacts.
-    pub contact_dissipation: f64,
-    /// E + D_c + D_k - W - E0.
-    pub residual: f64,
-}
-
-/// Builds the summary of a simulation.
-pub fn summary(model: &Model, sim: &Simulation) -> Summary {
-    let mut counts = vec![0usize; model.contacts().len()];
-    for i in &sim.impacts {
-        counts[i.contact] += 1;
-    }
-    let mut laws: Vec<String> = model
-        .contacts()
-        .iter()
-        .map(|c| format!("{} ({})", c.law.name(), c.law.form().name()))
-        .collect();
-    laws.dedup();
-    Summary {
-        completed: sim.error.is_none(),
-        error: sim.error.as_ref().map(ToString::to_string),
-        final_time: sim.final_time,
-        final_displacement: sim.final_displacement.clone(),
-        final_velocity: sim.final_velocity.clone(),
-        impact_count: sim.impacts.len(),
-        impacts_per_contact: counts
-            .iter()
-            .enumerate()
-            .map(|(k, &n)| ContactCount {
-                contact: model.contact_name(k),
-                impacts: n,
-            })
-            .collect(),
-        rhs_evaluations: sim.stats.rhs_evaluations,
-        steps: sim.stats.steps,
-        rejected_steps: sim.stats.rejected_steps,
-        contact_evaluations: sim.contact_evaluations,
-        contact_laws: laws,
-        energy: sim.energy.map(|e| EnergySummary {
-            initial: e.initial,
-            mechanical: e.mechanical,
-            input_work: e.input_work,
-            damping_dissipation: e.damping_dissipation,
-            contact_dissipation: e.contact_dissipation,
-            residual: e.residual(),
-        }),
-    }
-}
-
 /// Simulation options from the command line and the model file.
 fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOptions, CliError> {
     let model = &loaded.model;
@@ -241,7 +142,7 @@ pub fn write_outputs(
     dir: &Path,
     model: &Model,
     sim: &Simulation,
-    summary: &Summary,
+    summary: &SimulationSummary,
     phase_body: usize,
 ) -> Result<(), CliError> {
     ensure_dir(dir)?;
@@ -353,7 +254,7 @@ pub fn plot_history(
 }
 
 /// Human-readable summary.
-pub fn summary_text(s: &Summary) -> String {
+pub fn summary_text(s: &SimulationSummary) -> String {
     let mut t = format!(
         "{}: t = {:.6} s, {} impacts, {} steps ({} rejected), {} rhs evaluations, {} contact evaluations\n",
         if s.completed { "completed" } else { "STOPPED" },
@@ -393,7 +294,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             .ok_or_else(|| CliError::new(format!("--body {name}: no such body")))?,
     };
     let sim = simulate(model, &opts).map_err(|e| CliError::new(e.to_string()))?;
-    let s = summary(model, &sim);
+    let s = simulation_summary(model, &sim);
     if let Some(dir) = &args.out {
         write_outputs(dir, model, &sim, &s, phase_body)?;
     }

@@ -405,6 +405,7 @@ fn period_image(model: &Model, x: &[f64], opts: &ShootingOptions) -> Option<Vec<
         rtol: opts.rtol,
         atol: opts.rtol * opts.displacement_scale,
         max_steps: 200_000,
+        interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
     let (y, _) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
@@ -1092,6 +1093,79 @@ where
         "the corrector fails on the crossing branch at {}",
         point.parameter
     )))
+}
+
+/// Why a branch switch could not start.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct SwitchError(pub String);
+
+/// The branch through special point `label` of `branch` (a branch point's
+/// crossing branch or a period doubling's period-2n branch), continued
+/// within `range` (the main branch's start and end values), away from the
+/// special point.
+pub fn switch_branch<F, C>(
+    mut family: F,
+    branch: &Branch,
+    label: &str,
+    range: (f64, f64),
+    opts: &ContinuationOptions,
+    progress: C,
+) -> Result<Branch, SwitchError>
+where
+    F: FnMut(f64) -> Result<Model, String>,
+    C: FnMut(&BranchPoint) -> bool,
+{
+    let sp = branch
+        .special
+        .iter()
+        .find(|s| s.label == label)
+        .ok_or_else(|| {
+            SwitchError(format!(
+                "--switch-at {label}: no such special point on the branch (found: {})",
+                branch
+                    .special
+                    .iter()
+                    .map(|s| s.label.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+    let fail = |e: ContinuationError| {
+        SwitchError(format!(
+            "--switch-at {label}: {e} (the main branch is kept)"
+        ))
+    };
+    let sub = opts.shooting.subharmonic;
+    let (p1, x1, sub) = match sp.kind {
+        SpecialKind::PeriodDoubling => {
+            let (p, x) = period_doubled_start(&mut family, sp, opts).map_err(fail)?;
+            (p, x, sub * 2)
+        }
+        SpecialKind::BranchPoint => {
+            let (p, x) = branch_switch_start(&mut family, sp, range.0, opts, 0.02).map_err(fail)?;
+            (p, x, sub)
+        }
+        other => {
+            return Err(SwitchError(format!(
+                "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
+                other.name()
+            )))
+        }
+    };
+    let switched_opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            subharmonic: sub,
+            ..opts.shooting.clone()
+        },
+        bounds: Some(range),
+        ..opts.clone()
+    };
+    // Onward from the start, away from the special point (the branch stays
+    // within the range).
+    let (lo, hi) = (range.0.min(range.1), range.0.max(range.1));
+    let target = if p1 >= sp.parameter { hi } else { lo };
+    continue_branch(family, p1, &x1, target, &switched_opts, progress).map_err(fail)
 }
 
 #[cfg(test)]

@@ -581,6 +581,78 @@ pub fn fit_joint(
     })
 }
 
+/// Result of an identification from measured impacts.
+#[derive(Serialize, Debug, Clone)]
+pub struct Identification {
+    /// How it was made.
+    pub method: String,
+    /// a/b (m/s), if determined or given.
+    pub a_over_b: Option<Estimate>,
+    /// α (1/m), if acceleration data were given.
+    pub alpha: Option<Estimate>,
+    /// The a/b fit to the restitution data alone.
+    pub restitution_fit: Option<RestitutionFit>,
+    /// The α (or joint) fit.
+    pub acceleration_fit: Option<ExponentialLawFit>,
+}
+
+/// The identification of seed §3 from whatever was measured: a/b from
+/// restitution data alone; with acceleration data too, α given a/b
+/// (`a_over_b` known, or fitted to the restitution data first: sequential,
+/// as in the seed) or both jointly (`joint`, or no restitution data). An
+/// empty slice means that data set was not measured.
+pub fn identify(
+    restitution: &[RestitutionSample],
+    acceleration: &[AccelerationSample],
+    bodies: TwoBodies,
+    a_over_b: Option<f64>,
+    joint: bool,
+) -> Result<Identification, IdentifyError> {
+    let restitution_fit = (!restitution.is_empty())
+        .then(|| fit_a_over_b(restitution))
+        .transpose()?;
+    if acceleration.is_empty() {
+        let Some(fit) = restitution_fit else {
+            return Err(IdentifyError::InvalidParameter(
+                "nothing to identify: give restitution and/or acceleration data".into(),
+            ));
+        };
+        return Ok(Identification {
+            method: "a-over-b-from-restitution".into(),
+            a_over_b: Some(fit.a_over_b),
+            alpha: None,
+            restitution_fit: Some(fit),
+            acceleration_fit: None,
+        });
+    }
+    let (fit, method) = match (a_over_b, joint, &restitution_fit) {
+        (Some(q), _, _) => (fit_alpha(acceleration, bodies, q), "alpha-given-a-over-b"),
+        (None, true, _) | (None, false, None) => {
+            (fit_joint(restitution, acceleration, bodies), "joint")
+        }
+        (None, false, Some(r)) => (
+            fit_alpha(acceleration, bodies, r.a_over_b.value),
+            "sequential: a/b from restitution, then alpha given a/b (alpha's std_error excludes a/b's uncertainty; use --joint for both)",
+        ),
+    };
+    let fit = fit?;
+    let a_over_b = match (&restitution_fit, method) {
+        (Some(r), m) if m.starts_with("sequential") => Some(r.a_over_b),
+        _ => Some(fit.a_over_b),
+    };
+    Ok(Identification {
+        method: if method == "joint" {
+            fit.method.to_string()
+        } else {
+            method.to_string()
+        },
+        a_over_b,
+        alpha: Some(fit.alpha),
+        restitution_fit,
+        acceleration_fit: Some(fit),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,11 +15,20 @@
 //! - [`dynamics`]: the equations of motion with their banded Jacobian;
 //! - [`simulate`]: time histories with an impact log;
 //! - [`variational`]: sensitivities and monodromy matrices (§5);
+//! - [`periodic`]: periodic solutions by shooting, Floquet multipliers;
+//! - [`continuation`]: branches of periodic solutions and their special
+//!   points;
+//! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
+//! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
+//! - [`parameter`]: a numeric key of a model file made a parameter;
+//! - [`results`]: the documents of results (the CLI's JSON, Python's
+//!   result objects);
 //! - [`integrate`]: the integrators (DOP853, RODAS) shared by every time
 //!   integration;
 //! - [`numeric`]: scalar special functions and root finders.
 //!
-//! The library does no I/O: callers hand it numbers and get numbers back.
+//! The library does no I/O: callers hand it numbers and text and get
+//! numbers back.
 
 pub mod contact;
 pub mod continuation;
@@ -28,7 +37,11 @@ pub mod identify;
 pub mod impact;
 pub mod integrate;
 pub mod model;
+pub mod model_file;
 pub mod numeric;
+pub mod parameter;
 pub mod periodic;
+pub mod results;
 pub mod simulate;
+pub mod sweep;
 pub mod variational;

@@ -26,7 +26,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 
 use crate::dynamics::{from_interleaved, interleaved_index, to_interleaved, ChainDynamics};
-use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions};
+use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, Interrupt};
 use crate::model::Model;
 use crate::simulate::{simulate, OptionsError, SimulationOptions};
 use crate::variational::Variational;
@@ -57,6 +57,8 @@ pub struct ShootingOptions {
     /// (`Φ = (DG)²`): an eigenvalue -1 of `DG` is a symmetry-breaking
     /// pitchfork of the full system.
     pub symmetric: bool,
+    /// Stop request checked at every integration step (see [`Interrupt`]).
+    pub interrupt: Option<Interrupt>,
 }
 
 impl Default for ShootingOptions {
@@ -68,6 +70,7 @@ impl Default for ShootingOptions {
             max_iterations: 30,
             displacement_scale: 1e-3,
             symmetric: false,
+            interrupt: None,
         }
     }
 }
@@ -218,6 +221,7 @@ pub fn period_map(
         atol: opts.rtol * opts.displacement_scale,
         max_steps: MAX_STEPS,
         error_components: Some(d),
+        interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
     let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
@@ -424,6 +428,7 @@ impl MonodromyOperator<'_> {
             atol: self.opts.rtol * self.opts.displacement_scale,
             max_steps: MAX_STEPS,
             error_components: Some(d),
+            interrupt: self.opts.interrupt.clone(),
             ..IntegratorOptions::default()
         };
         let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
@@ -625,11 +630,22 @@ pub fn guess_by_simulation(
     periods: f64,
     rtol: f64,
 ) -> Result<Vec<f64>, PeriodicError> {
+    guess_by_simulation_with(model, periods, rtol, None)
+}
+
+/// [`guess_by_simulation`] that stops when `interrupt` is requested.
+pub fn guess_by_simulation_with(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+    interrupt: Option<Interrupt>,
+) -> Result<Vec<f64>, PeriodicError> {
     let t = forcing_period(model)?;
     let opts = SimulationOptions {
         t_end: periods * t,
         rtol,
         atol: rtol * 1e-4,
+        interrupt,
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;

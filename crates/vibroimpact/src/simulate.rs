@@ -32,7 +32,7 @@
 
 use crate::contact::LawKind;
 use crate::dynamics::ChainDynamics;
-use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stats, Stepper};
+use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
 use crate::numeric::{brent, golden_max};
 
@@ -65,6 +65,10 @@ pub struct SimulationOptions {
     /// Locate the exact extrema of every |u_i| and |v_i| over this time
     /// window (see [`Extrema`]).
     pub extrema_window: Option<(f64, f64)>,
+    /// Stop request checked at every step (see [`Interrupt`]): the
+    /// simulation then ends early with [`IntegrationError::Interrupted`] as
+    /// its error, keeping what was computed.
+    pub interrupt: Option<Interrupt>,
 }
 
 impl Default for SimulationOptions {
@@ -80,6 +84,7 @@ impl Default for SimulationOptions {
             start: None,
             method: Method::Dop853,
             extrema_window: None,
+            interrupt: None,
         }
     }
 }
@@ -572,6 +577,7 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         atol: opts.atol,
         max_steps: opts.max_steps,
         error_components: opts.energy.then_some(n2),
+        interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
     let mut st =

@@ -37,6 +37,39 @@ pub use linalg::{BandMatrix, Singular};
 pub use rosenbrock::Rodas;
 
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A shared stop request: a caller (a Ctrl-C handler, a Python binding
+/// watching for KeyboardInterrupt) sets it from another thread, and every
+/// integrator whose options carry it stops before its next step with
+/// [`IntegrationError::Interrupted`]. Clones share the flag.
+#[derive(Clone, Debug, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+impl Interrupt {
+    /// A new token, not yet requested.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Requests the stop.
+    pub fn request(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the stop was requested.
+    pub fn requested(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Two tokens are equal when they share the flag.
+impl PartialEq for Interrupt {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
 
 /// A system of first-order ordinary differential equations `y' = f(t, y)`.
 pub trait OdeSystem {
@@ -121,6 +154,9 @@ pub struct IntegratorOptions {
     /// step (see [`Dop853::stiffness_detected`]); it only reports and never
     /// changes the computed solution. Ignored by [`Rodas`]. Default `true`.
     pub stiffness_check: bool,
+    /// Stop request checked before every step (see [`Interrupt`]). Default
+    /// `None`.
+    pub interrupt: Option<Interrupt>,
 }
 
 impl Default for IntegratorOptions {
@@ -134,6 +170,7 @@ impl Default for IntegratorOptions {
             max_steps: 10_000_000,
             error_components: None,
             stiffness_check: true,
+            interrupt: None,
         }
     }
 }
@@ -267,6 +304,12 @@ pub enum IntegrationError {
         t: f64,
         /// Number of accepted steps since the last reset.
         steps: u64,
+    },
+    /// The caller's [`Interrupt`] was requested; `t` is the time reached.
+    #[error("interrupted at t = {t:e}")]
+    Interrupted {
+        /// Time reached.
+        t: f64,
     },
     /// Invalid options or arguments (tolerances, step limits, dimension
     /// mismatch, non-finite or out-of-order times, stepping before `reset`).

@@ -1,0 +1,929 @@
+//! Model files: the TOML schema of `docs/model.md` and its translation into
+//! a [`Model`]. The text comes from the caller (the library reads no
+//! files); an accelerogram named by file is handed in by a loader the caller
+//! supplies. Every error names the source, the line and the key.
+//!
+//! A [`ModelDocument`] is the parsed file. It builds the [`Model`]
+//! ([`ModelDocument::build`]), sets a numeric key to a new value without
+//! re-reading any text (see [`crate::parameter`]) and writes itself back as
+//! TOML with any record inlined ([`ModelDocument::to_toml`]), so that a
+//! model travels between processes without its files.
+
+use serde::{Deserialize, Serialize};
+use toml::Spanned;
+
+use crate::contact::{ContactLaw, ForceForm};
+use crate::model::{
+    Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, HarmonicForce, Model,
+};
+
+/// A model-file error: one line naming the source, the line and the key.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct ModelFileError(pub String);
+
+/// A contact law as written in a model file (`law = "..."` selects it).
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(tag = "law", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum LawSpec {
+    /// `F = (a + b ṡ) exp(α s)`.
+    Exponential {
+        /// a/b (m/s); or give `b`.
+        a_over_b: Option<f64>,
+        /// b (N s/m).
+        b: Option<f64>,
+        /// α (1/m).
+        alpha: f64,
+        /// a (N), default 1.
+        a: Option<f64>,
+        /// Force form.
+        form: Option<ForceForm>,
+    },
+    /// `k s^n`.
+    Hertz {
+        /// k.
+        stiffness: f64,
+        /// n, default 1.5.
+        exponent: Option<f64>,
+    },
+    /// `k s + c ṡ`.
+    KelvinVoigt {
+        /// k.
+        stiffness: f64,
+        /// c.
+        damping: f64,
+        /// Force form.
+        form: Option<ForceForm>,
+    },
+    /// `k s^n (1 + χ ṡ)`.
+    HuntCrossley {
+        /// k.
+        stiffness: f64,
+        /// n, default 1.5.
+        exponent: Option<f64>,
+        /// χ (s/m).
+        chi: f64,
+        /// Force form.
+        form: Option<ForceForm>,
+    },
+    /// `k s^n (1 + 3(1-e²)/4 ṡ/v₀)`.
+    LankaraniNikravesh {
+        /// k.
+        stiffness: f64,
+        /// n, default 1.5.
+        exponent: Option<f64>,
+        /// e.
+        restitution: f64,
+        /// Floor of v₀ (m/s), default 1e-3.
+        min_impact_velocity: Option<f64>,
+        /// Force form.
+        form: Option<ForceForm>,
+    },
+}
+
+impl LawSpec {
+    /// Builds the law.
+    pub fn build(&self) -> Result<ContactLaw, String> {
+        let r = match *self {
+            LawSpec::Exponential {
+                a_over_b,
+                b,
+                alpha,
+                a,
+                form,
+            } => {
+                let a = a.unwrap_or(1.0);
+                let form = form.unwrap_or_default();
+                match (a_over_b, b) {
+                    (Some(q), None) => ContactLaw::exponential_from_ratio(q, alpha, a, form),
+                    (None, Some(b)) => ContactLaw::exponential(a, b, alpha, form),
+                    _ => {
+                        return Err("exponential law: give exactly one of `a_over_b` and `b`".into())
+                    }
+                }
+            }
+            LawSpec::Hertz {
+                stiffness,
+                exponent,
+            } => ContactLaw::hertz(stiffness, exponent.unwrap_or(1.5)),
+            LawSpec::KelvinVoigt {
+                stiffness,
+                damping,
+                form,
+            } => ContactLaw::kelvin_voigt(stiffness, damping, form.unwrap_or_default()),
+            LawSpec::HuntCrossley {
+                stiffness,
+                exponent,
+                chi,
+                form,
+            } => ContactLaw::hunt_crossley(
+                stiffness,
+                exponent.unwrap_or(1.5),
+                chi,
+                form.unwrap_or_default(),
+            ),
+            LawSpec::LankaraniNikravesh {
+                stiffness,
+                exponent,
+                restitution,
+                min_impact_velocity,
+                form,
+            } => ContactLaw::lankarani_nikravesh(
+                stiffness,
+                exponent.unwrap_or(1.5),
+                restitution,
+                min_impact_velocity.unwrap_or(1e-3),
+                form.unwrap_or_default(),
+            ),
+        };
+        r.map_err(|e| e.to_string())
+    }
+}
+
+/// Spring and damper to the frame: `stiffness`/`natural_frequency`,
+/// `damping`/`damping_ratio`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Support {
+    pub(crate) stiffness: Option<f64>,
+    pub(crate) natural_frequency: Option<f64>,
+    pub(crate) damping: Option<f64>,
+    pub(crate) damping_ratio: Option<f64>,
+}
+
+impl Support {
+    fn resolve(&self, mass: f64) -> Result<(f64, f64), String> {
+        let k = match (self.stiffness, self.natural_frequency) {
+            (Some(_), Some(_)) => {
+                return Err("give `stiffness` or `natural_frequency`, not both".into())
+            }
+            (Some(k), None) => k,
+            (None, Some(w)) => {
+                if !(w >= 0.0 && w.is_finite()) {
+                    return Err(format!("natural_frequency = {w}: must be finite and >= 0"));
+                }
+                mass * w * w
+            }
+            (None, None) => 0.0,
+        };
+        let c = match (self.damping, self.damping_ratio) {
+            (Some(_), Some(_)) => return Err("give `damping` or `damping_ratio`, not both".into()),
+            (Some(c), None) => c,
+            (None, Some(z)) => {
+                if !(z >= 0.0 && z.is_finite()) {
+                    return Err(format!("damping_ratio = {z}: must be finite and >= 0"));
+                }
+                if k == 0.0 && z > 0.0 {
+                    return Err("damping_ratio needs a stiffness (or natural_frequency) > 0".into());
+                }
+                2.0 * z * (k * mass).sqrt()
+            }
+            (None, None) => 0.0,
+        };
+        Ok((k, c))
+    }
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RowSpec {
+    pub(crate) count: usize,
+    pub(crate) mass: f64,
+    pub(crate) stiffness: Option<f64>,
+    pub(crate) natural_frequency: Option<f64>,
+    pub(crate) damping: Option<f64>,
+    pub(crate) damping_ratio: Option<f64>,
+    pub(crate) clearance: f64,
+    pub(crate) contact: LawSpec,
+    /// "both" (default), "left", "right" or "none".
+    pub(crate) walls: Option<String>,
+    /// Spring–damper between neighbours.
+    pub(crate) coupling: Option<CouplingSpec>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CouplingSpec {
+    pub(crate) stiffness: Option<f64>,
+    pub(crate) damping: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct BodySpec {
+    pub(crate) name: String,
+    pub(crate) mass: f64,
+    pub(crate) stiffness: Option<f64>,
+    pub(crate) natural_frequency: Option<f64>,
+    pub(crate) damping: Option<f64>,
+    pub(crate) damping_ratio: Option<f64>,
+    pub(crate) initial_displacement: Option<f64>,
+    pub(crate) initial_velocity: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SpringSpec {
+    pub(crate) between: [String; 2],
+    pub(crate) stiffness: Option<f64>,
+    pub(crate) damping: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ContactSpec {
+    pub(crate) between: [String; 2],
+    pub(crate) clearance: f64,
+    pub(crate) law: LawSpec,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub(crate) enum ExcitationSpec {
+    None,
+    HarmonicBase {
+        amplitude: f64,
+        frequency: f64,
+        phase: Option<f64>,
+    },
+    Accelerogram {
+        file: Option<String>,
+        time: Option<Vec<f64>>,
+        acceleration: Option<Vec<f64>>,
+        scale: Option<f64>,
+    },
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ForceSpec {
+    pub(crate) body: String,
+    pub(crate) amplitude: f64,
+    pub(crate) frequency: f64,
+    pub(crate) phase: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct InitialSpec {
+    pub(crate) displacement: Option<Vec<f64>>,
+    pub(crate) velocity: Option<Vec<f64>>,
+}
+
+/// Optional simulation settings stored with the model.
+#[derive(Serialize, Deserialize, Debug, Default, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Relative tolerance.
+    pub rtol: Option<f64>,
+    /// Absolute tolerance.
+    pub atol: Option<f64>,
+    /// Impact force threshold F_on (N).
+    pub impact_force_threshold: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ModelFile {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) row: Option<Spanned<RowSpec>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(crate) body: Vec<Spanned<BodySpec>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(crate) spring: Vec<Spanned<SpringSpec>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(crate) contact: Vec<Spanned<ContactSpec>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) excitation: Option<Spanned<ExcitationSpec>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(crate) force: Vec<Spanned<ForceSpec>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) initial: Option<Spanned<InitialSpec>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) simulation: Option<SimulationSpec>,
+}
+
+/// A model built from a document, with the document's simulation settings.
+#[derive(Clone, Debug)]
+pub struct LoadedModel {
+    /// The model.
+    pub model: Model,
+    /// `[simulation]` settings.
+    pub simulation: SimulationSpec,
+}
+
+/// A recorded base acceleration as read, before scaling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordSamples {
+    /// Where it came from (a file name), for messages.
+    pub source: String,
+    /// Sample times (s), strictly increasing.
+    pub times: Vec<f64>,
+    /// Accelerations (m/s²).
+    pub values: Vec<f64>,
+}
+
+/// A parsed model file.
+#[derive(Clone, Debug)]
+pub struct ModelDocument {
+    pub(crate) file: ModelFile,
+    /// Byte offset of the start of every line of the text (for line numbers).
+    line_starts: Vec<usize>,
+    source: String,
+    record: Option<RecordSamples>,
+}
+
+/// Errors located in the document: `label:line: message`.
+struct Ctx<'a> {
+    label: &'a str,
+    line_starts: &'a [usize],
+}
+
+impl Ctx<'_> {
+    fn err_at(&self, span: std::ops::Range<usize>, msg: impl std::fmt::Display) -> ModelFileError {
+        let line = self.line_starts.partition_point(|&s| s <= span.start);
+        ModelFileError(format!("{}:{line}: {msg}", self.label))
+    }
+
+    fn plain(&self, msg: impl std::fmt::Display) -> ModelFileError {
+        ModelFileError(format!("{}: {msg}", self.label))
+    }
+}
+
+impl ModelDocument {
+    /// Parses model text. `source` names it in messages; `load_record` is
+    /// called with the `file` of an `accelerogram` excitation and returns its
+    /// samples (e.g. [`parse_accelerogram_csv`] of the file's text).
+    pub fn parse(
+        text: &str,
+        source: &str,
+        load_record: &mut dyn FnMut(&str) -> Result<RecordSamples, ModelFileError>,
+    ) -> Result<Self, ModelFileError> {
+        let line_starts: Vec<usize> = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        let cx = Ctx {
+            label: source,
+            line_starts: &line_starts,
+        };
+        let file: ModelFile = toml::from_str(text).map_err(|e| {
+            let msg = e.message().trim().replace('\n', " ");
+            match e.span() {
+                Some(span) => cx.err_at(span, msg),
+                None => cx.plain(msg),
+            }
+        })?;
+        let record = match file.excitation.as_ref().map(|e| (e.span(), e.get_ref())) {
+            Some((
+                span,
+                ExcitationSpec::Accelerogram {
+                    file: f,
+                    time,
+                    acceleration,
+                    ..
+                },
+            )) => Some(match (f, time, acceleration) {
+                (Some(f), None, None) => load_record(f)?,
+                (None, Some(t), Some(a)) => RecordSamples {
+                    source: format!("{source} [excitation]"),
+                    times: t.clone(),
+                    values: a.clone(),
+                },
+                _ => return Err(cx.err_at(
+                    span,
+                    "[excitation] accelerogram: give `file`, or `time` and `acceleration` arrays",
+                )),
+            }),
+            _ => None,
+        };
+        let doc = Self {
+            file,
+            line_starts,
+            source: source.to_string(),
+            record,
+        };
+        doc.build()?;
+        Ok(doc)
+    }
+
+    /// Parses model text that refers to no accelerogram file.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelFileError> {
+        Self::parse(text, source, &mut |f| {
+            Err(ModelFileError(format!(
+                "{source}: accelerogram file `{f}`: no files can be read here; give the samples inline (`time` and `acceleration` arrays)"
+            )))
+        })
+    }
+
+    /// The source named in messages.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Builds the model.
+    pub fn build(&self) -> Result<LoadedModel, ModelFileError> {
+        self.build_labelled(&self.source)
+    }
+
+    /// The document as TOML text, any accelerogram inlined as `time` and
+    /// `acceleration` arrays: [`ModelDocument::from_toml`] of it gives the
+    /// same model.
+    pub fn to_toml(&self) -> String {
+        let mut file = self.file.clone();
+        if let (Some(e), Some(r)) = (file.excitation.as_mut(), &self.record) {
+            if let ExcitationSpec::Accelerogram {
+                file: f,
+                time,
+                acceleration,
+                ..
+            } = e.get_mut()
+            {
+                *f = None;
+                *time = Some(r.times.clone());
+                *acceleration = Some(r.values.clone());
+            }
+        }
+        // Serialising plain data (numbers, strings, arrays, tables) cannot fail.
+        toml::to_string(&file).unwrap_or_default()
+    }
+
+    /// Builds the model, naming it `label` in messages.
+    pub(crate) fn build_labelled(&self, label: &str) -> Result<LoadedModel, ModelFileError> {
+        let cx = Ctx {
+            label,
+            line_starts: &self.line_starts,
+        };
+        let file = &self.file;
+        let physical = |v: f64, key: &str| -> Result<f64, String> {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("{key} = {v}: must be finite"))
+            }
+        };
+        let mut bodies: Vec<Body> = Vec::new();
+        let mut couplings = Vec::new();
+        let mut contacts = Vec::new();
+        let mut init_u = Vec::new();
+        let mut init_v = Vec::new();
+        match (&file.row, file.body.is_empty()) {
+            (Some(_), false) => {
+                let span = file.body[0].span();
+                return Err(cx.err_at(span, "give either [row] or [[body]] tables, not both"));
+            }
+            (None, true) => return Err(cx.plain("no bodies: add a [row] table or [[body]] tables")),
+            (Some(row), true) => {
+                let span = row.span();
+                let r = row.get_ref();
+                if r.count == 0 || r.count > 1_000_000 {
+                    return Err(cx.err_at(
+                        span,
+                        format!("[row] count = {}: must be from 1 to 1000000", r.count),
+                    ));
+                }
+                if !(r.mass > 0.0 && r.mass.is_finite()) {
+                    return Err(cx.err_at(
+                        span,
+                        format!("[row] mass = {}: must be finite and > 0", r.mass),
+                    ));
+                }
+                let support = Support {
+                    stiffness: r.stiffness,
+                    natural_frequency: r.natural_frequency,
+                    damping: r.damping,
+                    damping_ratio: r.damping_ratio,
+                };
+                let (k, c) = support
+                    .resolve(r.mass)
+                    .map_err(|m| cx.err_at(span.clone(), format!("[row] {m}")))?;
+                let law = r
+                    .contact
+                    .build()
+                    .map_err(|m| cx.err_at(span.clone(), format!("[row] contact: {m}")))?;
+                let walls = match r.walls.as_deref().unwrap_or("both") {
+                    "both" => (true, true),
+                    "left" => (true, false),
+                    "right" => (false, true),
+                    "none" => (false, false),
+                    w => {
+                        return Err(cx.err_at(
+                            span,
+                            format!("[row] walls = \"{w}\": must be both, left, right or none"),
+                        ))
+                    }
+                };
+                physical(r.clearance, "clearance")
+                    .map_err(|m| cx.err_at(span.clone(), format!("[row] {m}")))?;
+                let row_model = Model::row(
+                    r.count,
+                    r.mass,
+                    k,
+                    c,
+                    r.clearance,
+                    law,
+                    walls,
+                    BaseExcitation::None,
+                )
+                .map_err(|e| cx.err_at(span.clone(), format!("[row] {e}")))?;
+                bodies = row_model.bodies().to_vec();
+                contacts = row_model.contacts().to_vec();
+                if let Some(cp) = &r.coupling {
+                    for i in 0..r.count.saturating_sub(1) {
+                        couplings.push(Coupling {
+                            a: i,
+                            b: i + 1,
+                            stiffness: cp.stiffness.unwrap_or(0.0),
+                            damping: cp.damping.unwrap_or(0.0),
+                        });
+                    }
+                }
+            }
+            (None, false) => {
+                for (i, b) in file.body.iter().enumerate() {
+                    let span = b.span();
+                    let spec = b.get_ref();
+                    if bodies.iter().any(|x| x.name == spec.name) || spec.name == "wall" {
+                        return Err(cx.err_at(
+                            span,
+                            format!(
+                                "[[body]] #{}: name `{}` is used twice or reserved",
+                                i + 1,
+                                spec.name
+                            ),
+                        ));
+                    }
+                    if !(spec.mass > 0.0 && spec.mass.is_finite()) {
+                        return Err(cx.err_at(
+                            span,
+                            format!(
+                                "[[body]] {}: mass = {}: must be finite and > 0",
+                                spec.name, spec.mass
+                            ),
+                        ));
+                    }
+                    let support = Support {
+                        stiffness: spec.stiffness,
+                        natural_frequency: spec.natural_frequency,
+                        damping: spec.damping,
+                        damping_ratio: spec.damping_ratio,
+                    };
+                    let (k, c) = support.resolve(spec.mass).map_err(|m| {
+                        cx.err_at(span.clone(), format!("[[body]] {}: {m}", spec.name))
+                    })?;
+                    bodies.push(Body {
+                        name: spec.name.clone(),
+                        mass: spec.mass,
+                        stiffness: k,
+                        damping: c,
+                    });
+                    init_u.push(spec.initial_displacement.unwrap_or(0.0));
+                    init_v.push(spec.initial_velocity.unwrap_or(0.0));
+                }
+            }
+        }
+        let find = |name: &str| bodies.iter().position(|b| b.name == name);
+        let names = || {
+            bodies
+                .iter()
+                .map(|b| b.name.as_str())
+                .take(10)
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for s in &file.spring {
+            let span = s.span();
+            let spec = s.get_ref();
+            let idx: Vec<usize> = spec
+                .between
+                .iter()
+                .map(|n| {
+                    find(n).ok_or_else(|| {
+                        cx.err_at(
+                            span.clone(),
+                            format!("[[spring]]: unknown body `{n}` (bodies: {})", names()),
+                        )
+                    })
+                })
+                .collect::<Result<_, _>>()?;
+            couplings.push(Coupling {
+                a: idx[0],
+                b: idx[1],
+                stiffness: spec.stiffness.unwrap_or(0.0),
+                damping: spec.damping.unwrap_or(0.0),
+            });
+        }
+        for c in &file.contact {
+            let span = c.span();
+            let spec = c.get_ref();
+            let law = spec.law.build().map_err(|m| {
+                cx.err_at(
+                    span.clone(),
+                    format!("[[contact]] {}|{}: {m}", spec.between[0], spec.between[1]),
+                )
+            })?;
+            let side = |n: &str| -> Result<Option<usize>, ModelFileError> {
+                if n == "wall" {
+                    Ok(None)
+                } else {
+                    find(n).map(Some).ok_or_else(|| {
+                        cx.err_at(
+                            span.clone(),
+                            format!(
+                                "[[contact]]: unknown body `{n}` (bodies: {}; or `wall`)",
+                                names()
+                            ),
+                        )
+                    })
+                }
+            };
+            let pair = match (side(&spec.between[0])?, side(&spec.between[1])?) {
+                (None, None) => return Err(cx.err_at(span, "[[contact]]: between two walls")),
+                (None, Some(r)) => ContactPair::LeftWall { body: r },
+                (Some(l), None) => ContactPair::RightWall { body: l },
+                (Some(l), Some(r)) => {
+                    if l >= r {
+                        return Err(cx.err_at(
+                            span,
+                            format!("[[contact]] between = [\"{}\", \"{}\"]: give the left body first (bodies are in order along the line)", spec.between[0], spec.between[1]),
+                        ));
+                    }
+                    ContactPair::Bodies { left: l, right: r }
+                }
+            };
+            if !(spec.clearance >= 0.0 && spec.clearance.is_finite()) {
+                return Err(cx.err_at(
+                    span,
+                    format!(
+                        "[[contact]] {}|{}: clearance = {}: must be finite and >= 0",
+                        spec.between[0], spec.between[1], spec.clearance
+                    ),
+                ));
+            }
+            contacts.push(Contact {
+                pair,
+                clearance: spec.clearance,
+                law,
+            });
+        }
+        let base = match &file.excitation {
+            None => BaseExcitation::None,
+            Some(e) => {
+                let span = e.span();
+                match e.get_ref() {
+                    ExcitationSpec::None => BaseExcitation::None,
+                    ExcitationSpec::HarmonicBase {
+                        amplitude,
+                        frequency,
+                        phase,
+                    } => {
+                        if !(*frequency > 0.0 && frequency.is_finite()) {
+                            return Err(cx.err_at(span, format!("[excitation] frequency = {frequency}: must be finite and > 0 (rad/s)")));
+                        }
+                        physical(*amplitude, "amplitude")
+                            .map_err(|m| cx.err_at(span.clone(), format!("[excitation] {m}")))?;
+                        BaseExcitation::Harmonic {
+                            amplitude: *amplitude,
+                            frequency: *frequency,
+                            phase: phase.unwrap_or(0.0),
+                        }
+                    }
+                    ExcitationSpec::Accelerogram { scale, .. } => {
+                        let record = self.record.as_ref().ok_or_else(|| {
+                            cx.err_at(span.clone(), "[excitation] accelerogram: no record loaded")
+                        })?;
+                        let scale = scale.unwrap_or(1.0);
+                        BaseExcitation::Record(
+                            Accelerogram::new(record.times.clone(), record.values.clone(), scale)
+                                .map_err(|e| ModelFileError(format!("{}: {e}", record.source)))?,
+                        )
+                    }
+                }
+            }
+        };
+        let mut forces = Vec::new();
+        for f in &file.force {
+            let span = f.span();
+            let spec = f.get_ref();
+            let body = find(&spec.body).ok_or_else(|| {
+                cx.err_at(
+                    span.clone(),
+                    format!("[[force]]: unknown body `{}`", spec.body),
+                )
+            })?;
+            forces.push(HarmonicForce {
+                body,
+                amplitude: spec.amplitude,
+                frequency: spec.frequency,
+                phase: spec.phase.unwrap_or(0.0),
+            });
+        }
+        if let Some(init) = &file.initial {
+            let span = init.span();
+            if !file.body.is_empty()
+                && file.body.iter().any(|b| {
+                    b.get_ref().initial_displacement.is_some()
+                        || b.get_ref().initial_velocity.is_some()
+                })
+            {
+                return Err(cx.err_at(
+                    span,
+                    "give the initial state either in [initial] or in the [[body]] tables, not both",
+                ));
+            }
+            let spec = init.get_ref();
+            init_u = spec.displacement.clone().unwrap_or_default();
+            init_v = spec.velocity.clone().unwrap_or_default();
+        }
+        let model = Model::new(bodies, couplings, contacts, base, forces, init_u, init_v)
+            .map_err(|e| cx.plain(e))?;
+        Ok(LoadedModel {
+            model,
+            simulation: file.simulation.clone().unwrap_or_default(),
+        })
+    }
+}
+
+/// Parses a two-column accelerogram CSV (time s, acceleration m/s²); a
+/// header row and `#` comment lines are allowed. `source` names the text in
+/// messages, which give its line.
+pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<RecordSamples, ModelFileError> {
+    let err = |msg: String| Err(ModelFileError(msg));
+    let mut times = Vec::new();
+    let mut values = Vec::new();
+    let mut header_seen = false;
+    for (i, line) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = l.split(',').map(str::trim).collect();
+        let parsed: Option<(f64, f64)> = match cells.as_slice() {
+            [t, a] => t.parse().ok().zip(a.parse().ok()),
+            _ => {
+                return err(format!(
+                    "{source}:{line_no}: expected two columns (time, acceleration), found {}",
+                    cells.len()
+                ))
+            }
+        };
+        match parsed {
+            Some((t, a)) if t.is_finite() && a.is_finite() => {
+                if let Some(&last) = times.last() {
+                    if t <= last {
+                        return err(format!("{source}:{line_no}: time {t} is not after the previous {last} (times must increase)"));
+                    }
+                }
+                times.push(t);
+                values.push(a);
+            }
+            Some(_) => return err(format!("{source}:{line_no}: values must be finite")),
+            None if !header_seen && times.is_empty() => header_seen = true,
+            None => return err(format!("{source}:{line_no}: `{l}` is not two numbers")),
+        }
+    }
+    Ok(RecordSamples {
+        source: source.to_string(),
+        times,
+        values,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<LoadedModel, ModelFileError> {
+        ModelDocument::from_toml(text, "m.toml")?.build()
+    }
+
+    const ROW: &str = r#"
+[row]
+count = 3
+mass = 0.227
+natural_frequency = 7.41
+damping_ratio = 0.013
+clearance = 0.001
+contact = { law = "exponential", a_over_b = 1.2, alpha = 1.3e5, a = 1.0 }
+
+[excitation]
+type = "harmonic-base"
+amplitude = 0.05
+frequency = 7.0395
+"#;
+
+    const EXPLICIT: &str = r#"
+[[body]]
+name = "a"
+mass = 1.0
+stiffness = 100.0
+[[body]]
+name = "b"
+mass = 2.0
+natural_frequency = 5.0
+damping_ratio = 0.02
+initial_velocity = 0.1
+[[spring]]
+between = ["a", "b"]
+stiffness = 10.0
+[[contact]]
+between = ["wall", "a"]
+clearance = 0.002
+law = { law = "hertz", stiffness = 1e9 }
+[[contact]]
+between = ["a", "b"]
+clearance = 0.001
+law = { law = "kelvin-voigt", stiffness = 1e6, damping = 10.0, form = "non-negative" }
+[[force]]
+body = "b"
+amplitude = 1.0
+frequency = 3.0
+"#;
+
+    #[test]
+    fn row_form() {
+        let m = parse(ROW).unwrap().model;
+        assert_eq!(m.bodies().len(), 3);
+        assert_eq!(m.contacts().len(), 4);
+        assert!((m.bodies()[0].stiffness - 0.227 * 7.41 * 7.41).abs() < 1e-12);
+        assert!((m.bodies()[0].damping - 2.0 * 0.013 * 0.227 * 7.41).abs() < 1e-14);
+        assert_eq!(m.forcing_frequency(), Some(7.0395));
+    }
+
+    #[test]
+    fn explicit_form() {
+        let text = EXPLICIT;
+        let m = parse(text).unwrap().model;
+        assert_eq!(m.couplings().len(), 1);
+        assert_eq!(m.contact_name(0), "wall|a");
+        assert_eq!(m.contacts()[1].law.form(), ForceForm::NonNegative);
+        assert_eq!(m.initial_velocity(), &[0.0, 0.1]);
+        assert_eq!(m.forcing_frequency(), Some(3.0));
+    }
+
+    fn err(text: &str) -> String {
+        parse(text).err().expect("should fail").to_string()
+    }
+
+    #[test]
+    fn errors_name_line_and_key() {
+        let e = err(&ROW.replace("mass = 0.227", "mass = 0.227\nmasss = 1"));
+        assert!(e.starts_with("m.toml:") && e.contains("masss"), "{e}");
+        let e = err(&ROW.replace("clearance = 0.001\n", ""));
+        assert!(e.contains("clearance"), "{e}");
+        let e = err(&ROW.replace("mass = 0.227", "mass = -1"));
+        assert!(e.starts_with("m.toml:2:") && e.contains("mass = -1"), "{e}");
+        let e = err(&ROW.replace("alpha = 1.3e5", "alpha = 0"));
+        assert!(e.contains("alpha"), "{e}");
+        let e = err(&ROW.replace("clearance = 0.001", "clearance = -0.001"));
+        assert!(e.contains("clearance"), "{e}");
+        let e = err("[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"zz\"]\nclearance = 0.0\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+        assert!(
+            e.starts_with("m.toml:4:") && e.contains("unknown body `zz`"),
+            "{e}"
+        );
+        let e = err("[[body]]\nname = \"a\"\nmass = 1.0\ninitial_displacement = 0.01\n[[contact]]\nbetween = [\"a\", \"wall\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+        assert!(e.contains("overlap"), "{e}");
+        let e = err(&ROW.replace("type = \"harmonic-base\"", "type = \"quake\""));
+        assert!(e.contains("quake"), "{e}");
+        let e = err(&ROW.replace("law = \"exponential\"", "law = \"magic\""));
+        assert!(e.contains("magic"), "{e}");
+    }
+
+    #[test]
+    fn accelerograms_from_text_and_inline() {
+        let a = parse_accelerogram_csv("time,acceleration\n0,0\n0.5,1\n1.0,0\n", "ok.csv").unwrap();
+        assert_eq!((a.times.len(), a.values[1]), (3, 1.0));
+        let e = parse_accelerogram_csv("0,0\n0.5,1\n0.4,0\n", "bad.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.csv:3:") && e.contains("increase"), "{e}");
+        let text = "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"ok.csv\"\nscale = 0.5\n";
+        let doc = ModelDocument::parse(text, "m.toml", &mut |f| {
+            assert_eq!(f, "ok.csv");
+            Ok(a.clone())
+        })
+        .unwrap();
+        let m = doc.build().unwrap().model;
+        let BaseExcitation::Record(r) = m.base() else {
+            panic!("a record")
+        };
+        assert_eq!(r.at(0.25), 0.25);
+        // Written back with the record inline, it reads without the file.
+        let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+        assert_eq!(again.build().unwrap().model, m);
+        let e = ModelDocument::from_toml(text, "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("ok.csv") && e.contains("inline"), "{e}");
+    }
+
+    /// Every example form survives the round trip through `to_toml`.
+    #[test]
+    fn round_trip() {
+        for text in [ROW, EXPLICIT] {
+            let doc = ModelDocument::from_toml(text, "m.toml").unwrap();
+            let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+            assert_eq!(again.build().unwrap().model, doc.build().unwrap().model);
+        }
+    }
+}

@@ -1,0 +1,371 @@
+//! The documents of results that every face of the library shows: the
+//! CLI's JSON output and the Python package's result objects carry the same
+//! fields, made here once.
+
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use crate::contact::{ContactLaw, LawKind};
+use crate::continuation::Branch;
+use crate::impact::closed_form::ExponentialImpact;
+use crate::impact::direct::{integrate_impact, DirectOptions};
+use crate::impact::{ImpactError, TwoBodies};
+use crate::model::Model;
+use crate::periodic::{OrbitSummary, PeriodicSolution};
+use crate::simulate::Simulation;
+
+/// JSON description of a contact law: name, form and parameters.
+pub fn law_document(law: &ContactLaw) -> serde_json::Value {
+    let params = match *law.kind() {
+        LawKind::Exponential { a, b, alpha } => {
+            serde_json::json!({"a": a, "b": b, "a_over_b": a / b, "alpha": alpha})
+        }
+        LawKind::Hertz { k, n } => serde_json::json!({"stiffness": k, "exponent": n}),
+        LawKind::KelvinVoigt { k, c } => serde_json::json!({"stiffness": k, "damping": c}),
+        LawKind::HuntCrossley { k, n, chi } => {
+            serde_json::json!({"stiffness": k, "exponent": n, "chi": chi})
+        }
+        LawKind::LankaraniNikravesh {
+            k,
+            n,
+            restitution,
+            min_impact_velocity,
+        } => serde_json::json!({"stiffness": k, "exponent": n, "restitution": restitution,
+            "min_impact_velocity": min_impact_velocity}),
+    };
+    serde_json::json!({"law": law.name(), "form": law.form().name(), "parameters": params})
+}
+
+/// How impacts are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImpactMethod {
+    /// Fujita's closed form (exponential law only).
+    ClosedForm,
+    /// Direct integration of the relative motion (any law).
+    Integrate,
+}
+
+impl ImpactMethod {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImpactMethod::ClosedForm => "closed-form",
+            ImpactMethod::Integrate => "integrate",
+        }
+    }
+}
+
+/// Impact relations at one impact velocity.
+#[derive(Serialize, Debug)]
+pub struct ImpactRow {
+    /// U (m/s).
+    pub impact_velocity: f64,
+    /// V = U/(a/b), exponential law only.
+    pub v: Option<f64>,
+    /// e.
+    pub restitution: f64,
+    /// e U (m/s).
+    pub rebound_velocity: f64,
+    /// f_max = F_max / (μ α (a/b)²), exponential law only.
+    pub peak_force_dimensionless: Option<f64>,
+    /// F_max (N).
+    pub peak_force: f64,
+    /// F_max/m1 (m/s²).
+    pub peak_acceleration1: f64,
+    /// F_max/m2 (m/s²), 0 for a wall.
+    pub peak_acceleration2: f64,
+    /// Maximum approach coordinate (m).
+    pub max_penetration: f64,
+    /// Contact duration (s), integrate only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_duration: Option<f64>,
+}
+
+impl ImpactRow {
+    /// The values in the order of [`IMPACT_COLUMNS`].
+    pub fn values(&self) -> Vec<Option<f64>> {
+        vec![
+            Some(self.impact_velocity),
+            self.v,
+            Some(self.restitution),
+            Some(self.rebound_velocity),
+            self.peak_force_dimensionless,
+            Some(self.peak_force),
+            Some(self.peak_acceleration1),
+            Some(self.peak_acceleration2),
+            Some(self.max_penetration),
+            self.contact_duration,
+        ]
+    }
+}
+
+/// Column names of an [`ImpactRow`].
+pub const IMPACT_COLUMNS: [&str; 10] = [
+    "impact_velocity",
+    "v",
+    "restitution",
+    "rebound_velocity",
+    "peak_force_dimensionless",
+    "peak_force",
+    "peak_acceleration1",
+    "peak_acceleration2",
+    "max_penetration",
+    "contact_duration",
+];
+
+/// The impact relations of `law` between `bodies` at every impact
+/// velocity, by Fujita's closed form (exponential law only) or by direct
+/// integration.
+pub fn impact_rows(
+    law: &ContactLaw,
+    bodies: TwoBodies,
+    velocities: &[f64],
+    method: ImpactMethod,
+    opts: &DirectOptions,
+) -> Result<Vec<ImpactRow>, ImpactError> {
+    let closed = match law.kind() {
+        LawKind::Exponential { .. } => Some(ExponentialImpact::new(law, bodies)?),
+        _ => None,
+    };
+    velocities
+        .iter()
+        .map(|&u| {
+            Ok(match (method, &closed) {
+                (ImpactMethod::ClosedForm, None) => {
+                    return Err(ImpactError::Unsupported(format!(
+                        "method closed-form exists only for the exponential law, not for {}; use method integrate",
+                        law.name()
+                    )))
+                }
+                (ImpactMethod::ClosedForm, Some(cf)) => {
+                    let c = cf.impact(u)?;
+                    ImpactRow {
+                        impact_velocity: u,
+                        v: Some(c.v),
+                        restitution: c.restitution,
+                        rebound_velocity: c.rebound_velocity,
+                        peak_force_dimensionless: Some(c.peak_force_dimensionless),
+                        peak_force: c.peak_force,
+                        peak_acceleration1: c.peak_acceleration[0],
+                        peak_acceleration2: c.peak_acceleration[1],
+                        max_penetration: c.max_penetration,
+                        contact_duration: None,
+                    }
+                }
+                (ImpactMethod::Integrate, _) => {
+                    let d = integrate_impact(law, bodies, u, opts)?;
+                    ImpactRow {
+                        impact_velocity: u,
+                        v: closed.map(|cf| u / cf.a_over_b()),
+                        restitution: d.restitution,
+                        rebound_velocity: d.rebound_velocity,
+                        peak_force_dimensionless: closed.map(|cf| d.peak_force / cf.force_scale()),
+                        peak_force: d.peak_force,
+                        peak_acceleration1: d.peak_acceleration[0],
+                        peak_acceleration2: d.peak_acceleration[1],
+                        max_penetration: d.max_penetration,
+                        contact_duration: Some(d.contact_duration),
+                    }
+                }
+            })
+        })
+        .collect()
+}
+
+/// The document of `vibroimpact impact`: method, contact law, masses and
+/// one row per velocity.
+pub fn impact_document(
+    law: &ContactLaw,
+    bodies: TwoBodies,
+    method: ImpactMethod,
+    rows: &[ImpactRow],
+) -> Value {
+    json!({
+        "method": method.name(),
+        "contact_law": law_document(law),
+        "mass1": bodies.m1(),
+        "mass2": if bodies.m2().is_infinite() { json!("wall") } else { json!(bodies.m2()) },
+        "reduced_mass": bodies.reduced_mass(),
+        "rows": rows,
+    })
+}
+
+/// Impacts of one contact per period (periodic orbits).
+#[derive(Serialize, Debug)]
+struct ContactImpactsDocument {
+    contact: String,
+    count: usize,
+    impact_velocities: Vec<f64>,
+    peak_forces: Vec<f64>,
+}
+
+/// The document of a periodic solution (`vibroimpact periodic`).
+/// `symmetric_orbit`: whether the orbit is mirror-symmetric; `krylov`:
+/// whether it was found matrix-free.
+pub fn periodic_document(
+    model: &Model,
+    sol: &PeriodicSolution,
+    orbit: &OrbitSummary,
+    subharmonic: u32,
+    symmetric_orbit: bool,
+    krylov: bool,
+) -> Value {
+    let impacts: Vec<ContactImpactsDocument> = orbit
+        .impacts
+        .iter()
+        .map(|c| ContactImpactsDocument {
+            contact: model.contact_name(c.contact),
+            count: c.impact_velocities.len(),
+            impact_velocities: c.impact_velocities.clone(),
+            peak_forces: c.peak_forces.clone(),
+        })
+        .collect();
+    json!({
+        "converged": sol.converged,
+        "method": if krylov { "newton-krylov (dominant multipliers by Arnoldi)" } else { "newton (dense monodromy)" },
+        "period": sol.period,
+        "subharmonic": subharmonic,
+        "initial_state": sol.initial_state,
+        "residual_history": sol.residual_history,
+        "floquet_multipliers": sol.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "spectral_radius": sol.spectral_radius(),
+        "stable": sol.stable(),
+        "symmetric_orbit": symmetric_orbit,
+        "max_displacement": orbit.max_displacement,
+        "max_velocity": orbit.max_velocity,
+        "impacts_per_period": orbit.impacts_per_period(),
+        "impacts": impacts,
+    })
+}
+
+/// The document of a branch (`points`, `special_points`), as `vibroimpact
+/// continue` prints it.
+pub fn branch_document(branch: &Branch, model: &Model, name: &str) -> Value {
+    json!({
+        "parameter_name": name,
+        "subharmonic": branch.subharmonic,
+        "symmetric": branch.symmetric,
+        "stop": format!("{:?}", branch.stop),
+        "contacts": (0..model.contacts().len()).map(|k| model.contact_name(k)).collect::<Vec<_>>(),
+        "points": branch.points.iter().map(|p| json!({
+            "parameter": p.parameter,
+            "max_displacement": p.max_displacement,
+            "max_velocity": p.max_velocity,
+            "impacts_per_period": p.impacts_per_period,
+            "stable": p.stable,
+            "spectral_radius": p.spectral_radius(),
+            "floquet_multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+            "initial_state": p.state,
+            "label": p.label,
+        })).collect::<Vec<_>>(),
+        "special_points": branch.special.iter().map(|s| json!({
+            "kind": s.kind.name(),
+            "label": s.label,
+            "parameter": s.parameter,
+            "symmetry_breaking": s.symmetry_breaking,
+            "floquet_multipliers": s.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+            "initial_state": s.state,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The summary of a simulation (JSON).
+#[derive(Serialize, Debug)]
+pub struct SimulationSummary {
+    /// Whether the simulation reached the end time.
+    pub completed: bool,
+    /// The integration error that stopped it, if any.
+    pub error: Option<String>,
+    /// Time reached (s).
+    pub final_time: f64,
+    /// Final displacements in body order (m).
+    pub final_displacement: Vec<f64>,
+    /// Final velocities in body order (m/s).
+    pub final_velocity: Vec<f64>,
+    /// Number of logged impacts.
+    pub impact_count: usize,
+    /// Impacts per contact, in contact order.
+    pub impacts_per_contact: Vec<ContactCount>,
+    /// Right-hand side evaluations.
+    pub rhs_evaluations: u64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected steps.
+    pub rejected_steps: u64,
+    /// Contact-law evaluations (far contacts are skipped).
+    pub contact_evaluations: u64,
+    /// The contact laws and their force forms.
+    pub contact_laws: Vec<String>,
+    /// Energy audit (J), with --energy.
+    pub energy: Option<EnergySummary>,
+}
+
+/// Impacts of one contact.
+#[derive(Serialize, Debug)]
+pub struct ContactCount {
+    /// Contact name, e.g. `p1|p2`.
+    pub contact: String,
+    /// Number of impacts.
+    pub impacts: usize,
+}
+
+/// Energy audit (J).
+#[derive(Serialize, Debug)]
+pub struct EnergySummary {
+    /// Mechanical energy at the start.
+    pub initial: f64,
+    /// Mechanical energy at the end.
+    pub mechanical: f64,
+    /// Work of the excitation.
+    pub input_work: f64,
+    /// Dissipated in dampers.
+    pub damping_dissipation: f64,
+    /// Dissipated in contacts.
+    pub contact_dissipation: f64,
+    /// E + D_c + D_k - W - E0.
+    pub residual: f64,
+}
+
+/// Builds the summary of a simulation.
+pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary {
+    let mut counts = vec![0usize; model.contacts().len()];
+    for i in &sim.impacts {
+        counts[i.contact] += 1;
+    }
+    let mut laws: Vec<String> = model
+        .contacts()
+        .iter()
+        .map(|c| format!("{} ({})", c.law.name(), c.law.form().name()))
+        .collect();
+    laws.dedup();
+    SimulationSummary {
+        completed: sim.error.is_none(),
+        error: sim.error.as_ref().map(ToString::to_string),
+        final_time: sim.final_time,
+        final_displacement: sim.final_displacement.clone(),
+        final_velocity: sim.final_velocity.clone(),
+        impact_count: sim.impacts.len(),
+        impacts_per_contact: counts
+            .iter()
+            .enumerate()
+            .map(|(k, &n)| ContactCount {
+                contact: model.contact_name(k),
+                impacts: n,
+            })
+            .collect(),
+        rhs_evaluations: sim.stats.rhs_evaluations,
+        steps: sim.stats.steps,
+        rejected_steps: sim.stats.rejected_steps,
+        contact_evaluations: sim.contact_evaluations,
+        contact_laws: laws,
+        energy: sim.energy.map(|e| EnergySummary {
+            initial: e.initial,
+            mechanical: e.mechanical,
+            input_work: e.input_work,
+            damping_dissipation: e.damping_dissipation,
+            contact_dissipation: e.contact_dissipation,
+            residual: e.residual(),
+        }),
+    }
+}

@@ -1,0 +1,708 @@
+//! The brute-force bifurcation diagram (`vibroimpact sweep`).
+//!
+//! Each value of one model parameter is simulated for `transient` forcing
+//! periods, which are discarded, and then for `record` periods, whose
+//! Poincaré samples (the state at the forcing phase of t = 0, once per period
+//! T = 2π/Ω) are kept. Plotting the samples against the parameter shows
+//! period-1 responses as one point per value, period-n responses as n points
+//! and quasi-periodic or chaotic responses as clouds: the independent check
+//! of continuation.
+//!
+//! Without `up_down` every value starts from the model's initial state and
+//! all values run in parallel. With `up_down` the values are swept from
+//! the first to the last ("up") and from the last back to the first ("down"), each
+//! value starting from the previous value's final state (at the same forcing
+//! phase); the two directions run in parallel, each starting from the model's
+//! initial state at its first value.
+//!
+//! A simulation can only start from a state in which no two bodies overlap
+//! (every contact's approach s <= 0). When a handed-over state overlaps (a
+//! section instant that falls inside an impact), the latest sampled state
+//! before it that does not overlap is used instead, and the excitation's
+//! phase is shifted to match its instant, so the continuation stays exact.
+
+use serde::Serialize;
+
+use crate::integrate::{Interrupt, Method};
+use crate::model::{BaseExcitation, HarmonicForce, Model};
+use crate::parameter::ParameterizedModel;
+use crate::simulate::{simulate, Simulation, SimulationOptions};
+
+/// Samples per forcing period of the recorded window (for max |u|).
+const FINE: usize = 256;
+/// Samples per forcing period of the transient (candidate hand-over states).
+const COARSE: usize = 16;
+
+/// A sweep that cannot start (bad options or parameter values).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct SweepError(pub String);
+
+/// Options of a sweep; `None` takes the model's `[simulation]` setting, else
+/// the default stated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepOptions {
+    /// Forcing periods simulated and discarded before recording (default 100).
+    pub transient: usize,
+    /// Forcing periods recorded, one Poincaré sample at the end of each
+    /// (default 20).
+    pub record: usize,
+    /// Sweep up and down, each value continuing from the previous one's
+    /// final state.
+    pub up_down: bool,
+    /// Relative tolerance (default 1e-8).
+    pub rtol: Option<f64>,
+    /// Absolute tolerance in m and m/s (default rtol × 1e-4).
+    pub atol: Option<f64>,
+    /// Integration method.
+    pub method: Method,
+    /// Relative tolerance under which two Poincaré samples are the same
+    /// point (relative to the largest |u| and |v| in the recorded window);
+    /// default max(1e-5, 1000 rtol), above the integration noise of
+    /// impacting orbits (measured 1–3e-6 at rtol 1e-8).
+    pub cluster_tolerance: Option<f64>,
+    /// Stop request (see [`Interrupt`]).
+    pub interrupt: Option<Interrupt>,
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        Self {
+            transient: 100,
+            record: 20,
+            up_down: false,
+            rtol: None,
+            atol: None,
+            method: Method::Dop853,
+            cluster_tolerance: None,
+            interrupt: None,
+        }
+    }
+}
+
+/// Direction of a sweep value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// Every value from the model's initial state (no --up-down).
+    None,
+    /// From --from towards --to, continuing.
+    Up,
+    /// From --to towards --from, continuing.
+    Down,
+}
+
+impl Direction {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::None => "none",
+            Direction::Up => "up",
+            Direction::Down => "down",
+        }
+    }
+}
+
+/// The result at one parameter value.
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepPoint {
+    /// Parameter value.
+    pub parameter: f64,
+    /// Sweep direction.
+    pub direction: Direction,
+    /// Largest |u_i| over the recorded periods, body order (m); null if
+    /// nothing was recorded.
+    pub max_displacement: Vec<f64>,
+    /// Number of distinct Poincaré samples (1: period-1, 2: period-2, …,
+    /// as many as recorded: quasi-periodic, chaotic or not yet settled).
+    pub distinct_section_points: usize,
+    /// Spread of the Poincaré samples: the largest (max - min) of a
+    /// component over the samples, relative to the largest |u| (for
+    /// displacements) or |v| (for velocities) in the recorded window. About
+    /// the integration noise (~100 × rtol) or a decaying transient for a
+    /// periodic response; of order 1 for period-n and chaotic ones.
+    pub section_spread: f64,
+    /// Impacts (all contacts) per forcing period over the recorded periods.
+    pub impacts_per_period: f64,
+    /// Number of Poincaré samples recorded (--record unless it failed).
+    pub recorded_periods: usize,
+    /// Whether every period was simulated.
+    pub completed: bool,
+    /// The failure, if any (also set when a completed value leaves no state
+    /// to continue from, which ends its direction).
+    pub error: Option<String>,
+    /// Poincaré samples `[u_1..u_N, v_1..v_N]`, one per recorded period
+    /// (not in the JSON summary; `sweep.csv` holds them).
+    #[serde(skip)]
+    pub sections: Vec<Vec<f64>>,
+}
+
+/// The whole sweep (summary.json and the JSON on standard output).
+#[derive(Debug, Serialize)]
+pub struct SweepSummary {
+    /// Parameter name as given.
+    pub parameter_name: String,
+    /// Body names, the order of `max_displacement`.
+    pub bodies: Vec<String>,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Forcing periods discarded per value.
+    pub transient_periods: usize,
+    /// Forcing periods recorded per value.
+    pub record_periods: usize,
+    /// Whether the values were swept up and down with continuation.
+    pub up_down: bool,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Clustering tolerance of the Poincaré samples.
+    pub cluster_tolerance: f64,
+    /// One entry per value and direction, sorted by parameter, then direction.
+    pub points: Vec<SweepPoint>,
+}
+
+/// A state to start from: displacements, velocities and the forcing phase of
+/// its instant in 1/[`FINE`] of a period.
+#[derive(Clone, Debug)]
+struct Start {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    phase: usize,
+}
+
+/// Settings shared by all values.
+struct Settings {
+    transient: usize,
+    record: usize,
+    opts: SimulationOptions,
+    cluster_tolerance: f64,
+}
+
+/// The parameter values: `k` evenly spaced from `from` to `to`, ends exact.
+pub fn parameter_values(from: f64, to: f64, k: usize) -> Vec<f64> {
+    (0..k)
+        .map(|i| {
+            if i + 1 == k {
+                to
+            } else {
+                from + (to - from) * (i as f64) / ((k - 1) as f64)
+            }
+        })
+        .collect()
+}
+
+/// `model` started from `(u, v)` at the instant whose forcing phase is
+/// `phase`/[`FINE`] of a period: every harmonic excitation's phase is advanced
+/// by that fraction of 2π.
+fn start_model(model: &Model, start: &Start) -> Result<Model, String> {
+    let shift = 2.0 * std::f64::consts::PI * (start.phase % FINE) as f64 / FINE as f64;
+    let base = match model.base() {
+        BaseExcitation::Harmonic {
+            amplitude,
+            frequency,
+            phase,
+        } => BaseExcitation::Harmonic {
+            amplitude: *amplitude,
+            frequency: *frequency,
+            phase: phase + shift,
+        },
+        other => other.clone(),
+    };
+    let forces: Vec<HarmonicForce> = model
+        .forces()
+        .iter()
+        .map(|f| HarmonicForce {
+            phase: f.phase + shift,
+            ..f.clone()
+        })
+        .collect();
+    Model::new(
+        model.bodies().to_vec(),
+        model.couplings().to_vec(),
+        model.contacts().to_vec(),
+        base,
+        forces,
+        start.u.clone(),
+        start.v.clone(),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// Whether no contact overlaps at displacements `u`.
+fn admissible(model: &Model, u: &[f64]) -> bool {
+    (0..model.contacts().len()).all(|k| model.approach(k, u) <= 0.0)
+}
+
+/// The state to continue from after `sim`, which started at forcing phase
+/// `phase0` with output every `stride` fine phase steps: the final state
+/// (at forcing phase `phase_end`) if it does not overlap, else the latest
+/// sample that does not.
+fn handover(
+    model: &Model,
+    sim: &Simulation,
+    phase0: usize,
+    stride: usize,
+    phase_end: usize,
+) -> Option<Start> {
+    if admissible(model, &sim.final_displacement) {
+        return Some(Start {
+            u: sim.final_displacement.clone(),
+            v: sim.final_velocity.clone(),
+            phase: phase_end % FINE,
+        });
+    }
+    let n = model.bodies().len();
+    (0..sim.times.len()).rev().find_map(|j| {
+        let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
+        admissible(model, &row[..n]).then(|| Start {
+            u: row[..n].to_vec(),
+            v: row[n..].to_vec(),
+            phase: (phase0 + j * stride) % FINE,
+        })
+    })
+}
+
+/// Number of clusters of `points` (greedy, in order): two points are the same
+/// when every displacement differs by at most `tol_u` and every velocity by
+/// at most `tol_v`.
+fn distinct_points(points: &[Vec<f64>], n: usize, tol_u: f64, tol_v: f64) -> usize {
+    let mut reps: Vec<&Vec<f64>> = Vec::new();
+    for p in points {
+        let same = |r: &&Vec<f64>| {
+            (0..n).all(|i| (p[i] - r[i]).abs() <= tol_u)
+                && (n..2 * n).all(|i| (p[i] - r[i]).abs() <= tol_v)
+        };
+        if !reps.iter().any(same) {
+            reps.push(p);
+        }
+    }
+    reps.len()
+}
+
+/// Largest (max - min) of a component over `points`, relative to `scale_u`
+/// (displacements) or `scale_v` (velocities); 0 for a zero scale.
+fn spread(points: &[Vec<f64>], n: usize, scale_u: f64, scale_v: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for c in 0..2 * n {
+        let (lo, hi) = points
+            .iter()
+            .map(|p| p[c])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+        let scale = if c < n { scale_u } else { scale_v };
+        if hi > lo && scale > 0.0 {
+            worst = worst.max((hi - lo) / scale);
+        }
+    }
+    worst
+}
+
+/// Simulates one parameter value from `start` (None: the model's initial
+/// state). Returns the point and the state to continue from (None after a
+/// failure).
+fn run_value(
+    model: &Model,
+    parameter: f64,
+    direction: Direction,
+    start: Option<Start>,
+    settings: &Settings,
+) -> (SweepPoint, Option<Start>) {
+    let n = model.bodies().len();
+    let mut point = SweepPoint {
+        parameter,
+        direction,
+        max_displacement: vec![f64::NAN; n],
+        distinct_section_points: 0,
+        section_spread: f64::NAN,
+        impacts_per_period: f64::NAN,
+        recorded_periods: 0,
+        completed: false,
+        error: None,
+        sections: Vec::new(),
+    };
+    let fail = |mut point: SweepPoint, msg: String| {
+        point.error = Some(msg);
+        (point, None)
+    };
+    let Some(w) = model.forcing_frequency() else {
+        return fail(point, "no periodic forcing with one frequency".into());
+    };
+    let period = 2.0 * std::f64::consts::PI / w;
+    let mut start = start.unwrap_or_else(|| Start {
+        u: model.initial_displacement().to_vec(),
+        v: model.initial_velocity().to_vec(),
+        phase: 0,
+    });
+    // Transient: discarded, sampled coarsely for a hand-over state.
+    if settings.transient > 0 {
+        let m = match start_model(model, &start) {
+            Ok(m) => m,
+            Err(e) => return fail(point, format!("cannot start: {e}")),
+        };
+        let dt = period / COARSE as f64;
+        let opts = SimulationOptions {
+            t_end: (settings.transient * COARSE) as f64 * dt,
+            output_step: Some(dt),
+            ..settings.opts.clone()
+        };
+        let sim = match simulate(&m, &opts) {
+            Ok(s) => s,
+            Err(e) => return fail(point, e.to_string()),
+        };
+        if let Some(e) = &sim.error {
+            return fail(
+                point,
+                format!(
+                    "integration failed {:.9} s into the transient: {e}",
+                    sim.final_time
+                ),
+            );
+        }
+        match handover(&m, &sim, start.phase, FINE / COARSE, start.phase) {
+            Some(s) => start = s,
+            None => return fail(
+                point,
+                "after the transient no sampled state is free of contact overlap to record from"
+                    .into(),
+            ),
+        }
+    }
+    // Recorded window: the first section instant, then `record` periods.
+    let m = match start_model(model, &start) {
+        Ok(m) => m,
+        Err(e) => return fail(point, format!("cannot start: {e}")),
+    };
+    let dt = period / FINE as f64;
+    let j0 = (FINE - start.phase % FINE) % FINE;
+    let j_end = j0 + settings.record * FINE;
+    let opts = SimulationOptions {
+        t_end: j_end as f64 * dt,
+        output_step: Some(dt),
+        extrema_window: Some((j0 as f64 * dt, j_end as f64 * dt)),
+        ..settings.opts.clone()
+    };
+    let sim = match simulate(&m, &opts) {
+        Ok(s) => s,
+        Err(e) => return fail(point, e.to_string()),
+    };
+    let samples = sim.times.len();
+    let row = |j: usize| &sim.states[j * 2 * n..(j + 1) * 2 * n];
+    point.sections = (1..=settings.record)
+        .map(|k| j0 + k * FINE)
+        .filter(|&j| j < samples)
+        .map(|j| row(j).to_vec())
+        .collect();
+    point.recorded_periods = point.sections.len();
+    let window_end = (j0 + point.recorded_periods * FINE).min(samples.saturating_sub(1));
+    let mut max_v: f64 = 0.0;
+    if window_end > j0 {
+        // The exact extrema over the recorded periods (dense output).
+        if let Some(x) = &sim.extrema {
+            point.max_displacement.clone_from(&x.max_displacement);
+            max_v = x.max_velocity.iter().copied().fold(0.0, f64::max);
+        }
+    }
+    if point.recorded_periods > 0 {
+        let t0 = j0 as f64 * dt;
+        let t1 = (j0 + point.recorded_periods * FINE) as f64 * dt;
+        let count = sim
+            .impacts
+            .iter()
+            .filter(|i| i.start_time > t0 && i.start_time <= t1 && i.start_time > 0.0)
+            .count();
+        point.impacts_per_period = count as f64 / point.recorded_periods as f64;
+        let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
+        point.section_spread = spread(&point.sections, n, max_u, max_v);
+        point.distinct_section_points = distinct_points(
+            &point.sections,
+            n,
+            settings.cluster_tolerance * max_u,
+            settings.cluster_tolerance * max_v,
+        );
+    }
+    if let Some(e) = &sim.error {
+        let msg = format!(
+            "integration failed {:.9} s into the recorded run, after {} recorded periods: {e}",
+            sim.final_time, point.recorded_periods
+        );
+        return fail(point, msg);
+    }
+    point.completed = true;
+    let next = handover(&m, &sim, start.phase, 1, start.phase + j_end);
+    (point, next)
+}
+
+/// Runs the values in order, each from the previous one's final state; stops
+/// at the first failure.
+fn run_direction(
+    models: &[(f64, Model)],
+    direction: Direction,
+    settings: &Settings,
+    progress: &(dyn Fn() + Sync),
+) -> Vec<SweepPoint> {
+    let mut out = Vec::with_capacity(models.len());
+    let mut start = None;
+    for (p, model) in models {
+        let (mut point, next) = run_value(model, *p, direction, start, settings);
+        progress();
+        if point.completed && next.is_none() {
+            point.error = Some(
+                "no recorded state is free of contact overlap to continue from; this direction stops here"
+                    .into(),
+            );
+        }
+        let stop = next.is_none();
+        out.push(point);
+        if stop {
+            break;
+        }
+        start = next;
+    }
+    out
+}
+
+fn finite_positive(what: &str, x: f64) -> Result<(), SweepError> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err(SweepError(format!("{what} = {x}: must be finite and > 0")))
+    }
+}
+
+/// Sweeps `family` over `values` (at least two, finite). Every model is
+/// built first, so a bad value is an input error before anything runs; a
+/// value that fails numerically is kept in the result with its `error`.
+/// `progress` is called after every value, from any thread. The values run
+/// in parallel on rayon's current pool (up and down in parallel with
+/// `up_down`); the result does not depend on the number of threads.
+pub fn sweep(
+    family: &ParameterizedModel,
+    values: &[f64],
+    options: &SweepOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<SweepSummary, SweepError> {
+    use rayon::prelude::*;
+    if values.len() < 2 {
+        return Err(SweepError(format!(
+            "{} values: a sweep needs at least 2",
+            values.len()
+        )));
+    }
+    if let Some(x) = values.iter().find(|x| !x.is_finite()) {
+        return Err(SweepError(format!(
+            "parameter value {x}: the values must be finite"
+        )));
+    }
+    if options.record < 1 {
+        return Err(SweepError("record 0: record at least one period".into()));
+    }
+    let err = |e: crate::model_file::ModelFileError| SweepError(e.to_string());
+    let base = family.loaded_at(family.initial()).map_err(err)?;
+    let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
+    let atol = options.atol.or(base.simulation.atol).unwrap_or(rtol * 1e-4);
+    finite_positive("rtol", rtol)?;
+    let cluster_tolerance = options
+        .cluster_tolerance
+        .unwrap_or(1e-5_f64.max(1e3 * rtol));
+    finite_positive("cluster_tolerance", cluster_tolerance)?;
+    finite_positive("atol", atol)?;
+    let name = family.name();
+    let bodies: Vec<String> = base.model.bodies().iter().map(|b| b.name.clone()).collect();
+    let mut models: Vec<(f64, Model)> = Vec::with_capacity(values.len());
+    for &p in values {
+        let m = family.model_at(p).map_err(err)?;
+        if m.forcing_frequency().is_none() {
+            return Err(SweepError(format!(
+                "{name} = {p}: the model has no periodic excitation with one frequency (a sweep samples once per forcing period)"
+            )));
+        }
+        let names: Vec<&str> = m.bodies().iter().map(|b| b.name.as_str()).collect();
+        if names != bodies.iter().map(String::as_str).collect::<Vec<_>>() {
+            return Err(SweepError(format!(
+                "{name} = {p}: the bodies change along the sweep ({} instead of {}); sweep a parameter that keeps them",
+                names.len(),
+                bodies.len()
+            )));
+        }
+        models.push((p, m));
+    }
+    let settings = Settings {
+        transient: options.transient,
+        record: options.record,
+        opts: SimulationOptions {
+            rtol,
+            atol,
+            impact_force_threshold: base.simulation.impact_force_threshold.unwrap_or(1e-3),
+            method: options.method,
+            interrupt: options.interrupt.clone(),
+            ..SimulationOptions::default()
+        },
+        cluster_tolerance,
+    };
+    let mut points: Vec<SweepPoint> = if options.up_down {
+        let reversed: Vec<(f64, Model)> = models.iter().rev().cloned().collect();
+        let (mut up, down) = rayon::join(
+            || run_direction(&models, Direction::Up, &settings, progress),
+            || run_direction(&reversed, Direction::Down, &settings, progress),
+        );
+        up.extend(down);
+        up
+    } else {
+        models
+            .par_iter()
+            .map(|(p, m)| {
+                let point = run_value(m, *p, Direction::None, None, &settings).0;
+                progress();
+                point
+            })
+            .collect()
+    };
+    points.sort_by(|a, b| {
+        a.parameter
+            .total_cmp(&b.parameter)
+            .then(a.direction.cmp(&b.direction))
+    });
+    Ok(SweepSummary {
+        parameter_name: name.to_string(),
+        bodies,
+        from: values[0],
+        to: values[values.len() - 1],
+        transient_periods: options.transient,
+        record_periods: options.record,
+        up_down: options.up_down,
+        rtol,
+        atol,
+        cluster_tolerance,
+        points,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_are_even_with_exact_ends() {
+        let v = parameter_values(0.1, 0.7, 7);
+        assert_eq!(v.len(), 7);
+        assert_eq!(v[0], 0.1);
+        assert_eq!(v[6], 0.7);
+        assert!((v[3] - 0.4).abs() < 1e-15);
+        let v = parameter_values(2.0, 1.0, 2);
+        assert_eq!(v, vec![2.0, 1.0]);
+    }
+
+    const ROW: &str = "[row]\ncount = 2\nmass = 0.227\nnatural_frequency = 7.41\ndamping_ratio = 0.013\nclearance = 0.001\ncontact = { law = \"exponential\", a_over_b = 1.2, alpha = 1.3e5 }\n[excitation]\ntype = \"harmonic-base\"\namplitude = 0.5\nfrequency = 7.0\n";
+
+    fn row_model() -> Model {
+        crate::model_file::ModelDocument::from_toml(ROW, "m.toml")
+            .unwrap()
+            .build()
+            .unwrap()
+            .model
+    }
+
+    /// A run restarted from a sample in the middle of a period, with the
+    /// excitation's phase advanced to match, continues the original run.
+    #[test]
+    fn restart_at_a_phase_continues_the_trajectory() {
+        let model = row_model();
+        let period = 2.0 * std::f64::consts::PI / 7.0;
+        let dt = period / FINE as f64;
+        let opts = SimulationOptions {
+            rtol: 1e-11,
+            atol: 1e-15,
+            ..SimulationOptions::default()
+        };
+        let whole = simulate(
+            &model,
+            &SimulationOptions {
+                t_end: (3 * FINE) as f64 * dt,
+                output_step: Some(dt),
+                ..opts.clone()
+            },
+        )
+        .unwrap();
+        assert!(whole.impacts.len() > 2, "the test needs impacts");
+        let n = 2;
+        let j = FINE + 100;
+        let row = &whole.states[j * 2 * n..(j + 1) * 2 * n];
+        let start = Start {
+            u: row[..n].to_vec(),
+            v: row[n..].to_vec(),
+            phase: j % FINE,
+        };
+        let m = start_model(&model, &start).unwrap();
+        let rest = simulate(
+            &m,
+            &SimulationOptions {
+                t_end: (3 * FINE - j) as f64 * dt,
+                ..opts
+            },
+        )
+        .unwrap();
+        for i in 0..n {
+            let a = whole.final_displacement[i];
+            let b = rest.final_displacement[i];
+            assert!((a - b).abs() < 1e-7 * 1e-3, "u_{i}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn handover_skips_overlapping_states() {
+        let model = row_model();
+        // Samples: admissible, admissible, overlapping (p1 into the wall at u = -1 mm).
+        let states = vec![
+            0.0, 0.0, 0.1, 0.2, //
+            -5e-4, 1e-4, 0.3, 0.4, //
+            -1.5e-3, 0.0, 0.5, 0.6,
+        ];
+        let sim = Simulation {
+            times: vec![0.0, 1.0, 2.0],
+            states: states.clone(),
+            final_time: 2.0,
+            final_displacement: vec![-1.5e-3, 0.0],
+            final_velocity: vec![0.5, 0.6],
+            impacts: Vec::new(),
+            stats: Default::default(),
+            contact_evaluations: 0,
+            energy: None,
+            error: None,
+            extrema: None,
+        };
+        let s = handover(&model, &sim, 5, 16, 5 + 32).unwrap();
+        assert_eq!(s.u, vec![-5e-4, 1e-4]);
+        assert_eq!(s.v, vec![0.3, 0.4]);
+        assert_eq!(s.phase, 5 + 16);
+        let ok = Simulation {
+            final_displacement: vec![1e-4, 0.0],
+            final_velocity: vec![0.7, 0.8],
+            ..sim.clone()
+        };
+        let s = handover(&model, &ok, 5, 16, FINE + 5).unwrap();
+        assert_eq!((s.u[0], s.v[1], s.phase), (1e-4, 0.8, 5));
+        let none = Simulation {
+            states: states[8..].repeat(3),
+            ..sim
+        };
+        assert!(handover(&model, &none, 0, 1, 0).is_none());
+    }
+
+    #[test]
+    fn clusters() {
+        let p = |u: f64, v: f64| vec![u, v];
+        let pts = vec![
+            p(1.0, 2.0),
+            p(-1.0, 0.5),
+            p(1.0 + 1e-9, 2.0),
+            p(-1.0, 0.5 + 1e-3),
+        ];
+        assert_eq!(distinct_points(&pts, 1, 1e-6, 1e-6), 3);
+        assert_eq!(distinct_points(&pts, 1, 1e-6, 1e-2), 2);
+        assert_eq!(distinct_points(&[], 1, 1e-6, 1e-6), 0);
+    }
+}
