@@ -473,7 +473,8 @@ fn finite_positive(what: &str, x: f64) -> Result<(), SweepError> {
     }
 }
 
-/// Sweeps `family` over `values` (at least two, finite). Every model is
+/// Sweeps `family` over `values` (finite; one or more: a distributed
+/// sweep runs chunks of them). Every model is
 /// built first, so a bad value is an input error before anything runs; a
 /// value that fails numerically is kept in the result with its `error`.
 /// `progress` is called after every value, from any thread. The values run
@@ -486,11 +487,8 @@ pub fn sweep(
     progress: &(dyn Fn() + Sync),
 ) -> Result<SweepSummary, SweepError> {
     use rayon::prelude::*;
-    if values.len() < 2 {
-        return Err(SweepError(format!(
-            "{} values: a sweep needs at least 2",
-            values.len()
-        )));
+    if values.is_empty() {
+        return Err(SweepError("no parameter values to sweep".into()));
     }
     if let Some(x) = values.iter().find(|x| !x.is_finite()) {
         return Err(SweepError(format!(

@@ -1,0 +1,679 @@
+"""vibroimpact: vibrating systems whose bodies collide, after T. Fujita (1977).
+
+The library's computations from Python, named after the command line
+(subcommand -> function, ``--option-name`` -> ``option_name=``, same
+defaults). Results are :class:`Result` objects whose fields carry the names
+of the CLI's JSON output, with numpy arrays for numeric lists.
+
+>>> import vibroimpact as vi
+>>> r = vi.impact([0.01, 0.1, 1.0])              # the seed's law and balls
+>>> r.restitution                                 # doctest: +SKIP
+>>> m = vi.Model.load("examples/fujita-row.toml")
+>>> h = vi.simulate(m, periods=5)                 # h.t, h.displacement, h.impacts
+>>> s = vi.sweep(m, parameter="frequency", from_=5.9, to=8.9, points=41)
+
+Long calls release the GIL, stop on Ctrl-C (KeyboardInterrupt) and report
+progress to ``progress(done, total)`` if given. Bad input raises
+``ValueError`` naming the argument or model key; a numerical failure raises
+:class:`VibroimpactError`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any, Callable, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+from ._core import Model, VibroimpactError
+from ._results import Result
+
+__all__ = [
+    "Model",
+    "Result",
+    "VibroimpactError",
+    "contact_force",
+    "continue_",
+    "identify",
+    "impact",
+    "parameter_values",
+    "periodic",
+    "simulate",
+    "sweep",
+]
+
+try:  # pragma: no cover - metadata exists once installed
+    from importlib.metadata import version as _version
+
+    __version__ = _version("vibroimpact")
+except Exception:  # pragma: no cover
+    __version__ = "0+unknown"
+
+Progress = Optional[Callable[[int, int], Any]]
+ArrayLike = Union[Sequence[float], np.ndarray, float]
+ModelLike = Union[Model, str, "os.PathLike[str]"]
+
+
+def _floats(x: Any, name: str, *, allow_scalar: bool = True) -> np.ndarray:
+    """A contiguous, aligned float64 1-D array from any array-like; NaN and
+    infinities are rejected with the argument's name."""
+    if isinstance(x, (str, bytes)):
+        raise TypeError(f"{name}: expected numbers, got {type(x).__name__}")
+    try:
+        raw = np.asarray(x)
+    except Exception as e:  # ragged lists and the like
+        raise ValueError(f"{name}: not an array of numbers ({e})") from None
+    if np.iscomplexobj(raw):
+        raise ValueError(f"{name}: complex values are not accepted")
+    if raw.dtype == object or raw.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: expected numbers, got dtype {raw.dtype}")
+    a = np.asarray(raw, dtype=np.float64)
+    if a.ndim == 0 and allow_scalar:
+        a = a.reshape(1)
+    if a.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array, got shape {a.shape}")
+    a = np.require(a, np.float64, ["C", "A"])
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise ValueError(f"{name}[{bad[0]}] = {a[bad[0]]}: must be finite")
+    return a
+
+
+def _real(x: Any, name: str, *, positive: bool = False, optional: bool = False):
+    """A finite float (or None if optional)."""
+    if x is None and optional:
+        return None
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}: expected a number, got {type(x).__name__}")
+    v = float(x)
+    if not math.isfinite(v) or (positive and v <= 0.0):
+        raise ValueError(f"{name} = {v}: must be finite{' and > 0' if positive else ''}")
+    return v
+
+
+def _count(x: Any, name: str, *, minimum: int = 0) -> int:
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise TypeError(f"{name}: expected a whole number, got {type(x).__name__}")
+    if x < minimum:
+        raise ValueError(f"{name} = {x}: must be >= {minimum}")
+    return int(x)
+
+
+def _mass(x: Any, name: str) -> float:
+    if isinstance(x, str):
+        if x.strip() in ("wall", "inf", "infinity"):
+            return math.inf
+        raise ValueError(f"{name} = {x!r}: a mass in kg or 'wall'")
+    if isinstance(x, float) and math.isinf(x) and x > 0:
+        return math.inf
+    return _real(x, name, positive=True)
+
+
+def _model(model: Any) -> Model:
+    if isinstance(model, Model):
+        return model
+    if isinstance(model, (str, os.PathLike)):
+        return Model.load(os.fspath(model))
+    if isinstance(model, dict):
+        return Model.from_dict(model)
+    raise TypeError(
+        f"model: expected a vibroimpact.Model, a path or a dict, got {type(model).__name__}"
+    )
+
+
+def _method(name: str, choices: Sequence[str], arg: str = "method") -> str:
+    if name not in choices:
+        raise ValueError(f"{arg} = {name!r}: give one of {', '.join(map(repr, choices))}")
+    return name
+
+
+def _progress(progress: Progress) -> Progress:
+    if progress is not None and not callable(progress):
+        raise TypeError("progress: expected a callable progress(done, total)")
+    return progress
+
+
+def _law_spec(
+    law: str,
+    *,
+    a_over_b=None,
+    alpha=None,
+    a=1.0,
+    stiffness=None,
+    exponent=None,
+    damping=None,
+    chi=None,
+    law_restitution=None,
+    min_impact_velocity=1e-3,
+    form="published",
+) -> str:
+    """The contact law as the model-file schema writes it (JSON)."""
+    _method(form, ("published", "non-negative"), "form")
+
+    def need(v, key):
+        if v is None:
+            raise ValueError(f"law={law!r} needs {key}")
+        return _real(v, key)
+
+    n = 1.5 if exponent is None else _real(exponent, "exponent")
+    if law == "exponential":
+        spec = {
+            "law": law,
+            "a_over_b": 1.2 if a_over_b is None else _real(a_over_b, "a_over_b"),
+            "alpha": 1.3e5 if alpha is None else _real(alpha, "alpha"),
+            "a": _real(a, "a"),
+            "form": form,
+        }
+    elif law == "hertz":
+        spec = {"law": law, "stiffness": need(stiffness, "stiffness"), "exponent": n}
+    elif law == "kelvin-voigt":
+        spec = {
+            "law": law,
+            "stiffness": need(stiffness, "stiffness"),
+            "damping": need(damping, "damping"),
+            "form": form,
+        }
+    elif law == "hunt-crossley":
+        spec = {
+            "law": law,
+            "stiffness": need(stiffness, "stiffness"),
+            "exponent": n,
+            "chi": need(chi, "chi"),
+            "form": form,
+        }
+    elif law == "lankarani-nikravesh":
+        spec = {
+            "law": law,
+            "stiffness": need(stiffness, "stiffness"),
+            "exponent": n,
+            "restitution": need(law_restitution, "law_restitution"),
+            "min_impact_velocity": _real(min_impact_velocity, "min_impact_velocity"),
+            "form": form,
+        }
+    else:
+        raise ValueError(
+            f"law = {law!r}: give 'exponential', 'hertz', 'kelvin-voigt', "
+            "'hunt-crossley' or 'lankarani-nikravesh'"
+        )
+    return json.dumps(spec)
+
+
+def impact(
+    velocity: ArrayLike,
+    *,
+    law: str = "exponential",
+    a_over_b: Optional[float] = None,
+    alpha: Optional[float] = None,
+    a: float = 1.0,
+    stiffness: Optional[float] = None,
+    exponent: Optional[float] = None,
+    damping: Optional[float] = None,
+    chi: Optional[float] = None,
+    law_restitution: Optional[float] = None,
+    min_impact_velocity: float = 1e-3,
+    form: str = "published",
+    mass1: float = 0.227,
+    mass2: Union[float, str] = 0.227,
+    method: Optional[str] = None,
+    rtol: float = 1e-12,
+    duration_level: Optional[float] = None,
+) -> Result:
+    """Two-body impact relations at every impact velocity (``vibroimpact
+    impact``), vectorised over ``velocity`` (m/s, any array-like).
+
+    The law: ``law="exponential"`` (Fujita, seed eq. 1; ``a_over_b`` m/s,
+    default 1.2, ``alpha`` 1/m, default 1.3e5, ``a`` N), ``"hertz"``
+    (``stiffness``, ``exponent`` 1.5), ``"kelvin-voigt"`` (``stiffness``,
+    ``damping``), ``"hunt-crossley"`` (``stiffness``, ``exponent``,
+    ``chi``), ``"lankarani-nikravesh"`` (``stiffness``, ``exponent``,
+    ``law_restitution``, ``min_impact_velocity``); ``form`` "published" or
+    "non-negative". ``mass2`` may be ``"wall"``. ``method``:
+    "closed-form" (the exponential law's closed form, seed eqs. 8-18; its
+    default) or "integrate" (any law; the default for the others).
+
+    Returns a :class:`Result` with ``method``, ``contact_law``, ``mass1``,
+    ``mass2``, ``reduced_mass`` and one array per column: ``impact_velocity``,
+    ``v``, ``restitution``, ``rebound_velocity``,
+    ``peak_force_dimensionless``, ``peak_force``, ``peak_acceleration1``,
+    ``peak_acceleration2``, ``max_penetration`` and, for "integrate",
+    ``contact_duration`` (NaN where the CLI writes null).
+    """
+    spec = _law_spec(
+        law,
+        a_over_b=a_over_b,
+        alpha=alpha,
+        a=a,
+        stiffness=stiffness,
+        exponent=exponent,
+        damping=damping,
+        chi=chi,
+        law_restitution=law_restitution,
+        min_impact_velocity=min_impact_velocity,
+        form=form,
+    )
+    if method is None:
+        method = "closed-form" if law == "exponential" else "integrate"
+    _method(method, ("closed-form", "integrate"))
+    return Result(
+        _core.impact(
+            _floats(velocity, "velocity"),
+            spec,
+            _real(mass1, "mass1", positive=True),
+            _mass(mass2, "mass2"),
+            method,
+            _real(rtol, "rtol", positive=True),
+            _real(duration_level, "duration_level", optional=True),
+        )
+    )
+
+
+def contact_force(
+    s: ArrayLike,
+    sdot: ArrayLike = 0.0,
+    impact_velocity: ArrayLike = 1.0,
+    *,
+    law: str = "exponential",
+    a_over_b: Optional[float] = None,
+    alpha: Optional[float] = None,
+    a: float = 1.0,
+    stiffness: Optional[float] = None,
+    exponent: Optional[float] = None,
+    damping: Optional[float] = None,
+    chi: Optional[float] = None,
+    law_restitution: Optional[float] = None,
+    min_impact_velocity: float = 1e-3,
+    form: str = "published",
+) -> Result:
+    """A contact law's force F (N) and partial derivatives ``d_ds`` (N/m),
+    ``d_dsdot`` (N s/m) at penetration ``s`` (m), rate ``sdot`` (m/s) and
+    onset velocity ``impact_velocity`` (m/s, read by Lankarani-Nikravesh
+    only); arrays broadcast against each other. Law keywords as in
+    :func:`impact`."""
+    spec = _law_spec(
+        law,
+        a_over_b=a_over_b,
+        alpha=alpha,
+        a=a,
+        stiffness=stiffness,
+        exponent=exponent,
+        damping=damping,
+        chi=chi,
+        law_restitution=law_restitution,
+        min_impact_velocity=min_impact_velocity,
+        form=form,
+    )
+    arrays = [np.asarray(x) for x in (s, sdot, impact_velocity)]
+    try:
+        arrays = np.broadcast_arrays(*arrays)
+    except ValueError as e:
+        raise ValueError(f"s, sdot, impact_velocity: shapes do not broadcast ({e})") from None
+    shape = arrays[0].shape
+    flat = [
+        _floats(x.ravel(), name)
+        for x, name in zip(arrays, ("s", "sdot", "impact_velocity"))
+    ]
+    d = _core.contact_force(spec, *flat)
+    return Result({k: v.reshape(shape) for k, v in d.items()})
+
+
+def _pairs(data: Any, name: str, second: str) -> tuple:
+    if data is None:
+        return np.empty(0), np.empty(0)
+    if isinstance(data, tuple) and len(data) == 2:
+        u, y = data
+        u, y = _floats(u, f"{name}[0] (impact_velocity)"), _floats(y, f"{name}[1] ({second})")
+    else:
+        arr = np.asarray(data, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != 2:
+            raise ValueError(
+                f"{name}: give (impact_velocity, {second}) arrays or an (n, 2) array, got shape {arr.shape}"
+            )
+        u, y = _floats(arr[:, 0], f"{name}[:, 0]"), _floats(arr[:, 1], f"{name}[:, 1]")
+    if u.shape != y.shape:
+        raise ValueError(f"{name}: the two arrays differ in length ({u.size} and {y.size})")
+    return u, y
+
+
+def identify(
+    *,
+    restitution: Any = None,
+    acceleration: Any = None,
+    mass1: float = 0.227,
+    mass2: Union[float, str] = 0.227,
+    a_over_b: Optional[float] = None,
+    joint: bool = False,
+) -> Result:
+    """Identify a/b and alpha of the exponential law from measured impacts
+    (seed section 3; ``vibroimpact identify``).
+
+    ``restitution``: (impact velocity, restitution) measurements and
+    ``acceleration``: (impact velocity, peak acceleration of body 1 =
+    F_max/m1) measurements, each as a pair of arrays or an (n, 2) array;
+    either may be omitted. ``a_over_b`` fixes a/b; ``joint`` fits both at
+    once. Returns ``method``, ``a_over_b`` and ``alpha`` (each with
+    ``value`` and ``std_error``), ``restitution_fit`` and
+    ``acceleration_fit`` (with residuals).
+    """
+    if restitution is None and acceleration is None:
+        raise ValueError("nothing to identify: give restitution and/or acceleration")
+    ru, re = _pairs(restitution, "restitution", "restitution")
+    au, aa = _pairs(acceleration, "acceleration", "peak_acceleration")
+    return Result(
+        _core.identify(
+            ru,
+            re,
+            au,
+            aa,
+            _real(mass1, "mass1", positive=True),
+            _mass(mass2, "mass2"),
+            _real(a_over_b, "a_over_b", positive=True, optional=True),
+            bool(joint),
+        )
+    )
+
+
+def simulate(
+    model: ModelLike,
+    *,
+    periods: Optional[float] = None,
+    duration: Optional[float] = None,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    method: str = "dop853",
+    output_step: Optional[float] = None,
+    energy: bool = False,
+    impact_force_threshold: Optional[float] = None,
+    progress: Progress = None,
+) -> Result:
+    """A time history with its impact log (``vibroimpact simulate``).
+
+    Give ``duration`` (s) or ``periods`` (forcing periods). ``rtol``,
+    ``atol``, ``impact_force_threshold``: default the model's
+    ``[simulation]`` settings, else 1e-8, rtol*1e-4, 1e-3 N. ``method``:
+    "dop853", "rodas" or "auto". ``output_step`` (s): sampling of the
+    history, default 1/100 forcing period (or duration/2000); 0: none.
+
+    Returns the CLI's summary fields (``completed``, ``error``,
+    ``final_time``, ``final_displacement``, ``final_velocity``,
+    ``impact_count``, ``impacts_per_contact``, ``rhs_evaluations``,
+    ``steps``, ``rejected_steps``, ``contact_evaluations``,
+    ``contact_laws``, ``energy``) and the arrays ``t``, ``displacement``
+    and ``velocity`` (one row per time, one column per body) and
+    ``impacts`` (``contact``, ``start_time``, ``end_time``,
+    ``impact_velocity``, ``rebound_velocity``, ``restitution``,
+    ``peak_force``, ``duration``). An integration failure keeps what was
+    computed: ``completed`` is False and ``error`` says where.
+    """
+    m = _model(model)
+    if (periods is None) == (duration is None):
+        raise ValueError("give exactly one of periods= and duration=")
+    if periods is not None:
+        w = m.forcing_frequency
+        if w is None:
+            raise ValueError("periods= needs a periodic excitation with one frequency; use duration=")
+        t_end = _real(periods, "periods", positive=True) * 2.0 * math.pi / w
+    else:
+        t_end = _real(duration, "duration", positive=True)
+    if output_step is not None:
+        output_step = _real(output_step, "output_step")
+        if output_step < 0:
+            raise ValueError(f"output_step = {output_step}: must be >= 0")
+    return Result(
+        _core.simulate(
+            m,
+            t_end,
+            _real(rtol, "rtol", positive=True, optional=True),
+            _real(atol, "atol", positive=True, optional=True),
+            _method(method, ("dop853", "rodas", "auto")),
+            output_step,
+            bool(energy),
+            _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
+            _progress(progress),
+        )
+    )
+
+
+def periodic(
+    model: ModelLike,
+    *,
+    subharmonic: int = 1,
+    guess: Any = "simulate",
+    guess_periods: float = 200.0,
+    rtol: float = 1e-10,
+    tol: float = 1e-9,
+    krylov: Optional[bool] = None,
+    arnoldi: int = 20,
+    symmetric: bool = False,
+    progress: Progress = None,
+) -> Result:
+    """A periodic solution by shooting, with its Floquet multipliers
+    (``vibroimpact periodic``).
+
+    ``guess``: "simulate" (the state after ``guess_periods`` forcing periods
+    from the model's initial state), a state array ``[u..., v...]`` or an
+    earlier result with ``initial_state``. ``krylov``: matrix-free
+    Newton-Krylov with Arnoldi multipliers (default from 200 bodies on).
+    ``symmetric``: shoot on the half map of a mirror-symmetric row.
+
+    Returns ``converged``, ``method``, ``period``, ``subharmonic``,
+    ``initial_state``, ``residual_history``, ``floquet_multipliers`` ([re,
+    im] rows), ``spectral_radius``, ``stable``, ``symmetric_orbit``,
+    ``max_displacement``, ``max_velocity``, ``impacts_per_period``,
+    ``impacts``, and the orbit over one period (``orbit_t``,
+    ``orbit_displacement``, ``orbit_velocity``). Raises VibroimpactError if
+    Newton does not converge (the result is on the exception as
+    ``.result``).
+    """
+    m = _model(model)
+    if isinstance(guess, str):
+        if guess != "simulate":
+            raise ValueError(f"guess = {guess!r}: 'simulate', a state array or an earlier result")
+        g = None
+    elif isinstance(guess, (Result, dict)):
+        g = _floats(guess["initial_state"], "guess['initial_state']")
+    else:
+        g = _floats(guess, "guess")
+    if krylov is None:
+        krylov = len(m) >= 200
+    r = Result(
+        _core.periodic(
+            m,
+            _count(subharmonic, "subharmonic", minimum=1),
+            g,
+            _real(guess_periods, "guess_periods", positive=True),
+            _real(rtol, "rtol", positive=True),
+            _real(tol, "tol", positive=True),
+            bool(krylov),
+            _count(arnoldi, "arnoldi", minimum=1),
+            bool(symmetric),
+            _progress(progress),
+        )
+    )
+    if not r.converged:
+        e = VibroimpactError(
+            "Newton did not converge (residual history "
+            + str([f"{x:.2e}" for x in r.residual_history])
+            + ")"
+        )
+        e.result = r
+        raise e
+    return r
+
+
+def continue_(
+    model: ModelLike,
+    parameter: str,
+    from_: float,
+    to: float,
+    *,
+    subharmonic: int = 1,
+    switch_at: Optional[str] = None,
+    max_points: int = 1500,
+    ds_max: float = 0.05,
+    guess_periods: float = 200.0,
+    progress: Progress = None,
+) -> Result:
+    """A branch of periodic solutions by pseudo-arclength continuation in
+    ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
+    folds, branch points, period doublings, torus and grazing points
+    located. ``parameter``: "frequency", "amplitude" or a dotted key
+    ("row.clearance", "body.2.mass"). ``switch_at``: a special point's
+    label (e.g. "BP1", "PD1") whose crossing or period-doubled branch is
+    continued too (``switched_branch``). ``progress(points, max_points)``.
+
+    Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop``,
+    ``contacts``, ``points`` (each with ``parameter``, ``max_displacement``,
+    ``max_velocity``, ``impacts_per_period``, ``stable``,
+    ``spectral_radius``, ``floquet_multipliers``, ``initial_state``,
+    ``label``) and ``special_points``; ``result.column("parameter")`` gives
+    one field over the points. Raises VibroimpactError if the branch cannot
+    continue (the points so far are on the exception as ``.result``).
+    """
+    m = _model(model)
+    if not isinstance(parameter, str):
+        raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
+    if switch_at is not None and not isinstance(switch_at, str):
+        raise TypeError("switch_at: expected a label such as 'BP1'")
+    d = _core.continue_branch(
+        m,
+        parameter,
+        _real(from_, "from_"),
+        _real(to, "to"),
+        _count(subharmonic, "subharmonic", minimum=1),
+        switch_at,
+        _count(max_points, "max_points", minimum=2),
+        _real(ds_max, "ds_max", positive=True),
+        _real(guess_periods, "guess_periods", positive=True),
+        _progress(progress),
+    )
+    r = Result(d)
+    problem = None
+    if str(r.stop).startswith("CannotContinue"):
+        problem = f"the branch cannot continue: {r.stop} (the points computed so far are kept)"
+    elif "switch_error" in r:
+        problem = r.switch_error
+    if problem:
+        e = VibroimpactError(problem)
+        e.result = r
+        raise e
+    return r
+
+
+def parameter_values(from_: float, to: float, points: int) -> np.ndarray:
+    """``points`` values evenly spaced from ``from_`` to ``to``, both ends
+    exact (the values of ``vibroimpact sweep --from --to --points``)."""
+    from_, to = _real(from_, "from_"), _real(to, "to")
+    k = _count(points, "points", minimum=2)
+    if from_ == to:
+        raise ValueError(f"from_ and to are both {from_}: give a range")
+    v = from_ + (to - from_) * (np.arange(k, dtype=float) / (k - 1))
+    v[-1] = to
+    return v
+
+
+def _sweep_values(values, from_, to, points) -> np.ndarray:
+    if values is not None:
+        if from_ is not None or to is not None or points is not None:
+            raise ValueError("give values= or from_=, to=, points=, not both")
+        v = _floats(values, "values")
+        if v.size < 2:
+            raise ValueError(f"values: a sweep needs at least 2 values, got {v.size}")
+        return v
+    if from_ is None or to is None or points is None:
+        raise ValueError("give values= or all of from_=, to=, points=")
+    return parameter_values(from_, to, points)
+
+
+def sweep(
+    model: ModelLike,
+    parameter: str,
+    values: Optional[ArrayLike] = None,
+    *,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    points: Optional[int] = None,
+    transient: int = 100,
+    record: int = 20,
+    up_down: bool = False,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    method: str = "dop853",
+    cluster_tolerance: Optional[float] = None,
+    client: Any = None,
+    tasks: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+) -> Result:
+    """The brute-force bifurcation diagram (``vibroimpact sweep``): every
+    value of ``parameter`` simulated for ``transient`` forcing periods, then
+    ``record`` periods whose Poincaré samples are kept.
+
+    Values: ``values`` (any array-like) or ``from_``, ``to``, ``points``.
+    ``up_down``: sweep up and down, each value continuing from the previous
+    one's state. Without ``client`` the values run on this machine's cores
+    (``threads``: pool size, default all). With a
+    ``dask.distributed.Client`` they run on its workers in ``tasks``
+    chunks (see :mod:`vibroimpact.distributed`); the result is bit for bit
+    the local one.
+
+    Returns ``parameter_name``, ``bodies``, ``from``, ``to``,
+    ``transient_periods``, ``record_periods``, ``up_down``, ``rtol``,
+    ``atol``, ``cluster_tolerance`` and ``points`` (each with
+    ``parameter``, ``direction``, ``max_displacement``,
+    ``distinct_section_points``, ``section_spread``,
+    ``impacts_per_period``, ``recorded_periods``, ``completed``, ``error``
+    and ``sections``, the Poincaré samples as a record x 2N array). A value
+    that fails numerically is kept with its ``error``.
+    """
+    m = _model(model)
+    if not isinstance(parameter, str):
+        raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
+    v = _sweep_values(values, from_, to, points)
+    options = dict(
+        transient=_count(transient, "transient"),
+        record=_count(record, "record", minimum=1),
+        up_down=bool(up_down),
+        rtol=_real(rtol, "rtol", positive=True, optional=True),
+        atol=_real(atol, "atol", positive=True, optional=True),
+        method=_method(method, ("dop853", "rodas", "auto")),
+        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+    )
+    if threads is not None:
+        threads = _count(threads, "threads", minimum=1)
+    if client is not None:
+        from .distributed import sweep_on
+
+        return sweep_on(client, m, parameter, v, options, tasks=tasks, progress=progress)
+    return _sweep_local(m, parameter, v, options, threads=threads, progress=progress)
+
+
+def _sweep_local(
+    model: Model,
+    parameter: str,
+    values: np.ndarray,
+    options: dict,
+    *,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+    raw: bool = False,
+):
+    """One sweep on this machine (also one Dask task's work); ``raw``: the
+    plain document, for gathering."""
+    d = _core.sweep(
+        model,
+        parameter,
+        values,
+        options["transient"],
+        options["record"],
+        options["up_down"],
+        options["rtol"],
+        options["atol"],
+        options["method"],
+        options["cluster_tolerance"],
+        threads,
+        _progress(progress),
+    )
+    return d if raw else Result(d)

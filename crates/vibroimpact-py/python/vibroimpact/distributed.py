@@ -1,0 +1,146 @@
+"""Sweeps and ensembles on a Dask cluster.
+
+``vibroimpact.sweep(..., client=client)`` splits the parameter values into
+contiguous chunks, one Dask task each (a few per worker thread, so a task
+lasts long enough to pay for its scheduling), ships the model (it pickles as
+its TOML text, records inline), runs every chunk single-threaded on a worker
+and gathers the points into the same result as the local run: every value is
+computed by the same code from the same inputs, so the result is bit for bit
+the local one whatever the number of workers. An up-down sweep is two chains
+in which every value starts from the previous one's state: it runs as one
+task.
+
+:func:`ensemble` runs one computation (``simulate``, ``periodic``,
+``sweep``, ...) over a list of models (e.g. one per accelerogram) and
+returns one result per model, in order; a model that fails numerically gives
+a result with its ``error`` instead of stopping the others. Worker failures
+are retried by Dask (``retries``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, List, Optional, Sequence
+
+import numpy as np
+
+from ._results import Result
+
+
+def _sweep_task(model, parameter, values, options):
+    from . import _sweep_local
+
+    return _sweep_local(model, parameter, values, options, threads=1, raw=True)
+
+
+def _worker_threads(client) -> int:
+    info = client.scheduler_info()
+    workers = info.get("workers", {})
+    return max(1, sum(int(w.get("nthreads", 1)) for w in workers.values()))
+
+
+def _chunks(values: np.ndarray, tasks: int) -> List[np.ndarray]:
+    k = max(1, min(int(tasks), values.size))
+    bounds = np.linspace(0, values.size, k + 1).round().astype(int)
+    return [values[a:b] for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+
+
+def _gather(futures, progress: Optional[Callable[[int, int], Any]], total: int):
+    from dask.distributed import as_completed
+
+    done = 0
+    for f in as_completed(futures):
+        if f.status == "error":
+            f.result()  # raises the task's exception here
+        done += 1
+        if progress is not None:
+            progress(done, total)
+    return [f.result() for f in futures]
+
+
+def sweep_on(
+    client,
+    model,
+    parameter: str,
+    values: np.ndarray,
+    options: dict,
+    *,
+    tasks: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+    retries: int = 2,
+) -> Result:
+    """The sweep of :func:`vibroimpact.sweep` on the workers of ``client``
+    (``tasks`` chunks; default four per worker thread)."""
+    if not hasattr(client, "submit") or not hasattr(client, "scheduler_info"):
+        raise TypeError(
+            f"client: expected a dask.distributed.Client, got {type(client).__name__}"
+        )
+    if tasks is not None and (isinstance(tasks, bool) or int(tasks) < 1):
+        raise ValueError(f"tasks = {tasks}: must be >= 1")
+    if options["up_down"]:
+        chunks = [values]
+    else:
+        chunks = _chunks(values, tasks or 4 * _worker_threads(client))
+    [model_future] = client.scatter([model], broadcast=False)
+    futures = [
+        client.submit(
+            _sweep_task, model_future, parameter, c, options, retries=retries, pure=False
+        )
+        for c in chunks
+    ]
+    docs = _gather(futures, progress, len(futures))
+    head = dict(docs[0])
+    points = [p for d in docs for p in d["points"]]
+    direction_order = {"none": 0, "up": 1, "down": 2}
+    points.sort(key=lambda p: (p["parameter"], direction_order[p["direction"]]))
+    head["points"] = points
+    head["from"] = float(values[0])
+    head["to"] = float(values[-1])
+    return Result(head)
+
+
+def _ensemble_task(name: str, model, kwargs: dict):
+    import vibroimpact
+
+    try:
+        return getattr(vibroimpact, name)(model, **kwargs).to_dict()
+    except vibroimpact.VibroimpactError as e:
+        partial = getattr(e, "result", None)
+        out = partial.to_dict() if partial is not None else {}
+        out["error"] = str(e)
+        return out
+
+
+def ensemble(
+    models: Sequence[Any],
+    function: str = "simulate",
+    *,
+    client=None,
+    retries: int = 2,
+    progress: Optional[Callable[[int, int], Any]] = None,
+    **kwargs,
+) -> List[Result]:
+    """Runs ``vibroimpact.<function>(model, **kwargs)`` for every model (one
+    Dask task each with ``client``, else one after the other here) and
+    returns the results in order. A numerical failure gives that model's
+    result with ``error`` set (and what was computed); bad arguments raise
+    at once."""
+    import vibroimpact
+
+    names = ("simulate", "periodic", "continue_", "sweep")
+    if function not in names:
+        raise ValueError(f"function = {function!r}: give one of {', '.join(names)}")
+    models = [vibroimpact._model(m) for m in models]
+    if not models:
+        return []
+    if client is None:
+        out = []
+        for k, m in enumerate(models):
+            out.append(Result(_ensemble_task(function, m, kwargs)))
+            if progress is not None:
+                progress(k + 1, len(models))
+        return out
+    futures = [
+        client.submit(_ensemble_task, function, m, kwargs, retries=retries, pure=False)
+        for m in models
+    ]
+    return [Result(d) for d in _gather(futures, progress, len(futures))]

@@ -1,0 +1,43 @@
+//! `vibroimpact._core`: the Python binding of the vibroimpact library.
+//!
+//! A thin layer: it converts arguments, runs the library with the GIL
+//! released and converts results. The user-facing API (keyword defaults,
+//! result objects, plots, Dask) is the Python package `vibroimpact` beside
+//! this crate, which calls these functions with checked, contiguous `float64`
+//! arrays. Results come back as the same documents the CLI prints as JSON
+//! ([`vibroimpact::results`]), as Python dicts, plus numpy arrays for the
+//! bulky parts (time histories, Poincaré samples, orbits).
+//!
+//! Long calls run on a worker thread while the calling thread, holding the
+//! GIL only briefly, reports progress and checks for Ctrl-C
+//! ([`monitor::run`]); a request to stop reaches the integrators through
+//! [`vibroimpact::integrate::Interrupt`].
+
+mod convert;
+mod model;
+mod monitor;
+mod solve;
+
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    _core,
+    VibroimpactError,
+    pyo3::exceptions::PyException,
+    "A numerical failure of vibroimpact (an integration that cannot go on, a Newton iteration that does not converge)."
+);
+
+/// The extension module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("VibroimpactError", m.py().get_type::<VibroimpactError>())?;
+    m.add_class::<model::PyModel>()?;
+    m.add_function(wrap_pyfunction!(solve::impact, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::contact_force, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::identify, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::periodic, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::continue_branch, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
+    Ok(())
+}

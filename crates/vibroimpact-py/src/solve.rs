@@ -1,0 +1,477 @@
+//! The computations, one function per CLI subcommand. Arguments arrive
+//! checked and defaulted by the Python package (`vibroimpact/__init__.py`);
+//! the library validates them again and its messages become `ValueError`.
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact::contact::ContactLaw;
+use vibroimpact::continuation::{continue_branch as run_branch, switch_branch, ContinuationOptions};
+use vibroimpact::identify::{AccelerationSample, RestitutionSample};
+use vibroimpact::impact::direct::DirectOptions;
+use vibroimpact::impact::TwoBodies;
+use vibroimpact::integrate::Method;
+use vibroimpact::model_file::LawSpec;
+use vibroimpact::parameter::ParameterizedModel;
+use vibroimpact::periodic::{
+    guess_by_simulation_with, orbit_summary, shoot, shoot_krylov, ShootingOptions,
+};
+use vibroimpact::results::{
+    branch_document, impact_document, impact_rows, periodic_document, simulation_summary,
+    ImpactMethod, IMPACT_COLUMNS,
+};
+use vibroimpact::simulate::SimulationOptions;
+use vibroimpact::sweep::{sweep as run_sweep, SweepOptions};
+
+use crate::convert::{array1, array2, document, floats, numerical_error, to_python, value_error};
+use crate::model::PyModel;
+use crate::monitor::{self, Progress};
+
+fn law(spec: &str) -> PyResult<ContactLaw> {
+    let spec: LawSpec = serde_json::from_str(spec).map_err(|e| value_error(format!("law: {e}")))?;
+    spec.build().map_err(|e| value_error(format!("law: {e}")))
+}
+
+fn method(name: &str) -> PyResult<Method> {
+    match name {
+        "dop853" => Ok(Method::Dop853),
+        "rodas" => Ok(Method::Rodas),
+        "auto" => Ok(Method::Auto),
+        other => Err(value_error(format!(
+            "method = {other:?}: give \"dop853\", \"rodas\" or \"auto\""
+        ))),
+    }
+}
+
+/// Impact relations at every velocity: the `impact` document with each
+/// column of its rows as an array.
+#[pyfunction]
+#[pyo3(signature = (velocity, law_spec, mass1, mass2, method, rtol, duration_level))]
+#[allow(clippy::too_many_arguments)]
+pub fn impact<'py>(
+    py: Python<'py>,
+    velocity: PyReadonlyArray1<'py, f64>,
+    law_spec: &str,
+    mass1: f64,
+    mass2: f64,
+    method: &str,
+    rtol: f64,
+    duration_level: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let law = law(law_spec)?;
+    let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
+    let velocities = floats(&velocity, "velocity", true)?;
+    let m = match method {
+        "closed-form" if law.has_compact_support() => {
+            return Err(value_error(format!(
+                "method = \"closed-form\" exists only for the exponential law, not for {}; use method=\"integrate\"",
+                law.name()
+            )))
+        }
+        "closed-form" => ImpactMethod::ClosedForm,
+        "integrate" => ImpactMethod::Integrate,
+        other => {
+            return Err(value_error(format!(
+                "method = {other:?}: give \"closed-form\" or \"integrate\""
+            )))
+        }
+    };
+    let opts = DirectOptions {
+        rtol,
+        duration_level,
+        ..DirectOptions::default()
+    };
+    let rows = py
+        .detach(|| impact_rows(&law, bodies, &velocities, m, &opts))
+        .map_err(value_error)?;
+    let doc = to_python(py, &impact_document(&law, bodies, m, &[]))?.cast_into::<PyDict>()?;
+    let ncol = if m == ImpactMethod::Integrate { 10 } else { 9 };
+    for (c, name) in IMPACT_COLUMNS.iter().enumerate().take(ncol) {
+        let col: Vec<f64> = rows
+            .iter()
+            .map(|r| r.values()[c].unwrap_or(f64::NAN))
+            .collect();
+        doc.set_item(*name, array1(py, col))?;
+    }
+    doc.del_item("rows")?;
+    Ok(doc)
+}
+
+/// Force and partial derivatives of a contact law at arrays of
+/// penetration, rate and onset velocity.
+#[pyfunction]
+pub fn contact_force<'py>(
+    py: Python<'py>,
+    law_spec: &str,
+    s: PyReadonlyArray1<'py, f64>,
+    sdot: PyReadonlyArray1<'py, f64>,
+    impact_velocity: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let law = law(law_spec)?;
+    let s = floats(&s, "s", true)?;
+    let sdot = floats(&sdot, "sdot", true)?;
+    let v0 = floats(&impact_velocity, "impact_velocity", true)?;
+    if sdot.len() != s.len() || v0.len() != s.len() {
+        return Err(value_error(format!(
+            "s, sdot and impact_velocity must have one length: {}, {}, {}",
+            s.len(),
+            sdot.len(),
+            v0.len()
+        )));
+    }
+    let (mut f, mut ds, mut dsdot) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..s.len() {
+        let c = law.eval(s[i], sdot[i], v0[i]);
+        f.push(c.force);
+        ds.push(c.d_ds);
+        dsdot.push(c.d_dsdot);
+    }
+    let d = PyDict::new(py);
+    d.set_item("force", array1(py, f))?;
+    d.set_item("d_ds", array1(py, ds))?;
+    d.set_item("d_dsdot", array1(py, dsdot))?;
+    Ok(d)
+}
+
+/// a/b and α from measured impacts (empty arrays: not measured).
+#[pyfunction]
+#[pyo3(signature = (restitution_velocity, restitution, acceleration_velocity, peak_acceleration, mass1, mass2, a_over_b, joint))]
+#[allow(clippy::too_many_arguments)]
+pub fn identify<'py>(
+    py: Python<'py>,
+    restitution_velocity: PyReadonlyArray1<'py, f64>,
+    restitution: PyReadonlyArray1<'py, f64>,
+    acceleration_velocity: PyReadonlyArray1<'py, f64>,
+    peak_acceleration: PyReadonlyArray1<'py, f64>,
+    mass1: f64,
+    mass2: f64,
+    a_over_b: Option<f64>,
+    joint: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
+    let ru = floats(&restitution_velocity, "restitution_velocity", true)?;
+    let re = floats(&restitution, "restitution", true)?;
+    let au = floats(&acceleration_velocity, "acceleration_velocity", true)?;
+    let aa = floats(&peak_acceleration, "peak_acceleration", true)?;
+    let rest: Vec<RestitutionSample> = ru
+        .iter()
+        .zip(&re)
+        .map(|(&u, &e)| RestitutionSample {
+            impact_velocity: u,
+            restitution: e,
+        })
+        .collect();
+    let acc: Vec<AccelerationSample> = au
+        .iter()
+        .zip(&aa)
+        .map(|(&u, &a)| AccelerationSample {
+            impact_velocity: u,
+            peak_acceleration: a,
+        })
+        .collect();
+    let r = py
+        .detach(|| vibroimpact::identify::identify(&rest, &acc, bodies, a_over_b, joint))
+        .map_err(value_error)?;
+    document(py, &r)
+}
+
+/// A time history: the `simulate` summary plus `t`, `displacement`,
+/// `velocity` (rows per output time) and the impact log as arrays.
+#[pyfunction]
+#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    duration: f64,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    method_name: &str,
+    output_step: Option<f64>,
+    energy: bool,
+    impact_force_threshold: Option<f64>,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.loaded.model;
+    let settings = &model.loaded.simulation;
+    let method = method(method_name)?;
+    // The CLI's defaults: the model's [simulation] settings, else these.
+    let rtol = rtol.or(settings.rtol).unwrap_or(1e-8);
+    let atol = atol.or(settings.atol).unwrap_or(rtol * 1e-4);
+    let impact_force_threshold = impact_force_threshold
+        .or(settings.impact_force_threshold)
+        .unwrap_or(1e-3);
+    let output_step = match output_step {
+        Some(dt) if dt == 0.0 => None,
+        Some(dt) => Some(dt),
+        None => Some(match m.forcing_frequency() {
+            Some(w) => 2.0 * std::f64::consts::PI / w / 100.0,
+            None => duration / 2000.0,
+        }),
+    };
+    let result = monitor::run(py, progress, |p: &Progress| {
+        let opts = SimulationOptions {
+            t_end: duration,
+            rtol,
+            atol,
+            output_step,
+            impact_force_threshold,
+            energy,
+            method,
+            interrupt: Some(p.interrupt.clone()),
+            ..SimulationOptions::default()
+        };
+        vibroimpact::simulate::simulate(m, &opts)
+    })?;
+    let sim = result.map_err(value_error)?;
+    let n = m.bodies().len();
+    let d = document(py, &simulation_summary(m, &sim))?;
+    let rows = sim.times.len();
+    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
+    for j in 0..rows {
+        u.extend_from_slice(&sim.states[j * 2 * n..j * 2 * n + n]);
+        v.extend_from_slice(&sim.states[j * 2 * n + n..(j + 1) * 2 * n]);
+    }
+    d.set_item("t", array1(py, sim.times))?;
+    d.set_item("displacement", array2(py, u, rows, n)?)?;
+    d.set_item("velocity", array2(py, v, rows, n)?)?;
+    let log = PyDict::new(py);
+    let col = |f: &dyn Fn(&vibroimpact::simulate::ImpactRecord) -> f64| {
+        sim.impacts.iter().map(f).collect::<Vec<f64>>()
+    };
+    let contact: Vec<i64> = sim.impacts.iter().map(|i| i.contact as i64).collect();
+    log.set_item("contact", numpy::PyArray1::from_vec(py, contact))?;
+    log.set_item("start_time", array1(py, col(&|i| i.start_time)))?;
+    log.set_item("end_time", array1(py, col(&|i| i.end_time)))?;
+    log.set_item("impact_velocity", array1(py, col(&|i| i.impact_velocity)))?;
+    log.set_item("rebound_velocity", array1(py, col(&|i| i.rebound_velocity)))?;
+    log.set_item("restitution", array1(py, col(&|i| i.restitution())))?;
+    log.set_item("peak_force", array1(py, col(&|i| i.peak_force)))?;
+    log.set_item("duration", array1(py, col(&|i| i.duration())))?;
+    d.set_item("impacts", log)?;
+    d.set_item("interrupted", sim.error.as_ref().is_some_and(|e| {
+        matches!(e.source, vibroimpact::integrate::IntegrationError::Interrupted { .. })
+    }))?;
+    Ok(d)
+}
+
+/// A periodic solution: the `periodic` document plus the orbit over one
+/// period (`orbit_t`, `orbit_displacement`, `orbit_velocity`).
+#[pyfunction]
+#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn periodic<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    subharmonic: u32,
+    guess: Option<PyReadonlyArray1<'py, f64>>,
+    guess_periods: f64,
+    rtol: f64,
+    tol: f64,
+    krylov: bool,
+    arnoldi: usize,
+    symmetric: bool,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.loaded.model;
+    if m.forcing_frequency().is_none() {
+        return Err(value_error(format!(
+            "{}: the model has no periodic forcing with one frequency, so it has no periodic solutions",
+            model.document.source()
+        )));
+    }
+    if subharmonic == 0 {
+        return Err(value_error("subharmonic must be >= 1"));
+    }
+    if symmetric && (!m.is_mirror_symmetric() || subharmonic % 2 == 0) {
+        return Err(value_error(format!(
+            "{}: symmetric=True needs a mirror-symmetric model (mirrored bodies, contacts, walls and forcing) and an odd subharmonic",
+            model.document.source()
+        )));
+    }
+    let guess = match guess {
+        Some(g) => {
+            let g = floats(&g, "guess", true)?;
+            if g.len() != 2 * m.bodies().len() {
+                return Err(value_error(format!(
+                    "guess has {} values, the model needs {} (u then v)",
+                    g.len(),
+                    2 * m.bodies().len()
+                )));
+            }
+            Some(g)
+        }
+        None => None,
+    };
+    let out = monitor::run(py, progress, |p: &Progress| {
+        let interrupt = Some(p.interrupt.clone());
+        let x0 = match guess {
+            Some(g) => g,
+            None => guess_by_simulation_with(m, guess_periods, rtol.max(1e-9), interrupt.clone())
+                .map_err(|e| format!("guess by simulation: {e}"))?,
+        };
+        let opts = ShootingOptions {
+            subharmonic,
+            rtol,
+            tol,
+            symmetric,
+            interrupt,
+            ..ShootingOptions::default()
+        };
+        let sol = if krylov {
+            shoot_krylov(m, &x0, &opts, arnoldi)
+        } else {
+            shoot(m, &x0, &opts)
+        }
+        .map_err(|e| e.to_string())?;
+        let orbit = orbit_summary(m, &sol.initial_state, sol.period, 512, rtol)
+            .map_err(|e| e.to_string())?;
+        let symmetric_orbit = symmetric
+            || vibroimpact::continuation::is_symmetric_orbit(m, &sol.initial_state, &opts);
+        Ok::<_, String>((sol, orbit, symmetric_orbit))
+    })?;
+    let (sol, orbit, symmetric_orbit) = out.map_err(numerical_error)?;
+    let doc = periodic_document(m, &sol, &orbit, subharmonic, symmetric_orbit, krylov);
+    let d = to_python(py, &doc)?.cast_into::<PyDict>()?;
+    let n = m.bodies().len();
+    let rows = orbit.times.len();
+    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
+    for j in 0..rows {
+        u.extend_from_slice(&orbit.states[j * 2 * n..j * 2 * n + n]);
+        v.extend_from_slice(&orbit.states[j * 2 * n + n..(j + 1) * 2 * n]);
+    }
+    d.set_item("orbit_t", array1(py, orbit.times))?;
+    d.set_item("orbit_displacement", array2(py, u, rows, n)?)?;
+    d.set_item("orbit_velocity", array2(py, v, rows, n)?)?;
+    Ok(d)
+}
+
+/// A branch of periodic solutions: the `continue` document (with
+/// `switched_branch` when `switch_at` is given); progress counts points.
+#[pyfunction]
+#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn continue_branch<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    parameter: &str,
+    from_: f64,
+    to: f64,
+    subharmonic: u32,
+    switch_at: Option<String>,
+    max_points: usize,
+    ds_max: f64,
+    guess_periods: f64,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let family =
+        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    if !(from_.is_finite() && to.is_finite()) || from_ == to {
+        return Err(value_error(format!(
+            "from_ = {from_}, to = {to}: the range is empty or not finite"
+        )));
+    }
+    if subharmonic == 0 {
+        return Err(value_error("subharmonic must be >= 1"));
+    }
+    let start = family.model_at(from_).map_err(value_error)?;
+    if start.forcing_frequency().is_none() {
+        return Err(value_error(
+            "the model has no periodic forcing with one frequency at from_: nothing to continue",
+        ));
+    }
+    let out = monitor::run(py, progress, |p: &Progress| {
+        p.total.store(max_points, std::sync::atomic::Ordering::Relaxed);
+        let opts = ContinuationOptions {
+            max_points,
+            ds_max,
+            shooting: ShootingOptions {
+                subharmonic,
+                interrupt: Some(p.interrupt.clone()),
+                ..ContinuationOptions::default().shooting
+            },
+            ..ContinuationOptions::default()
+        };
+        let guess = guess_by_simulation_with(&start, guess_periods, 1e-9, Some(p.interrupt.clone()))
+            .map_err(|e| format!("start guess: {e}"))?;
+        let on_point = |_: &vibroimpact::continuation::BranchPoint| {
+            p.tick();
+            !p.interrupt.requested()
+        };
+        let fam = |x: f64| family.model_at(x).map_err(|e| e.to_string());
+        let branch =
+            run_branch(fam, from_, &guess, to, &opts, on_point).map_err(|e| e.to_string())?;
+        let switched = switch_at.as_deref().map(|label| {
+            let fam = |x: f64| family.model_at(x).map_err(|e| e.to_string());
+            switch_branch(fam, &branch, label, (from_, to), &opts, on_point)
+                .map_err(|e| e.to_string())
+        });
+        Ok::<_, String>((branch, switched))
+    })?;
+    let (branch, switched) = out.map_err(numerical_error)?;
+    let mut doc = branch_document(&branch, &start, parameter);
+    match switched {
+        Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start, parameter),
+        Some(Err(e)) => doc["switch_error"] = serde_json::Value::String(e),
+        None => {}
+    }
+    Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
+}
+
+/// A brute-force sweep: the `sweep` document; every point also carries its
+/// Poincaré samples as a `record × 2N` array (`sections`). `threads`: the
+/// size of the thread pool (None: all cores).
+#[pyfunction]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn sweep<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    parameter: &str,
+    values: PyReadonlyArray1<'py, f64>,
+    transient: usize,
+    record: usize,
+    up_down: bool,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    method_name: &str,
+    cluster_tolerance: Option<f64>,
+    threads: Option<usize>,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let family =
+        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let values = floats(&values, "values", true)?;
+    let method = method(method_name)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(numerical_error)?;
+    let total = values.len() * if up_down { 2 } else { 1 };
+    let summary = monitor::run(py, progress, |p: &Progress| {
+        p.total.store(total, std::sync::atomic::Ordering::Relaxed);
+        let options = SweepOptions {
+            transient,
+            record,
+            up_down,
+            rtol,
+            atol,
+            method,
+            cluster_tolerance,
+            interrupt: Some(p.interrupt.clone()),
+        };
+        pool.install(|| run_sweep(&family, &values, &options, &|| p.tick()))
+    })?
+    .map_err(value_error)?;
+    let d = document(py, &summary)?;
+    let points = d.get_item("points")?.ok_or_else(|| numerical_error("no points"))?;
+    let n2 = 2 * summary.bodies.len();
+    for (k, point) in summary.points.iter().enumerate() {
+        let rows = point.sections.len();
+        let flat: Vec<f64> = point.sections.iter().flatten().copied().collect();
+        points
+            .get_item(k)?
+            .set_item("sections", array2(py, flat, rows, n2)?)?;
+    }
+    Ok(d)
+}
