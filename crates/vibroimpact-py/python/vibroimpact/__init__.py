@@ -662,6 +662,8 @@ def _sweep_local(
 ):
     """One sweep on this machine (also one Dask task's work); ``raw``: the
     plain document, for gathering."""
+    # Arrays unpickled on a Dask worker are often misaligned: copy those.
+    values = np.require(values, np.float64, ["C", "A"])
     d = _core.sweep(
         model,
         parameter,

@@ -80,7 +80,7 @@ def sweep_on(
         chunks = [values]
     else:
         chunks = _chunks(values, tasks or 4 * _worker_threads(client))
-    [model_future] = client.scatter([model], broadcast=False)
+    [model_future] = client.scatter([model], broadcast=False, hash=False)
     futures = [
         client.submit(
             _sweep_task, model_future, parameter, c, options, retries=retries, pure=False

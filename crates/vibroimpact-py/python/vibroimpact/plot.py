@@ -1,0 +1,143 @@
+"""Matplotlib helpers for notebooks: one figure type per computation.
+
+Every function takes a result, draws on ``ax`` (a new figure's Axes if
+None) and returns the Axes. Matplotlib is imported only when a function is
+called, so ``import vibroimpact`` does not need it.
+
+>>> import vibroimpact as vi, vibroimpact.plot as vp
+>>> b = vi.continue_("examples/fujita-row-n2.toml", "frequency", 11.115, 3.705)
+>>> ax = vp.frequency_response(b, x_scale=1 / 7.41)   # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["frequency_response", "poincare", "restitution", "time_history"]
+
+# Marker per special-point kind (the ``kind`` strings of ``continue_``).
+_MARKERS = {
+    "fold": "o",
+    "branch-point": "s",
+    "period-doubling": "D",
+    "neimark-sacker": "^",
+    "torus": "^",
+    "grazing": "X",
+}
+# Colour per sweep direction.
+_DIRECTIONS = {"none": "0.2", "up": "tab:red", "down": "tab:green"}
+
+
+def _axes(ax):
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots()
+    return ax
+
+
+def _labels(ax, x, y):
+    """Axis labels, unless an earlier plot on these axes set them."""
+    if not ax.get_xlabel():
+        ax.set_xlabel(x)
+    if not ax.get_ylabel():
+        ax.set_ylabel(y)
+
+
+def _branch(ax, branch, body, x_scale, label, color, seen):
+    p = branch.column("parameter")
+    u = 1e3 * np.abs(np.array([pt.max_displacement[body] for pt in branch.points]))
+    stable = np.array([bool(pt.stable) for pt in branch.points])
+    starts = np.flatnonzero(np.r_[True, stable[1:] != stable[:-1]])
+    for i, (a, b) in enumerate(zip(starts, np.r_[starts[1:], len(p)])):
+        # Each run ends on the next run's first point: the curve is continuous.
+        end = min(b + 1, len(p))
+        ax.plot(p[a:end] * x_scale, u[a:end], color=color,
+                ls="-" if stable[a] else "--", label=label if i == 0 else None)
+    # A special point sits on the branch point nearest in parameter and state.
+    states = np.array([pt.initial_state for pt in branch.points])
+    scale = np.ptp(p) or 1.0, np.abs(states).max() or 1.0
+    for sp in branch.special_points:
+        d = np.hypot((p - sp.parameter) / scale[0],
+                     np.linalg.norm(states - sp.initial_state, axis=1) / scale[1])
+        y = u[np.argmin(d)]
+        ax.plot(sp.parameter * x_scale, y, ls="none", marker=_MARKERS.get(sp.kind, "*"),
+                mfc=color, mec="k", ms=7, zorder=3,
+                label=None if sp.kind in seen else sp.kind)
+        seen.add(sp.kind)
+        ax.annotate(sp.label, (sp.parameter * x_scale, y), xytext=(4, 4),
+                    textcoords="offset points", fontsize="x-small")
+
+
+def frequency_response(branch, ax=None, body=0, x_scale=1.0, label="branch", switched=True):
+    """The branch of a :func:`vibroimpact.continue_` result: max |u| of body
+    ``body`` (mm) against its parameter times ``x_scale`` (e.g. ``1/omega0``
+    for Omega/omega0); stable stretches solid, unstable dashed, special
+    points marked by kind and labelled (BP1, PD1, ...). With ``switched``,
+    the ``switched_branch`` (if any) is drawn too, in another colour."""
+    ax = _axes(ax)
+    seen: set = set()
+    _branch(ax, branch, body, x_scale, label, "tab:blue", seen)
+    if switched and "switched_branch" in branch:
+        _branch(ax, branch.switched_branch, body, x_scale, f"{label} (switched)",
+                "tab:orange", seen)
+    x = branch.parameter_name + (f" × {x_scale:.4g}" if x_scale != 1.0 else "")
+    _labels(ax, x, f"max |u{body + 1}| (mm)")
+    ax.legend(fontsize="small")
+    return ax
+
+
+def time_history(history, ax=None, bodies=None):
+    """The displacements (mm) against time (s) of a
+    :func:`vibroimpact.simulate` result, for the body indices ``bodies``
+    (default: all, at most 8), with each impact's start time ticked along
+    the bottom of the axes in its contact's colour."""
+    ax = _axes(ax)
+    u = np.asarray(history.displacement).reshape(len(history.t), -1)
+    for i in range(min(u.shape[1], 8)) if bodies is None else bodies:
+        ax.plot(history.t, 1e3 * u[:, i], lw=1, label=f"body {i + 1}")
+    contact = np.asarray(history.impacts.contact, dtype=int)
+    start = np.asarray(history.impacts.start_time, dtype=float)
+    trans = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    for k, c in enumerate(history.impacts_per_contact):
+        t = start[contact == k]
+        if t.size:
+            ax.vlines(t, 0.0, 0.05, transform=trans, colors=f"C{(k + 3) % 10}",
+                      lw=1.2, label=f"impact {c.contact}")
+    _labels(ax, "t (s)", "u (mm)")
+    ax.legend(fontsize="small", ncol=2)
+    return ax
+
+
+def poincare(sweep, ax=None, body=0, x_scale=1.0):
+    """The brute-force bifurcation diagram of a :func:`vibroimpact.sweep`
+    result: every point's Poincaré samples of body ``body``'s displacement
+    (mm) against the parameter times ``x_scale``; an up-down sweep's two
+    directions in two colours, with a legend."""
+    ax = _axes(ax)
+    n = 2 * len(sweep.bodies)
+    xs: dict = {}
+    for pt in sweep.points:
+        sec = np.asarray(pt.sections, dtype=float).reshape(-1, n)[:, body]
+        x, y = xs.setdefault(pt.direction, ([], []))
+        x.extend([pt.parameter * x_scale] * len(sec))
+        y.extend(1e3 * sec)
+    for direction, (x, y) in xs.items():
+        name = "sweep" if direction == "none" else f"sweep {direction}"
+        ax.scatter(x, y, s=6, color=_DIRECTIONS.get(direction, "k"), label=name, zorder=2)
+    x = sweep.parameter_name + (f" × {x_scale:.4g}" if x_scale != 1.0 else "")
+    _labels(ax, x, f"u{body + 1} at the Poincaré section (mm)")
+    if sweep.up_down or ax.get_legend() is not None:
+        ax.legend(fontsize="small")
+    return ax
+
+
+def restitution(impact, ax=None, label=None):
+    """Coefficient of restitution against impact velocity (m/s, log axis)
+    of a :func:`vibroimpact.impact` result; ``label`` defaults to its
+    method ("closed-form" or "integrate")."""
+    ax = _axes(ax)
+    ax.semilogx(impact.impact_velocity, impact.restitution, label=label or impact.method)
+    _labels(ax, "impact velocity V (m/s)", "coefficient of restitution e")
+    ax.legend(fontsize="small")
+    return ax

@@ -1,0 +1,127 @@
+"""The Python API against the CLI on the same inputs: same numbers to 1e-12
+(both are the same library; the tolerance only allows for the JSON text)."""
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from conftest import EXAMPLES, ROOT
+
+REL = 1e-12
+
+
+def close(a, b):
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    assert a.shape == b.shape
+    np.testing.assert_allclose(a, b, rtol=REL, atol=1e-300)
+
+
+def read_measured(path):
+    """Two numeric columns after the header row, `#` comments skipped."""
+    rows = [l for l in path.read_text().splitlines() if l.strip() and not l.startswith("#")]
+    return np.array([[float(x) for x in l.split(",")] for l in rows[1:]])
+
+
+@pytest.mark.parametrize("method", ["closed-form", "integrate"])
+def test_impact(cli, method):
+    v = np.logspace(-3, 1, 25)
+    doc = cli(
+        "impact", "--velocity", ",".join(repr(float(x)) for x in v), "--method", method
+    )
+    r = vi.impact(v, method=method)
+    assert r.method == doc["method"] == method
+    assert r.contact_law.to_dict() == doc["contact_law"]
+    for key in doc["rows"][0]:
+        want = [np.nan if row[key] is None else row[key] for row in doc["rows"]]
+        close(r[key], want)
+
+
+def test_impact_other_law_and_wall(cli):
+    v = [0.05, 0.2, 0.7]
+    doc = cli(
+        "impact", "--law", "hunt-crossley", "--stiffness", "2e9", "--chi", "0.4",
+        "--mass2", "wall", "--velocity", "0.05,0.2,0.7",
+    )
+    r = vi.impact(v, law="hunt-crossley", stiffness=2e9, chi=0.4, mass2="wall")
+    assert r.mass2 == "wall" and r.method == "integrate"
+    for key in ("restitution", "peak_force", "contact_duration", "max_penetration"):
+        close(r[key], [row[key] for row in doc["rows"]])
+
+
+def test_identify(cli):
+    rest = read_measured(EXAMPLES / "seed-impacts/restitution.csv")
+    acc = read_measured(EXAMPLES / "seed-impacts/acceleration.csv")
+    for joint in (False, True):
+        args = [
+            "identify", "--restitution", EXAMPLES / "seed-impacts/restitution.csv",
+            "--acceleration", EXAMPLES / "seed-impacts/acceleration.csv",
+        ] + (["--joint"] if joint else [])
+        doc = cli(*args)
+        r = vi.identify(restitution=rest, acceleration=(acc[:, 0], acc[:, 1]), joint=joint)
+        assert r.method == doc["method"]
+        for key in ("a_over_b", "alpha"):
+            close(r[key].value, doc[key]["value"])
+            close(r[key].std_error, doc[key]["std_error"])
+        close(r.acceleration_fit.alpha.value, doc["acceleration_fit"]["alpha"]["value"])
+
+
+def test_simulate(cli):
+    doc = cli("simulate", EXAMPLES / "fujita-row.toml", "--periods", "5")
+    # Without a history, as the CLI without --out (dense output costs
+    # evaluations, so the counters would differ).
+    r = vi.simulate(EXAMPLES / "fujita-row.toml", periods=5, output_step=0)
+    for key in ("final_time", "final_displacement", "final_velocity"):
+        close(r[key], doc[key])
+    for key in ("impact_count", "rhs_evaluations", "steps", "rejected_steps", "completed"):
+        assert r[key] == doc[key], key
+    assert [c.impacts for c in r.impacts_per_contact] == [c["impacts"] for c in doc["impacts_per_contact"]]
+    assert r.impacts["restitution"].size == doc["impact_count"]
+    # With a history the trajectory is the same to the tolerance, and the
+    # history ends at the final state.
+    h = vi.simulate(EXAMPLES / "fujita-row.toml", periods=5)
+    assert h.t[-1] == pytest.approx(doc["final_time"], rel=1e-12)
+    np.testing.assert_allclose(h.displacement[-1], doc["final_displacement"], atol=1e-9)
+    close(h.displacement[-1], h.final_displacement)
+
+
+def test_periodic(cli):
+    doc = cli("periodic", EXAMPLES / "fujita-row-n2.toml", "--symmetric")
+    r = vi.periodic(EXAMPLES / "fujita-row-n2.toml", symmetric=True)
+    for key in ("period", "initial_state", "floquet_multipliers", "max_displacement", "max_velocity", "spectral_radius"):
+        close(r[key], doc[key])
+    assert r.stable == doc["stable"] and r.symmetric_orbit == doc["symmetric_orbit"]
+    assert r.orbit_displacement.shape == (r.orbit_t.size, 2)
+
+
+def test_continue(cli):
+    m = EXAMPLES / "fujita-row-n2.toml"
+    doc = cli("continue", m, "--parameter", "frequency", "--from", "11.115", "--to", "3.705")
+    r = vi.continue_(m, "frequency", 11.115, 3.705)
+    assert len(r.points) == len(doc["points"])
+    close(r.column("parameter"), [p["parameter"] for p in doc["points"]])
+    close(r.column("max_displacement"), [p["max_displacement"] for p in doc["points"]])
+    assert [s.label for s in r.special_points] == [s["label"] for s in doc["special_points"]]
+    close(r.column("parameter", "special_points"), [s["parameter"] for s in doc["special_points"]])
+
+
+def test_sweep(cli):
+    m = EXAMPLES / "fujita-row.toml"
+    doc = cli(
+        "sweep", m, "--parameter", "frequency", "--from", "5.9", "--to", "8.9",
+        "--points", "5", "--transient", "20", "--record", "5", "--up-down",
+    )
+    r = vi.sweep(m, "frequency", from_=5.9, to=8.9, points=5, transient=20, record=5, up_down=True)
+    assert len(r.points) == len(doc["points"]) == 10
+    for p, q in zip(r.points, doc["points"]):
+        assert (p.direction, p.distinct_section_points, p.completed) == (q["direction"], q["distinct_section_points"], q["completed"])
+        close(p.parameter, q["parameter"])
+        close(p.max_displacement, q["max_displacement"])
+        close(p.section_spread, q["section_spread"])
+        assert p.sections.shape == (5, 6)
+
+
+def test_parameter_values_match_the_cli():
+    v = vi.parameter_values(5.9, 8.9, 41)
+    assert v[0] == 5.9 and v[-1] == 8.9 and v.size == 41
+    assert ROOT.exists()

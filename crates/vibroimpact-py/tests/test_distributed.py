@@ -1,0 +1,91 @@
+"""Sweeps and ensembles on a Dask LocalCluster of two worker processes: bit
+for bit the local results; the command-line entry; a missing scheduler."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from conftest import EXAMPLES, ROOT
+from vibroimpact.distributed import ensemble
+
+distributed = pytest.importorskip("dask.distributed")
+
+ROW = EXAMPLES / "fujita-row.toml"
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def same(a, b):
+    """Bit-for-bit equality of two results (NaN equal to NaN)."""
+    da, db = a.to_dict(), b.to_dict()
+    return json.dumps(da, sort_keys=True) == json.dumps(db, sort_keys=True)
+
+
+def test_sweep_is_bit_identical_to_the_local_run(client):
+    kw = dict(from_=5.9, to=8.9, points=13, transient=15, record=4)
+    local = vi.sweep(ROW, "frequency", **kw)
+    for tasks in (None, 3, 13):
+        remote = vi.sweep(ROW, "frequency", client=client, tasks=tasks, **kw)
+        assert same(local, remote), tasks
+        for p, q in zip(local.points, remote.points):
+            assert np.array_equal(p.sections, q.sections)
+    one_thread = vi.sweep(ROW, "frequency", threads=1, **kw)
+    assert same(local, one_thread)
+
+
+def test_up_down_sweep_on_the_cluster(client):
+    kw = dict(values=[6.0, 7.0, 8.0], transient=10, record=3, up_down=True)
+    assert same(vi.sweep(ROW, "frequency", **kw), vi.sweep(ROW, "frequency", client=client, **kw))
+
+
+def test_ensemble_of_models(client):
+    base = vi.Model.load(ROW)
+    models = [base.with_(amplitude=a) for a in (0.02, 0.05, 0.08)]
+    here = ensemble(models, "simulate", periods=3, output_step=0)
+    there = ensemble(models, "simulate", client=client, periods=3, output_step=0)
+    assert len(there) == 3
+    for a, b in zip(here, there):
+        assert np.array_equal(a.final_displacement, b.final_displacement)
+    assert here[0].impact_count < here[2].impact_count
+    # A numerical failure is one entry's error, not the ensemble's.
+    out = ensemble([base, base], "periodic", client=client, guess_periods=1)
+    assert all("Newton did not converge" in r.error for r in out)
+
+
+def test_command_line_entry_matches_the_cli(cli):
+    args = ["--parameter", "frequency", "--from", "6", "--to", "8", "--points", "4",
+            "--transient", "10", "--record", "3"]
+    out = subprocess.run(
+        [sys.executable, "-m", "vibroimpact", "sweep", str(ROW), *args],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    assert out.returncode == 0, out.stderr
+    mine = json.loads(out.stdout)
+    theirs = cli("sweep", ROW, *args)
+    assert mine == theirs
+
+
+def test_missing_scheduler_is_a_clear_error():
+    out = subprocess.run(
+        [sys.executable, "-m", "vibroimpact", "sweep", str(ROW), "--parameter", "frequency",
+         "--from", "6", "--to", "8", "--points", "3", "--scheduler", "tcp://127.0.0.1:9",
+         "--timeout", "2"],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    assert out.returncode == 2
+    assert "--scheduler tcp://127.0.0.1:9: cannot connect" in out.stderr
+    with pytest.raises(TypeError, match="client"):
+        vi.sweep(ROW, "frequency", values=[6.0, 7.0], client=object())
