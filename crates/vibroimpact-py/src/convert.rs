@@ -23,8 +23,10 @@ pub fn to_python<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>>
         },
         Value::String(s) => s.into_bound_py_any(py)?,
         Value::Array(a) => {
-            let items: Vec<Bound<'py, PyAny>> =
-                a.iter().map(|x| to_python(py, x)).collect::<PyResult<_>>()?;
+            let items: Vec<Bound<'py, PyAny>> = a
+                .iter()
+                .map(|x| to_python(py, x))
+                .collect::<PyResult<_>>()?;
             PyList::new(py, items)?.into_any()
         }
         Value::Object(o) => {

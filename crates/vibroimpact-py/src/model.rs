@@ -99,7 +99,10 @@ impl PyModel {
             for (k, v) in d.iter() {
                 let name: String = k.extract()?;
                 let value: f64 = v.extract().map_err(|_| {
-                    value_error(format!("{name}: a number is needed, not {}", v.repr().map_or_else(|_| "?".into(), |r| r.to_string())))
+                    value_error(format!(
+                        "{name}: a number is needed, not {}",
+                        v.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+                    ))
                 })?;
                 let p = doc.parameter(&name).map_err(value_error)?;
                 doc.set(&p, value).map_err(value_error)?;

@@ -5,8 +5,11 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 use vibroimpact::contact::ContactLaw;
-use vibroimpact::continuation::{continue_branch as run_branch, switch_branch, ContinuationOptions};
+use vibroimpact::continuation::{
+    continue_branch as run_branch, switch_branch, ContinuationOptions,
+};
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::TwoBodies;
@@ -17,8 +20,8 @@ use vibroimpact::periodic::{
     guess_by_simulation_with, orbit_summary, shoot, shoot_krylov, ShootingOptions,
 };
 use vibroimpact::results::{
-    branch_document, impact_document, impact_rows, periodic_document, simulation_summary,
-    ImpactMethod, IMPACT_COLUMNS,
+    branch_document, impact_document, periodic_document, simulation_summary, ImpactMethod,
+    ImpactRelations, IMPACT_COLUMNS,
 };
 use vibroimpact::simulate::SimulationOptions;
 use vibroimpact::sweep::{sweep as run_sweep, SweepOptions};
@@ -62,12 +65,6 @@ pub fn impact<'py>(
     let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
     let velocities = floats(&velocity, "velocity", true)?;
     let m = match method {
-        "closed-form" if law.has_compact_support() => {
-            return Err(value_error(format!(
-                "method = \"closed-form\" exists only for the exponential law, not for {}; use method=\"integrate\"",
-                law.name()
-            )))
-        }
         "closed-form" => ImpactMethod::ClosedForm,
         "integrate" => ImpactMethod::Integrate,
         other => {
@@ -81,19 +78,48 @@ pub fn impact<'py>(
         duration_level,
         ..DirectOptions::default()
     };
-    let rows = py
-        .detach(|| impact_rows(&law, bodies, &velocities, m, &opts))
-        .map_err(value_error)?;
-    let doc = to_python(py, &impact_document(&law, bodies, m, &[]))?.cast_into::<PyDict>()?;
+    let relations = ImpactRelations::new(&law, bodies, m, &opts).map_err(value_error)?;
     let ncol = if m == ImpactMethod::Integrate { 10 } else { 9 };
-    for (c, name) in IMPACT_COLUMNS.iter().enumerate().take(ncol) {
-        let col: Vec<f64> = rows
-            .iter()
-            .map(|r| r.values()[c].unwrap_or(f64::NAN))
-            .collect();
+    // Columns straight from the rows, chunk by chunk in parallel; the first
+    // error in velocity order is reported.
+    let chunks: Vec<Result<Vec<Vec<f64>>, _>> = py.detach(|| {
+        velocities
+            .par_chunks(4096)
+            .map(|chunk| {
+                let mut cols = vec![Vec::with_capacity(chunk.len()); ncol];
+                for &u in chunk {
+                    let r = relations.row(u)?;
+                    let values = [
+                        r.impact_velocity,
+                        r.v.unwrap_or(f64::NAN),
+                        r.restitution,
+                        r.rebound_velocity,
+                        r.peak_force_dimensionless.unwrap_or(f64::NAN),
+                        r.peak_force,
+                        r.peak_acceleration1,
+                        r.peak_acceleration2,
+                        r.max_penetration,
+                        r.contact_duration.unwrap_or(f64::NAN),
+                    ];
+                    for (col, x) in cols.iter_mut().zip(values) {
+                        col.push(x);
+                    }
+                }
+                Ok::<_, vibroimpact::impact::ImpactError>(cols)
+            })
+            .collect()
+    });
+    let mut columns = vec![Vec::with_capacity(velocities.len()); ncol];
+    for chunk in chunks {
+        for (all, part) in columns.iter_mut().zip(chunk.map_err(value_error)?) {
+            all.extend(part);
+        }
+    }
+    let doc = to_python(py, &impact_document(&law, bodies, m, &[]))?.cast_into::<PyDict>()?;
+    doc.del_item("rows")?;
+    for (name, col) in IMPACT_COLUMNS.iter().zip(columns) {
         doc.set_item(*name, array1(py, col))?;
     }
-    doc.del_item("rows")?;
     Ok(doc)
 }
 
@@ -249,9 +275,15 @@ pub fn simulate<'py>(
     log.set_item("peak_force", array1(py, col(&|i| i.peak_force)))?;
     log.set_item("duration", array1(py, col(&|i| i.duration())))?;
     d.set_item("impacts", log)?;
-    d.set_item("interrupted", sim.error.as_ref().is_some_and(|e| {
-        matches!(e.source, vibroimpact::integrate::IntegrationError::Interrupted { .. })
-    }))?;
+    d.set_item(
+        "interrupted",
+        sim.error.as_ref().is_some_and(|e| {
+            matches!(
+                e.source,
+                vibroimpact::integrate::IntegrationError::Interrupted { .. }
+            )
+        }),
+    )?;
     Ok(d)
 }
 
@@ -364,8 +396,7 @@ pub fn continue_branch<'py>(
     guess_periods: f64,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let family =
-        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
     if !(from_.is_finite() && to.is_finite()) || from_ == to {
         return Err(value_error(format!(
             "from_ = {from_}, to = {to}: the range is empty or not finite"
@@ -381,7 +412,8 @@ pub fn continue_branch<'py>(
         ));
     }
     let out = monitor::run(py, progress, |p: &Progress| {
-        p.total.store(max_points, std::sync::atomic::Ordering::Relaxed);
+        p.total
+            .store(max_points, std::sync::atomic::Ordering::Relaxed);
         let opts = ContinuationOptions {
             max_points,
             ds_max,
@@ -392,8 +424,9 @@ pub fn continue_branch<'py>(
             },
             ..ContinuationOptions::default()
         };
-        let guess = guess_by_simulation_with(&start, guess_periods, 1e-9, Some(p.interrupt.clone()))
-            .map_err(|e| format!("start guess: {e}"))?;
+        let guess =
+            guess_by_simulation_with(&start, guess_periods, 1e-9, Some(p.interrupt.clone()))
+                .map_err(|e| format!("start guess: {e}"))?;
         let on_point = |_: &vibroimpact::continuation::BranchPoint| {
             p.tick();
             !p.interrupt.requested()
@@ -439,8 +472,7 @@ pub fn sweep<'py>(
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let family =
-        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
     let values = floats(&values, "values", true)?;
     let method = method(method_name)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -464,7 +496,9 @@ pub fn sweep<'py>(
     })?
     .map_err(value_error)?;
     let d = document(py, &summary)?;
-    let points = d.get_item("points")?.ok_or_else(|| numerical_error("no points"))?;
+    let points = d
+        .get_item("points")?
+        .ok_or_else(|| numerical_error("no points"))?;
     let n2 = 2 * summary.bodies.len();
     for (k, point) in summary.points.iter().enumerate() {
         let rows = point.sections.len();

@@ -86,9 +86,67 @@ pub fn x_minus_log1p(u: f64) -> f64 {
 /// Reports non-convergence after `max_iter` iterations instead of returning a
 /// poor value.
 pub fn newton_bracketed<F>(
+    f_df: F,
+    lo: f64,
+    hi: f64,
+    xtol: f64,
+    max_iter: usize,
+) -> Result<f64, RootError>
+where
+    F: FnMut(f64) -> (f64, f64),
+{
+    safeguarded_newton(f_df, lo, hi, 0.5 * (lo + hi), xtol, max_iter)
+}
+
+/// [`newton_bracketed`] starting from the guess `x0` instead of the
+/// bracket's midpoint. From a good guess plain Newton steps are tried first:
+/// while they stay strictly inside the bracket and converge (within 8
+/// steps), their limit is returned without evaluating `f` at the bracket's
+/// ends (for a function with one root in the bracket, the one the
+/// safeguarded iteration finds, by the same steps). Otherwise the
+/// safeguarded iteration runs from `x0` (clamped into the bracket).
+pub fn newton_bracketed_from<F>(
+    mut f_df: F,
+    lo: f64,
+    hi: f64,
+    x0: f64,
+    xtol: f64,
+    max_iter: usize,
+) -> Result<f64, RootError>
+where
+    F: FnMut(f64) -> (f64, f64),
+{
+    let inside = |x: f64| x > lo.min(hi) && x < lo.max(hi);
+    let mut x = x0;
+    for _ in 0..8 {
+        if !inside(x) {
+            break;
+        }
+        let (fx, dfx) = f_df(x);
+        if !(fx.is_finite() && dfx.is_finite()) || dfx == 0.0 {
+            break;
+        }
+        if fx == 0.0 {
+            return Ok(x);
+        }
+        let next = x - fx / dfx;
+        if !inside(next) {
+            break;
+        }
+        if (next - x).abs() <= xtol * next.abs().max(f64::MIN_POSITIVE) {
+            return Ok(next);
+        }
+        x = next;
+    }
+    safeguarded_newton(f_df, lo, hi, x0, xtol, max_iter)
+}
+
+/// The safeguarded iteration of [`newton_bracketed`] from `x0`.
+fn safeguarded_newton<F>(
     mut f_df: F,
     mut lo: f64,
     mut hi: f64,
+    x0: f64,
     xtol: f64,
     max_iter: usize,
 ) -> Result<f64, RootError>
@@ -113,7 +171,11 @@ where
         return Err(RootError::NotBracketed { lo, hi, f_lo, f_hi });
     }
     let lo_negative = f_lo < 0.0;
-    let mut x = 0.5 * (lo + hi);
+    let mut x = if x0 > lo.min(hi) && x0 < lo.max(hi) {
+        x0
+    } else {
+        0.5 * (lo + hi)
+    };
     for _ in 0..max_iter {
         let (fx, dfx) = f_df(x);
         if !fx.is_finite() {

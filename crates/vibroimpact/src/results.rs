@@ -2,6 +2,7 @@
 //! CLI's JSON output and the Python package's result objects carry the same
 //! fields, made here once.
 
+use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -114,9 +115,86 @@ pub const IMPACT_COLUMNS: [&str; 10] = [
     "contact_duration",
 ];
 
-/// The impact relations of `law` between `bodies` at every impact
-/// velocity, by Fujita's closed form (exponential law only) or by direct
+/// The impact relations of one law between two bodies, velocity by
+/// velocity: Fujita's closed form (exponential law only) or direct
 /// integration.
+#[derive(Clone, Debug)]
+pub struct ImpactRelations<'a> {
+    law: &'a ContactLaw,
+    bodies: TwoBodies,
+    method: ImpactMethod,
+    opts: DirectOptions,
+    closed: Option<ExponentialImpact>,
+}
+
+impl<'a> ImpactRelations<'a> {
+    /// The relations by `method`; the closed form needs the exponential law.
+    pub fn new(
+        law: &'a ContactLaw,
+        bodies: TwoBodies,
+        method: ImpactMethod,
+        opts: &DirectOptions,
+    ) -> Result<Self, ImpactError> {
+        let closed = match law.kind() {
+            LawKind::Exponential { .. } => Some(ExponentialImpact::new(law, bodies)?),
+            _ => None,
+        };
+        if method == ImpactMethod::ClosedForm && closed.is_none() {
+            return Err(ImpactError::Unsupported(format!(
+                "method closed-form exists only for the exponential law, not for {}; use method integrate",
+                law.name()
+            )));
+        }
+        Ok(Self {
+            law,
+            bodies,
+            method,
+            opts: opts.clone(),
+            closed,
+        })
+    }
+
+    /// The row at impact velocity `u` (m/s).
+    pub fn row(&self, u: f64) -> Result<ImpactRow, ImpactError> {
+        Ok(match (self.method, &self.closed) {
+            (ImpactMethod::ClosedForm, Some(cf)) => {
+                let c = cf.impact(u)?;
+                ImpactRow {
+                    impact_velocity: u,
+                    v: Some(c.v),
+                    restitution: c.restitution,
+                    rebound_velocity: c.rebound_velocity,
+                    peak_force_dimensionless: Some(c.peak_force_dimensionless),
+                    peak_force: c.peak_force,
+                    peak_acceleration1: c.peak_acceleration[0],
+                    peak_acceleration2: c.peak_acceleration[1],
+                    max_penetration: c.max_penetration,
+                    contact_duration: None,
+                }
+            }
+            _ => {
+                let d = integrate_impact(self.law, self.bodies, u, &self.opts)?;
+                let closed = self.closed.as_ref();
+                ImpactRow {
+                    impact_velocity: u,
+                    v: closed.map(|cf| u / cf.a_over_b()),
+                    restitution: d.restitution,
+                    rebound_velocity: d.rebound_velocity,
+                    peak_force_dimensionless: closed.map(|cf| d.peak_force / cf.force_scale()),
+                    peak_force: d.peak_force,
+                    peak_acceleration1: d.peak_acceleration[0],
+                    peak_acceleration2: d.peak_acceleration[1],
+                    max_penetration: d.max_penetration,
+                    contact_duration: Some(d.contact_duration),
+                }
+            }
+        })
+    }
+}
+
+/// The impact relations at every velocity, in parallel on rayon's pool; the
+/// first error in velocity order is reported, so the outcome does not depend
+/// on the thread count.
 pub fn impact_rows(
     law: &ContactLaw,
     bodies: TwoBodies,
@@ -124,53 +202,10 @@ pub fn impact_rows(
     method: ImpactMethod,
     opts: &DirectOptions,
 ) -> Result<Vec<ImpactRow>, ImpactError> {
-    let closed = match law.kind() {
-        LawKind::Exponential { .. } => Some(ExponentialImpact::new(law, bodies)?),
-        _ => None,
-    };
-    velocities
-        .iter()
-        .map(|&u| {
-            Ok(match (method, &closed) {
-                (ImpactMethod::ClosedForm, None) => {
-                    return Err(ImpactError::Unsupported(format!(
-                        "method closed-form exists only for the exponential law, not for {}; use method integrate",
-                        law.name()
-                    )))
-                }
-                (ImpactMethod::ClosedForm, Some(cf)) => {
-                    let c = cf.impact(u)?;
-                    ImpactRow {
-                        impact_velocity: u,
-                        v: Some(c.v),
-                        restitution: c.restitution,
-                        rebound_velocity: c.rebound_velocity,
-                        peak_force_dimensionless: Some(c.peak_force_dimensionless),
-                        peak_force: c.peak_force,
-                        peak_acceleration1: c.peak_acceleration[0],
-                        peak_acceleration2: c.peak_acceleration[1],
-                        max_penetration: c.max_penetration,
-                        contact_duration: None,
-                    }
-                }
-                (ImpactMethod::Integrate, _) => {
-                    let d = integrate_impact(law, bodies, u, opts)?;
-                    ImpactRow {
-                        impact_velocity: u,
-                        v: closed.map(|cf| u / cf.a_over_b()),
-                        restitution: d.restitution,
-                        rebound_velocity: d.rebound_velocity,
-                        peak_force_dimensionless: closed.map(|cf| d.peak_force / cf.force_scale()),
-                        peak_force: d.peak_force,
-                        peak_acceleration1: d.peak_acceleration[0],
-                        peak_acceleration2: d.peak_acceleration[1],
-                        max_penetration: d.max_penetration,
-                        contact_duration: Some(d.contact_duration),
-                    }
-                }
-            })
-        })
-        .collect()
+    let relations = ImpactRelations::new(law, bodies, method, opts)?;
+    let rows: Vec<Result<ImpactRow, ImpactError>> =
+        velocities.par_iter().map(|&u| relations.row(u)).collect();
+    rows.into_iter().collect()
 }
 
 /// The document of `vibroimpact impact`: method, contact law, masses and

@@ -37,7 +37,7 @@
 
 use super::{positive, ImpactError, TwoBodies};
 use crate::contact::{ContactLaw, LawKind};
-use crate::numeric::{exp_neg_minus_one_plus, newton_bracketed, x_minus_log1p};
+use crate::numeric::{exp_neg_minus_one_plus, newton_bracketed_from, x_minus_log1p};
 
 const XTOL: f64 = 4.0 * f64::EPSILON;
 const MAX_ITER: usize = 200;
@@ -60,11 +60,14 @@ pub fn restitution(v: f64) -> Result<f64, ImpactError> {
         (value, slope)
     };
     let p_lower = 4.0 * v / (1.0 + (1.0 + 4.0 * v / 3.0).sqrt());
-    let lo = 0.999 * p_lower.max((1.0 + v) * -(-p_lower).exp_m1());
-    let hi = 1.001 * (2.0 * v).min(1.0 + v);
-    let p = newton_bracketed(g, lo, hi, XTOL, MAX_ITER).map_err(|source| ImpactError::Solver {
-        what: "restitution, seed eq. (10)",
-        source,
+    let bound = p_lower.max((1.0 + v) * -(-p_lower).exp_m1());
+    let (lo, hi) = (0.999 * bound, 1.001 * (2.0 * v).min(1.0 + v));
+    // Newton from the lower bound, which is within a few per cent of the root.
+    let p = newton_bracketed_from(g, lo, hi, bound, XTOL, MAX_ITER).map_err(|source| {
+        ImpactError::Solver {
+            what: "restitution, seed eq. (10)",
+            source,
+        }
     })?;
     Ok(if v < 1.0 {
         (p - v) / v
@@ -136,7 +139,10 @@ pub fn peak_velocity(v: f64) -> Result<f64, ImpactError> {
             (1.0 + 2.0 * w) / (1.0 + w),
         )
     };
-    newton_bracketed(k, 0.0, v, XTOL, MAX_ITER).map_err(|source| ImpactError::Solver {
+    // The guess w ≈ V²/(2(1 + V)) has the limits of eq. (17) for small V
+    // (w* → V²/2) and large V (w* → V/2).
+    let guess = v * v / (2.0 * (1.0 + v));
+    newton_bracketed_from(k, 0.0, v, guess, XTOL, MAX_ITER).map_err(|source| ImpactError::Solver {
         what: "peak-force velocity, seed eq. (17)",
         source,
     })

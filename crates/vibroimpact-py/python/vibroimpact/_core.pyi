@@ -1,0 +1,71 @@
+"""Type stubs of the compiled extension ``vibroimpact._core``. Users call the
+package's functions (``vibroimpact.simulate`` ...), which check and default
+their arguments and wrap these results in ``Result`` objects."""
+
+from os import PathLike
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+Progress = Optional[Callable[[int, int], Any]]
+F64 = npt.NDArray[np.float64]
+
+class VibroimpactError(Exception):
+    """A numerical failure (an integration that cannot go on, a Newton
+    iteration that does not converge)."""
+
+class Model:
+    """A model of bodies, springs, contacts and excitation (the model-file
+    schema of docs/model.md). Immutable and picklable."""
+
+    @staticmethod
+    def load(path: Union[str, PathLike[str]]) -> Model: ...
+    @staticmethod
+    def from_toml(text: str, source: str = "<string>") -> Model: ...
+    @staticmethod
+    def from_dict(document: dict[str, Any], source: str = "<dict>") -> Model: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def to_toml(self) -> str: ...
+    def with_(self, values: Optional[dict[str, float]] = None, **kwargs: float) -> Model: ...
+    def get(self, name: str) -> float: ...
+    @property
+    def bodies(self) -> list[str]: ...
+    @property
+    def contacts(self) -> list[str]: ...
+    @property
+    def forcing_frequency(self) -> Optional[float]: ...
+    @property
+    def mirror_symmetric(self) -> bool: ...
+    @property
+    def source(self) -> str: ...
+    def __len__(self) -> int: ...
+
+def impact(
+    velocity: F64, law_spec: str, mass1: float, mass2: float, method: str,
+    rtol: float, duration_level: Optional[float],
+) -> dict[str, Any]: ...
+def contact_force(law_spec: str, s: F64, sdot: F64, impact_velocity: F64) -> dict[str, F64]: ...
+def identify(
+    restitution_velocity: F64, restitution: F64, acceleration_velocity: F64,
+    peak_acceleration: F64, mass1: float, mass2: float, a_over_b: Optional[float], joint: bool,
+) -> dict[str, Any]: ...
+def simulate(
+    model: Model, duration: float, rtol: Optional[float], atol: Optional[float],
+    method_name: str, output_step: Optional[float], energy: bool,
+    impact_force_threshold: Optional[float], progress: Progress = None,
+) -> dict[str, Any]: ...
+def periodic(
+    model: Model, subharmonic: int, guess: Optional[F64], guess_periods: float, rtol: float,
+    tol: float, krylov: bool, arnoldi: int, symmetric: bool, progress: Progress = None,
+) -> dict[str, Any]: ...
+def continue_branch(
+    model: Model, parameter: str, from_: float, to: float, subharmonic: int,
+    switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
+    progress: Progress = None,
+) -> dict[str, Any]: ...
+def sweep(
+    model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,
+    rtol: Optional[float], atol: Optional[float], method_name: str,
+    cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
+) -> dict[str, Any]: ...
