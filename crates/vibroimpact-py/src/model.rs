@@ -1,12 +1,10 @@
 //! `vibroimpact.Model`: a model file's document and the model built from it.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use vibroimpact::model_file::{
-    parse_accelerogram_csv, LoadedModel, ModelDocument, ModelFileError, RecordSamples,
-};
+use vibroimpact::model_file::{LoadedModel, ModelDocument};
 
 use crate::convert::value_error;
 
@@ -34,22 +32,14 @@ impl PyModel {
     /// it. Raises ValueError naming the file, line and key.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Self> {
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            pyo3::exceptions::PyOSError::new_err(format!("{}: cannot read: {e}", path.display()))
-        })?;
-        let dir = path
-            .parent()
-            .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-        let mut load = |file: &str| -> Result<RecordSamples, ModelFileError> {
-            let record = dir.join(file);
-            let source = record.display().to_string();
-            let text = std::fs::read_to_string(&record).map_err(|e| {
-                ModelFileError(format!("{source}: cannot read the accelerogram: {e}"))
-            })?;
-            parse_accelerogram_csv(&text, &source)
-        };
-        let doc = ModelDocument::parse(&text, &path.display().to_string(), &mut load)
-            .map_err(value_error)?;
+        if let Err(e) = std::fs::metadata(&path) {
+            return Err(pyo3::exceptions::PyOSError::new_err(format!(
+                "{}: cannot read: {e}",
+                path.display()
+            )));
+        }
+        let doc =
+            ModelDocument::read(&path, &|p| std::fs::read_to_string(p)).map_err(value_error)?;
         Self::new(doc)
     }
 

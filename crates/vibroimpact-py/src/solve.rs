@@ -201,6 +201,22 @@ pub fn identify<'py>(
     document(py, &r)
 }
 
+/// Sampled states (`rows` of `[u_1..u_N, v_1..v_N]`) as two `rows × N`
+/// arrays: displacements and velocities.
+fn split_states<'py>(
+    py: Python<'py>,
+    states: &[f64],
+    rows: usize,
+    n: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
+    for row in states.chunks_exact(2 * n).take(rows) {
+        u.extend_from_slice(&row[..n]);
+        v.extend_from_slice(&row[n..]);
+    }
+    Ok((array2(py, u, rows, n)?, array2(py, v, rows, n)?))
+}
+
 /// A time history: the `simulate` summary plus `t`, `displacement`,
 /// `velocity` (rows per output time) and the impact log as arrays.
 #[pyfunction]
@@ -252,15 +268,10 @@ pub fn simulate<'py>(
     let sim = result.map_err(value_error)?;
     let n = m.bodies().len();
     let d = document(py, &simulation_summary(m, &sim))?;
-    let rows = sim.times.len();
-    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
-    for j in 0..rows {
-        u.extend_from_slice(&sim.states[j * 2 * n..j * 2 * n + n]);
-        v.extend_from_slice(&sim.states[j * 2 * n + n..(j + 1) * 2 * n]);
-    }
+    let (u, v) = split_states(py, &sim.states, sim.times.len(), n)?;
     d.set_item("t", array1(py, sim.times))?;
-    d.set_item("displacement", array2(py, u, rows, n)?)?;
-    d.set_item("velocity", array2(py, v, rows, n)?)?;
+    d.set_item("displacement", u)?;
+    d.set_item("velocity", v)?;
     let log = PyDict::new(py);
     let col = |f: &dyn Fn(&vibroimpact::simulate::ImpactRecord) -> f64| {
         sim.impacts.iter().map(f).collect::<Vec<f64>>()
@@ -366,15 +377,10 @@ pub fn periodic<'py>(
     let doc = periodic_document(m, &sol, &orbit, subharmonic, symmetric_orbit, krylov);
     let d = to_python(py, &doc)?.cast_into::<PyDict>()?;
     let n = m.bodies().len();
-    let rows = orbit.times.len();
-    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
-    for j in 0..rows {
-        u.extend_from_slice(&orbit.states[j * 2 * n..j * 2 * n + n]);
-        v.extend_from_slice(&orbit.states[j * 2 * n + n..(j + 1) * 2 * n]);
-    }
+    let (u, v) = split_states(py, &orbit.states, orbit.times.len(), n)?;
     d.set_item("orbit_t", array1(py, orbit.times))?;
-    d.set_item("orbit_displacement", array2(py, u, rows, n)?)?;
-    d.set_item("orbit_velocity", array2(py, v, rows, n)?)?;
+    d.set_item("orbit_displacement", u)?;
+    d.set_item("orbit_velocity", v)?;
     Ok(d)
 }
 

@@ -405,6 +405,27 @@ impl ModelDocument {
         Ok(doc)
     }
 
+    /// Reads the model file `path` and any accelerogram file it names
+    /// (relative to its folder) through `read`, the caller's file reader
+    /// (e.g. `std::fs::read_to_string`): the library itself reads nothing.
+    pub fn read(
+        path: &std::path::Path,
+        read: &dyn Fn(&std::path::Path) -> std::io::Result<String>,
+    ) -> Result<Self, ModelFileError> {
+        let text = read(path)
+            .map_err(|e| ModelFileError(format!("{}: cannot read: {e}", path.display())))?;
+        let dir = path.parent().unwrap_or_else(|| std::path::Path::new("."));
+        let mut load = |file: &str| -> Result<RecordSamples, ModelFileError> {
+            let record = dir.join(file);
+            let source = record.display().to_string();
+            let text = read(&record).map_err(|e| {
+                ModelFileError(format!("{source}: cannot read the accelerogram: {e}"))
+            })?;
+            parse_accelerogram_csv(&text, &source)
+        };
+        Self::parse(&text, &path.display().to_string(), &mut load)
+    }
+
     /// Parses model text that refers to no accelerogram file.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelFileError> {
         Self::parse(text, source, &mut |f| {

@@ -136,6 +136,12 @@ def _progress(progress: Progress) -> Progress:
     return progress
 
 
+_LAW_KEYS = (
+    "law", "a_over_b", "alpha", "a", "stiffness", "exponent", "damping", "chi",
+    "law_restitution", "min_impact_velocity", "form",
+)
+
+
 def _law_spec(
     law: str,
     *,
@@ -241,19 +247,7 @@ def impact(
     ``peak_acceleration2``, ``max_penetration`` and, for "integrate",
     ``contact_duration`` (NaN where the CLI writes null).
     """
-    spec = _law_spec(
-        law,
-        a_over_b=a_over_b,
-        alpha=alpha,
-        a=a,
-        stiffness=stiffness,
-        exponent=exponent,
-        damping=damping,
-        chi=chi,
-        law_restitution=law_restitution,
-        min_impact_velocity=min_impact_velocity,
-        form=form,
-    )
+    spec = _law_spec(**{k: v for k, v in locals().items() if k in _LAW_KEYS})
     if method is None:
         method = "closed-form" if law == "exponential" else "integrate"
     _method(method, ("closed-form", "integrate"))
@@ -292,19 +286,7 @@ def contact_force(
     onset velocity ``impact_velocity`` (m/s, read by Lankarani-Nikravesh
     only); arrays broadcast against each other. Law keywords as in
     :func:`impact`."""
-    spec = _law_spec(
-        law,
-        a_over_b=a_over_b,
-        alpha=alpha,
-        a=a,
-        stiffness=stiffness,
-        exponent=exponent,
-        damping=damping,
-        chi=chi,
-        law_restitution=law_restitution,
-        min_impact_velocity=min_impact_velocity,
-        form=form,
-    )
+    spec = _law_spec(**{k: v for k, v in locals().items() if k in _LAW_KEYS})
     arrays = [np.asarray(x) for x in (s, sdot, impact_velocity)]
     try:
         arrays = np.broadcast_arrays(*arrays)
