@@ -244,7 +244,7 @@ pub fn simulate<'py>(
         .or(settings.impact_force_threshold)
         .unwrap_or(1e-3);
     let output_step = match output_step {
-        Some(dt) if dt == 0.0 => None,
+        Some(0.0) => None,
         Some(dt) => Some(dt),
         None => Some(match m.forcing_frequency() {
             Some(w) => 2.0 * std::f64::consts::PI / w / 100.0,

@@ -882,7 +882,7 @@ frequency = 3.0
     }
 
     fn err(text: &str) -> String {
-        parse(text).err().expect("should fail").to_string()
+        parse(text).expect_err("should fail").to_string()
     }
 
     #[test]

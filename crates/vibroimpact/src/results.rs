@@ -149,7 +149,7 @@ impl<'a> ImpactRelations<'a> {
             law,
             bodies,
             method,
-            opts: opts.clone(),
+            opts: *opts,
             closed,
         })
     }
