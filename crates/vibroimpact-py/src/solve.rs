@@ -286,15 +286,6 @@ pub fn simulate<'py>(
     log.set_item("peak_force", array1(py, col(&|i| i.peak_force)))?;
     log.set_item("duration", array1(py, col(&|i| i.duration())))?;
     d.set_item("impacts", log)?;
-    d.set_item(
-        "interrupted",
-        sim.error.as_ref().is_some_and(|e| {
-            matches!(
-                e.source,
-                vibroimpact::integrate::IntegrationError::Interrupted { .. }
-            )
-        }),
-    )?;
     Ok(d)
 }
 

@@ -423,7 +423,10 @@ mod tests {
             let want = series(p * p / 2.0, &|t, k| -t * p / (k + 1.0));
             worst = worst.max((exp_neg_minus_one_plus(p) - want).abs() / want);
         }
-        assert!(worst <= 4.0 * f64::EPSILON, "worst relative difference {worst:e}");
+        assert!(
+            worst <= 4.0 * f64::EPSILON,
+            "worst relative difference {worst:e}"
+        );
     }
 
     #[test]
