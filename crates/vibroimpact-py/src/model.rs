@@ -1,6 +1,7 @@
 //! `vibroimpact.Model`: a model file's document and the model built from it.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -16,12 +17,12 @@ use crate::convert::value_error;
 #[pyclass(name = "Model", module = "vibroimpact._core", frozen)]
 pub struct PyModel {
     pub(crate) document: ModelDocument,
-    pub(crate) loaded: LoadedModel,
+    pub(crate) loaded: Arc<LoadedModel>,
 }
 
 impl PyModel {
     fn new(document: ModelDocument) -> PyResult<Self> {
-        let loaded = document.build().map_err(value_error)?;
+        let loaded = Arc::new(document.build().map_err(value_error)?);
         Ok(Self { document, loaded })
     }
 }

@@ -251,7 +251,8 @@ pub fn simulate<'py>(
             None => duration / 2000.0,
         }),
     };
-    let result = monitor::run(py, progress, |p: &Progress| {
+    let job = model.loaded.clone();
+    let result = monitor::run(py, progress, move |p: &Progress| {
         let opts = SimulationOptions {
             t_end: duration,
             rtol,
@@ -263,7 +264,7 @@ pub fn simulate<'py>(
             interrupt: Some(p.interrupt.clone()),
             ..SimulationOptions::default()
         };
-        vibroimpact::simulate::simulate(m, &opts)
+        vibroimpact::simulate::simulate(&job.model, &opts)
     })?;
     let sim = result.map_err(value_error)?;
     let n = m.bodies().len();
@@ -337,7 +338,9 @@ pub fn periodic<'py>(
         }
         None => None,
     };
-    let out = monitor::run(py, progress, |p: &Progress| {
+    let job = model.loaded.clone();
+    let out = monitor::run(py, progress, move |p: &Progress| {
+        let m = &job.model;
         let interrupt = Some(p.interrupt.clone());
         let x0 = match guess {
             Some(g) => g,
@@ -408,9 +411,9 @@ pub fn continue_branch<'py>(
             "the model has no periodic forcing with one frequency at from_: nothing to continue",
         ));
     }
-    let out = monitor::run(py, progress, |p: &Progress| {
-        p.total
-            .store(max_points, std::sync::atomic::Ordering::Relaxed);
+    let start_job = start.clone();
+    let out = monitor::run(py, progress, move |p: &Progress| {
+        p.set_total(max_points);
         let opts = ContinuationOptions {
             max_points,
             ds_max,
@@ -422,7 +425,7 @@ pub fn continue_branch<'py>(
             ..ContinuationOptions::default()
         };
         let guess =
-            guess_by_simulation_with(&start, guess_periods, 1e-9, Some(p.interrupt.clone()))
+            guess_by_simulation_with(&start_job, guess_periods, 1e-9, Some(p.interrupt.clone()))
                 .map_err(|e| format!("start guess: {e}"))?;
         let on_point = |_: &vibroimpact::continuation::BranchPoint| {
             p.tick();
@@ -477,8 +480,8 @@ pub fn sweep<'py>(
         .build()
         .map_err(numerical_error)?;
     let total = values.len() * if up_down { 2 } else { 1 };
-    let summary = monitor::run(py, progress, |p: &Progress| {
-        p.total.store(total, std::sync::atomic::Ordering::Relaxed);
+    let summary = monitor::run(py, progress, move |p: &Progress| {
+        p.set_total(total);
         let options = SweepOptions {
             transient,
             record,
