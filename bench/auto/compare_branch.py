@@ -543,7 +543,7 @@ def main(argv):
     doc = {
         "date": today,
         "timestamp": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
-        "problem": "R2 (THEORY.md), N = 2, periodic-solution branch in Omega from %g to %g omega0, omega0 = %g rad/s"
+        "problem": "R2 (docs/theory.md §6), N = 2, periodic-solution branch in Omega from %g to %g omega0, omega0 = %g rad/s"
                    % (args.wmin, args.wmax, omega0),
         "command": " ".join(["python3", os.path.relpath(os.path.abspath(argv[0]), ROOT)] + argv[1:]),
         "times": {

@@ -1,5 +1,5 @@
 !----------------------------------------------------------------------
-!  r2n2 : reference problem R2 (/work/shared/THEORY.md, section 6) with
+!  r2n2 : reference problem R2 (docs/theory.md §6) with
 !         N = 2 pendulums between two walls, exponential contact law,
 !         harmonic base acceleration made autonomous by an appended
 !         oscillator. AUTO-07p equations file (IPS=2 periodic orbits).

@@ -10,7 +10,7 @@ periods (default 10): per period the maximum of |u_i| (from the dense output,
 SAMPLES points per period, plus the accepted step points) and one stroboscopic
 (Poincare) sample of the state at the end of the period.
 
-Model: /work/shared/THEORY.md sections 4 and 6, as in bench/peers/r2_scipy.py
+Model: docs/theory.md §4 and §6, as in bench/peers/r2_scipy.py
 (published contact law, no clamping; vectorised NumPy right-hand side, state
 (u_1..u_N, v_1..v_N) in SI units). Base acceleration A sin(Omega t), t = 0 at
 the start of every frequency (with --continue the previous run ended after a

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""SciPy peer for reference problem R2 (/work/shared/THEORY.md, section 6).
+"""SciPy peer for reference problem R2 (docs/theory.md §6).
 
 N identical pendulums in a row between two walls, exponential contact law
 F = (a + b*sdot) * exp(alpha*s) (published form, no clamping), harmonic base

@@ -1,6 +1,6 @@
 /*
  * r2_sundials.c -- SUNDIALS (6.4.1, Debian bookworm libsundials-dev) peer for
- * reference problem R2 of /work/shared/THEORY.md: N identical pendulums in a
+ * reference problem R2 of docs/theory.md: N identical pendulums in a
  * row between two walls, exponential contact law, harmonic base acceleration.
  *
  * Usage:
@@ -56,7 +56,7 @@
 #include <sunmatrix/sunmatrix_band.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
-/* ---- R2 parameters (THEORY.md section 6) ---- */
+/* ---- R2 parameters (docs/theory.md §6) ---- */
 #define R2_M      0.227      /* kg */
 #define R2_OMEGA0 7.41       /* rad/s */
 #define R2_ZETA   0.013

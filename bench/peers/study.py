@@ -130,7 +130,7 @@ def main():
                     "loadavg_at_start": open("/proc/loadavg").read().split()[:3],
                     "note": "shared machine: other sessions' load is invisible to ps; "
                             "seconds are best-of-repeats"},
-        "problem": "R2 (THEORY.md 6): m 0.227, omega0 7.41, zeta 0.013, A 0.05, g 1e-3, "
+        "problem": "R2 (docs/theory.md §6): m 0.227, omega0 7.41, zeta 0.013, A 0.05, g 1e-3, "
                    "a 1, b 1/1.2, alpha 1.3e5, published (unclamped) law, start at rest",
         "error_measure": "max_i |y_i - y_ref_i| / max_i |y_ref_i| over the final (u, v)",
         "atol_rule": "atol = rtol * 1e-3 unless stated",

@@ -1,7 +1,7 @@
 //! `vibroimpact-bench`: the project's performance claims, measured against
 //! peers on the same problem in one run (ratios, not absolute times).
 //!
-//! Problem R2 (THEORY.md §6): N pendulums between walls, exponential law,
+//! Problem R2 (docs/theory.md §6): N pendulums between walls, exponential law,
 //! base acceleration 0.05 sin(0.95 ω0 t), from rest. Peers (bench/peers):
 //! SUNDIALS 6.4.1 (CVODE, ARKODE explicit tables) with a C right-hand side
 //! and SciPy `solve_ivp` with a vectorised NumPy right-hand side.

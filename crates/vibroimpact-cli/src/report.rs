@@ -244,7 +244,7 @@ fn seed_part3(report: &mut Report) -> Result<(), CliError> {
     let model = ExponentialImpact::new(&law, bodies)?;
     let opts = DirectOptions::default();
 
-    // Reference table (THEORY.md §2) against the closed form and direct integration.
+    // Reference table (docs/theory.md §2) against the closed form and direct integration.
     const TABLE: [(f64, f64, f64); 6] = [
         (0.01, 0.993377454400, 4.96703803e-05),
         (0.1, 0.937475579950, 4.70080031e-03),
@@ -287,10 +287,10 @@ fn seed_part3(report: &mut Report) -> Result<(), CliError> {
              (m1 = m2 = 0.227 kg, mu = m/2), a/b = 1.2 m/s, alpha = 1.3e5 1/m, a = 1 N. \
              Closed form: Newton on cancellation-free forms of eqs. (10) and (17); direct integration: DOP853 at \
              rtol 1e-12 in scaled variables, restitution read at the start position.</p>\n\
-             <p>Reference values (THEORY.md §2; its V = 0.01 entry is rounded at the 10th decimal) against the \
+             <p>Reference values (docs/theory.md §2; its V = 0.01 entry is rounded at the 10th decimal) against the \
              closed form and the direct integration:</p>\n{}",
             html_table(
-                &["V", "e closed form", "e THEORY.md", "|Δe|", "|e integrated − e closed|", "f_max closed form", "f_max THEORY.md", "rel. Δf integrated"],
+                &["V", "e closed form", "e reference", "|Δe|", "|e integrated − e closed|", "f_max closed form", "f_max reference", "rel. Δf integrated"],
                 &rows
             )
         ),

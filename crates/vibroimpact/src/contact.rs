@@ -5,7 +5,7 @@
 //! Every law returns the force together with its partial derivatives
 //! `∂F/∂s` and `∂F/∂ṡ` (for Jacobians of the equations of motion).
 //!
-//! Sign convention (THEORY.md §1): `F > 0` is repulsive; it acts as `-F` on the
+//! Sign convention (docs/theory.md §1): `F > 0` is repulsive; it acts as `-F` on the
 //! left body and `+F` on the right body.
 //!
 //! Laws whose published form can become attractive (negative) while the bodies

@@ -1,6 +1,6 @@
 //! Pseudo-arclength continuation of periodic solutions in a parameter, with
 //! Floquet stability and detection and location of special points
-//! (THEORY.md §5).
+//! (docs/theory.md §5).
 //!
 //! ## Formulation
 //! Unknowns `z = (x, p)`: the state at t = 0 of an nT-periodic orbit and the

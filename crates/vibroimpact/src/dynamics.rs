@@ -1,5 +1,5 @@
 //! The equations of motion of a [`Model`] as a first-order ODE
-//! (THEORY.md §4), for the integrators.
+//! (docs/theory.md §4), for the integrators.
 //!
 //! ## State layout
 //! Interleaved, `y = [u_1, v_1, u_2, v_2, …, u_N, v_N]`, so that a chain whose

@@ -1,5 +1,5 @@
 //! Identification of the exponential law's a/b and α from measured impacts
-//! (seed §3, THEORY.md §3).
+//! (seed §3, docs/theory.md §3).
 //!
 //! The seed fits by eye: measured (impact velocity U, restitution e) pairs
 //! fix a/b through e(U/(a/b)) (eqs. 9–10, its figure 4); measured

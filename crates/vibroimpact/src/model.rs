@@ -1,4 +1,4 @@
-//! The system model (THEORY.md §4): N bodies on a line with springs and
+//! The system model (docs/theory.md §4): N bodies on a line with springs and
 //! dampers to the frame and between each other, contact pairs with their
 //! clearances and laws, and the excitation.
 //!

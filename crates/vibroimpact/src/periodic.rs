@@ -1,4 +1,4 @@
-//! Periodic solutions by shooting and their Floquet stability (THEORY.md §5;
+//! Periodic solutions by shooting and their Floquet stability (docs/theory.md §5;
 //! the seed's parts I–II).
 //!
 //! Under forcing of period `T = 2π/Ω`, a periodic solution of period `nT`

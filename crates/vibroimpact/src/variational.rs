@@ -1,5 +1,5 @@
 //! Variational equations: a system integrated together with the
-//! sensitivity of its state to the initial state (THEORY.md §5).
+//! sensitivity of its state to the initial state (docs/theory.md §5).
 //!
 //! For `y' = f(t, y)`, the matrix `Φ(t) = ∂y(t)/∂y(0)` obeys
 //! `Φ' = J(t, y(t)) Φ`, `Φ(0) = I`, with the Jacobian `J = ∂f/∂y`. Over a

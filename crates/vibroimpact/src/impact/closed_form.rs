@@ -1,5 +1,5 @@
 //! Fujita's closed-form impact relations for the exponential law
-//! (seed eqs. 8–18; THEORY.md §2).
+//! (seed eqs. 8–18; docs/theory.md §2).
 //!
 //! Relative motion: `μ ẍ = -(a + b ẋ) exp(α x)`, `x(0) = -X`, `ẋ(0) = U`.
 //! With `y = ẋ`, `dy/dx = -(a + b y) exp(α x) / (μ y)` integrates to the phase
@@ -331,7 +331,7 @@ mod tests {
     use super::*;
     use crate::contact::ForceForm;
 
-    /// THEORY.md §2 reference table (V, e, f_max).
+    /// docs/theory.md §2 reference table (V, e, f_max).
     const TABLE: [(f64, f64, f64); 6] = [
         (0.01, 0.993377454400, 4.96703803e-05),
         (0.1, 0.937475579950, 4.70080031e-03),
@@ -357,7 +357,7 @@ mod tests {
     fn reproduces_theory_table() {
         for (v, e_ref, f_ref) in TABLE {
             let e = restitution(v).unwrap();
-            // THEORY.md prints 12 decimals, but its V = 0.01 entry is rounded
+            // docs/theory.md prints 12 decimals, but its V = 0.01 entry is rounded
             // at the 10th (exact: 0.99337745439877): allow 1.5e-12 there.
             let tol = if v == 0.01 { 1.5e-12 } else { 1e-12 };
             assert!((e - e_ref).abs() < tol, "e({v}) = {e:.15} vs {e_ref}");

@@ -1,5 +1,5 @@
 //! Two-body impact by direct integration of the relative motion
-//! `μ s̈ = -F(s, ṡ)` for any contact law (THEORY.md §2).
+//! `μ s̈ = -F(s, ṡ)` for any contact law (docs/theory.md §2).
 //!
 //! ## Set-up
 //! - Start: `s(0) = s₀`, `ṡ(0) = U`. For laws with compact support `s₀ = 0`

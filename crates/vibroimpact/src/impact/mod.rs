@@ -1,4 +1,4 @@
-//! Two-body impact relations (THEORY.md §2, seed eqs. 4–18).
+//! Two-body impact relations (docs/theory.md §2, seed eqs. 4–18).
 //!
 //! Two bodies on a line (or a body and a wall, `m2 = ∞`) collide through a
 //! contact law. Their relative motion `x = s` obeys
