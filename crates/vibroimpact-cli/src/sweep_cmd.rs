@@ -302,6 +302,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         transient: args.transient,
         record: args.record,
         up_down: args.up_down,
+        only: None,
         rtol: args.rtol,
         atol: args.atol,
         method: args.method.method(),

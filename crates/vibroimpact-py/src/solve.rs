@@ -24,7 +24,7 @@ use vibroimpact::results::{
     ImpactRelations, IMPACT_COLUMNS,
 };
 use vibroimpact::simulate::SimulationOptions;
-use vibroimpact::sweep::{sweep as run_sweep, SweepOptions};
+use vibroimpact::sweep::{sweep as run_sweep, Direction, SweepOptions};
 
 use crate::convert::{array1, array2, document, floats, numerical_error, to_python, value_error};
 use crate::model::PyModel;
@@ -455,7 +455,7 @@ pub fn continue_branch<'py>(
 /// Poincaré samples as a `record × 2N` array (`sections`). `threads`: the
 /// size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, progress = None))]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -470,6 +470,7 @@ pub fn sweep<'py>(
     method_name: &str,
     cluster_tolerance: Option<f64>,
     threads: Option<usize>,
+    only: Option<&str>,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
@@ -479,13 +480,24 @@ pub fn sweep<'py>(
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(numerical_error)?;
-    let total = values.len() * if up_down { 2 } else { 1 };
+    let only = match only {
+        None => None,
+        Some("up") => Some(Direction::Up),
+        Some("down") => Some(Direction::Down),
+        Some(other) => {
+            return Err(value_error(format!(
+                "only = {other:?}: give \"up\" or \"down\""
+            )))
+        }
+    };
+    let total = values.len() * if up_down && only.is_none() { 2 } else { 1 };
     let summary = monitor::run(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
             transient,
             record,
             up_down,
+            only,
             rtol,
             atol,
             method,

@@ -50,6 +50,11 @@ pub struct SweepOptions {
     /// Sweep up and down, each value continuing from the previous one's
     /// final state.
     pub up_down: bool,
+    /// With `up_down`, run only this direction (`Up` or `Down`; `None`:
+    /// both). The two chains are independent, so two such runs (e.g. two
+    /// tasks of a cluster) together give exactly the points of one run with
+    /// both directions.
+    pub only: Option<Direction>,
     /// Relative tolerance (default 1e-8).
     pub rtol: Option<f64>,
     /// Absolute tolerance in m and m/s (default rtol × 1e-4).
@@ -71,6 +76,7 @@ impl Default for SweepOptions {
             transient: 100,
             record: 20,
             up_down: false,
+            only: None,
             rtol: None,
             atol: None,
             method: Method::Dop853,
@@ -543,12 +549,17 @@ pub fn sweep(
     };
     let mut points: Vec<SweepPoint> = if options.up_down {
         let reversed: Vec<(f64, Model)> = models.iter().rev().cloned().collect();
-        let (mut up, down) = rayon::join(
-            || run_direction(&models, Direction::Up, &settings, progress),
-            || run_direction(&reversed, Direction::Down, &settings, progress),
-        );
-        up.extend(down);
-        up
+        let up = || run_direction(&models, Direction::Up, &settings, progress);
+        let down = || run_direction(&reversed, Direction::Down, &settings, progress);
+        match options.only {
+            Some(Direction::Up) => up(),
+            Some(Direction::Down) => down(),
+            _ => {
+                let (mut up, down) = rayon::join(up, down);
+                up.extend(down);
+                up
+            }
+        }
     } else {
         models
             .par_iter()

@@ -641,6 +641,7 @@ def _sweep_local(
     threads: Optional[int] = None,
     progress: Progress = None,
     raw: bool = False,
+    only: Optional[str] = None,
 ):
     """One sweep on this machine (also one Dask task's work); ``raw``: the
     plain document, for gathering."""
@@ -658,6 +659,7 @@ def _sweep_local(
         options["method"],
         options["cluster_tolerance"],
         threads,
+        only,
         _progress(progress),
     )
     return d if raw else Result(d)

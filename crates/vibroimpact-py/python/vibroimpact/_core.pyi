@@ -67,5 +67,6 @@ def continue_branch(
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,
     rtol: Optional[float], atol: Optional[float], method_name: str,
-    cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
+    cluster_tolerance: Optional[float], threads: Optional[int], only: Optional[str] = None,
+    progress: Progress = None,
 ) -> dict[str, Any]: ...

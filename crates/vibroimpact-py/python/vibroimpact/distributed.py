@@ -7,8 +7,7 @@ its TOML text, records inline), runs every chunk single-threaded on a worker
 and gathers the points into the same result as the local run: every value is
 computed by the same code from the same inputs, so the result is bit for bit
 the local one whatever the number of workers. An up-down sweep is two chains
-in which every value starts from the previous one's state: it runs as one
-task.
+in which every value starts from the previous one's state: one task each.
 
 :func:`ensemble` runs one computation (``simulate``, ``periodic``,
 ``sweep``, ...) over a list of models (e.g. one per accelerogram) and
@@ -26,10 +25,10 @@ import numpy as np
 from ._results import Result
 
 
-def _sweep_task(model, parameter, values, options):
+def _sweep_task(model, parameter, values, options, only=None):
     from . import _sweep_local
 
-    return _sweep_local(model, parameter, values, options, threads=1, raw=True)
+    return _sweep_local(model, parameter, values, options, threads=1, raw=True, only=only)
 
 
 def _worker_threads(client) -> int:
@@ -77,15 +76,16 @@ def sweep_on(
     if tasks is not None and (isinstance(tasks, bool) or int(tasks) < 1):
         raise ValueError(f"tasks = {tasks}: must be >= 1")
     if options["up_down"]:
-        chunks = [values]
+        # Two chains of continued states: one task each.
+        work = [(values, "up"), (values, "down")]
     else:
-        chunks = _chunks(values, tasks or 4 * _worker_threads(client))
+        work = [(c, None) for c in _chunks(values, tasks or 4 * _worker_threads(client))]
     [model_future] = client.scatter([model], broadcast=False, hash=False)
     futures = [
         client.submit(
-            _sweep_task, model_future, parameter, c, options, retries=retries, pure=False
+            _sweep_task, model_future, parameter, c, options, only, retries=retries, pure=False
         )
-        for c in chunks
+        for c, only in work
     ]
     docs = _gather(futures, progress, len(futures))
     head = dict(docs[0])
