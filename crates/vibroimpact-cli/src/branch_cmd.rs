@@ -426,6 +426,12 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     if args.subharmonic == 0 {
         return Err(CliError::new("--subharmonic must be >= 1"));
     }
+    if pm.parameter.integer {
+        return Err(CliError::new(format!(
+            "--parameter {}: takes whole numbers; a branch needs a continuous parameter (use sweep)",
+            args.parameter
+        )));
+    }
     let start_model = pm.model_at(args.from)?;
     if start_model.forcing_frequency().is_none() {
         return Err(CliError::new(

@@ -39,5 +39,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(solve::continue_branch, m)?)?;
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
     Ok(())
 }

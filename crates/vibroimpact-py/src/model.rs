@@ -27,6 +27,72 @@ impl PyModel {
     }
 }
 
+/// Python data as TOML values; `path` names the key in messages.
+fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+    let at = |what: String| {
+        value_error(if path.is_empty() {
+            what
+        } else {
+            format!("{path}: {what}")
+        })
+    };
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                at(format!(
+                    "keys must be strings, not {}",
+                    k.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+                ))
+            })?;
+            let sub = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            table.insert(key, to_toml(&v, &sub)?);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if obj.is_instance_of::<pyo3::types::PyBool>() {
+        return Ok(toml::Value::Boolean(obj.extract()?));
+    }
+    if let Ok(s) = obj.extract::<String>() {
+        return Ok(toml::Value::String(s));
+    }
+    if let Ok(i) = obj.extract::<i64>() {
+        return Ok(toml::Value::Integer(i));
+    }
+    if let Ok(x) = obj.extract::<f64>() {
+        if !x.is_finite() {
+            return Err(at(format!("{x} is not a finite number")));
+        }
+        return Ok(toml::Value::Float(x));
+    }
+    // numpy arrays and scalars, tuples, lists: their plain Python form.
+    let plain = if obj.hasattr("tolist")? {
+        obj.call_method0("tolist")?
+    } else {
+        obj.clone()
+    };
+    if let Ok(items) = plain.try_iter() {
+        let values = items
+            .enumerate()
+            .map(|(i, item)| to_toml(&item?, &format!("{path}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(values));
+    }
+    if !plain.is(obj) {
+        return to_toml(&plain, path);
+    }
+    Err(at(format!(
+        "{} is not a number, string, list or dict",
+        obj.get_type()
+            .name()
+            .map_or_else(|_| "?".into(), |n| n.to_string())
+    )))
+}
+
 #[pymethods]
 impl PyModel {
     /// Reads a model file (TOML); an accelerogram file is read relative to
@@ -52,18 +118,15 @@ impl PyModel {
     }
 
     /// A model from a dict in the model-file schema (as `tomllib` reads a
-    /// model file), e.g. `{"row": {"count": 3, ...}, "excitation": {...}}`.
+    /// model file), e.g. `{"row": {"count": 3, ...}, "excitation": {...}}`;
+    /// lists may be numpy arrays. Errors name the key.
     #[staticmethod]
     #[pyo3(signature = (document, source = "<dict>"))]
     fn from_dict(document: &Bound<'_, PyAny>, source: &str) -> PyResult<Self> {
-        let json: String = document
-            .py()
-            .import("json")?
-            .call_method1("dumps", (document,))
-            .map_err(|e| value_error(format!("{source}: not plain data: {e}")))?
-            .extract()?;
-        let table: toml::Table = serde_json::from_str(&json)
-            .map_err(|e| value_error(format!("{source}: not a model document: {e}")))?;
+        let table = match to_toml(document, "")? {
+            toml::Value::Table(t) => t,
+            _ => return Err(value_error(format!("{source}: expected a dict"))),
+        };
         let text = toml::to_string(&table)
             .map_err(|e| value_error(format!("{source}: not a model document: {e}")))?;
         Self::from_toml(&text, source)

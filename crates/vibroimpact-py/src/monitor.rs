@@ -11,7 +11,7 @@
 //! arena, 5–10 % of a 2 ms simulation (bench/python).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::Duration;
 
@@ -29,6 +29,9 @@ pub struct Progress {
     pub total: AtomicUsize,
     /// The stop request handed to the library.
     pub interrupt: Interrupt,
+    /// Bits of the end time when progress is the integration time reached
+    /// (0: progress counts units).
+    t_end: AtomicU64,
 }
 
 impl Progress {
@@ -40,6 +43,23 @@ impl Progress {
     /// Sets the number of units in all.
     pub fn set_total(&self, total: usize) {
         self.total.store(total, Ordering::Relaxed);
+    }
+
+    /// Reports progress as the time the integration has reached out of
+    /// `t_end`, in thousandths.
+    pub fn track_time(&self, t_end: f64) {
+        self.set_total(1000);
+        self.t_end.store(t_end.to_bits(), Ordering::Relaxed);
+    }
+
+    /// Units done so far.
+    fn done(&self) -> usize {
+        let t_end = f64::from_bits(self.t_end.load(Ordering::Relaxed));
+        if t_end > 0.0 {
+            (1000.0 * (self.interrupt.time() / t_end).clamp(0.0, 1.0)) as usize
+        } else {
+            self.done.load(Ordering::Relaxed)
+        }
     }
 }
 
@@ -79,6 +99,9 @@ fn submit(job: Job) {
 /// How often the calling thread wakes.
 const POLL: Duration = Duration::from_millis(50);
 
+/// How long an interrupted call waits for its worker to stop.
+const ABANDON: Duration = Duration::from_secs(1);
+
 /// Runs `work` on a worker thread, reporting to `callback(done, total)`
 /// when `done` changes and checking for signals.
 pub fn run<T, F>(py: Python<'_>, callback: Option<&Bound<'_, PyAny>>, work: F) -> PyResult<T>
@@ -108,13 +131,20 @@ where
     let mut reported = usize::MAX;
     loop {
         let received = py.detach(|| recv(Some(POLL)));
+        let finished = received.is_ok();
         let stop = py.check_signals().and_then(|()| {
-            let done = progress.done.load(Ordering::Relaxed);
+            let total = progress.total.load(Ordering::Relaxed);
+            // Time-tracked work marks the start of its last step: report
+            // the end on completion.
+            let done = if finished && total > 0 {
+                total
+            } else {
+                progress.done()
+            };
             match callback {
                 Some(cb) if done != reported => {
                     reported = done;
-                    cb.call1((done, progress.total.load(Ordering::Relaxed)))
-                        .map(|_| ())
+                    cb.call1((done, total)).map(|_| ())
                 }
                 _ => Ok(()),
             }
@@ -125,8 +155,10 @@ where
             (Err(mpsc::RecvTimeoutError::Timeout), Ok(())) => continue,
             (Err(_), Err(e)) => {
                 progress.interrupt.request();
-                // Wait for the worker to notice (at its next step).
-                let _ = py.detach(|| recv(None));
+                // Integrations stop at their next step; work that cannot be
+                // interrupted (a least-squares fit) finishes on its own: the
+                // job owns its data, so it is left to end in the background.
+                let _ = py.detach(|| recv(Some(ABANDON)));
                 return Err(e);
             }
             (Err(mpsc::RecvTimeoutError::Disconnected), Ok(())) => {

@@ -12,7 +12,7 @@ use vibroimpact::continuation::{
 };
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
-use vibroimpact::impact::TwoBodies;
+use vibroimpact::impact::{ImpactError, TwoBodies};
 use vibroimpact::integrate::Method;
 use vibroimpact::model_file::LawSpec;
 use vibroimpact::parameter::ParameterizedModel;
@@ -35,6 +35,18 @@ fn law(spec: &str) -> PyResult<ContactLaw> {
     spec.build().map_err(|e| value_error(format!("law: {e}")))
 }
 
+/// Velocities per task of `impact`.
+const CHUNK: usize = 4096;
+
+/// An impact error: bad input is `ValueError`, a failed solve or
+/// integration `VibroimpactError`.
+fn impact_error(e: ImpactError) -> PyErr {
+    match e {
+        ImpactError::InvalidParameter { .. } | ImpactError::Unsupported(_) => value_error(e),
+        _ => numerical_error(e),
+    }
+}
+
 fn method(name: &str) -> PyResult<Method> {
     match name {
         "dop853" => Ok(Method::Dop853),
@@ -49,7 +61,7 @@ fn method(name: &str) -> PyResult<Method> {
 /// Impact relations at every velocity: the `impact` document with each
 /// column of its rows as an array.
 #[pyfunction]
-#[pyo3(signature = (velocity, law_spec, mass1, mass2, method, rtol, duration_level))]
+#[pyo3(signature = (velocity, law_spec, mass1, mass2, method, rtol, duration_level, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn impact<'py>(
     py: Python<'py>,
@@ -60,6 +72,7 @@ pub fn impact<'py>(
     method: &str,
     rtol: f64,
     duration_level: Option<f64>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law(law_spec)?;
     let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
@@ -78,14 +91,22 @@ pub fn impact<'py>(
         duration_level,
         ..DirectOptions::default()
     };
-    let relations = ImpactRelations::new(&law, bodies, m, &opts).map_err(value_error)?;
+    // Checks the method against the law before anything runs.
+    ImpactRelations::new(&law, bodies, m, &opts).map_err(impact_error)?;
     let ncol = if m == ImpactMethod::Integrate { 10 } else { 9 };
+    let job_law = law;
     // Columns straight from the rows, chunk by chunk in parallel; the first
-    // error in velocity order is reported.
-    let chunks: Vec<Result<Vec<Vec<f64>>, _>> = py.detach(|| {
-        velocities
-            .par_chunks(4096)
+    // error in velocity order is reported; an interrupt stops at the next
+    // chunk.
+    let chunks = monitor::run(py, progress, move |p: &Progress| {
+        let relations = ImpactRelations::new(&job_law, bodies, m, &opts)?;
+        p.set_total(velocities.len().div_ceil(CHUNK));
+        let chunks: Vec<Result<Vec<Vec<f64>>, ImpactError>> = velocities
+            .par_chunks(CHUNK)
             .map(|chunk| {
+                if p.interrupt.requested() {
+                    return Err(ImpactError::Integration("interrupted".into()));
+                }
                 let mut cols = vec![Vec::with_capacity(chunk.len()); ncol];
                 for &u in chunk {
                     let r = relations.row(u)?;
@@ -105,16 +126,19 @@ pub fn impact<'py>(
                         col.push(x);
                     }
                 }
-                Ok::<_, vibroimpact::impact::ImpactError>(cols)
+                p.tick();
+                Ok(cols)
             })
-            .collect()
-    });
-    let mut columns = vec![Vec::with_capacity(velocities.len()); ncol];
-    for chunk in chunks {
-        for (all, part) in columns.iter_mut().zip(chunk.map_err(value_error)?) {
-            all.extend(part);
+            .collect();
+        let mut columns = vec![Vec::with_capacity(velocities.len()); ncol];
+        for chunk in chunks {
+            for (all, part) in columns.iter_mut().zip(chunk?) {
+                all.extend(part);
+            }
         }
-    }
+        Ok::<_, ImpactError>(columns)
+    })?;
+    let columns = chunks.map_err(impact_error)?;
     let doc = to_python(py, &impact_document(&law, bodies, m, &[]))?.cast_into::<PyDict>()?;
     doc.del_item("rows")?;
     for (name, col) in IMPACT_COLUMNS.iter().zip(columns) {
@@ -195,9 +219,10 @@ pub fn identify<'py>(
             peak_acceleration: a,
         })
         .collect();
-    let r = py
-        .detach(|| vibroimpact::identify::identify(&rest, &acc, bodies, a_over_b, joint))
-        .map_err(value_error)?;
+    let r = monitor::run(py, None, move |_: &Progress| {
+        vibroimpact::identify::identify(&rest, &acc, bodies, a_over_b, joint)
+    })?
+    .map_err(value_error)?;
     document(py, &r)
 }
 
@@ -253,6 +278,7 @@ pub fn simulate<'py>(
     };
     let job = model.loaded.clone();
     let result = monitor::run(py, progress, move |p: &Progress| {
+        p.track_time(duration);
         let opts = SimulationOptions {
             t_end: duration,
             rtol,
@@ -402,6 +428,11 @@ pub fn continue_branch<'py>(
             "from_ = {from_}, to = {to}: the range is empty or not finite"
         )));
     }
+    if family.parameter.integer {
+        return Err(value_error(format!(
+            "parameter `{parameter}` takes whole numbers: a branch needs a continuous parameter (sweep it instead)"
+        )));
+    }
     if subharmonic == 0 {
         return Err(value_error("subharmonic must be >= 1"));
     }
@@ -449,6 +480,18 @@ pub fn continue_branch<'py>(
         None => {}
     }
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
+}
+
+/// `k` values evenly spaced from `from_` to `to`, both ends exact (the
+/// values of `vibroimpact sweep --from --to --points`).
+#[pyfunction]
+pub fn parameter_values<'py>(
+    py: Python<'py>,
+    from_: f64,
+    to: f64,
+    k: usize,
+) -> Bound<'py, numpy::PyArray1<f64>> {
+    array1(py, vibroimpact::sweep::parameter_values(from_, to, k))
 }
 
 /// A brute-force sweep: the `sweep` document; every point also carries its

@@ -180,7 +180,14 @@ def test_ctrl_c_interrupts_a_long_call():
     start = time.perf_counter()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        vi.simulate(ROW, periods=1e6)
+        vi.simulate(ROW, periods=1e6, output_step=0)
+    assert time.perf_counter() - start < 5.0
+    # Impacts by integration stop between chunks of velocities.
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        vi.impact(np.linspace(0.01, 1.0, 400_000), method="integrate")
     assert time.perf_counter() - start < 5.0
 
 
@@ -193,6 +200,43 @@ def test_progress_is_reported():
     with pytest.raises(ZeroDivisionError):
         vi.sweep(ROW, "frequency", from_=6.0, to=8.0, points=4, transient=5, record=2,
                  progress=lambda d, t: 1 / 0)
+
+
+def test_simulate_reports_the_time_reached():
+    seen = []
+    vi.simulate(ROW, periods=400, output_step=0, progress=lambda d, t: seen.append((d, t)))
+    assert seen[-1] == (1000, 1000) and all(t == 1000 for _, t in seen)
+
+
+def test_strict_arguments():
+    with pytest.raises(TypeError, match="energy: expected True or False"):
+        vi.simulate(ROW, periods=1, energy="no")
+    with pytest.raises(ValueError, match="alpha: not a parameter of law='hertz'"):
+        vi.impact([0.1], law="hertz", stiffness=1e9, alpha=1e5)
+    with pytest.raises(ValueError, match="transient = 4611686018427387904: must be from 0 to"):
+        vi.sweep(ROW, "frequency", values=[6.0, 7.0], transient=2**62)
+    with pytest.raises(ValueError, match="tasks: applies with a Dask client only"):
+        vi.sweep(ROW, "frequency", values=[6.0, 7.0], tasks=3)
+    with pytest.raises(ValueError, match="output step"):
+        vi.simulate(ROW, duration=1.0, output_step=1e-9)
+    with pytest.raises(ValueError, match="whole numbers"):
+        vi.continue_(EXAMPLES / "fujita-row-n2.toml", "row.count", 2, 4)
+    with pytest.raises(vi.VibroimpactError, match="maximal number of steps"):
+        vi.impact([1.0], method="integrate", rtol=1e-30)
+
+
+def test_from_dict_takes_numpy_and_names_bad_keys():
+    d = vi.Model.load(EXAMPLES / "pounding-buildings.toml").to_dict()
+    d["excitation"]["time"] = np.asarray(d["excitation"]["time"])
+    d["excitation"]["acceleration"] = np.asarray(d["excitation"]["acceleration"])
+    assert vi.Model.from_dict(d) == vi.Model.load(EXAMPLES / "pounding-buildings.toml")
+    d["excitation"]["acceleration"][3] = np.nan
+    with pytest.raises(ValueError, match=r"excitation.acceleration\[3\]: NaN is not a finite number"):
+        vi.Model.from_dict(d)
+    d["excitation"]["acceleration"] = d["excitation"]["acceleration"][:-1]
+    d["excitation"]["acceleration"][3] = 0.0
+    with pytest.raises(ValueError, match="`time` has"):
+        vi.Model.from_dict(d)
 
 
 def test_a_panic_is_an_exception_not_a_crash():

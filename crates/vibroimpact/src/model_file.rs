@@ -383,6 +383,16 @@ impl ModelDocument {
                 },
             )) => Some(match (f, time, acceleration) {
                 (Some(f), None, None) => load_record(f)?,
+                (None, Some(t), Some(a)) if t.len() != a.len() => {
+                    return Err(cx.err_at(
+                        span,
+                        format!(
+                            "[excitation] accelerogram: `time` has {} values, `acceleration` {}",
+                            t.len(),
+                            a.len()
+                        ),
+                    ))
+                }
                 (None, Some(t), Some(a)) => RecordSamples {
                     source: format!("{source} [excitation]"),
                     times: t.clone(),
@@ -756,10 +766,17 @@ impl ModelDocument {
         }
         let model = Model::new(bodies, couplings, contacts, base, forces, init_u, init_v)
             .map_err(|e| cx.plain(e))?;
-        Ok(LoadedModel {
-            model,
-            simulation: file.simulation.clone().unwrap_or_default(),
-        })
+        let simulation = file.simulation.clone().unwrap_or_default();
+        for (key, value) in [
+            ("rtol", simulation.rtol),
+            ("atol", simulation.atol),
+            ("impact_force_threshold", simulation.impact_force_threshold),
+        ] {
+            if let Some(v) = value.filter(|v| !(*v > 0.0 && v.is_finite())) {
+                return Err(cx.plain(format!("[simulation] {key} = {v}: must be finite and > 0")));
+            }
+        }
+        Ok(LoadedModel { model, simulation })
     }
 }
 
@@ -936,6 +953,25 @@ frequency = 3.0
             .unwrap_err()
             .to_string();
         assert!(e.contains("ok.csv") && e.contains("inline"), "{e}");
+    }
+
+    #[test]
+    fn inline_records_and_settings_are_checked() {
+        let base = "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n";
+        let e = err(&format!(
+            "{base}[excitation]\ntype = \"accelerogram\"\ntime = [0.0, 1.0, 2.0]\nacceleration = [0.0, 1.0]\n"
+        ));
+        assert!(
+            e.starts_with("m.toml:7:") && e.contains("`time` has 3 values, `acceleration` 2"),
+            "{e}"
+        );
+        let e = err(&format!("{base}[simulation]\natol = -1e-9\n"));
+        assert!(
+            e.contains("[simulation] atol = -0.000000001: must be finite and > 0"),
+            "{e}"
+        );
+        let e = err(&format!("{base}[simulation]\nrtol = nan\n"));
+        assert!(e.contains("[simulation] rtol = NaN"), "{e}");
     }
 
     /// Every example form survives the round trip through `to_toml`.

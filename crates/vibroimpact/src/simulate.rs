@@ -552,9 +552,22 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
     Ok(())
 }
 
+/// The most values a time history may hold (2 GB of f64): a longer history
+/// is refused up front rather than exhausting memory.
+pub const MAX_HISTORY_VALUES: f64 = 2.5e8;
+
 /// Simulates `model` from its initial state over `[0, opts.t_end]`.
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
+    if let Some(dt) = opts.output_step {
+        let values = (opts.t_end / dt + 1.0) * (2 * model.bodies().len() + 1) as f64;
+        if values > MAX_HISTORY_VALUES {
+            return Err(OptionsError(format!(
+                "output step = {dt} s over {} s: the history would hold {values:.3e} values, more than {MAX_HISTORY_VALUES:e}; take a larger output step or a shorter duration",
+                opts.t_end
+            )));
+        }
+    }
     let mut sys = ChainDynamics::new(model, opts.energy);
     let mut y0 = sys.initial_state(model);
     if let Some(start) = &opts.start {
@@ -761,6 +774,29 @@ mod tests {
 
     /// R3: clearances so large nothing touches; displacement equals the exact
     /// steady state plus transient to 1e-9 relative.
+    /// A history that would exhaust memory is refused before anything runs.
+    #[test]
+    fn oversized_history_is_refused() {
+        let model = Model::row(
+            3,
+            0.227,
+            12.46,
+            0.0437,
+            1e-3,
+            ContactLaw::hertz(1e9, 1.5).unwrap(),
+            (true, true),
+            BaseExcitation::None,
+        )
+        .unwrap();
+        let opts = SimulationOptions {
+            t_end: 1.0,
+            output_step: Some(1e-9),
+            ..SimulationOptions::default()
+        };
+        let e = simulate(&model, &opts).unwrap_err().to_string();
+        assert!(e.starts_with("output step = 0.000000001 s over 1 s"), "{e}");
+    }
+
     #[test]
     fn r3_linear_limit_matches_exact_solution() {
         let omega = 0.95 * W0;

@@ -504,6 +504,12 @@ pub fn sweep(
     if options.record < 1 {
         return Err(SweepError("record 0: record at least one period".into()));
     }
+    if options.transient > 1_000_000_000 {
+        return Err(SweepError(format!(
+            "transient = {}: at most 1e9 periods",
+            options.transient
+        )));
+    }
     let err = |e: crate::model_file::ModelFileError| SweepError(e.to_string());
     let base = family.loaded_at(family.initial()).map_err(err)?;
     let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
@@ -516,6 +522,14 @@ pub fn sweep(
     finite_positive("atol", atol)?;
     let name = family.name();
     let bodies: Vec<String> = base.model.bodies().iter().map(|b| b.name.clone()).collect();
+    let window = (options.record as f64 * FINE as f64 + 1.0) * (2 * bodies.len() + 1) as f64;
+    if window > crate::simulate::MAX_HISTORY_VALUES {
+        return Err(SweepError(format!(
+            "record = {}: the recorded window ({FINE} samples per period) would hold {window:.3e} values, more than {:e}",
+            options.record,
+            crate::simulate::MAX_HISTORY_VALUES
+        )));
+    }
     let mut models: Vec<(f64, Model)> = Vec::with_capacity(values.len());
     for &p in values {
         let m = family.model_at(p).map_err(err)?;
@@ -699,6 +713,25 @@ mod tests {
             ..sim
         };
         assert!(handover(&model, &none, 0, 1, 0).is_none());
+    }
+
+    /// Counts that would overflow or exhaust memory are refused up front.
+    #[test]
+    fn huge_counts_are_input_errors() {
+        let doc = crate::model_file::ModelDocument::from_toml(ROW, "m.toml").unwrap();
+        let family = ParameterizedModel::new(doc, "frequency").unwrap();
+        let run = |transient, record| {
+            let options = SweepOptions {
+                transient,
+                record,
+                ..SweepOptions::default()
+            };
+            sweep(&family, &[6.0, 7.0], &options, &|| {})
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(run(1 << 62, 1).contains("transient = 4611686018427387904: at most 1e9"));
+        assert!(run(1, 1 << 40).contains("record = 1099511627776"));
     }
 
     #[test]

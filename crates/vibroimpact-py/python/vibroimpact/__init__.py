@@ -94,12 +94,18 @@ def _real(x: Any, name: str, *, positive: bool = False, optional: bool = False):
     return v
 
 
-def _count(x: Any, name: str, *, minimum: int = 0) -> int:
+def _count(x: Any, name: str, *, minimum: int = 0, maximum: int = 10**9) -> int:
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
         raise TypeError(f"{name}: expected a whole number, got {type(x).__name__}")
-    if x < minimum:
-        raise ValueError(f"{name} = {x}: must be >= {minimum}")
+    if not minimum <= x <= maximum:
+        raise ValueError(f"{name} = {x}: must be from {minimum} to {maximum}")
     return int(x)
+
+
+def _flag(x: Any, name: str) -> bool:
+    if not isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected True or False, got {type(x).__name__}")
+    return bool(x)
 
 
 def _mass(x: Any, name: str) -> float:
@@ -158,6 +164,22 @@ def _law_spec(
 ) -> str:
     """The contact law as the model-file schema writes it (JSON)."""
     _method(form, ("published", "non-negative"), "form")
+    uses = {
+        "exponential": {"a_over_b", "alpha", "a", "form"},
+        "hertz": {"stiffness", "exponent"},
+        "kelvin-voigt": {"stiffness", "damping", "form"},
+        "hunt-crossley": {"stiffness", "exponent", "chi", "form"},
+        "lankarani-nikravesh": {"stiffness", "exponent", "law_restitution", "min_impact_velocity", "form"},
+    }.get(law, set())
+    given = {
+        "a_over_b": a_over_b, "alpha": alpha, "stiffness": stiffness, "exponent": exponent,
+        "damping": damping, "chi": chi, "law_restitution": law_restitution,
+        "a": None if a == 1.0 else a, "form": None if form == "published" else form,
+        "min_impact_velocity": None if min_impact_velocity == 1e-3 else min_impact_velocity,
+    }
+    unused = sorted(k for k, v in given.items() if v is not None and k not in uses)
+    if uses and unused:
+        raise ValueError(f"{', '.join(unused)}: not a parameter of law={law!r}")
 
     def need(v, key):
         if v is None:
@@ -226,6 +248,7 @@ def impact(
     method: Optional[str] = None,
     rtol: float = 1e-12,
     duration_level: Optional[float] = None,
+    progress: Progress = None,
 ) -> Result:
     """Two-body impact relations at every impact velocity (``vibroimpact
     impact``), vectorised over ``velocity`` (m/s, any array-like).
@@ -260,6 +283,7 @@ def impact(
             method,
             _real(rtol, "rtol", positive=True),
             _real(duration_level, "duration_level", optional=True),
+            _progress(progress),
         )
     )
 
@@ -352,7 +376,7 @@ def identify(
             _real(mass1, "mass1", positive=True),
             _mass(mass2, "mass2"),
             _real(a_over_b, "a_over_b", positive=True, optional=True),
-            bool(joint),
+            _flag(joint, "joint"),
         )
     )
 
@@ -387,7 +411,11 @@ def simulate(
     ``impacts`` (``contact``, ``start_time``, ``end_time``,
     ``impact_velocity``, ``rebound_velocity``, ``restitution``,
     ``peak_force``, ``duration``). An integration failure keeps what was
-    computed: ``completed`` is False and ``error`` says where.
+    computed: ``completed`` is False and ``error`` says where. The
+    counters (``rhs_evaluations``, ``steps``) include the dense-output
+    evaluations of the history, as the CLI's with ``--out``; with
+    ``output_step=0`` they equal the CLI's without ``--out``.
+    ``progress(done, 1000)`` reports the time reached in thousandths.
     """
     m = _model(model)
     if (periods is None) == (duration is None):
@@ -411,7 +439,7 @@ def simulate(
             _real(atol, "atol", positive=True, optional=True),
             _method(method, ("dop853", "rodas", "auto")),
             output_step,
-            bool(energy),
+            _flag(energy, "energy"),
             _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
             _progress(progress),
         )
@@ -463,14 +491,14 @@ def periodic(
     r = Result(
         _core.periodic(
             m,
-            _count(subharmonic, "subharmonic", minimum=1),
+            _count(subharmonic, "subharmonic", minimum=1, maximum=10**6),
             g,
             _real(guess_periods, "guess_periods", positive=True),
             _real(rtol, "rtol", positive=True),
             _real(tol, "tol", positive=True),
-            bool(krylov),
-            _count(arnoldi, "arnoldi", minimum=1),
-            bool(symmetric),
+            _flag(krylov, "krylov"),
+            _count(arnoldi, "arnoldi", minimum=1, maximum=10**5),
+            _flag(symmetric, "symmetric"),
             _progress(progress),
         )
     )
@@ -524,9 +552,9 @@ def continue_(
         parameter,
         _real(from_, "from_"),
         _real(to, "to"),
-        _count(subharmonic, "subharmonic", minimum=1),
+        _count(subharmonic, "subharmonic", minimum=1, maximum=10**6),
         switch_at,
-        _count(max_points, "max_points", minimum=2),
+        _count(max_points, "max_points", minimum=2, maximum=10**8),
         _real(ds_max, "ds_max", positive=True),
         _real(guess_periods, "guess_periods", positive=True),
         _progress(progress),
@@ -546,14 +574,13 @@ def continue_(
 
 def parameter_values(from_: float, to: float, points: int) -> np.ndarray:
     """``points`` values evenly spaced from ``from_`` to ``to``, both ends
-    exact (the values of ``vibroimpact sweep --from --to --points``)."""
+    exact: the values of ``vibroimpact sweep --from --to --points``, bit for
+    bit."""
     from_, to = _real(from_, "from_"), _real(to, "to")
-    k = _count(points, "points", minimum=2)
+    k = _count(points, "points", minimum=2, maximum=10**7)
     if from_ == to:
         raise ValueError(f"from_ and to are both {from_}: give a range")
-    v = from_ + (to - from_) * (np.arange(k, dtype=float) / (k - 1))
-    v[-1] = to
-    return v
+    return _core.parameter_values(from_, to, k)
 
 
 def _sweep_values(values, from_, to, points) -> np.ndarray:
@@ -616,15 +643,21 @@ def sweep(
     v = _sweep_values(values, from_, to, points)
     options = dict(
         transient=_count(transient, "transient"),
-        record=_count(record, "record", minimum=1),
-        up_down=bool(up_down),
+        record=_count(record, "record", minimum=1, maximum=10**7),
+        up_down=_flag(up_down, "up_down"),
         rtol=_real(rtol, "rtol", positive=True, optional=True),
         atol=_real(atol, "atol", positive=True, optional=True),
         method=_method(method, ("dop853", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
     )
     if threads is not None:
-        threads = _count(threads, "threads", minimum=1)
+        threads = _count(threads, "threads", minimum=1, maximum=4096)
+        if client is not None:
+            raise ValueError("threads: applies to a local sweep; with a client every task runs on one thread")
+    if tasks is not None:
+        if client is None:
+            raise ValueError("tasks: applies with a Dask client only")
+        tasks = _count(tasks, "tasks", minimum=1, maximum=10**6)
     if client is not None:
         from .distributed import sweep_on
 

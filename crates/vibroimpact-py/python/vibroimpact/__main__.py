@@ -3,7 +3,8 @@
 
 The brute-force sweep of ``vibroimpact sweep``, run here (all cores) or on
 a Dask cluster given by its scheduler address; prints (or writes atomically)
-the same JSON summary as the CLI's ``--format json``.
+the JSON summary of the CLI's ``--format json``: the same fields and values
+(keys in alphabetical order).
 """
 
 from __future__ import annotations
@@ -94,7 +95,11 @@ def main(argv=None) -> int:
         p.pop("sections", None)
     text = json.dumps(doc, indent=2)
     if a.out:
-        _write(a.out, text + "\n")
+        try:
+            _write(a.out, text + "\n")
+        except OSError as e:
+            print(f"error: --out {a.out}: {e}", file=sys.stderr)
+            return 1
     else:
         print(text)
     failed = [p for p in doc["points"] if p["error"]]

@@ -14,9 +14,10 @@ def _number(x: Any) -> bool:
 
 
 def _numeric(v: list) -> bool:
-    """Whether a list holds only numbers, or only equally long non-empty
-    lists of numbers: then it is an array."""
-    if all(_number(x) for x in v):
+    """Whether a list holds only numbers (None, JSON's null, counting as
+    NaN), or only equally long non-empty lists of numbers: then it is an
+    array."""
+    if all(_number(x) or x is None for x in v):
         return True
     return (
         all(isinstance(x, list) and x and all(_number(y) for y in x) for x in v)
@@ -31,7 +32,7 @@ def _convert(v: Any) -> Any:
         if v and all(isinstance(x, dict) for x in v):
             return [Result(x) for x in v]
         if _numeric(v):
-            return np.asarray(v, dtype=float)
+            return np.asarray([np.nan if x is None else x for x in v], dtype=float)
         return [_convert(x) for x in v]
     return v
 

@@ -129,6 +129,8 @@ def ensemble(
     names = ("simulate", "periodic", "continue_", "sweep")
     if function not in names:
         raise ValueError(f"function = {function!r}: give one of {', '.join(names)}")
+    if isinstance(models, (str, bytes)) or not hasattr(models, "__iter__"):
+        raise TypeError("models: expected a list of models (or paths or dicts)")
     models = [vibroimpact._model(m) for m in models]
     if not models:
         return []

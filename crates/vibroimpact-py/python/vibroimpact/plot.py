@@ -92,8 +92,10 @@ def time_history(history, ax=None, bodies=None):
     :func:`vibroimpact.simulate` result, for the body indices ``bodies``
     (default: all, at most 8), with each impact's start time ticked along
     the bottom of the axes in its contact's colour."""
+    if len(history.t) == 0:
+        raise ValueError("history: no samples to draw (simulated with output_step=0)")
     ax = _axes(ax)
-    u = np.asarray(history.displacement).reshape(len(history.t), -1)
+    u = np.asarray(history.displacement)
     for i in range(min(u.shape[1], 8)) if bodies is None else bodies:
         ax.plot(history.t, 1e3 * u[:, i], lw=1, label=f"body {i + 1}")
     contact = np.asarray(history.impacts.contact, dtype=int)

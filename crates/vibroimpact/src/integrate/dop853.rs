@@ -45,7 +45,7 @@
 //! output do not allocate (except for building an error value).
 
 use super::dop853_tableau::{A, B, C, D, E3, E5, N_STAGES, N_STAGES_EXTENDED};
-use super::{IntegrationError, IntegratorOptions, Interrupt, OdeSystem, RejectReason, Stats};
+use super::{IntegrationError, IntegratorOptions, OdeSystem, RejectReason, Stats};
 
 /// Safety factor of the step-size prediction.
 const SAFETY: f64 = 0.9;
@@ -313,13 +313,8 @@ impl Dop853 {
                 steps: self.steps_since_reset,
             });
         }
-        if self
-            .opts
-            .interrupt
-            .as_ref()
-            .is_some_and(Interrupt::requested)
-        {
-            return Err(IntegrationError::Interrupted { t: self.t });
+        if let Some(stop) = &self.opts.interrupt {
+            stop.check(self.t)?;
         }
         let n = self.n;
         self.k[..n].copy_from_slice(&self.dydt);

@@ -37,15 +37,24 @@ pub use linalg::{BandMatrix, Singular};
 pub use rosenbrock::Rodas;
 
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
-/// A shared stop request: a caller (a Ctrl-C handler, a Python binding
-/// watching for KeyboardInterrupt) sets it from another thread, and every
-/// integrator whose options carry it stops before its next step with
-/// [`IntegrationError::Interrupted`]. Clones share the flag.
+/// A shared stop request and progress mark: a caller (a Ctrl-C handler, a
+/// Python binding watching for KeyboardInterrupt) requests the stop from
+/// another thread, and every integrator whose options carry the token stops
+/// before its next step with [`IntegrationError::Interrupted`]; each step
+/// also marks the time it starts from, for progress reports. Clones share
+/// the state.
 #[derive(Clone, Debug, Default)]
-pub struct Interrupt(Arc<AtomicBool>);
+pub struct Interrupt(Arc<InterruptState>);
+
+#[derive(Debug, Default)]
+struct InterruptState {
+    stop: AtomicBool,
+    /// Bits of the last marked time.
+    time: AtomicU64,
+}
 
 impl Interrupt {
     /// A new token, not yet requested.
@@ -55,12 +64,33 @@ impl Interrupt {
 
     /// Requests the stop.
     pub fn request(&self) {
-        self.0.store(true, Ordering::Relaxed);
+        self.0.stop.store(true, Ordering::Relaxed);
     }
 
     /// Whether the stop was requested.
     pub fn requested(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        self.0.stop.load(Ordering::Relaxed)
+    }
+
+    /// Marks the time an integrator has reached.
+    pub fn mark(&self, t: f64) {
+        self.0.time.store(t.to_bits(), Ordering::Relaxed);
+    }
+
+    /// The last marked time (0 before any step).
+    pub fn time(&self) -> f64 {
+        f64::from_bits(self.0.time.load(Ordering::Relaxed))
+    }
+
+    /// Checks the token before a step from `t`: marks `t`, and fails if the
+    /// stop was requested.
+    pub fn check(&self, t: f64) -> Result<(), IntegrationError> {
+        self.mark(t);
+        if self.requested() {
+            Err(IntegrationError::Interrupted { t })
+        } else {
+            Ok(())
+        }
     }
 }
 

@@ -69,7 +69,7 @@
 //! has a different shape). Stepping and dense output do not allocate.
 
 use super::linalg::BandMatrix;
-use super::{IntegrationError, IntegratorOptions, Interrupt, OdeSystem, RejectReason, Stats};
+use super::{IntegrationError, IntegratorOptions, OdeSystem, RejectReason, Stats};
 
 /// Diagonal `γ` of the method.
 const GAMMA: f64 = 0.25;
@@ -405,13 +405,8 @@ impl Rodas {
                 steps: self.steps_since_reset,
             });
         }
-        if self
-            .opts
-            .interrupt
-            .as_ref()
-            .is_some_and(Interrupt::requested)
-        {
-            return Err(IntegrationError::Interrupted { t: self.t });
+        if let Some(stop) = &self.opts.interrupt {
+            stop.check(self.t)?;
         }
         if !self.jac_current {
             self.evaluate_jacobian(sys);
