@@ -2,7 +2,6 @@
 //! stability) and `vibroimpact continue` (a branch of them by
 //! pseudo-arclength continuation, with special points).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -456,17 +455,16 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         // process) is not an error worth stopping for.
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    let tty = std::io::stderr().is_terminal();
+    let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
-        if tty {
-            eprint!(
-                "\r{} = {:.8}  max|u| = {:.4e}  {}   ",
-                args.parameter,
-                p.parameter,
-                p.max_displacement[0],
-                if p.stable { "stable  " } else { "unstable" }
-            );
-        }
+        bar.inc(1);
+        bar.set_message(format!(
+            "{} = {:.8}  max|u| = {:.4e}  {}",
+            args.parameter,
+            p.parameter,
+            p.max_displacement[0],
+            if p.stable { "stable" } else { "unstable" }
+        ));
         !stop.load(Ordering::SeqCst)
     };
     let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
@@ -489,9 +487,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             Err(e) => switch_error = Some(CliError::new(e.to_string())),
         }
     }
-    if tty {
-        eprintln!();
-    }
+    bar.finish_and_clear();
     let scale = 1.0;
     if let Some(dir) = &args.out {
         write_branch(

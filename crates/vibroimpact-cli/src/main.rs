@@ -12,6 +12,7 @@ mod impact_cmd;
 mod model_io;
 mod output;
 mod plot;
+mod progress;
 mod report;
 mod simulate_cmd;
 mod sweep_cmd;
@@ -62,6 +63,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Output into a closed pipe (`vibroimpact … | head`) ends the command
+    // quietly, as for other command-line tools, instead of a panic.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of SIGPIPE before any thread
+    // starts; no handler of ours is replaced.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Impact(args)) => impact_cmd::run(args),

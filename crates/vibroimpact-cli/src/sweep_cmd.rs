@@ -1,9 +1,7 @@
 //! `vibroimpact sweep`: the brute-force bifurcation diagram of
 //! [`vibroimpact::sweep`], its CSV, figures and table.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use clap::Args;
 use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, SweepSummary};
@@ -66,33 +64,6 @@ pub struct SweepArgs {
     /// Summary format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-}
-
-/// Progress on standard error when it is a terminal.
-struct Progress {
-    done: AtomicUsize,
-    total: usize,
-    show: bool,
-}
-
-impl Progress {
-    fn new(total: usize) -> Self {
-        Self {
-            done: AtomicUsize::new(0),
-            total,
-            show: std::io::stderr().is_terminal(),
-        }
-    }
-
-    fn tick(&self) {
-        let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        if self.show {
-            eprint!("\rsweep: {k}/{} values", self.total);
-            if k == self.total {
-                eprintln!();
-            }
-        }
-    }
 }
 
 /// Axis label of the parameter.
@@ -309,13 +280,15 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         cluster_tolerance: args.cluster_tolerance,
         interrupt: None,
     };
-    let progress = Progress::new(if args.up_down { 2 } else { 1 } * values.len());
-    let summary = sweep(&family, &values, &options, &|| progress.tick()).map_err(|e| {
+    let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
+        .with_prefix("sweep");
+    let summary = sweep(&family, &values, &options, &|| progress.inc(1)).map_err(|e| {
         CliError::new(
             e.to_string()
                 .replace("cluster_tolerance =", "--cluster-tolerance ="),
         )
     })?;
+    progress.finish_and_clear();
     if let Some(dir) = &args.out {
         write_outputs(dir, &summary)?;
     }
