@@ -140,6 +140,9 @@ impl Method {
     }
 }
 
+/// The most impact velocities of one call (about 1 GB of output rows).
+const MAX_VELOCITIES: usize = 10_000_000;
+
 /// Options of `vibroimpact impact`.
 #[derive(Args, Debug)]
 pub struct ImpactArgs {
@@ -198,8 +201,10 @@ pub fn parse_velocities(spec: &str) -> Result<Vec<f64>, CliError> {
                 "`{count_spec}` is not a point count like 200 or 200log"
             ))
         })?;
-        if n < 2 {
-            return Err(bad("a range needs at least 2 points".into()));
+        if !(2..=MAX_VELOCITIES).contains(&n) {
+            return Err(bad(format!(
+                "a range needs from 2 to {MAX_VELOCITIES} points"
+            )));
         }
         if log && !(start > 0.0 && stop > 0.0) {
             return Err(bad("a log range needs positive ends".into()));

@@ -257,9 +257,9 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             args.from
         )));
     }
-    if args.points < 2 {
+    if !(2..=10_000_000).contains(&args.points) {
         return Err(CliError::new(format!(
-            "--points {}: a sweep needs at least 2 values",
+            "--points {}: a sweep needs at least 2 values and at most 10000000",
             args.points
         )));
     }

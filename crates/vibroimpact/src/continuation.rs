@@ -634,6 +634,23 @@ where
             "the range from {p0} to {p_end} is empty or not finite (and the start must be nonzero)"
         )));
     }
+    for (name, value) in [
+        ("ds", opts.ds),
+        ("ds_min", opts.ds_min),
+        ("ds_max", opts.ds_max),
+    ] {
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(ContinuationError::Invalid(format!(
+                "{name} = {value}: must be finite and > 0"
+            )));
+        }
+    }
+    if opts.max_points < 2 {
+        return Err(ContinuationError::Invalid(format!(
+            "max_points = {}: at least 2",
+            opts.max_points
+        )));
+    }
     let model = family(p0).map_err(|message| ContinuationError::Model {
         parameter: p0,
         message,
