@@ -3,8 +3,6 @@
 //! pseudo-arclength continuation, with special points).
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 use clap::Args;
 use vibroimpact::continuation::{
@@ -12,7 +10,8 @@ use vibroimpact::continuation::{
 };
 use vibroimpact::model::Model;
 use vibroimpact::periodic::{
-    guess_by_simulation, orbit_summary, shoot, shoot_krylov, ShootingOptions,
+    guess_by_simulation, guess_by_simulation_with, orbit_summary, shoot, shoot_krylov,
+    ShootingOptions,
 };
 
 use crate::error::CliError;
@@ -437,24 +436,24 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             "the model has no periodic forcing with one frequency at --from: nothing to continue",
         ));
     }
+    let interrupt = crate::interrupt::on_ctrl_c();
     let opts = ContinuationOptions {
         max_points: args.max_points,
         ds_max: args.ds_max,
         shooting: ShootingOptions {
             subharmonic: args.subharmonic,
+            interrupt: Some(interrupt.clone()),
             ..ContinuationOptions::default().shooting
         },
         ..ContinuationOptions::default()
     };
-    let guess = guess_by_simulation(&start_model, args.guess_periods, 1e-9)
-        .map_err(|e| CliError::new(format!("start guess: {e}")))?;
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        // A second handler registration (tests run many commands in one
-        // process) is not an error worth stopping for.
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+    let guess = guess_by_simulation_with(
+        &start_model,
+        args.guess_periods,
+        1e-9,
+        Some(interrupt.clone()),
+    )
+    .map_err(|e| CliError::new(format!("start guess: {e}")))?;
     let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
         bar.inc(1);
@@ -465,7 +464,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             p.max_displacement[0],
             if p.stable { "stable" } else { "unstable" }
         ));
-        !stop.load(Ordering::SeqCst)
+        !interrupt.requested()
     };
     let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
     let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)
@@ -550,6 +549,11 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     }
     if let Some(e) = switch_error {
         return Err(e);
+    }
+    if interrupt.requested() {
+        return Err(CliError::new(
+            "interrupted (Ctrl-C): the points computed so far are kept",
+        ));
     }
     match &branches[0].stop {
         vibroimpact::continuation::StopReason::CannotContinue(why) => Err(CliError::new(format!(

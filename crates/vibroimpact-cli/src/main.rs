@@ -9,6 +9,7 @@ mod error;
 mod format;
 mod identify_cmd;
 mod impact_cmd;
+mod interrupt;
 mod model_io;
 mod output;
 mod plot;

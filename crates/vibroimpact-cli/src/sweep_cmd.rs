@@ -269,6 +269,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
 
     let family = read_family(&args.model, &args.parameter)?;
     let values = parameter_values(args.from, args.to, args.points);
+    let interrupt = crate::interrupt::on_ctrl_c();
     let options = SweepOptions {
         transient: args.transient,
         record: args.record,
@@ -278,7 +279,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         atol: args.atol,
         method: args.method.method(),
         cluster_tolerance: args.cluster_tolerance,
-        interrupt: None,
+        interrupt: Some(interrupt.clone()),
     };
     let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
         .with_prefix("sweep");
@@ -310,6 +311,16 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             )
         })
         .collect();
+    if interrupt.requested() {
+        return Err(CliError::new(format!(
+            "interrupted (Ctrl-C): the values computed so far are kept{}",
+            if args.out.is_some() {
+                " in the output folder"
+            } else {
+                ""
+            }
+        )));
+    }
     let expected = if args.up_down { 2 } else { 1 } * values.len();
     let skipped = expected - summary.points.len();
     if failed.is_empty() {

@@ -1020,3 +1020,45 @@ fn closed_pipe_ends_quietly() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_ne!(out.status.code(), Some(101), "{stderr}");
 }
+
+/// Ctrl-C in a sweep keeps the values computed so far, in complete files,
+/// and exits non-zero saying so.
+#[cfg(unix)]
+#[test]
+fn interrupted_sweep_keeps_complete_outputs() {
+    let dir = temp_dir("sweep-interrupted");
+    let child = bin()
+        .args([
+            "sweep",
+            &repo_file("examples/fujita-row.toml"),
+            "--parameter",
+            "frequency",
+        ])
+        .args(["--from", "5.9", "--to", "8.9", "--points", "2000", "--out"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // SAFETY: signalling our own child process.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+    }
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted (Ctrl-C)"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let points = summary["points"].as_array().unwrap();
+    let done = points.iter().filter(|p| p["completed"] == true).count();
+    assert_eq!(points.len(), 2000, "every value is reported, run or not");
+    assert!(done < 2000, "{done} values completed");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
