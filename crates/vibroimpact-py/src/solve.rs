@@ -350,6 +350,12 @@ pub fn periodic<'py>(
             model.document.source()
         )));
     }
+    let need = vibroimpact::periodic::MIN_ARNOLDI.min(2 * m.bodies().len());
+    if krylov && arnoldi < need {
+        return Err(value_error(format!(
+            "arnoldi = {arnoldi}: at least {need} Krylov vectors are needed for a stability verdict"
+        )));
+    }
     let guess = match guess {
         Some(g) => {
             let g = floats(&g, "guess", true)?;

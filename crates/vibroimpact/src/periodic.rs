@@ -33,6 +33,11 @@ use crate::variational::Variational;
 
 /// Largest Newton step in the scaled norm (displacement scales).
 const TRUST: f64 = 0.5;
+/// The fewest Arnoldi vectors behind a stability verdict of Newton–Krylov
+/// shooting (R2 N = 2 with one vector: "stable, 0.887" for an orbit whose
+/// largest multiplier is 1.274).
+pub const MIN_ARNOLDI: usize = 8;
+
 /// Step budget of one period-map integration.
 const MAX_STEPS: u64 = 200_000;
 
@@ -527,7 +532,10 @@ fn gmres(
 /// by GMRES to a relative residual of 1e-3 (inexact Newton). The dominant
 /// Floquet multipliers come from an Arnoldi iteration of Φ at the solution
 /// (`arnoldi` Krylov vectors; Ritz values, largest modulus first). The
-/// returned `monodromy` is empty (0 × 0).
+/// returned `monodromy` is empty (0 × 0). At least
+/// [`MIN_ARNOLDI`] vectors (or the whole space, if smaller) are required:
+/// with fewer the dominant multiplier can be missed and an unstable orbit
+/// called stable.
 pub fn shoot_krylov(
     model: &Model,
     guess: &[f64],
@@ -542,6 +550,12 @@ pub fn shoot_krylov(
             expected: d,
             got: guess.len(),
         });
+    }
+    if arnoldi < MIN_ARNOLDI.min(d) {
+        return Err(PeriodicError::Options(format!(
+            "arnoldi = {arnoldi}: at least {} Krylov vectors are needed for a stability verdict",
+            MIN_ARNOLDI.min(d)
+        )));
     }
     let scale = scales(model, opts);
     let mut x = guess.to_vec();
@@ -925,6 +939,18 @@ mod tests {
                 "{half:?} vs {full:?}"
             );
         }
+    }
+
+    /// Too few Arnoldi vectors for a stability verdict are refused (one
+    /// vector called an unstable R2 N = 2 orbit stable).
+    #[test]
+    fn krylov_refuses_too_few_arnoldi_vectors() {
+        let model = r2(3, 1e-3, 1.3 * W0);
+        let guess = vec![0.0; 6];
+        let e = shoot_krylov(&model, &guess, &ShootingOptions::default(), 1)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("arnoldi = 1: at least 6 Krylov vectors"), "{e}");
     }
 
     /// Newton–Krylov shooting reproduces dense shooting on an impacting
