@@ -65,18 +65,16 @@ pub fn array2<'py>(
 }
 
 /// The values of a float array argument (`name` in messages); NaN and
-/// infinities are rejected unless `finite` is false.
-pub fn floats(a: &PyReadonlyArray1<'_, f64>, name: &str, finite: bool) -> PyResult<Vec<f64>> {
+/// infinities are rejected.
+pub fn floats(a: &PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<Vec<f64>> {
     let s = a
         .as_slice()
         .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
-    if finite {
-        if let Some(i) = s.iter().position(|x| !x.is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "{name}[{i}] = {}: must be finite",
-                s[i]
-            )));
-        }
+    if let Some(i) = s.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "{name}[{i}] = {}: must be finite",
+            s[i]
+        )));
     }
     Ok(s.to_vec())
 }

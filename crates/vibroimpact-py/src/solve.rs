@@ -76,7 +76,7 @@ pub fn impact<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law(law_spec)?;
     let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
-    let velocities = floats(&velocity, "velocity", true)?;
+    let velocities = floats(&velocity, "velocity")?;
     let m = match method {
         "closed-form" => ImpactMethod::ClosedForm,
         "integrate" => ImpactMethod::Integrate,
@@ -109,21 +109,9 @@ pub fn impact<'py>(
                 }
                 let mut cols = vec![Vec::with_capacity(chunk.len()); ncol];
                 for &u in chunk {
-                    let r = relations.row(u)?;
-                    let values = [
-                        r.impact_velocity,
-                        r.v.unwrap_or(f64::NAN),
-                        r.restitution,
-                        r.rebound_velocity,
-                        r.peak_force_dimensionless.unwrap_or(f64::NAN),
-                        r.peak_force,
-                        r.peak_acceleration1,
-                        r.peak_acceleration2,
-                        r.max_penetration,
-                        r.contact_duration.unwrap_or(f64::NAN),
-                    ];
+                    let values = relations.row(u)?.values();
                     for (col, x) in cols.iter_mut().zip(values) {
-                        col.push(x);
+                        col.push(x.unwrap_or(f64::NAN));
                     }
                 }
                 p.tick();
@@ -158,9 +146,9 @@ pub fn contact_force<'py>(
     impact_velocity: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law(law_spec)?;
-    let s = floats(&s, "s", true)?;
-    let sdot = floats(&sdot, "sdot", true)?;
-    let v0 = floats(&impact_velocity, "impact_velocity", true)?;
+    let s = floats(&s, "s")?;
+    let sdot = floats(&sdot, "sdot")?;
+    let v0 = floats(&impact_velocity, "impact_velocity")?;
     if sdot.len() != s.len() || v0.len() != s.len() {
         return Err(value_error(format!(
             "s, sdot and impact_velocity must have one length: {}, {}, {}",
@@ -199,10 +187,10 @@ pub fn identify<'py>(
     joint: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let bodies = TwoBodies::new(mass1, mass2).map_err(value_error)?;
-    let ru = floats(&restitution_velocity, "restitution_velocity", true)?;
-    let re = floats(&restitution, "restitution", true)?;
-    let au = floats(&acceleration_velocity, "acceleration_velocity", true)?;
-    let aa = floats(&peak_acceleration, "peak_acceleration", true)?;
+    let ru = floats(&restitution_velocity, "restitution_velocity")?;
+    let re = floats(&restitution, "restitution")?;
+    let au = floats(&acceleration_velocity, "acceleration_velocity")?;
+    let aa = floats(&peak_acceleration, "peak_acceleration")?;
     let rest: Vec<RestitutionSample> = ru
         .iter()
         .zip(&re)
@@ -358,7 +346,7 @@ pub fn periodic<'py>(
     }
     let guess = match guess {
         Some(g) => {
-            let g = floats(&g, "guess", true)?;
+            let g = floats(&g, "guess")?;
             if g.len() != 2 * m.bodies().len() {
                 return Err(value_error(format!(
                     "guess has {} values, the model needs {} (u then v)",
@@ -523,7 +511,7 @@ pub fn sweep<'py>(
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
-    let values = floats(&values, "values", true)?;
+    let values = floats(&values, "values")?;
     let method = method(method_name)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))

@@ -85,8 +85,8 @@ pub struct ImpactRow {
 
 impl ImpactRow {
     /// The values in the order of [`IMPACT_COLUMNS`].
-    pub fn values(&self) -> Vec<Option<f64>> {
-        vec![
+    pub fn values(&self) -> [Option<f64>; 10] {
+        [
             Some(self.impact_velocity),
             self.v,
             Some(self.restitution),
