@@ -528,7 +528,7 @@ fn gmres(
 }
 
 /// Newton–Krylov shooting for large systems (matrix-free; see
-/// [`MonodromyOperator`]): each Newton step solves `(Φ - I) δ = -(P(x) - x)`
+/// `MonodromyOperator`): each Newton step solves `(Φ - I) δ = -(P(x) - x)`
 /// by GMRES to a relative residual of 1e-3 (inexact Newton). The dominant
 /// Floquet multipliers come from an Arnoldi iteration of Φ at the solution
 /// (`arnoldi` Krylov vectors; Ritz values, largest modulus first). The

@@ -32,9 +32,10 @@
 
 use crate::contact::LawKind;
 use crate::dynamics::ChainDynamics;
+use crate::integrate::events::EventLocator;
 use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
-use crate::numeric::{brent, golden_max};
+use crate::numeric::golden_max;
 
 /// Options of a simulation.
 #[derive(Clone, Debug, PartialEq)]
@@ -264,9 +265,8 @@ impl ExtremaScan {
                 let mut max_u = ua.abs().max(ub.abs());
                 let mut max_v = va.abs().max(vb.abs());
                 if va * vb < 0.0 {
-                    let xtol = 4.0 * f64::EPSILON * t1.abs().max(1.0);
                     let v = |t| st.dense_component(sys, iv, t);
-                    if let Ok(t) = brent(v, a, b, va, vb, xtol, ROOT_ITER) {
+                    if let Ok(t) = EventLocator::FINE.locate(v, (a, va), (b, vb)) {
                         max_u = max_u.max(st.dense_component(sys, iu, t).abs());
                     }
                 }
@@ -332,8 +332,6 @@ fn contact_end(sys: &ChainDynamics, k: usize, y: &[f64], dydt: &[f64]) -> (f64, 
     (s, sd, sys.contact_force_rate(k, s, sd, sdd))
 }
 
-const ROOT_ITER: usize = 200;
-
 /// Dense-output evaluation of contact k's (s, ṡ) at time t.
 fn contact_at(st: &mut Stepper, sys: &mut ChainDynamics, k: usize, t: f64) -> (f64, f64) {
     let mut v = [0.0; 4];
@@ -354,16 +352,9 @@ impl StepScan<'_> {
         (ta, ga): (f64, f64),
         (tb, gb): (f64, f64),
     ) -> f64 {
-        brent(
-            |t| contact_at(st, sys, k, t).0 - s_on,
-            ta,
-            tb,
-            ga,
-            gb,
-            4.0 * f64::EPSILON * tb.abs().max(1.0),
-            ROOT_ITER,
-        )
-        .unwrap_or(0.5 * (ta + tb))
+        EventLocator::FINE
+            .locate(|t| contact_at(st, sys, k, t).0 - s_on, (ta, ga), (tb, gb))
+            .unwrap_or(0.5 * (ta + tb))
     }
 
     /// Largest force of contact k on [ta, tb]. `interior`: the force rate
@@ -490,16 +481,9 @@ impl StepScan<'_> {
             } else if g0 <= 0.0 && sd0 > 0.0 && sd1 < 0.0 {
                 // Approach turned to separation inside the step: was s_on
                 // exceeded in between?
-                let tm = brent(
-                    |t| contact_at(st, sys, k, t).1,
-                    t0,
-                    t1,
-                    sd0,
-                    sd1,
-                    4.0 * f64::EPSILON * t1.abs().max(1.0),
-                    ROOT_ITER,
-                )
-                .unwrap_or(0.5 * (t0 + t1));
+                let tm = EventLocator::FINE
+                    .locate(|t| contact_at(st, sys, k, t).1, (t0, sd0), (t1, sd1))
+                    .unwrap_or(0.5 * (t0 + t1));
                 let gm = contact_at(st, sys, k, tm).0 - s_on;
                 if gm > 0.0 {
                     let ts = Self::locate(st, sys, k, s_on, (t0, g0), (tm, gm));

@@ -29,8 +29,15 @@
 use super::closed_form::ExponentialImpact;
 use super::{positive, ImpactError, TwoBodies};
 use crate::contact::{ContactLaw, ForceForm, LawKind};
+use crate::integrate::events::{Crossing, EventLocator};
 use crate::integrate::{Dop853, IntegratorOptions, OdeSystem, Stats};
-use crate::numeric::brent;
+
+/// Event location on the dense output, to 1e-14 relative in time (the
+/// start is on σ₀ itself, so slightly past σ₀ counts as returned).
+const LOCATOR: EventLocator = EventLocator {
+    rel_tol: 1e-14,
+    max_iter: 200,
+};
 
 /// Options of the direct integration.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,32 +193,32 @@ fn walk(
     let mut y_old = [sigma0, 1.0];
     let mut rate_old = sys.force_rate(&y_old);
     let mut ind_old = level.map(|l| indicator(sys, &y_old, l));
-    // Slightly past σ₀ counts as returned (the start is on σ₀ itself).
-    let tol_root = 1e-14;
+    let located = |what: &'static str| {
+        move |e: crate::numeric::RootError| {
+            ImpactError::Integration(format!("locating the {what}: {e}"))
+        }
+    };
     loop {
         st.step(sys, f64::INFINITY).map_err(err)?;
         let (t0, t1) = (st.t_prev(), st.t());
         let y_new = [st.y()[0], st.y()[1]];
+        let state = |st: &mut Dop853, sys: &mut RelativeMotion, t| {
+            [st.dense_component(sys, 0, t), st.dense_component(sys, 1, t)]
+        };
         // Peak force: dF/dτ from + to -.
         let rate_new = sys.force_rate(&y_new);
-        if rate_old > 0.0 && rate_new <= 0.0 {
-            let tp = brent(
-                |t| {
-                    let y = [st.dense_component(sys, 0, t), st.dense_component(sys, 1, t)];
-                    sys.force_rate(&y)
-                },
-                t0,
-                t1,
-                rate_old,
-                rate_new,
-                tol_root * t1.max(1.0),
-                200,
-            )
-            .map_err(|e| ImpactError::Integration(format!("locating the peak force: {e}")))?;
-            let y = [
-                st.dense_component(sys, 0, tp),
-                st.dense_component(sys, 1, tp),
-            ];
+        if Crossing::Falling.happened(rate_old, rate_new) {
+            let tp = LOCATOR
+                .locate(
+                    |t| {
+                        let y = state(&mut st, sys, t);
+                        sys.force_rate(&y)
+                    },
+                    (t0, rate_old),
+                    (t1, rate_new),
+                )
+                .map_err(located("peak force"))?;
+            let y = state(&mut st, sys, tp);
             let f = sys.force(&y);
             if f > w.peak_force {
                 w.peak_force = f;
@@ -219,40 +226,30 @@ fn walk(
             }
         }
         // Maximum penetration: ν from + to -.
-        if y_old[1] > 0.0 && y_new[1] <= 0.0 {
-            let tm = brent(
-                |t| st.dense_component(sys, 1, t),
-                t0,
-                t1,
-                y_old[1],
-                y_new[1],
-                tol_root * t1.max(1.0),
-                200,
-            )
-            .map_err(|e| {
-                ImpactError::Integration(format!("locating the maximum penetration: {e}"))
-            })?;
+        if Crossing::Falling.happened(y_old[1], y_new[1]) {
+            let tm = LOCATOR
+                .locate(
+                    |t| st.dense_component(sys, 1, t),
+                    (t0, y_old[1]),
+                    (t1, y_new[1]),
+                )
+                .map_err(located("maximum penetration"))?;
             w.max_sigma = w.max_sigma.max(st.dense_component(sys, 0, tm));
         }
         // Contact indicator crossings.
         if let (Some(l), Some(io)) = (level, ind_old) {
             let in_new = indicator(sys, &y_new, l);
-            if (io > 0.0) != (in_new > 0.0) {
-                let tc = brent(
-                    |t| {
-                        let y = [st.dense_component(sys, 0, t), st.dense_component(sys, 1, t)];
-                        indicator(sys, &y, l)
-                    },
-                    t0,
-                    t1,
-                    io,
-                    in_new,
-                    tol_root * t1.max(1.0),
-                    200,
-                )
-                .map_err(|e| {
-                    ImpactError::Integration(format!("locating the contact boundary: {e}"))
-                })?;
+            if Crossing::Either.happened(io, in_new) {
+                let tc = LOCATOR
+                    .locate(
+                        |t| {
+                            let y = state(&mut st, sys, t);
+                            indicator(sys, &y, l)
+                        },
+                        (t0, io),
+                        (t1, in_new),
+                    )
+                    .map_err(located("contact boundary"))?;
                 w.crossings.push((tc, in_new > 0.0));
             }
             ind_old = Some(in_new);
@@ -260,17 +257,14 @@ fn walk(
         // Return to the start position while separating.
         let g_old = y_old[0] - sigma0;
         let g_new = y_new[0] - sigma0;
-        if y_new[1] < 0.0 && g_new <= 0.0 && g_old > 0.0 {
-            let te = brent(
-                |t| st.dense_component(sys, 0, t) - sigma0,
-                t0,
-                t1,
-                g_old,
-                g_new,
-                tol_root * t1.max(1.0),
-                200,
-            )
-            .map_err(|e| ImpactError::Integration(format!("locating the separation: {e}")))?;
+        if y_new[1] < 0.0 && Crossing::Falling.happened(g_old, g_new) {
+            let te = LOCATOR
+                .locate(
+                    |t| st.dense_component(sys, 0, t) - sigma0,
+                    (t0, g_old),
+                    (t1, g_new),
+                )
+                .map_err(located("separation"))?;
             w.end_time = te;
             w.end_velocity = st.dense_component(sys, 1, te);
             return Ok((w, st.stats()));
