@@ -30,8 +30,8 @@ use std::time::Instant;
 
 use clap::Parser;
 use serde_json::{json, Value};
-use vibroimpact::contact::{ContactLaw, ForceForm};
-use vibroimpact::model::{BaseExcitation, Model};
+use vibroimpact::model::Model;
+use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 #[derive(Parser, Debug)]
@@ -59,29 +59,16 @@ const ATOL_RATIOS: [f64; 3] = [1e-2, 1e-3, 1e-4];
 type Sweep = Vec<(f64, f64, Run)>;
 
 fn r2(n: usize) -> Model {
-    let (m, w0, zeta) = (0.227, 7.41, 0.013);
-    let law = ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published)
-        .expect("valid law");
-    let base = BaseExcitation::Harmonic {
-        amplitude: 0.05,
-        frequency: OMEGA_RATIO * w0,
-        phase: 0.0,
-    };
-    Model::row(
+    reference::r2(
         n,
-        m,
-        m * w0 * w0,
-        2.0 * zeta * m * w0,
-        1e-3,
-        law,
-        (true, true),
-        base,
+        reference::CLEARANCE,
+        OMEGA_RATIO * reference::NATURAL_FREQUENCY,
     )
     .expect("valid model")
 }
 
 fn t_end(periods: f64) -> f64 {
-    periods * 2.0 * std::f64::consts::PI / (OMEGA_RATIO * 7.41)
+    periods * 2.0 * std::f64::consts::PI / (OMEGA_RATIO * reference::NATURAL_FREQUENCY)
 }
 
 /// One solver run: final state [u.., v..], best wall time, work counters.
@@ -451,11 +438,12 @@ fn main() {
         // end pendulums strike the walls), against the dense Newton step it
         // replaces (one period map with Φ, extrapolated from N = 160 with
         // the measured exponent).
-        let model = r2(1000).with_base(BaseExcitation::Harmonic {
-            amplitude: 0.05,
-            frequency: 0.5 * 7.41,
-            phase: 0.0,
-        });
+        let model = reference::r2(
+            1000,
+            reference::CLEARANCE,
+            0.5 * reference::NATURAL_FREQUENCY,
+        )
+        .expect("valid model");
         let start = Instant::now();
         let guess = vibroimpact::periodic::guess_by_simulation(&model, 200.0, 1e-9).expect("guess");
         let guess_seconds = start.elapsed().as_secs_f64();

@@ -29,6 +29,7 @@ from_display!(
     vibroimpact::contact::ContactLawError,
     vibroimpact::impact::ImpactError,
     vibroimpact::identify::IdentifyError,
+    vibroimpact::model::ModelError,
     vibroimpact::model_file::ModelFileError,
     vibroimpact::sweep::SweepError,
     serde_json::Error

@@ -6,6 +6,7 @@ use clap::{Args, ValueEnum};
 use vibroimpact::contact::{ContactLaw, ForceForm};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::TwoBodies;
+use vibroimpact::reference;
 use vibroimpact::results::{impact_document, impact_rows, ImpactMethod, IMPACT_COLUMNS};
 
 use crate::error::CliError;
@@ -88,8 +89,8 @@ impl LawArgs {
         let n = self.exponent.unwrap_or(1.5);
         Ok(match self.law {
             LawName::Exponential => ContactLaw::exponential_from_ratio(
-                self.a_over_b.unwrap_or(1.2),
-                self.alpha.unwrap_or(1.3e5),
+                self.a_over_b.unwrap_or(reference::A_OVER_B),
+                self.alpha.unwrap_or(reference::ALPHA),
                 self.a,
                 form,
             )?,

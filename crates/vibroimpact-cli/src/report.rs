@@ -14,7 +14,7 @@ use vibroimpact::identify::Estimate;
 use vibroimpact::impact::closed_form::{peak_force_dimensionless, restitution, ExponentialImpact};
 use vibroimpact::impact::direct::{integrate_impact, DirectOptions};
 use vibroimpact::impact::TwoBodies;
-use vibroimpact::model::{BaseExcitation, Model};
+use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 use crate::error::CliError;
@@ -237,25 +237,21 @@ fn estimate_text(e: &Estimate) -> String {
 /// The seed's part III: impact relations of the exponential law and the
 /// identification of its parameters.
 fn seed_part3(report: &mut Report) -> Result<(), CliError> {
-    let q = 1.2;
-    let alpha = 1.3e5;
-    let law = ContactLaw::exponential_from_ratio(q, alpha, 1.0, ForceForm::Published)?;
-    let bodies = TwoBodies::new(0.227, 0.227)?;
+    let q = reference::A_OVER_B;
+    let law = reference::seed_law();
+    let bodies = reference::seed_bodies();
     let model = ExponentialImpact::new(&law, bodies)?;
     let opts = DirectOptions::default();
 
-    // Reference table (docs/theory.md §2) against the closed form and direct integration.
-    const TABLE: [(f64, f64, f64); 6] = [
-        (0.01, 0.993377454400, 4.96703803e-05),
-        (0.1, 0.937475579950, 4.70080031e-03),
-        (0.5, 0.748434931597, 9.88769556e-02),
-        (1.0, 0.593624260040, 3.50368739e-01),
-        (2.0, 0.410719686061, 1.24478950e+00),
-        (10.0, 0.099981624753, 2.64635581e+01),
-    ];
+    // Reference table R1 (docs/theory.md §2) against the closed form and direct integration.
     let mut rows = Vec::new();
     let mut table_json = Vec::new();
-    for (v, e_ref, f_ref) in TABLE {
+    for reference::R1Row {
+        v,
+        e: e_ref,
+        f_max: f_ref,
+    } in reference::R1_TABLE
+    {
         let e = restitution(v)?;
         let f = peak_force_dimensionless(v)?;
         let d = integrate_impact(&law, bodies, v * q, &opts)?;
@@ -484,17 +480,17 @@ fn identification_figures(
                 vec![
                     "sequential (seed): a/b from e, then alpha".into(),
                     estimate_text(&q),
-                    format!("{:+.2}", z(&q, 1.2)),
+                    format!("{:+.2}", z(&q, reference::A_OVER_B)),
                     format!("{:.4e} ± {:.1e}", alpha.value, alpha.std_error),
-                    format!("{:+.2}", z(&alpha, 1.3e5)),
+                    format!("{:+.2}", z(&alpha, reference::ALPHA)),
                     "—".into(),
                 ],
                 vec![
                     "joint (weighted)".into(),
                     estimate_text(&qj),
-                    format!("{:+.2}", z(&qj, 1.2)),
+                    format!("{:+.2}", z(&qj, reference::A_OVER_B)),
                     format!("{:.4e} ± {:.1e}", alphaj.value, alphaj.std_error),
-                    format!("{:+.2}", z(&alphaj, 1.3e5)),
+                    format!("{:+.2}", z(&alphaj, reference::ALPHA)),
                     format!("{:.2}", joint.acceleration_fit.as_ref().map_or(0.0, |f| f.correlation)),
                 ],
             ]
@@ -504,8 +500,7 @@ fn identification_figures(
     let fitted_law =
         ContactLaw::exponential_from_ratio(q.value, alpha.value, 1.0, ForceForm::Published)?;
     let fitted = ExponentialImpact::new(&fitted_law, bodies)?;
-    let seed_law = ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published)?;
-    let seed = ExponentialImpact::new(&seed_law, bodies)?;
+    let seed = ExponentialImpact::new(&reference::seed_law(), bodies)?;
     let mut curve_rows = Vec::new();
     let (mut fit_e, mut fit_a, mut seed_e, mut seed_a) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -599,25 +594,9 @@ fn identification_figures(
 /// The seed's row (R2, N = 3) near resonance: time history and impact log,
 /// with the logged impacts over the two-body relations of part III.
 fn seed_row_time_history(report: &mut Report) -> Result<(), CliError> {
-    let (m, w0, zeta, q, alpha) = (0.227, 7.41, 0.013, 1.2, 1.3e5);
-    let omega = 0.95 * w0;
-    let law = ContactLaw::exponential_from_ratio(q, alpha, 1.0, ForceForm::Published)?;
-    let base = BaseExcitation::Harmonic {
-        amplitude: 0.05,
-        frequency: omega,
-        phase: 0.0,
-    };
-    let model = Model::row(
-        3,
-        m,
-        m * w0 * w0,
-        2.0 * zeta * m * w0,
-        1e-3,
-        law,
-        (true, true),
-        base,
-    )
-    .map_err(|e| CliError::new(e.to_string()))?;
+    let (m, law) = (reference::MASS, reference::seed_law());
+    let omega = 0.95 * reference::NATURAL_FREQUENCY;
+    let model = reference::r2(3, reference::CLEARANCE, omega)?;
     let period = 2.0 * std::f64::consts::PI / omega;
     let periods = 20.0;
     let opts = SimulationOptions {
@@ -831,26 +810,9 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
     };
     use vibroimpact::periodic::{guess_by_simulation, orbit_summary};
 
-    let (m, w0, zeta) = (0.227, 7.41, 0.013);
-    let law = ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published)?;
-    let row = |n: usize, w: f64| {
-        let base = BaseExcitation::Harmonic {
-            amplitude: 0.05,
-            frequency: w,
-            phase: 0.0,
-        };
-        Model::row(
-            n,
-            m,
-            m * w0 * w0,
-            2.0 * zeta * m * w0,
-            1e-3,
-            law,
-            (true, true),
-            base,
-        )
-        .map_err(|e| e.to_string())
-    };
+    let w0 = reference::NATURAL_FREQUENCY;
+    let row =
+        |n: usize, w: f64| reference::r2(n, reference::CLEARANCE, w).map_err(|e| e.to_string());
     let mut intro = String::from(
         "<p>Periodic solutions of the row (the seed's parts I–II) found by shooting (Newton on the period map, \
          monodromy from the variational equations) and followed in the forcing frequency Ω by pseudo-arclength \

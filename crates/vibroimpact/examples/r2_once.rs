@@ -1,7 +1,6 @@
 //! One simulation of reference problem R2 (for profiling):
 //! `cargo run --release -p vibroimpact --example r2_once -- N PERIODS RTOL`.
-use vibroimpact::contact::{ContactLaw, ForceForm};
-use vibroimpact::model::{BaseExcitation, Model};
+use vibroimpact::reference::{r2, CLEARANCE, NATURAL_FREQUENCY};
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 fn main() {
@@ -12,25 +11,8 @@ fn main() {
             .unwrap_or(d)
     };
     let (n, periods, rtol) = (arg(1, 3.0) as usize, arg(2, 5.0), arg(3, 1e-10));
-    let (m, w0, z) = (0.227, 7.41, 0.013);
-    let law =
-        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).expect("law");
-    let base = BaseExcitation::Harmonic {
-        amplitude: 0.05,
-        frequency: 0.95 * w0,
-        phase: 0.0,
-    };
-    let model = Model::row(
-        n,
-        m,
-        m * w0 * w0,
-        2.0 * z * m * w0,
-        1e-3,
-        law,
-        (true, true),
-        base,
-    )
-    .expect("model");
+    let w0 = NATURAL_FREQUENCY;
+    let model = r2(n, CLEARANCE, 0.95 * w0).expect("model");
     let t_end = periods * 2.0 * std::f64::consts::PI / (0.95 * w0);
     let sim = simulate(
         &model,

@@ -1190,11 +1190,10 @@ mod tests {
     use super::*;
     use crate::simulate::{simulate, SimulationOptions};
 
-    const W0: f64 = 7.41;
-    const ZETA: f64 = 0.013;
+    use crate::reference::NATURAL_FREQUENCY as W0;
 
     fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
-        Ok(crate::model::seed_row(n, clearance, omega))
+        crate::reference::r2(n, clearance, omega).map_err(|e| e.to_string())
     }
 
     /// R3 along a branch: amplitude equals the exact steady state, no
@@ -1221,7 +1220,7 @@ mod tests {
         assert!(b.points.len() > 10);
         for p in &b.points {
             let w = p.parameter;
-            let exact = 0.05 / ((W0 * W0 - w * w).powi(2) + (2.0 * ZETA * W0 * w).powi(2)).sqrt();
+            let exact = crate::reference::r3_steady_amplitude(w);
             // The exact extremum (located on the dense output).
             assert!(
                 (p.max_displacement[0] / exact - 1.0).abs() < 1e-8,

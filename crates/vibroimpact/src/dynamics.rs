@@ -570,13 +570,10 @@ impl OdeSystem for ChainDynamics {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::ForceForm;
     use crate::integrate::BandMatrix;
     use crate::model::{Body, Contact, ContactPair, Coupling};
 
-    fn law() -> ContactLaw {
-        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap()
-    }
+    use crate::reference::seed_law as law;
 
     /// The right-hand side by hand for two bodies with a coupling, a contact
     /// and base excitation.

@@ -672,7 +672,7 @@ mod tests {
     }
 
     fn bodies() -> TwoBodies {
-        TwoBodies::new(0.227, 0.227).unwrap()
+        crate::reference::seed_bodies()
     }
 
     fn accel(u: f64, q: f64, alpha: f64) -> f64 {

@@ -576,40 +576,11 @@ impl Model {
     }
 }
 
-/// The seed's row (reference problem R2) for tests: N pendulums, every gap
-/// `clearance`, base acceleration 0.05 sin(Ω t).
-#[cfg(test)]
-pub(crate) fn seed_row(n: usize, clearance: f64, omega: f64) -> Model {
-    let (m, w0, zeta) = (0.227, 7.41, 0.013);
-    let law =
-        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, crate::contact::ForceForm::Published)
-            .expect("valid law");
-    let base = BaseExcitation::Harmonic {
-        amplitude: 0.05,
-        frequency: omega,
-        phase: 0.0,
-    };
-    Model::row(
-        n,
-        m,
-        m * w0 * w0,
-        2.0 * zeta * m * w0,
-        clearance,
-        law,
-        (true, true),
-        base,
-    )
-    .expect("valid row")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::ForceForm;
 
-    fn law() -> ContactLaw {
-        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap()
-    }
+    use crate::reference::seed_law as law;
 
     #[test]
     fn row_layout_and_names() {

@@ -780,11 +780,10 @@ mod tests {
     use super::*;
     use crate::model::BaseExcitation;
 
-    const W0: f64 = 7.41;
-    const ZETA: f64 = 0.013;
+    use crate::reference::{DAMPING_RATIO as ZETA, NATURAL_FREQUENCY as W0};
 
     fn r2(n: usize, clearance: f64, omega: f64) -> Model {
-        crate::model::seed_row(n, clearance, omega)
+        crate::reference::r2(n, clearance, omega).unwrap()
     }
 
     /// R3: the periodic solution is the exact steady state to 1e-10 and the
@@ -1032,8 +1031,7 @@ mod tests {
         let model = r2(1000, 1e-3, omega);
         let t = 2.0 * std::f64::consts::PI / omega;
         let guess = guess_by_simulation(&model, 200.0, 1e-9).unwrap();
-        let linear =
-            0.05 / ((W0 * W0 - omega * omega).powi(2) + (2.0 * ZETA * W0 * omega).powi(2)).sqrt();
+        let linear = crate::reference::r3_steady_amplitude(omega);
         let decay = (-ZETA * W0 * t).exp();
         krylov_on_both_maps(&model, &guess, t, |_, sol, orbit| {
             assert!(sol.stable());

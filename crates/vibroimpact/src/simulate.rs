@@ -728,32 +728,12 @@ mod tests {
     use crate::impact::TwoBodies;
     use crate::model::{Body, Contact, ContactPair};
 
-    const W0: f64 = 7.41;
-    const ZETA: f64 = 0.013;
+    use crate::reference::NATURAL_FREQUENCY as W0;
 
-    fn law() -> ContactLaw {
-        ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap()
-    }
+    use crate::reference::{r3_response as linear_exact, seed_law as law};
 
     fn r2(n: usize, clearance: f64, omega: f64) -> Model {
-        crate::model::seed_row(n, clearance, omega)
-    }
-
-    /// Exact response of `u'' + 2ζω0 u' + ω0² u = -A sin(Ωt)` from rest.
-    fn linear_exact(t: f64, omega: f64) -> (f64, f64) {
-        let a = 0.05;
-        let d = (W0 * W0 - omega * omega).powi(2) + (2.0 * ZETA * W0 * omega).powi(2);
-        let b1 = -a * (W0 * W0 - omega * omega) / d;
-        let b2 = a * 2.0 * ZETA * W0 * omega / d;
-        let wd = W0 * (1.0 - ZETA * ZETA).sqrt();
-        let c1 = -b2;
-        let c2 = (ZETA * W0 * c1 - omega * b1) / wd;
-        let e = (-ZETA * W0 * t).exp();
-        let (sn, cs) = (wd * t).sin_cos();
-        let u = b1 * (omega * t).sin() + b2 * (omega * t).cos() + e * (c1 * cs + c2 * sn);
-        let v = b1 * omega * (omega * t).cos() - b2 * omega * (omega * t).sin()
-            + e * (-ZETA * W0 * (c1 * cs + c2 * sn) + wd * (-c1 * sn + c2 * cs));
-        (u, v)
+        crate::reference::r2(n, clearance, omega).unwrap()
     }
 
     /// R3: clearances so large nothing touches; displacement equals the exact

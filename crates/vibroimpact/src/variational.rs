@@ -151,11 +151,10 @@ mod tests {
     use crate::integrate::{integrate_to, IntegratorOptions};
     use crate::model::Model;
 
-    const W0: f64 = 7.41;
-    const ZETA: f64 = 0.013;
+    use crate::reference::{DAMPING_RATIO as ZETA, NATURAL_FREQUENCY as W0};
 
     fn r2(n: usize, clearance: f64) -> Model {
-        crate::model::seed_row(n, clearance, 0.95 * W0)
+        crate::reference::r2(n, clearance, 0.95 * W0).unwrap()
     }
 
     fn opts(tol: f64, error_components: Option<usize>) -> IntegratorOptions {

@@ -329,17 +329,6 @@ impl ExponentialImpact {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::ForceForm;
-
-    /// docs/theory.md §2 reference table (V, e, f_max).
-    const TABLE: [(f64, f64, f64); 6] = [
-        (0.01, 0.993377454400, 4.96703803e-05),
-        (0.1, 0.937475579950, 4.70080031e-03),
-        (0.5, 0.748434931597, 9.88769556e-02),
-        (1.0, 0.593624260040, 3.50368739e-01),
-        (2.0, 0.410719686061, 1.24478950e+00),
-        (10.0, 0.099981624753, 2.64635581e+01),
-    ];
 
     /// The same six roots to 20 digits (mpmath, 40-digit arithmetic:
     /// `findroot(e - 1/V + (1 + 1/V) exp(-V(e + 1)))`, and likewise eq. 17).
@@ -355,7 +344,12 @@ mod tests {
 
     #[test]
     fn reproduces_theory_table() {
-        for (v, e_ref, f_ref) in TABLE {
+        for crate::reference::R1Row {
+            v,
+            e: e_ref,
+            f_max: f_ref,
+        } in crate::reference::R1_TABLE
+        {
             let e = restitution(v).unwrap();
             // docs/theory.md prints 12 decimals, but its V = 0.01 entry is rounded
             // at the 10th (exact: 0.99337745439877): allow 1.5e-12 there.
@@ -490,9 +484,8 @@ mod tests {
     /// reaches the maximum penetration at y = 0.
     #[test]
     fn trajectory_endpoints_and_peak() {
-        let law =
-            ContactLaw::exponential_from_ratio(1.2, 1.3e5, 1.0, ForceForm::Published).unwrap();
-        let imp = ExponentialImpact::new(&law, TwoBodies::new(0.227, 0.227).unwrap()).unwrap();
+        let law = crate::reference::seed_law();
+        let imp = ExponentialImpact::new(&law, crate::reference::seed_bodies()).unwrap();
         let u = 0.3;
         let x_start = 3e-5;
         let c = imp.impact(u).unwrap();
