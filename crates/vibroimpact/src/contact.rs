@@ -340,6 +340,45 @@ impl ContactLaw {
         !matches!(self.kind, LawKind::Exponential { .. })
     }
 
+    /// The approach `s` at which the contact counts as engaged when its
+    /// static force reaches `force_threshold` (N): `ln(F/a)/α` for the
+    /// exponential law (which never vanishes), 0 for the laws with compact
+    /// support. Simulation logs an impact while `s` is above it.
+    pub fn onset_approach(&self, force_threshold: f64) -> f64 {
+        match self.kind {
+            LawKind::Exponential { a, alpha, .. } => (force_threshold / a).ln() / alpha,
+            _ => 0.0,
+        }
+    }
+
+    /// How far past its onset approach a step may end when the contact
+    /// engages: `2/α` for the exponential law (its force grows by e² over
+    /// it), 0 for the laws with compact support (their onset is located as
+    /// an event).
+    pub fn entry_margin(&self) -> f64 {
+        match self.kind {
+            LawKind::Exponential { alpha, .. } => 2.0 / alpha,
+            _ => 0.0,
+        }
+    }
+
+    /// The penetration scale L (m) of an impact at approach velocity `u`
+    /// between bodies of reduced mass `mu`: `1/α` for the exponential law;
+    /// `u·sqrt(μ/k)` for Kelvin–Voigt; the elastic maximum penetration
+    /// `((n+1) μ u² / (2k))^(1/(n+1))` for the Hertz family. The two-body
+    /// impact integration is written in `s/L`.
+    pub fn length_scale(&self, mu: f64, u: f64) -> f64 {
+        match self.kind {
+            LawKind::Exponential { alpha, .. } => 1.0 / alpha,
+            LawKind::KelvinVoigt { k, .. } => u * (mu / k).sqrt(),
+            LawKind::Hertz { k, n }
+            | LawKind::HuntCrossley { k, n, .. }
+            | LawKind::LankaraniNikravesh { k, n, .. } => {
+                ((n + 1.0) * mu * u * u / (2.0 * k)).powf(1.0 / (n + 1.0))
+            }
+        }
+    }
+
     /// Whether the law reads the onset approach velocity `v₀`
     /// (Lankarani–Nikravesh).
     pub fn needs_impact_velocity(&self) -> bool {
@@ -580,5 +619,30 @@ mod tests {
         assert!(
             ContactLaw::lankarani_nikravesh(1.0, 1.5, 1.5, 1e-3, ForceForm::Published).is_err()
         );
+    }
+
+    /// The law's scales: the exponential force equals the threshold at the
+    /// onset approach and grows by e² over the entry margin; the Hertz
+    /// length scale is the penetration where the elastic energy equals the
+    /// kinetic energy ½ μ u²; compact laws start at s = 0.
+    #[test]
+    fn onset_margin_and_length_scales() {
+        let exp = ContactLaw::exponential(2.0, 2.0 / 1.2, 1.3e5, ForceForm::Published).unwrap();
+        let s_on = exp.onset_approach(1e-2);
+        assert!((exp.force(s_on, 0.0, 0.0) / 1e-2 - 1.0).abs() < 1e-12);
+        let grown = exp.force(s_on + exp.entry_margin(), 0.0, 0.0) / 1e-2;
+        assert!((grown / 2.0f64.exp() - 1.0).abs() < 1e-12);
+        assert_eq!(exp.length_scale(0.1, 1.0), 1.0 / 1.3e5);
+        let hertz = ContactLaw::hertz(5e9, 1.5).unwrap();
+        assert_eq!(
+            (hertz.onset_approach(1e-2), hertz.entry_margin()),
+            (0.0, 0.0)
+        );
+        let (mu, u) = (0.1135, 0.3);
+        let l = hertz.length_scale(mu, u);
+        assert!((hertz.potential(l) / (0.5 * mu * u * u) - 1.0).abs() < 1e-12);
+        let kv = ContactLaw::kelvin_voigt(1e6, 0.0, ForceForm::Published).unwrap();
+        let l = kv.length_scale(mu, u);
+        assert!((kv.potential(l) / (0.5 * mu * u * u) - 1.0).abs() < 1e-12);
     }
 }

@@ -30,7 +30,6 @@
 //! in the message), the result keeps everything computed up to the failure
 //! and carries the error.
 
-use crate::contact::LawKind;
 use crate::dynamics::ChainDynamics;
 use crate::integrate::events::EventLocator;
 use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
@@ -497,14 +496,6 @@ impl StepScan<'_> {
     }
 }
 
-/// The impact threshold s_on of a contact (see the module notes).
-fn impact_threshold(model: &Model, k: usize, force_threshold: f64) -> f64 {
-    match *model.contacts()[k].law.kind() {
-        LawKind::Exponential { a, alpha, .. } => (force_threshold / a).ln() / alpha,
-        _ => 0.0,
-    }
-}
-
 /// Errors in the options, before anything runs.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{0}")]
@@ -593,11 +584,10 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         model,
         trackers: (0..model.contacts().len())
             .map(|k| Tracker {
-                s_on: impact_threshold(model, k, opts.impact_force_threshold),
-                entry_margin: match *model.contacts()[k].law.kind() {
-                    LawKind::Exponential { alpha, .. } => 2.0 / alpha,
-                    _ => 0.0,
-                },
+                s_on: model.contacts()[k]
+                    .law
+                    .onset_approach(opts.impact_force_threshold),
+                entry_margin: model.contacts()[k].law.entry_margin(),
                 active: None,
             })
             .collect(),

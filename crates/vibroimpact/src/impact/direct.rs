@@ -128,19 +128,6 @@ impl OdeSystem for RelativeMotion {
     }
 }
 
-/// Contact length scale L (m), see the module notes.
-fn length_scale(law: &ContactLaw, mu: f64, u: f64) -> f64 {
-    match *law.kind() {
-        LawKind::Exponential { alpha, .. } => 1.0 / alpha,
-        LawKind::KelvinVoigt { k, .. } => u * (mu / k).sqrt(),
-        LawKind::Hertz { k, n }
-        | LawKind::HuntCrossley { k, n, .. }
-        | LawKind::LankaraniNikravesh { k, n, .. } => {
-            ((n + 1.0) * mu * u * u / (2.0 * k)).powf(1.0 / (n + 1.0))
-        }
-    }
-}
-
 /// What a walk over the accepted steps observes.
 struct Walk {
     end_time: f64,
@@ -284,7 +271,7 @@ pub fn integrate_impact(
     let u = positive("impact velocity", impact_velocity)?;
     positive("rtol", opts.rtol)?;
     let mu = bodies.reduced_mass();
-    let length = length_scale(law, mu, u);
+    let length = law.length_scale(mu, u);
     let s0 = match *law.kind() {
         LawKind::Exponential { alpha, .. } => {
             ExponentialImpact::new(law, bodies)?
