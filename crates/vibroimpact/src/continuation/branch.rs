@@ -1,0 +1,420 @@
+//! The [`Continuation`] iterator: one accepted point of the branch per
+//! step (predictor, corrector, step control, special points between the
+//! points), ending with the reason it stopped.
+
+use nalgebra::Complex;
+
+use super::events::{BranchEvent, BUILT_IN};
+use super::problem::{period_image, Evaluated, Problem};
+use super::{
+    is_symmetric_orbit, BranchPoint, ContinuationError, ContinuationOptions, SpecialPoint,
+    StopReason,
+};
+use crate::model::Model;
+use crate::periodic::{shoot, ShootingOptions};
+
+/// One step of a [`Continuation`].
+#[derive(Clone, Debug)]
+pub enum BranchStep {
+    /// An accepted point (the first is the start), with the special points
+    /// located between it and the point before.
+    Point {
+        /// The point.
+        point: BranchPoint,
+        /// Special points located since the previous point, in order.
+        special: Vec<SpecialPoint>,
+    },
+    /// The branch ended; nothing follows.
+    Stop(StopReason),
+}
+
+/// Pseudo-arclength continuation as an iterator over the steps of a branch
+/// ([`BranchStep`]): the caller decides when to stop (a point budget of its
+/// own, Ctrl-C, a condition on the points), watches progress, or collects
+/// the branch ([`continue_branch`](super::continue_branch)).
+///
+/// Built-in events are the fold, branch point, period doubling,
+/// Neimark–Sacker and grazing tests; [`with_event`](Self::with_event) adds
+/// more (e.g. a [`UserEvent`](super::UserEvent)).
+pub struct Continuation<F> {
+    problem: Problem<F>,
+    events: Vec<Box<dyn BranchEvent>>,
+    /// Special points found so far, per event (for the labels).
+    counts: Vec<usize>,
+    /// Parameter interval the branch stays in.
+    bounds: (f64, f64),
+    current: Evaluated,
+    /// The start, not yet yielded.
+    start: Option<BranchPoint>,
+    ds: f64,
+    /// Points yielded so far.
+    points: usize,
+    /// First point and its tangent (closing a loop).
+    origin: (Vec<f64>, Vec<f64>),
+    /// Mirror images of the points traversed, for asymmetric branches of
+    /// a mirror-symmetric row (closing a loop onto the mirror image).
+    mirrors: Option<(ShootingOptions, Vec<Vec<f64>>)>,
+    symmetric: bool,
+    /// The stop reason decided with the last point, yielded next.
+    pending: Option<StopReason>,
+    done: bool,
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
+    /// Starts the branch of nT-periodic solutions at `(x0, p0)` toward
+    /// `p_end`: validates the options, refines `x0` by shooting and
+    /// corrects the start with the parameter held. `family(p)` builds the
+    /// model at parameter p. Symmetric orbits of a mirror-symmetric row are
+    /// followed on the half map when `opts.use_symmetry` allows.
+    pub fn new(
+        mut family: F,
+        p0: f64,
+        x0: &[f64],
+        p_end: f64,
+        opts: &ContinuationOptions,
+    ) -> Result<Self, ContinuationError> {
+        validate(p0, p_end, opts)?;
+        let model = family(p0).map_err(|message| ContinuationError::Model {
+            parameter: p0,
+            message,
+        })?;
+        let start = shoot(&model, x0, &opts.shooting)?;
+        if !start.converged {
+            return Err(ContinuationError::StartNotConverged(
+                *start.residual_history.last().unwrap_or(&f64::NAN),
+            ));
+        }
+        let d = x0.len();
+        let odd = opts.shooting.subharmonic.max(1) % 2 == 1;
+        let symmetric = opts.shooting.symmetric
+            || (opts.use_symmetry
+                && odd
+                && model.is_mirror_symmetric()
+                && is_symmetric_orbit(&model, &start.initial_state, &opts.shooting));
+        let local = ContinuationOptions {
+            shooting: ShootingOptions {
+                symmetric,
+                ..opts.shooting.clone()
+            },
+            ..opts.clone()
+        };
+        let mut problem = Problem::new(family, local, &model, p0);
+        let bounds = opts
+            .bounds
+            .map_or((p0.min(p_end), p0.max(p_end)), |(a, b)| {
+                (a.min(b), a.max(b))
+            });
+        let z0 = problem.scale_state(&start.initial_state, p0);
+        // The start point: corrected with the parameter held (t = e_p).
+        let mut dir = vec![0.0; d + 1];
+        dir[d] = 1.0;
+        let (solved0, _) = problem
+            .correct(&z0, &dir)
+            .ok_or(ContinuationError::StartNotConverged(f64::NAN))?;
+        dir[d] = (p_end - p0).signum();
+        let first = problem
+            .evaluate(solved0, &dir)
+            .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the start point".into()))?;
+        // Closing the loop: the branch is back at its first point, or (for
+        // an asymmetric branch of a mirror-symmetric row) at the mirror
+        // image S x(nT/2) of a point already traversed, which happens right
+        // after it passes a pitchfork on the symmetric branch; the rest
+        // would be the mirror image of what is known.
+        let mirrors =
+            (!symmetric && opts.use_symmetry && odd && model.is_mirror_symmetric()).then(|| {
+                let half = ShootingOptions {
+                    symmetric: true,
+                    ..problem.opts.shooting.clone()
+                };
+                (half, Vec::new())
+            });
+        let events: Vec<Box<dyn BranchEvent>> = BUILT_IN
+            .iter()
+            .map(|k| Box::new(*k) as Box<dyn BranchEvent>)
+            .collect();
+        let mut this = Self {
+            counts: vec![0; events.len()],
+            events,
+            bounds,
+            origin: (first.solved.z.clone(), first.tangent.clone()),
+            start: Some(first.point.clone()),
+            current: first,
+            ds: opts.ds,
+            points: 0,
+            mirrors,
+            symmetric,
+            pending: None,
+            done: false,
+            problem,
+        };
+        this.remember_mirror();
+        Ok(this)
+    }
+
+    /// Adds an event to detect and locate between points (after the
+    /// built-in ones).
+    pub fn with_event(mut self, event: Box<dyn BranchEvent>) -> Self {
+        self.events.push(event);
+        self.counts.push(0);
+        self
+    }
+
+    /// Whether the branch is followed on the symmetric half map.
+    pub fn symmetric(&self) -> bool {
+        self.symmetric
+    }
+
+    /// Period multiple n of the branch.
+    pub fn subharmonic(&self) -> u32 {
+        self.problem.opts.shooting.subharmonic
+    }
+
+    /// The stop reason decided together with the last point yielded (the
+    /// end of the range, a closed loop), if any: the next step yields it.
+    pub fn pending_stop(&self) -> Option<&StopReason> {
+        self.pending.as_ref()
+    }
+
+    /// Records the mirror image of the current point (asymmetric branches
+    /// of mirror-symmetric rows).
+    fn remember_mirror(&mut self) {
+        if let Some((half, list)) = &mut self.mirrors {
+            let (x, p) = self.problem.unscale(&self.current.solved.z);
+            let image = self
+                .problem
+                .model(p)
+                .ok()
+                .and_then(|model| period_image(&model, &x, half));
+            list.extend(image.map(|image| self.problem.scale_state(&image, p)));
+        }
+    }
+
+    /// Predictor and corrector with step `ds` from the current point; the
+    /// evaluated point and the corrector iterations, or None if the
+    /// correction failed, turned too sharply or moved the multipliers too
+    /// far (two crossings of the unit circle could cancel in the tests).
+    fn try_step(&mut self, ds: f64) -> Option<(Evaluated, usize)> {
+        let cur = &self.current;
+        let pred: Vec<f64> = cur
+            .solved
+            .z
+            .iter()
+            .zip(&cur.tangent)
+            .map(|(z, t)| z + ds * t)
+            .collect();
+        let tangent = cur.tangent.clone();
+        let (solved, iterations) = self.problem.correct(&pred, &tangent)?;
+        let next = self.problem.evaluate(solved, &tangent)?;
+        let cos: f64 = next.tangent.iter().zip(&tangent).map(|(a, b)| a * b).sum();
+        let opts = &self.problem.opts;
+        let spectrum_ok = 0.5 * ds < opts.ds_min
+            || spectral_distance(&self.current.point.multipliers, &next.point.multipliers)
+                <= opts.max_multiplier_change;
+        (cos > opts.step.min_tangent_cos && spectrum_ok).then_some((next, iterations))
+    }
+
+    /// Detects and locates the events between the current point and `next`.
+    fn special_points(&mut self, next: &Evaluated) -> Vec<SpecialPoint> {
+        let ((lo, hi), tol) = (self.bounds, self.problem.opts.locate_tol);
+        let inside = |q: f64| q >= lo - tol && q <= hi + tol;
+        let mut found = Vec::new();
+        for (k, event) in self.events.iter().enumerate() {
+            if !event.between(self.current.observed(), next.observed()) {
+                continue;
+            }
+            let located = self
+                .problem
+                .locate(event.as_ref(), &self.current, next, self.ds);
+            let Some(loc) = located.filter(|l| inside(l.point.parameter)) else {
+                continue;
+            };
+            self.counts[k] += 1;
+            let kind = event.kind();
+            found.push(SpecialPoint {
+                kind,
+                label: format!("{}{}", kind.prefix(), self.counts[k]),
+                parameter: loc.point.parameter,
+                state: loc.point.state.clone(),
+                multipliers: loc.point.multipliers.clone(),
+                tangent: loc.tangent.clone(),
+                after_point: self.points - 1,
+                symmetry_breaking: kind == super::SpecialKind::BranchPoint
+                    && self.current.tests.det_sym.signum() != next.tests.det_sym.signum(),
+            });
+        }
+        found
+    }
+
+    /// Whether parameter `q` is inside the range (to `locate_tol`).
+    fn inside(&self, q: f64) -> bool {
+        let (lo, hi) = self.bounds;
+        let tol = self.problem.opts.locate_tol;
+        q >= lo - tol && q <= hi + tol
+    }
+
+    /// One accepted point, or the reason the branch ends.
+    fn advance(&mut self) -> BranchStep {
+        if self.points >= self.problem.opts.max_points {
+            return BranchStep::Stop(StopReason::MaxPoints);
+        }
+        let (next, iterations) = loop {
+            if let Some(found) = self.try_step(self.ds) {
+                break found;
+            }
+            self.ds *= self.problem.opts.step.fail;
+            if self.ds < self.problem.opts.ds_min {
+                let p = self.current.point.parameter;
+                return BranchStep::Stop(StopReason::CannotContinue(format!(
+                    "the corrector does not converge beyond parameter {p} even with step {:e}",
+                    self.ds
+                )));
+            }
+        };
+        let special = self.special_points(&next);
+        let opts = &self.problem.opts;
+        self.ds = opts
+            .step
+            .next(self.ds, iterations, opts.ds_min, opts.ds_max);
+        // A step past the end of the range: the last point is the solution
+        // at the end itself (the parameter held there), if it converges.
+        let p = next.point.parameter;
+        let beyond = !self.inside(p);
+        let next = if beyond {
+            let bound = if p > self.bounds.1 {
+                self.bounds.1
+            } else {
+                self.bounds.0
+            };
+            match self.problem.end_point(&self.current, &next, bound) {
+                Some(end) => end,
+                None => return BranchStep::Stop(StopReason::ReachedEnd),
+            }
+        } else {
+            next
+        };
+        let mut point = next.point.clone();
+        point.label = special.last().map(|s| s.label.clone());
+        self.points += 1;
+        let previous_z = std::mem::replace(&mut self.current, next).solved.z;
+        if beyond {
+            self.pending = Some(StopReason::ReachedEnd);
+        } else if self.points > 4 && self.closes_loop(&previous_z) {
+            self.pending = Some(StopReason::ClosedLoop);
+        } else {
+            self.remember_mirror();
+        }
+        BranchStep::Point { point, special }
+    }
+
+    /// Whether the step just taken (from `previous_z`) passed through the
+    /// first point (in the same direction) or a mirror image traversed
+    /// before the last two.
+    fn closes_loop(&self, previous_z: &[f64]) -> bool {
+        let (z0, t0) = &self.origin;
+        returns_to(z0, Some(t0), previous_z, &self.current)
+            || self.mirrors.as_ref().is_some_and(|(_, list)| {
+                list[..list.len().saturating_sub(2)]
+                    .iter()
+                    .any(|m| returns_to(m, None, previous_z, &self.current))
+            })
+    }
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Iterator for Continuation<F> {
+    type Item = BranchStep;
+
+    fn next(&mut self) -> Option<BranchStep> {
+        if self.done {
+            return None;
+        }
+        if let Some(point) = self.start.take() {
+            self.points = 1;
+            return Some(BranchStep::Point {
+                point,
+                special: Vec::new(),
+            });
+        }
+        if let Some(reason) = self.pending.take() {
+            self.done = true;
+            return Some(BranchStep::Stop(reason));
+        }
+        let step = self.advance();
+        self.done = matches!(step, BranchStep::Stop(_));
+        Some(step)
+    }
+}
+
+/// The checks of the range and the options before anything runs.
+fn validate(p0: f64, p_end: f64, opts: &ContinuationOptions) -> Result<(), ContinuationError> {
+    if !(p0.is_finite() && p_end.is_finite()) || p0 == p_end || p0 == 0.0 {
+        return Err(ContinuationError::Invalid(format!(
+            "the range from {p0} to {p_end} is empty or not finite (and the start must be nonzero)"
+        )));
+    }
+    for (name, value) in [
+        ("ds", opts.ds),
+        ("ds_min", opts.ds_min),
+        ("ds_max", opts.ds_max),
+    ] {
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(ContinuationError::Invalid(format!(
+                "{name} = {value}: must be finite and > 0"
+            )));
+        }
+    }
+    if opts.max_points < 2 {
+        return Err(ContinuationError::Invalid(format!(
+            "max_points = {}: at least 2",
+            opts.max_points
+        )));
+    }
+    opts.step.validate()
+}
+
+/// Whether the step from `previous` to `current` (scaled unknowns) passes
+/// through the point `origin`: within a quarter step of the chord (a chord
+/// of the same curve deviates from it by O(curvature × step²)) and, if the
+/// origin's tangent is given, in the same direction.
+fn returns_to(z0: &[f64], t0: Option<&[f64]>, previous: &[f64], current: &Evaluated) -> bool {
+    let z1 = &current.solved.z;
+    let chord: Vec<f64> = z1.iter().zip(previous).map(|(b, a)| b - a).collect();
+    let len2: f64 = chord.iter().map(|c| c * c).sum();
+    if len2 == 0.0 {
+        return false;
+    }
+    let along: f64 = z0
+        .iter()
+        .zip(previous)
+        .zip(&chord)
+        .map(|((z, a), c)| (z - a) * c)
+        .sum::<f64>()
+        / len2;
+    let dist2: f64 = z0
+        .iter()
+        .zip(previous)
+        .zip(&chord)
+        .map(|((z, a), c)| (z - a - along.clamp(0.0, 1.0) * c).powi(2))
+        .sum();
+    let aligned = t0.is_none_or(|t0| {
+        t0.iter()
+            .zip(&current.tangent)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            > 0.5
+    });
+    (0.0..=1.0).contains(&along) && dist2 <= 0.0625 * len2 && aligned
+}
+
+/// Distance between two spectra (each closed under conjugation): the
+/// Hausdorff distance with `d(a, b) = |a - b| / max(1/2, min(|a|, |b|))`,
+/// absolute near and inside the unit circle and relative for large
+/// multipliers.
+pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
+    let d = |x: &Complex<f64>, y: &Complex<f64>| (x - y).norm() / x.norm().min(y.norm()).max(0.5);
+    let one_way = |p: &[Complex<f64>], q: &[Complex<f64>]| {
+        p.iter()
+            .map(|x| q.iter().map(|y| d(x, y)).fold(f64::INFINITY, f64::min))
+            .fold(0.0, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
+}

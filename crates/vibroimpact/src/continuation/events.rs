@@ -1,0 +1,200 @@
+//! Special points of a branch as events: test functions evaluated at every
+//! point ([`TestValues`]), the [`BranchEvent`] trait that says whether an
+//! event lies between two consecutive points (the built-in kinds — fold,
+//! branch point, period doubling, Neimark–Sacker, grazing — and user
+//! conditions on a point, [`UserEvent`]), and their location by bisection
+//! of the arclength.
+
+use nalgebra::{Complex, DMatrix};
+
+use super::problem::{Evaluated, Problem};
+use super::{BranchPoint, SpecialKind};
+use crate::model::Model;
+
+/// The values of the built-in test functions at a point of a branch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TestValues {
+    /// Parameter component of the unit tangent (changes sign at a fold).
+    pub tangent_p: f64,
+    /// `det [J; t]` of the extended system (changes sign at a branch point).
+    pub det_ext: f64,
+    /// det(DG + I) of the symmetric half map (an eigenvalue -1 of DG is a
+    /// symmetry-breaking pitchfork); 1 off the half map.
+    pub det_sym: f64,
+    /// det(Φ + I) (changes sign at a period doubling).
+    pub det_pd: f64,
+    /// Multipliers outside the unit circle.
+    pub outside: usize,
+    /// Impacts per period.
+    pub impacts: usize,
+}
+
+impl TestValues {
+    /// The test values from the extended Jacobian `jac`, the tangent `t`,
+    /// the monodromy matrix (of the half map if `symmetric`), its
+    /// multipliers and the impacts per period.
+    pub(super) fn at(
+        jac: &DMatrix<f64>,
+        t: &[f64],
+        monodromy: &DMatrix<f64>,
+        multipliers: &[Complex<f64>],
+        impacts: usize,
+        symmetric: bool,
+    ) -> TestValues {
+        let d = jac.nrows();
+        let mut a = DMatrix::zeros(d + 1, d + 1);
+        a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
+        for c in 0..=d {
+            a[(d, c)] = t[c];
+        }
+        let identity = DMatrix::<f64>::identity(d, d);
+        // Φ + I; on the half map Φ = DG².
+        let (det_sym, pd) = if symmetric {
+            (
+                (monodromy + &identity).determinant(),
+                monodromy * monodromy + &identity,
+            )
+        } else {
+            (1.0, monodromy + &identity)
+        };
+        TestValues {
+            tangent_p: t[d],
+            det_ext: a.determinant(),
+            det_sym,
+            det_pd: pd.determinant(),
+            outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
+            impacts,
+        }
+    }
+}
+
+/// A point of a branch as an event sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct Observed<'a> {
+    /// The built-in test values.
+    pub tests: &'a TestValues,
+    /// The point itself (parameter, state, amplitudes, multipliers).
+    pub point: &'a BranchPoint,
+}
+
+/// A condition whose occurrence between consecutive points of a branch is
+/// detected and then located (to the continuation's `locate_tol` in the
+/// parameter) by bisection of the arclength.
+pub trait BranchEvent {
+    /// The kind reported (and the label prefix).
+    fn kind(&self) -> SpecialKind;
+    /// Whether the event lies between the points `a` and `b`.
+    fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool;
+}
+
+/// The built-in special points, from the test values.
+impl BranchEvent for SpecialKind {
+    fn kind(&self) -> SpecialKind {
+        *self
+    }
+
+    fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool {
+        match self {
+            SpecialKind::Fold => a.tests.tangent_p.signum() != b.tests.tangent_p.signum(),
+            SpecialKind::BranchPoint => {
+                (a.tests.det_ext.signum() != b.tests.det_ext.signum()
+                    && a.tests.tangent_p.signum() == b.tests.tangent_p.signum())
+                    || a.tests.det_sym.signum() != b.tests.det_sym.signum()
+            }
+            SpecialKind::PeriodDoubling => a.tests.det_pd.signum() != b.tests.det_pd.signum(),
+            // A change of the number of multipliers outside the circle that no
+            // real crossing at +1 (fold, branch point) or -1 (period doubling)
+            // explains: a complex pair crossed. (Two real multipliers that
+            // collide and turn complex outside the circle change nothing.)
+            SpecialKind::NeimarkSacker => {
+                a.tests.outside != b.tests.outside
+                    && a.tests.det_pd.signum() == b.tests.det_pd.signum()
+                    && a.tests.det_ext.signum() == b.tests.det_ext.signum()
+                    && a.tests.det_sym.signum() == b.tests.det_sym.signum()
+                    && a.tests.tangent_p.signum() == b.tests.tangent_p.signum()
+            }
+            SpecialKind::Grazing => a.tests.impacts != b.tests.impacts,
+            // User conditions are events of their own (UserEvent).
+            SpecialKind::User => false,
+        }
+    }
+}
+
+/// A user condition: an event where `g(point)` changes sign, e.g. an
+/// amplitude reaching a level (`|u_1| = 5 mm`) or the parameter passing a
+/// value of interest. Reported as [`SpecialKind::User`] (labels `UZ1`, …).
+pub struct UserEvent<G>(pub G);
+
+impl<G: Fn(&BranchPoint) -> f64> BranchEvent for UserEvent<G> {
+    fn kind(&self) -> SpecialKind {
+        SpecialKind::User
+    }
+
+    fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool {
+        (self.0)(a.point).signum() != (self.0)(b.point).signum()
+    }
+}
+
+/// The built-in events, in the order they are reported within a step.
+pub(super) const BUILT_IN: [SpecialKind; 5] = [
+    SpecialKind::Fold,
+    SpecialKind::BranchPoint,
+    SpecialKind::PeriodDoubling,
+    SpecialKind::NeimarkSacker,
+    SpecialKind::Grazing,
+];
+
+impl Evaluated {
+    /// The point as an event sees it.
+    pub(super) fn observed(&self) -> Observed<'_> {
+        Observed {
+            tests: &self.tests,
+            point: &self.point,
+        }
+    }
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+    /// Bisection of the arclength in (0, ds) from `a` for the event that
+    /// occurs before `b`; returns the located point.
+    pub(super) fn locate(
+        &mut self,
+        event: &dyn BranchEvent,
+        a: &Evaluated,
+        b: &Evaluated,
+        ds: f64,
+    ) -> Option<Evaluated> {
+        let (mut lo, mut hi) = (0.0, ds);
+        let (mut p_lo, mut p_hi) = (a.point.parameter, b.point.parameter);
+        let mut best: Option<Evaluated> = None;
+        let mut lo_point: Option<Evaluated> = None;
+        for _ in 0..80 {
+            if (p_hi - p_lo).abs() <= self.opts.locate_tol && best.is_some() {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            let pred: Vec<f64> = a
+                .solved
+                .z
+                .iter()
+                .zip(&a.tangent)
+                .map(|(z, t)| z + mid * t)
+                .collect();
+            let (solved, _) = self.correct(&pred, &a.tangent)?;
+            let e = self.evaluate(solved, &a.tangent)?;
+            if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {
+                hi = mid;
+                p_hi = e.point.parameter;
+            } else {
+                lo = mid;
+                p_lo = e.point.parameter;
+                lo_point = Some(e.clone());
+            }
+            best = Some(e);
+            if hi - lo < 1e-14 {
+                break;
+            }
+        }
+        best
+    }
+}

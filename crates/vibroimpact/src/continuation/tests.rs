@@ -1,0 +1,376 @@
+//! Tests of continuation: the linear limit, the R2 branches against
+//! AUTO-07p and brute force, branch switching.
+use super::*;
+use crate::periodic::{orbit_summary, period_map, shoot};
+use crate::simulate::{simulate, SimulationOptions};
+
+use crate::reference::NATURAL_FREQUENCY as W0;
+
+fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
+    crate::reference::r2(n, clearance, omega).map_err(|e| e.to_string())
+}
+
+/// R3 along a branch: amplitude equals the exact steady state, no
+/// special points, all stable.
+#[test]
+fn linear_branch_is_exact() {
+    let family = |w: f64| r2(2, 1e3, w);
+    let opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            rtol: 1e-12,
+            tol: 1e-10,
+            displacement_scale: 1e-2,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let b = continue_branch(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts, |_| true).unwrap();
+    assert_eq!(b.stop, StopReason::ReachedEnd);
+    assert!(
+        b.special.is_empty(),
+        "{:?}",
+        b.special.iter().map(|s| &s.label).collect::<Vec<_>>()
+    );
+    assert!(b.points.len() > 10);
+    for p in &b.points {
+        let w = p.parameter;
+        let exact = crate::reference::r3_steady_amplitude(w);
+        // The exact extremum (located on the dense output).
+        assert!(
+            (p.max_displacement[0] / exact - 1.0).abs() < 1e-8,
+            "at {w}: {} vs {exact}",
+            p.max_displacement[0]
+        );
+        assert!(p.stable);
+    }
+}
+
+/// The iterator on R3 with a user event: the amplitude of body 1 reaching
+/// the steady amplitude at 0.9 ω0 is found twice (below and above
+/// resonance) and located to the exact amplitude; the first step is the
+/// start, the last the stop reason; a user stop (dropping the iterator)
+/// needs no special handling.
+#[test]
+fn iterator_steps_and_user_event() {
+    let level = crate::reference::r3_steady_amplitude(0.9 * W0);
+    let opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            rtol: 1e-12,
+            tol: 1e-10,
+            displacement_scale: 1e-2,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let family = |w: f64| r2(2, 1e3, w);
+    let steps = Continuation::new(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts)
+        .unwrap()
+        .with_event(Box::new(UserEvent(move |p: &BranchPoint| {
+            p.max_displacement[0] - level
+        })));
+    let all: Vec<BranchStep> = steps.collect();
+    match (all.first(), all.last()) {
+        (Some(BranchStep::Point { point, special }), Some(BranchStep::Stop(reason))) => {
+            assert_eq!(point.parameter, 0.8 * W0);
+            assert!(special.is_empty());
+            assert_eq!(*reason, StopReason::ReachedEnd);
+        }
+        other => panic!("unexpected ends {other:?}"),
+    }
+    let user: Vec<&SpecialPoint> = all
+        .iter()
+        .flat_map(|s| match s {
+            BranchStep::Point { special, .. } => special.iter().collect(),
+            BranchStep::Stop(_) => Vec::new(),
+        })
+        .collect();
+    assert_eq!(user.len(), 2, "{user:?}");
+    assert_eq!(
+        (user[0].label.as_str(), user[1].label.as_str()),
+        ("UZ1", "UZ2")
+    );
+    assert!((user[0].parameter / (0.9 * W0) - 1.0).abs() < 1e-7);
+    assert!(user[1].parameter > W0);
+    for u in user {
+        assert_eq!(u.kind, SpecialKind::User);
+        let amplitude = crate::reference::r3_steady_amplitude(u.parameter);
+        assert!(
+            (amplitude / level - 1.0).abs() < 1e-6,
+            "{amplitude} vs {level}"
+        );
+    }
+    // Taking only the first three steps computes no more than that.
+    let first: Vec<BranchStep> = Continuation::new(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts)
+        .unwrap()
+        .take(3)
+        .collect();
+    assert_eq!(first.len(), 3);
+}
+
+/// AUTO-07p's special points of the R2, N = 2 branch (bench/auto,
+/// Ω/ω0): six symmetry-breaking branch points and a torus bifurcation.
+const AUTO_BP: [f64; 6] = [0.983100, 0.949393, 0.794528, 0.552497, 0.534043, 0.509475];
+const AUTO_TR: f64 = 0.502479;
+
+fn r2_branch(from: f64, to: f64) -> Branch {
+    let family = |w: f64| r2(2, 1e-3, w);
+    let start = r2(2, 1e-3, from * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let opts = ContinuationOptions::default();
+    continue_branch(family, from * W0, &guess, to * W0, &opts, |_| true).unwrap()
+}
+
+/// R2, N = 2 (a mirror-symmetric row): the branch from 1.5 ω0 down is
+/// followed on the half map and has exactly AUTO-07p's special points
+/// (plus grazing, which AUTO does not detect), located from either
+/// direction to the same values; stable points agree with brute-force
+/// simulation.
+#[test]
+fn r2_symmetric_branch_matches_auto() {
+    let down = r2_branch(1.5, 0.5);
+    assert_eq!(down.stop, StopReason::ReachedEnd);
+    // The branch runs from one end of the range exactly to the other.
+    let ends = |b: &Branch| {
+        let p = |q: &BranchPoint| q.parameter / W0;
+        (p(&b.points[0]), p(b.points.last().expect("points")))
+    };
+    let (first, last) = ends(&down);
+    assert!(
+        (first - 1.5).abs() < 1e-12 && (last - 0.5).abs() < 1e-12,
+        "{first}..{last}"
+    );
+    assert!(down.symmetric);
+    let of = |b: &Branch, kind| {
+        b.special
+            .iter()
+            .filter(|s| s.kind == kind)
+            .map(|s| s.parameter / W0)
+            .collect::<Vec<f64>>()
+    };
+    let bps = of(&down, SpecialKind::BranchPoint);
+    assert_eq!(bps.len(), AUTO_BP.len(), "{bps:?}");
+    for (ours, auto) in bps.iter().zip(AUTO_BP) {
+        // AUTO's collocation (NTST 300) agrees to ~5e-6.
+        assert!((ours / auto - 1.0).abs() < 2e-5, "BP {ours} vs AUTO {auto}");
+    }
+    let ns = of(&down, SpecialKind::NeimarkSacker);
+    assert_eq!(ns.len(), 1);
+    assert!((ns[0] / AUTO_TR - 1.0).abs() < 2e-5, "NS {}", ns[0]);
+    assert!(of(&down, SpecialKind::Fold).is_empty());
+    assert!(of(&down, SpecialKind::PeriodDoubling).is_empty());
+    for s in down
+        .special
+        .iter()
+        .filter(|s| s.kind == SpecialKind::BranchPoint)
+    {
+        assert!(s.symmetry_breaking);
+        let near_one = s
+            .multipliers
+            .iter()
+            .map(|m| (m - Complex::new(1.0, 0.0)).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(near_one < 1e-4, "{}: {:?}", s.label, s.multipliers);
+    }
+    // Every point is symmetric: u1 and u2 have the same amplitude (to
+    // 1e-7 where the orbit is unstable with multipliers ~200, 4e-8 on
+    // stable ones: integration at rtol 1e-10 through contact pulses).
+    for p in &down.points {
+        let (a, b) = (p.max_displacement[0], p.max_displacement[1]);
+        assert!((a - b).abs() < 1e-6 * a, "{}: {a} vs {b}", p.parameter);
+    }
+    // The same special points from 0.5 ω0 upward.
+    let up = r2_branch(0.5, 1.5);
+    assert_eq!(up.stop, StopReason::ReachedEnd);
+    let (first, last) = ends(&up);
+    assert!(
+        (first - 0.5).abs() < 1e-12 && (last - 1.5).abs() < 1e-12,
+        "{first}..{last}"
+    );
+    let mut a: Vec<(SpecialKind, f64)> =
+        down.special.iter().map(|s| (s.kind, s.parameter)).collect();
+    let b: Vec<(SpecialKind, f64)> = up.special.iter().map(|s| (s.kind, s.parameter)).collect();
+    a.reverse();
+    assert_eq!(a.len(), b.len(), "{a:?} vs {b:?}");
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.0, y.0);
+        let tol = if x.0 == SpecialKind::Grazing {
+            1e-4
+        } else {
+            1e-7
+        };
+        assert!((x.1 / y.1 - 1.0).abs() < tol, "{x:?} vs {y:?}");
+    }
+    // Stable points agree with brute-force simulation.
+    let stable: Vec<&BranchPoint> = down
+        .points
+        .iter()
+        .filter(|p| p.stable && p.spectral_radius() < 0.95)
+        .step_by(15)
+        .take(3)
+        .collect();
+    assert!(stable.len() >= 2);
+    for p in stable {
+        assert_brute_force_agrees(p);
+    }
+}
+
+/// Simulation from a 0.1 % perturbation of the orbit settles back on it:
+/// max |u_i| to 1e-6. (A larger perturbation can leave the basin: below
+/// 0.51 ω0 the symmetric orbit coexists with other attractors, and a 1 %
+/// kick lands on one with max |u| 11 % smaller.)
+fn assert_brute_force_agrees(p: &BranchPoint) {
+    let model = r2(2, 1e-3, p.parameter).unwrap();
+    let t = 2.0 * std::f64::consts::PI / p.parameter;
+    let sim = simulate(
+        &model,
+        &SimulationOptions {
+            t_end: 400.0 * t,
+            rtol: 1e-11,
+            atol: 1e-15,
+            start: Some(p.state.iter().map(|x| x * 0.999).collect()),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let end: Vec<f64> = sim.final_state();
+    let orbit = orbit_summary(&model, &end, t, 256, 1e-11).unwrap();
+    for i in 0..2 {
+        assert!(
+            (orbit.max_displacement[i] - p.max_displacement[i]).abs()
+                < 1e-6 * p.max_displacement[i].max(1e-3),
+            "at {}: {} vs {}",
+            p.parameter,
+            orbit.max_displacement[i],
+            p.max_displacement[i]
+        );
+    }
+}
+
+/// Switching at the first two pitchforks onto the asymmetric branches:
+/// a period doubling confirmed by the period-2 orbit next to it, a fold
+/// confirmed by the change of stability on either side.
+#[test]
+fn r2_asymmetric_branches_fold_and_period_doubling() {
+    let family = |w: f64| r2(2, 1e-3, w);
+    let main = r2_branch(1.5, 0.9);
+    let opts = ContinuationOptions {
+        max_points: 45,
+        bounds: Some((0.5 * W0, 1.5 * W0)),
+        ..Default::default()
+    };
+    let switched = |label: &str| {
+        let bp = main.special.iter().find(|s| s.label == label).unwrap();
+        let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+        let model = r2(2, 1e-3, p).unwrap();
+        // Off the symmetric branch: the two bodies move differently.
+        let orbit = orbit_summary(&model, &x, 2.0 * std::f64::consts::PI / p, 256, 1e-11).unwrap();
+        let (a, b) = (orbit.max_displacement[0], orbit.max_displacement[1]);
+        assert!((a - b).abs() > 1e-7, "{label}: still symmetric ({a} {b})");
+        let b = continue_branch(family, p, &x, 0.5 * W0, &opts, |_| true).unwrap();
+        assert!(!b.symmetric);
+        b
+    };
+    let unstable_count = |p: &BranchPoint| p.multipliers.iter().filter(|m| m.norm() > 1.0).count();
+    // BP1 (0.9831 ω0): a period doubling at 0.97820 ω0.
+    let b1 = switched("BP1");
+    let pd = b1
+        .special
+        .iter()
+        .find(|s| s.kind == SpecialKind::PeriodDoubling)
+        .expect("a period doubling");
+    assert!(
+        (pd.parameter / W0 - 0.978202).abs() < 1e-5,
+        "{}",
+        pd.parameter / W0
+    );
+    assert!(
+        pd.multipliers
+            .iter()
+            .any(|m| (m.re + 1.0).abs() < 1e-3 && m.im.abs() < 1e-6),
+        "{:?}",
+        pd.multipliers
+    );
+    // Its stable points (between the pitchfork and the period doubling)
+    // agree with brute-force simulation as well.
+    let stable: Vec<&BranchPoint> = b1
+        .points
+        .iter()
+        .filter(|p| p.stable && p.spectral_radius() < 0.95)
+        .collect();
+    assert!(!stable.is_empty());
+    for p in stable.iter().step_by(stable.len().div_ceil(2).max(1)) {
+        assert_brute_force_agrees(p);
+    }
+    let (p2, x2) = period_doubled_start(family, pd, &opts).unwrap();
+    assert!((p2 / pd.parameter - 1.0).abs() < 0.02);
+    let model = r2(2, 1e-3, p2).unwrap();
+    let two = shoot(
+        &model,
+        &x2,
+        &ShootingOptions {
+            subharmonic: 2,
+            ..opts.shooting.clone()
+        },
+    )
+    .unwrap();
+    assert!(two.converged);
+    let one = period_map(&model, &two.initial_state, &opts.shooting).unwrap();
+    let gap = one
+        .image
+        .iter()
+        .zip(&two.initial_state)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(gap > 1e-7, "the period-2 orbit is period-1 (gap {gap:e})");
+    // BP2 (0.9494 ω0): a fold at 0.91225 ω0, stability changes across it.
+    let b2 = switched("BP2");
+    let fold = b2
+        .special
+        .iter()
+        .find(|s| s.kind == SpecialKind::Fold)
+        .expect("a fold");
+    assert!((fold.parameter / W0 - 0.912249).abs() < 1e-5);
+    let (a, c) = (
+        &b2.points[fold.after_point],
+        &b2.points[fold.after_point + 1],
+    );
+    assert_ne!(
+        unstable_count(a),
+        unstable_count(c),
+        "fold at {}",
+        fold.parameter
+    );
+}
+
+/// The asymmetric branch from BP2 (0.9494 ω0) is a connection: it meets
+/// the symmetric branch again at BP3 (AUTO: 0.794528 ω0), where it turns
+/// (a fold of the pitchfork) onto its mirror image; the continuation
+/// stops there as a closed loop instead of retracing the mirror.
+#[test]
+fn r2_asymmetric_branch_connects_bp2_to_bp3() {
+    let family = |w: f64| r2(2, 1e-3, w);
+    let main = r2_branch(1.5, 0.9);
+    let opts = ContinuationOptions {
+        max_points: 3000,
+        bounds: Some((0.5 * W0, 1.5 * W0)),
+        ..Default::default()
+    };
+    let bp = main.special.iter().find(|s| s.label == "BP2").unwrap();
+    let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+    let b = continue_branch(family, p, &x, 0.5 * W0, &opts, |_| true).unwrap();
+    assert_eq!(b.stop, StopReason::ClosedLoop);
+    let last = b.special.last().expect("special points");
+    assert_eq!(last.kind, SpecialKind::Fold);
+    assert!(
+        (last.parameter / W0 / AUTO_BP[2] - 1.0).abs() < 2e-5,
+        "{}",
+        last.parameter / W0
+    );
+    // At the fold the orbit is (nearly) symmetric again.
+    let model = r2(2, 1e-3, last.parameter).unwrap();
+    let period = 2.0 * std::f64::consts::PI / last.parameter;
+    let at = orbit_summary(&model, &last.state, period, 256, 1e-11).unwrap();
+    let (u1, u2) = (at.max_displacement[0], at.max_displacement[1]);
+    assert!((u1 - u2).abs() < 1e-3 * u1, "{u1} vs {u2}");
+    assert!(b.points.len() < 1500, "{} points", b.points.len());
+}
