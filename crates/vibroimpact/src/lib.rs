@@ -21,7 +21,7 @@
 //! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
 //! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
 //! - [`parameter`]: a numeric key of a model file made a parameter;
-//! - [`reference`]: the reference problems R1–R3 (`docs/theory.md` §6);
+//! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
 //! - [`results`]: the documents of results (the CLI's JSON, Python's
 //!   result objects);
 //! - [`integrate`]: the integrators (DOP853, RODAS) shared by every time
