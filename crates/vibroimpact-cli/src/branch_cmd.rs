@@ -221,7 +221,8 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::new(format!(
-            "Newton did not converge (residual history {:?})",
+            "Newton did not converge: {} (residual history {:?})",
+            sol.stop.explanation(),
             sol.residual_history
                 .iter()
                 .map(|r| format!("{r:.2e}"))

@@ -15,6 +15,7 @@
 //! - [`dynamics`]: the equations of motion with their banded Jacobian;
 //! - [`simulate`]: time histories with an impact log;
 //! - [`variational`]: sensitivities and monodromy matrices (§5);
+//! - [`newton`]: the damped Newton method of every periodic solve;
 //! - [`periodic`]: periodic solutions by shooting, Floquet multipliers;
 //! - [`continuation`]: branches of periodic solutions and their special
 //!   points;
@@ -39,6 +40,7 @@ pub mod impact;
 pub mod integrate;
 pub mod model;
 pub mod model_file;
+pub mod newton;
 pub mod numeric;
 pub mod parameter;
 pub mod periodic;

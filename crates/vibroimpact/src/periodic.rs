@@ -28,6 +28,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use crate::dynamics::{from_interleaved, interleaved_index, to_interleaved, ChainDynamics};
 use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, Interrupt};
 use crate::model::Model;
+use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::simulate::{simulate, OptionsError, SimulationOptions};
 use crate::variational::Variational;
 
@@ -126,6 +127,8 @@ pub struct PeriodMap {
 pub struct PeriodicSolution {
     /// Whether Newton converged.
     pub converged: bool,
+    /// Why Newton ended ([`NewtonStop::explanation`] says what to do).
+    pub stop: NewtonStop,
     /// Period nT (s).
     pub period: f64,
     /// The state at t = 0 (body order); the last iterate if not converged.
@@ -291,26 +294,133 @@ fn scaled_norm(r: &[f64], scale: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Backtracking along a Newton direction: tries λ = λ0, λ0/2, … (12 times)
-/// and returns the first trial whose scaled residual `trial(λ)` reports
-/// below `norm` (or below `tol`). `trial` returns `Ok(None)` for a trial to
-/// skip (e.g. an integration that failed at a large λ) and `Err` to stop.
-fn backtrack<S, E>(
-    lambda0: f64,
-    norm: f64,
-    tol: f64,
-    mut trial: impl FnMut(f64) -> Result<Option<(S, f64)>, E>,
-) -> Result<Option<(S, f64)>, E> {
-    let mut lambda = lambda0;
-    for _ in 0..12 {
-        if let Some((state, tn)) = trial(lambda)? {
-            if tn < norm || tn <= tol {
-                return Ok(Some((state, tn)));
-            }
-        }
-        lambda *= 0.5;
+/// The damped Newton options of shooting: a trust region of half a
+/// displacement scale per iteration (a full Newton step can land deep
+/// inside a contact, where e^{αs} makes the period map astronomically
+/// stiff), with a line search.
+fn newton_options(opts: &ShootingOptions) -> NewtonOptions {
+    NewtonOptions {
+        tol: opts.tol,
+        max_iterations: opts.max_iterations,
+        max_step: TRUST,
+        line_search: true,
+        stall: None,
     }
-    Ok(None)
+}
+
+/// Shooting with the dense monodromy matrix: residual `P(x) − x`,
+/// direction from the LU factors of `Φ − I`.
+struct DenseShooting<'a> {
+    model: &'a Model,
+    opts: &'a ShootingOptions,
+    scale: Vec<f64>,
+    /// Newton iterations so far (for error reports).
+    iteration: usize,
+}
+
+impl NewtonSystem for DenseShooting<'_> {
+    /// The period map and the residual `P(x) − x` (unscaled).
+    type Point = (PeriodMap, Vec<f64>);
+    type Error = PeriodicError;
+
+    fn evaluate(&mut self, x: &[f64]) -> Result<Self::Point, PeriodicError> {
+        let map =
+            period_map(self.model, x, self.opts).map_err(|source| PeriodicError::Integration {
+                iteration: self.iteration,
+                source,
+            })?;
+        let r = map.image.iter().zip(x).map(|(p, x)| p - x).collect();
+        Ok((map, r))
+    }
+
+    fn residual_norm(&self, (_, r): &Self::Point) -> f64 {
+        scaled_norm(r, &self.scale)
+    }
+
+    fn direction(
+        &mut self,
+        _x: &[f64],
+        (map, r): &Self::Point,
+    ) -> Result<Option<Vec<f64>>, PeriodicError> {
+        self.iteration += 1;
+        let d = r.len();
+        let a = &map.monodromy - DMatrix::<f64>::identity(d, d);
+        let rhs = DVector::from_iterator(d, r.iter().map(|v| -v));
+        Ok(a.lu().solve(&rhs).map(|delta| delta.as_slice().to_vec()))
+    }
+
+    fn step_norm(&self, delta: &[f64]) -> f64 {
+        scaled_norm(delta, &self.scale)
+    }
+
+    /// A failed integration at a large trial step is skipped (the step may
+    /// reach far into a contact); at `λ <= 1e-3` it is an error.
+    fn skip_failed_trial(&self, lambda: f64, _error: &PeriodicError) -> bool {
+        lambda > 1e-3
+    }
+}
+
+/// Matrix-free Newton–Krylov shooting: residual `P(x) − x` (scaled), the
+/// direction by GMRES on the monodromy operator to a relative residual of
+/// 1e-3 (inexact Newton).
+struct KrylovShooting<'a> {
+    model: &'a Model,
+    opts: &'a ShootingOptions,
+    scale: &'a [f64],
+    /// Newton iterations so far (for error reports).
+    iteration: usize,
+}
+
+impl NewtonSystem for KrylovShooting<'_> {
+    /// The scaled residual.
+    type Point = Vec<f64>;
+    type Error = PeriodicError;
+
+    fn evaluate(&mut self, x: &[f64]) -> Result<Vec<f64>, PeriodicError> {
+        let mut op = MonodromyOperator {
+            model: self.model,
+            x: x.to_vec(),
+            opts: self.opts,
+            products: 0,
+        };
+        let (image, _) =
+            op.apply(&vec![0.0; x.len()])
+                .map_err(|source| PeriodicError::Integration {
+                    iteration: self.iteration,
+                    source,
+                })?;
+        Ok((0..x.len())
+            .map(|i| (image[i] - x[i]) / self.scale[i])
+            .collect())
+    }
+
+    fn residual_norm(&self, r: &Vec<f64>) -> f64 {
+        r.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    fn direction(&mut self, x: &[f64], r: &Vec<f64>) -> Result<Option<Vec<f64>>, PeriodicError> {
+        self.iteration += 1;
+        let mut op = MonodromyOperator {
+            model: self.model,
+            x: x.to_vec(),
+            opts: self.opts,
+            products: 0,
+        };
+        let b: Vec<f64> = r.iter().map(|v| -v).collect();
+        let (delta, _, _) = gmres(&mut op, &b, self.scale, 60, 1e-3).map_err(|source| {
+            PeriodicError::Integration {
+                iteration: self.iteration,
+                source,
+            }
+        })?;
+        Ok(Some(
+            delta.iter().zip(self.scale).map(|(d, s)| d * s).collect(),
+        ))
+    }
+
+    fn step_norm(&self, delta: &[f64]) -> f64 {
+        scaled_norm(delta, self.scale)
+    }
 }
 
 /// Finds a periodic solution of period nT near `guess` (body order) by
@@ -334,63 +444,14 @@ pub fn shoot(
             "shooting: rtol, tol and displacement scale must be > 0".into(),
         ));
     }
-    let scale = scales(model, opts);
-    let mut x = guess.to_vec();
-    let mut history = Vec::new();
-    let eval = |x: &[f64], iteration: usize| {
-        period_map(model, x, opts)
-            .map_err(|source| PeriodicError::Integration { iteration, source })
+    let mut sys = DenseShooting {
+        model,
+        opts,
+        scale: scales(model, opts),
+        iteration: 0,
     };
-    let mut map = eval(&x, 0)?;
-    let residual = |map: &PeriodMap, x: &[f64]| -> Vec<f64> {
-        map.image.iter().zip(x).map(|(p, x)| p - x).collect()
-    };
-    let mut r = residual(&map, &x);
-    let mut norm = scaled_norm(&r, &scale);
-    history.push(norm);
-    let mut converged = norm <= opts.tol;
-    let mut iteration = 0;
-    while !converged && iteration < opts.max_iterations {
-        iteration += 1;
-        let a = &map.monodromy - DMatrix::<f64>::identity(d, d);
-        let Some(delta) = a
-            .lu()
-            .solve(&DVector::from_iterator(d, r.iter().map(|v| -v)))
-        else {
-            break; // singular Newton matrix (a multiplier at +1): report non-convergence
-        };
-        // Trust region: at most half a displacement scale per iteration (a
-        // full Newton step can land deep inside a contact, where e^{αs}
-        // makes the period map astronomically stiff).
-        let step = scaled_norm(delta.as_slice(), &scale);
-        let found = backtrack((TRUST / step).min(1.0), norm, opts.tol, |lambda| {
-            let trial: Vec<f64> = x
-                .iter()
-                .zip(delta.iter())
-                .map(|(x, dx)| x + lambda * dx)
-                .collect();
-            let trial_map = match eval(&trial, iteration) {
-                Ok(m) => m,
-                Err(_) if lambda > 1e-3 => return Ok(None),
-                Err(e) => return Err(e),
-            };
-            let tr = residual(&trial_map, &trial);
-            let tn = scaled_norm(&tr, &scale);
-            Ok(Some(((trial, trial_map, tr), tn)))
-        })?;
-        let accepted = found.is_some();
-        if let Some(((trial, trial_map, tr), tn)) = found {
-            x = trial;
-            map = trial_map;
-            r = tr;
-            norm = tn;
-        }
-        history.push(norm);
-        if !accepted {
-            break;
-        }
-        converged = norm <= opts.tol;
-    }
+    let out = damped_newton(&mut sys, guess, &newton_options(opts))?;
+    let (map, _) = out.point;
     let multipliers = map_multipliers(&map.monodromy, opts.symmetric)?;
     let monodromy = if opts.symmetric {
         &map.monodromy * &map.monodromy
@@ -398,10 +459,11 @@ pub fn shoot(
         map.monodromy
     };
     Ok(PeriodicSolution {
-        converged,
+        converged: out.stop == NewtonStop::Converged,
+        stop: out.stop,
         period,
-        initial_state: x,
-        residual_history: history,
+        initial_state: out.x,
+        residual_history: out.history,
         monodromy,
         multipliers,
     })
@@ -558,59 +620,14 @@ pub fn shoot_krylov(
         )));
     }
     let scale = scales(model, opts);
-    let mut x = guess.to_vec();
-    let mut history = Vec::new();
-    let image = |x: &[f64], iteration: usize| -> Result<Vec<f64>, PeriodicError> {
-        let mut op = MonodromyOperator {
-            model,
-            x: x.to_vec(),
-            opts,
-            products: 0,
-        };
-        op.apply(&vec![0.0; d])
-            .map(|r| r.0)
-            .map_err(|source| PeriodicError::Integration { iteration, source })
+    let mut sys = KrylovShooting {
+        model,
+        opts,
+        scale: &scale,
+        iteration: 0,
     };
-    let p0 = image(&x, 0)?;
-    let mut r: Vec<f64> = (0..d).map(|i| (p0[i] - x[i]) / scale[i]).collect();
-    let mut norm = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    history.push(norm);
-    let mut converged = norm <= opts.tol;
-    let mut iteration = 0;
-    while !converged && iteration < opts.max_iterations {
-        iteration += 1;
-        let mut op = MonodromyOperator {
-            model,
-            x: x.clone(),
-            opts,
-            products: 0,
-        };
-        let b: Vec<f64> = r.iter().map(|v| -v).collect();
-        let (delta, _, _) = gmres(&mut op, &b, &scale, 60, 1e-3)
-            .map_err(|source| PeriodicError::Integration { iteration, source })?;
-        let step = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let found = backtrack((TRUST / step).min(1.0), norm, opts.tol, |lambda| {
-            let trial: Vec<f64> = (0..d)
-                .map(|i| x[i] + lambda * delta[i] * scale[i])
-                .collect();
-            Ok::<_, PeriodicError>(image(&trial, iteration).ok().map(|tp| {
-                let tr: Vec<f64> = (0..d).map(|i| (tp[i] - trial[i]) / scale[i]).collect();
-                let tn = tr.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                ((trial, tr), tn)
-            }))
-        })?;
-        let accepted = found.is_some();
-        if let Some(((trial, tr), tn)) = found {
-            x = trial;
-            r = tr;
-            norm = tn;
-        }
-        history.push(norm);
-        if !accepted {
-            break;
-        }
-        converged = norm <= opts.tol;
-    }
+    let out = damped_newton(&mut sys, guess, &newton_options(opts))?;
+    let (x, iteration) = (out.x, sys.iteration);
     // Dominant multipliers: Arnoldi on Φ (Ritz values of the Hessenberg
     // matrix of Φ - I, shifted back by 1), from a generic start vector.
     let mut op = MonodromyOperator {
@@ -628,10 +645,11 @@ pub fn shoot_krylov(
     let square = h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k);
     let multipliers = map_multipliers(&square, opts.symmetric)?;
     Ok(PeriodicSolution {
-        converged,
+        converged: out.stop == NewtonStop::Converged,
+        stop: out.stop,
         period,
         initial_state: x,
-        residual_history: history,
+        residual_history: out.history,
         monodromy: DMatrix::zeros(0, 0),
         multipliers,
     })

@@ -258,6 +258,7 @@ pub fn periodic_document(
         .collect();
     json!({
         "converged": sol.converged,
+        "newton_stop": sol.stop.name(),
         "method": if krylov { "newton-krylov (dominant multipliers by Arnoldi)" } else { "newton (dense monodromy)" },
         "period": sol.period,
         "subharmonic": subharmonic,

@@ -504,7 +504,7 @@ def periodic(
     )
     if not r.converged:
         e = VibroimpactError(
-            "Newton did not converge (residual history "
+            f"Newton did not converge ({r.newton_stop}; residual history "
             + str([f"{x:.2e}" for x in r.residual_history])
             + ")"
         )

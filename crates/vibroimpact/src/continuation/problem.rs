@@ -9,6 +9,7 @@ use super::events::TestValues;
 use super::{BranchPoint, ContinuationError, ContinuationOptions};
 use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
+use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
     forcing_period, map_multipliers, map_time, mirror, orbit_summary, period_map, ShootingOptions,
 };
@@ -91,41 +92,35 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         Some((g, jac, map.monodromy))
     }
 
-    /// Newton on [Ĝ(z) = 0, t·(z - z_pred) = 0] from `pred`. Returns the
-    /// solution and the iterations used.
+    /// Newton on [Ĝ(z) = 0, t·(z - z_pred) = 0] from `pred` (the shared
+    /// damped Newton, no line search, steps damped to
+    /// `step.corrector_max_step`, stagnation at the period map's noise
+    /// floor accepted). Returns the solution and the evaluations used.
     pub(super) fn correct(&mut self, pred: &[f64], t: &[f64]) -> Option<(Solved, usize)> {
-        let d = self.d;
-        let mut z = pred.to_vec();
-        let max_step = self.opts.step.corrector_max_step;
-        for it in 1..=self.opts.max_corrector {
-            let (g, jac, monodromy) = self.residual(&z)?;
-            let gn = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let mut a = DMatrix::zeros(d + 1, d + 1);
-            a.view_mut((0, 0), (d, d + 1)).copy_from(&jac);
-            for c in 0..=d {
-                a[(d, c)] = t[c];
-            }
-            let mut rhs = DVector::zeros(d + 1);
-            for r in 0..d {
-                rhs[r] = -g[r];
-            }
-            rhs[d] = -(0..=d).map(|c| t[c] * (z[c] - pred[c])).sum::<f64>();
-            if gn <= self.opts.shooting.tol && rhs[d].abs() <= self.opts.shooting.tol {
-                return Some((Solved { z, jac, monodromy }, it));
-            }
-            let delta = a.lu().solve(&rhs)?;
-            let step = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            // Stagnation at the period map's noise floor: the correction is
-            // negligible although the residual is a little above tol.
-            if step <= 1e-2 * self.opts.shooting.tol && gn <= 100.0 * self.opts.shooting.tol {
-                return Some((Solved { z, jac, monodromy }, it));
-            }
-            let lambda = (max_step / step).min(1.0);
-            for c in 0..=d {
-                z[c] += lambda * delta[c];
-            }
-        }
-        None
+        let opts = NewtonOptions {
+            tol: self.opts.shooting.tol,
+            max_iterations: self.opts.max_corrector.saturating_sub(1),
+            max_step: self.opts.step.corrector_max_step,
+            line_search: false,
+            // The correction is negligible although the residual is a
+            // little above tol.
+            stall: Some((1e-2, 100.0)),
+        };
+        let mut corrector = Corrector {
+            problem: self,
+            pred,
+            t,
+        };
+        let out = damped_newton(&mut corrector, pred, &opts).ok()?;
+        let (_, jac, monodromy, _) = out.point;
+        out.stop.eq(&NewtonStop::Converged).then_some((
+            Solved {
+                z: out.x,
+                jac,
+                monodromy,
+            },
+            out.evaluations,
+        ))
     }
 
     /// Unit tangent at a solution, oriented along `previous`.
@@ -252,5 +247,56 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         held[self.d] = 1.0;
         let (solved, _) = self.correct(&pred, &held)?;
         self.evaluate(solved, &a.tangent)
+    }
+}
+
+/// The pseudo-arclength corrector as a Newton system: unknowns z (scaled),
+/// residual `[Ĝ(z); t·(z − z_pred)]`, direction from the LU factors of
+/// `[Ĵ; tᵀ]`.
+struct Corrector<'p, 'a, F> {
+    problem: &'p mut Problem<F>,
+    pred: &'a [f64],
+    t: &'a [f64],
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
+    /// Ĝ(z), its Jacobian, Φ and the constraint residual.
+    type Point = (Vec<f64>, DMatrix<f64>, DMatrix<f64>, f64);
+    /// Any failure (model, integration) ends the correction.
+    type Error = ();
+
+    fn evaluate(&mut self, z: &[f64]) -> Result<Self::Point, ()> {
+        let (g, jac, monodromy) = self.problem.residual(z).ok_or(())?;
+        let c = (0..z.len())
+            .map(|i| self.t[i] * (z[i] - self.pred[i]))
+            .sum::<f64>();
+        Ok((g, jac, monodromy, c))
+    }
+
+    fn residual_norm(&self, (g, _, _, c): &Self::Point) -> f64 {
+        g.iter().fold(c.abs(), |m, v| m.max(v.abs()))
+    }
+
+    fn direction(
+        &mut self,
+        _z: &[f64],
+        (g, jac, _, c): &Self::Point,
+    ) -> Result<Option<Vec<f64>>, ()> {
+        let d = self.problem.d;
+        let mut a = DMatrix::zeros(d + 1, d + 1);
+        a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
+        for (col, &tc) in self.t.iter().enumerate() {
+            a[(d, col)] = tc;
+        }
+        let mut rhs = DVector::zeros(d + 1);
+        for (r, gr) in g.iter().enumerate() {
+            rhs[r] = -gr;
+        }
+        rhs[d] = -c;
+        Ok(a.lu().solve(&rhs).map(|delta| delta.as_slice().to_vec()))
+    }
+
+    fn step_norm(&self, delta: &[f64]) -> f64 {
+        delta.iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 }
