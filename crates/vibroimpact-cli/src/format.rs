@@ -3,6 +3,8 @@
 use clap::ValueEnum;
 use std::io::Write;
 
+use vibroimpact::model::Model;
+
 use crate::error::CliError;
 
 /// Output format of the commands.
@@ -85,4 +87,24 @@ pub fn print_rows(
     std::io::stdout()
         .write_all(text.as_bytes())
         .map_err(|e| CliError::new(format!("cannot write to standard output: {e}")))
+}
+
+/// CSV of sampled states: `t, u_<body>…, v_<body>…` (rows of `states` are
+/// `[u.., v..]` at `times`).
+pub fn history_csv(model: &Model, times: &[f64], states: &[f64]) -> Result<String, CliError> {
+    let n = model.bodies().len();
+    let mut columns: Vec<String> = vec!["t".into()];
+    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
+    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+    let rows: Vec<Vec<Option<f64>>> = times
+        .iter()
+        .enumerate()
+        .map(|(j, &t)| {
+            std::iter::once(Some(t))
+                .chain(states[j * 2 * n..(j + 1) * 2 * n].iter().map(|&x| Some(x)))
+                .collect()
+        })
+        .collect();
+    let cols: Vec<&str> = columns.iter().map(String::as_str).collect();
+    csv_text(&cols, &rows)
 }

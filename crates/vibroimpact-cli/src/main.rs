@@ -3,25 +3,26 @@
 //! Without arguments it runs the built-in default study and writes its
 //! report (see [`report`]); subcommands expose the library's computations.
 
-mod branch_cmd;
+mod args;
+mod commands;
 mod data;
 mod error;
+mod figures;
 mod format;
-mod identify_cmd;
-mod impact_cmd;
 mod interrupt;
+mod measurements;
 mod model_io;
 mod output;
 mod plot;
 mod progress;
 mod report;
-mod simulate_cmd;
-mod sweep_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use commands::{branch, identify, impact, simulate, sweep};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -38,23 +39,23 @@ struct Cli {
 enum Command {
     /// Two-body impact relations: restitution, peak force, contact duration.
     #[command(allow_negative_numbers = true)]
-    Impact(impact_cmd::ImpactArgs),
+    Impact(impact::ImpactArgs),
     /// Identify a/b and alpha of the exponential law from measured impacts.
     #[command(allow_negative_numbers = true)]
-    Identify(identify_cmd::IdentifyArgs),
+    Identify(identify::IdentifyArgs),
     /// Simulate a model file: time history, impact log, summary and plots.
     #[command(allow_negative_numbers = true)]
-    Simulate(simulate_cmd::SimulateArgs),
+    Simulate(simulate::SimulateArgs),
     /// Brute-force bifurcation diagram: Poincaré samples against a parameter.
     #[command(allow_negative_numbers = true)]
-    Sweep(sweep_cmd::SweepArgs),
+    Sweep(sweep::SweepArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
-    Periodic(branch_cmd::PeriodicArgs),
+    Periodic(branch::PeriodicArgs),
     /// Continue a branch of periodic solutions in a parameter (folds, branch
     /// points, period doublings, torus and grazing points).
     #[command(allow_negative_numbers = true)]
-    Continue(branch_cmd::ContinueArgs),
+    Continue(branch::ContinueArgs),
     /// Run the default study and write its report (same as no subcommand).
     Report {
         /// Report folder.
@@ -74,12 +75,12 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     let result = match &cli.command {
-        Some(Command::Impact(args)) => impact_cmd::run(args),
-        Some(Command::Identify(args)) => identify_cmd::run(args),
-        Some(Command::Simulate(args)) => simulate_cmd::run(args),
-        Some(Command::Periodic(args)) => branch_cmd::run_periodic(args),
-        Some(Command::Continue(args)) => branch_cmd::run_continue(args),
-        Some(Command::Sweep(args)) => sweep_cmd::run(args),
+        Some(Command::Impact(args)) => impact::run(args),
+        Some(Command::Identify(args)) => identify::run(args),
+        Some(Command::Simulate(args)) => simulate::run(args),
+        Some(Command::Periodic(args)) => branch::run_periodic(args),
+        Some(Command::Continue(args)) => branch::run_continue(args),
+        Some(Command::Sweep(args)) => sweep::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

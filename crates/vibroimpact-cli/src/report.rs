@@ -19,9 +19,10 @@ use vibroimpact::simulate::{simulate, SimulationOptions};
 
 use crate::error::CliError;
 use crate::format::csv_text;
-use crate::identify_cmd::{Identification, Measurements};
+use crate::measurements::Measurements;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use vibroimpact::identify::Identification;
 
 /// The example impact data shipped in `examples/seed-impacts/` (embedded so
 /// the default study runs from any directory).
@@ -951,7 +952,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
         }
         let mut all: Vec<(&Branch, &str)> = vec![(&branch, "symmetric (in-phase)")];
         all.extend(asymmetric.iter().map(|(b, name)| (b, name.as_str())));
-        let mut fig = crate::branch_cmd::branch_figure(
+        let mut fig = crate::figures::branch_figure(
             &all,
             &format!("Frequency response of the seed's row, N = {n}"),
             "forcing frequency Ω/ω0",

@@ -1074,3 +1074,73 @@ fn interrupted_sweep_keeps_complete_outputs() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+/// Ctrl-C in `simulate --out` keeps a complete, valid history up to the
+/// time reached (every row whole), the impact log and the summary, and no
+/// temporary file; the exit status says it was interrupted.
+#[test]
+fn interrupted_simulation_keeps_complete_outputs() {
+    let dir = temp_dir("simulate-interrupted");
+    let child = bin()
+        .args(["simulate", &repo_file("examples/fujita-row.toml")])
+        .args(["--periods", "1000000", "--format", "json", "--out"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // SAFETY: signalling our own child process.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+    }
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted (Ctrl-C) at t ="), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["completed"], false);
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let rows: Vec<&str> = history.lines().collect();
+    assert!(rows.len() > 100, "{} rows", rows.len());
+    for row in &rows[1..] {
+        let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
+        assert_eq!(cells.len(), 7, "{row}");
+    }
+    let t_last: f64 = rows
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(t_last <= summary["final_time"].as_f64().unwrap());
+    for f in [
+        "impacts.csv",
+        "summary.json",
+        "displacements.svg",
+        "phase_portrait.png",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    assert_clean_error(
+        &[
+            "simulate",
+            &repo_file("examples/fujita-row.toml"),
+            "--periods",
+            "2",
+            "--output-step",
+            "1e-300",
+            "--out",
+            &dir.display().to_string(),
+        ],
+        "more than 1e9",
+    );
+}

@@ -531,7 +531,14 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
 /// is refused up front rather than exhausting memory.
 pub const MAX_HISTORY_VALUES: f64 = 2.5e8;
 
-/// Simulates `model` from its initial state over `[0, opts.t_end]`.
+/// The most output samples a streamed history may have (a CSV of 10⁹ rows
+/// is tens of GB): more is refused up front.
+pub const MAX_SAMPLES: f64 = 1e9;
+
+/// Simulates `model` from its initial state over `[0, opts.t_end]`, keeping
+/// the sampled time history in [`Simulation::times`] and
+/// [`Simulation::states`] (refused up front beyond [`MAX_HISTORY_VALUES`]
+/// values; [`simulate_streaming`] has no such limit).
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
     if let Some(dt) = opts.output_step {
@@ -539,6 +546,37 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         if values > MAX_HISTORY_VALUES {
             return Err(OptionsError(format!(
                 "output step = {dt} s over {} s: the history would hold {values:.3e} values, more than {MAX_HISTORY_VALUES:e}; take a larger output step or a shorter duration",
+                opts.t_end
+            )));
+        }
+    }
+    let (mut times, mut states) = (Vec::new(), Vec::new());
+    let mut sim = simulate_streaming(model, opts, |t, state| {
+        times.push(t);
+        states.extend_from_slice(state);
+        true
+    })?;
+    (sim.times, sim.states) = (times, states);
+    Ok(sim)
+}
+
+/// Simulates `model` as [`simulate`] does, handing every output sample to
+/// `sink(t, [u.., v..])` instead of keeping it (the returned history is
+/// empty), so that a history of any length is written as it is computed in
+/// bounded memory. `sink` returns false to stop the simulation (e.g. when
+/// the disk is full); the result then ends there with
+/// [`IntegrationError::Interrupted`]. At most [`MAX_SAMPLES`] samples.
+pub fn simulate_streaming(
+    model: &Model,
+    opts: &SimulationOptions,
+    mut sink: impl FnMut(f64, &[f64]) -> bool,
+) -> Result<Simulation, OptionsError> {
+    check_options(opts)?;
+    if let Some(dt) = opts.output_step {
+        let samples = opts.t_end / dt + 1.0;
+        if samples > MAX_SAMPLES {
+            return Err(OptionsError(format!(
+                "output step = {dt} s over {} s: {samples:.3e} samples, more than {MAX_SAMPLES:e}; take a larger output step or a shorter duration",
                 opts.t_end
             )));
         }
@@ -594,17 +632,22 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         impacts: Vec::new(),
         previous: Vec::new(),
     };
-    let mut times = Vec::new();
-    let mut states = Vec::new();
     let mut buf = vec![0.0; y0.len()];
-    let record = |t: f64, y: &[f64], times: &mut Vec<f64>, states: &mut Vec<f64>| {
-        times.push(t);
-        states.extend((0..n2 / 2).map(|i| y[2 * i]));
-        states.extend((0..n2 / 2).map(|i| y[2 * i + 1]));
+    // One sample in body order [u.., v..].
+    let mut sample = vec![0.0; n2];
+    let mut record = |t: f64, y: &[f64]| {
+        for i in 0..n2 / 2 {
+            sample[i] = y[2 * i];
+            sample[n2 / 2 + i] = y[2 * i + 1];
+        }
+        sink(t, &sample)
     };
     let mut next_sample = 0usize;
+    let mut sink_stopped = None;
     if opts.output_step.is_some() {
-        record(0.0, &y0, &mut times, &mut states);
+        if !record(0.0, &y0) {
+            sink_stopped = Some(0.0);
+        }
         next_sample = 1;
     }
     let e0 = sys.mechanical_energy(&y0);
@@ -625,7 +668,7 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         (Some(window), None) => Some(ExtremaScan::new(window, n2 / 2, &st)),
         _ => None,
     };
-    while error.is_none() && st.t() < opts.t_end {
+    while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
             next_break += 1;
         }
@@ -660,10 +703,16 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
                     break;
                 }
                 st.dense_output(&mut sys, ts, &mut buf);
-                record(ts, &buf, &mut times, &mut states);
                 next_sample += 1;
+                if !record(ts, &buf) {
+                    sink_stopped = Some(ts);
+                    break;
+                }
             }
         }
+    }
+    if let (None, Some(t)) = (&error, sink_stopped) {
+        error = Some(IntegrationError::Interrupted { t });
     }
     let y = st.y().to_vec();
     let mut impacts = scan.impacts;
@@ -696,8 +745,8 @@ pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, O
         }
     });
     Ok(Simulation {
-        times,
-        states,
+        times: Vec::new(),
+        states: Vec::new(),
         final_time: st.t(),
         final_displacement: (0..n2 / 2).map(|i| y[2 * i]).collect(),
         final_velocity: (0..n2 / 2).map(|i| y[2 * i + 1]).collect(),

@@ -5,9 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::continuation::{
-    continue_branch, switch_branch, Branch, ContinuationOptions, SpecialKind,
-};
+use vibroimpact::continuation::{continue_branch, switch_branch, Branch, ContinuationOptions};
 use vibroimpact::model::Model;
 use vibroimpact::periodic::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary, shoot, shoot_krylov,
@@ -15,11 +13,11 @@ use vibroimpact::periodic::{
 };
 
 use crate::error::CliError;
-use crate::format::Format;
+use crate::figures::branch_figure;
+use crate::format::{history_csv, Format};
 use crate::model_io::{read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition, Marker, Series};
-use crate::simulate_cmd::history_csv;
+use crate::plot::{render, Figure, LegendPosition, Series};
 use vibroimpact::results::{branch_document, periodic_document};
 
 /// Options of `vibroimpact periodic`.
@@ -299,84 +297,6 @@ pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
     }
     String::from_utf8(w.into_inner().map_err(|e| CliError::new(e.to_string()))?)
         .map_err(|e| CliError::new(e.to_string()))
-}
-
-/// Frequency-response figure: max |u| of the first body against the
-/// parameter, stable solid, unstable dashed, special points marked.
-pub fn branch_figure(
-    branches: &[(&Branch, &str)],
-    title: &str,
-    x_label: &str,
-    x_scale: f64,
-    body: usize,
-) -> Figure {
-    let mut fig = Figure::new(title, x_label, "max |u| over the period  [mm]")
-        .legend_at(LegendPosition::Best);
-    let mut labelled: Vec<SpecialKind> = Vec::new();
-    for (bi, (branch, name)) in branches.iter().enumerate() {
-        let color = 2 * bi;
-        let mut start = 0;
-        let pts = &branch.points;
-        let (mut stable_labelled, mut unstable_labelled) = (false, false);
-        while start < pts.len() {
-            let stable = pts[start].stable;
-            let mut end = start + 1;
-            while end < pts.len() && pts[end].stable == stable {
-                end += 1;
-            }
-            let seg: Vec<(f64, f64)> = pts[start..(end + 1).min(pts.len())]
-                .iter()
-                .map(|p| (p.parameter * x_scale, 1e3 * p.max_displacement[body]))
-                .collect();
-            let label = match (stable, stable_labelled, unstable_labelled) {
-                (true, false, _) => {
-                    stable_labelled = true;
-                    format!("{name}, stable")
-                }
-                (false, _, false) => {
-                    unstable_labelled = true;
-                    format!("{name}, unstable")
-                }
-                _ => String::new(),
-            };
-            fig.push(
-                if stable {
-                    Series::line(label, seg)
-                } else {
-                    Series::dashed(label, seg)
-                }
-                .with_color(color),
-            );
-            start = end;
-        }
-        for (kind, marker, c) in [
-            (SpecialKind::Fold, Marker::Triangle, 1),
-            (SpecialKind::PeriodDoubling, Marker::Square, 3),
-            (SpecialKind::BranchPoint, Marker::Circle, 4),
-            (SpecialKind::NeimarkSacker, Marker::Triangle, 5),
-        ] {
-            let sp: Vec<(f64, f64)> = branch
-                .special
-                .iter()
-                .filter(|s| s.kind == kind)
-                .filter_map(|s| {
-                    let p = &branch.points[s.after_point.min(pts.len() - 1)];
-                    Some((s.parameter * x_scale, 1e3 * p.max_displacement.get(body)?))
-                })
-                .collect();
-            if !sp.is_empty() {
-                // Each kind in the legend once, wherever it first appears.
-                let name = if labelled.contains(&kind) {
-                    ""
-                } else {
-                    labelled.push(kind);
-                    kind.name()
-                };
-                fig.push(Series::markers(name, sp, marker).with_color(c));
-            }
-        }
-    }
-    fig
 }
 
 fn write_branch(

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, SweepSummary};
 
+use crate::args::MethodName;
 use crate::error::CliError;
 use crate::format::Format;
 use crate::model_io::read_family;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
-use crate::simulate_cmd::MethodName;
 
 /// Options of `vibroimpact sweep`.
 #[derive(Args, Debug)]

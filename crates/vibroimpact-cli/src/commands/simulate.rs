@@ -2,40 +2,19 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
-use vibroimpact::integrate::Method;
+use clap::Args;
 use vibroimpact::model::Model;
-use vibroimpact::simulate::{simulate, Simulation, SimulationOptions};
+use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
 
+use crate::args::MethodName;
 use crate::error::CliError;
-use crate::format::{csv_text, Format};
+use crate::format::{number, Format};
 use crate::model_io::read_model;
-use crate::output::{ensure_dir, write_atomic};
+use crate::output::{commit_temp, temp_path};
+use crate::output::{ensure_dir, write_atomic, OutputError};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use vibroimpact::model_file::LoadedModel;
 use vibroimpact::results::{simulation_summary, SimulationSummary};
-
-/// Integration method on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MethodName {
-    /// Explicit 8th-order Dormand–Prince (DOP853): impacts, free flight.
-    Dop853,
-    /// Implicit Rosenbrock (RODAS): bodies pressed together for long times.
-    Rodas,
-    /// DOP853, switching to RODAS when its stiffness test fires.
-    Auto,
-}
-
-impl MethodName {
-    /// The library's method.
-    pub fn method(self) -> Method {
-        match self {
-            MethodName::Dop853 => Method::Dop853,
-            MethodName::Rodas => Method::Rodas,
-            MethodName::Auto => Method::Auto,
-        }
-    }
-}
 
 /// Options of `vibroimpact simulate`.
 #[derive(Args, Debug)]
@@ -117,27 +96,47 @@ fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOption
     })
 }
 
-/// CSV of sampled states: `t, u_<body>…, v_<body>…` (rows of `states` are
-/// `[u.., v..]` at `times`).
-pub fn history_csv(model: &Model, times: &[f64], states: &[f64]) -> Result<String, CliError> {
-    let n = model.bodies().len();
-    let mut columns: Vec<String> = vec!["t".into()];
-    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
-    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
-    let rows: Vec<Vec<Option<f64>>> = times
-        .iter()
-        .enumerate()
-        .map(|(j, &t)| {
-            std::iter::once(Some(t))
-                .chain(states[j * 2 * n..(j + 1) * 2 * n].iter().map(|&x| Some(x)))
-                .collect()
-        })
-        .collect();
-    let cols: Vec<&str> = columns.iter().map(String::as_str).collect();
-    csv_text(&cols, &rows)
+/// The impact log as CSV (quoted where a pair name needs it).
+fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
+    let io = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "start_time",
+        "end_time",
+        "pair",
+        "impact_velocity",
+        "rebound_velocity",
+        "restitution",
+        "peak_force",
+        "duration",
+    ])
+    .map_err(io)?;
+    let f = |x: f64| {
+        if x.is_finite() {
+            format!("{x:e}")
+        } else {
+            String::new()
+        }
+    };
+    for i in &sim.impacts {
+        w.write_record([
+            f(i.start_time),
+            f(i.end_time),
+            model.contact_name(i.contact),
+            f(i.impact_velocity),
+            f(i.rebound_velocity),
+            f(i.restitution()),
+            f(i.peak_force),
+            f(i.duration()),
+        ])
+        .map_err(io)?;
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::new(e.to_string()))?;
+    String::from_utf8(bytes).map_err(|e| CliError::new(e.to_string()))
 }
 
-/// Writes the time history, impact log, summary and plots into `dir`.
+/// Writes the impact log, summary and plots into `dir` (the time history
+/// is streamed there by [`HistoryFile`] while the simulation runs).
 pub fn write_outputs(
     dir: &Path,
     model: &Model,
@@ -147,31 +146,9 @@ pub fn write_outputs(
 ) -> Result<(), CliError> {
     ensure_dir(dir)?;
     write_atomic(
-        &dir.join("history.csv"),
-        history_csv(model, &sim.times, &sim.states)?.as_bytes(),
+        &dir.join("impacts.csv"),
+        impact_log_csv(model, sim)?.as_bytes(),
     )?;
-    let mut log = String::from("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration\n");
-    for i in &sim.impacts {
-        let f = |x: f64| {
-            if x.is_finite() {
-                format!("{x:e}")
-            } else {
-                String::new()
-            }
-        };
-        log.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            f(i.start_time),
-            f(i.end_time),
-            model.contact_name(i.contact),
-            f(i.impact_velocity),
-            f(i.rebound_velocity),
-            f(i.restitution()),
-            f(i.peak_force),
-            f(i.duration())
-        ));
-    }
-    write_atomic(&dir.join("impacts.csv"), log.as_bytes())?;
     write_atomic(
         &dir.join("summary.json"),
         serde_json::to_string_pretty(summary)?.as_bytes(),
@@ -293,14 +270,41 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             .position(|b| &b.name == name)
             .ok_or_else(|| CliError::new(format!("--body {name}: no such body")))?,
     };
-    let sim = simulate(model, &opts).map_err(|e| CliError::new(e.to_string()))?;
+    let interrupt = crate::interrupt::on_ctrl_c();
+    let opts = SimulationOptions {
+        interrupt: Some(interrupt.clone()),
+        ..opts
+    };
+    let mut history = match &args.out {
+        Some(dir) => {
+            ensure_dir(dir)?;
+            Some(HistoryFile::create(&dir.join("history.csv"), model, &opts)?)
+        }
+        None => None,
+    };
+    let mut sim = simulate_streaming(model, &opts, |t, state| {
+        history.as_mut().is_none_or(|h| h.sample(t, state))
+    })
+    .map_err(|e| CliError::new(e.to_string()))?;
     let s = simulation_summary(model, &sim);
-    if let Some(dir) = &args.out {
+    if let (Some(dir), Some(history)) = (&args.out, history) {
+        (sim.times, sim.states) = history.finish()?;
         write_outputs(dir, model, &sim, &s, phase_body)?;
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&s)?),
         _ => print!("{}", summary_text(&s)),
+    }
+    if interrupt.requested() {
+        return Err(CliError::new(format!(
+            "interrupted (Ctrl-C) at t = {:.9} s: the results up to there are kept{}",
+            sim.final_time,
+            if args.out.is_some() {
+                " in the output folder"
+            } else {
+                ""
+            }
+        )));
     }
     match &sim.error {
         None => Ok(()),
@@ -313,5 +317,129 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 ""
             }
         ))),
+    }
+}
+
+/// Points of the history kept for the figures (every k-th sample).
+const PLOTTED_SAMPLES: f64 = 20_000.0;
+
+/// `history.csv` written while the simulation runs: rows go through a
+/// buffered CSV writer into a temporary sibling, renamed when complete; the
+/// figures get every k-th sample (at most about 20 000).
+struct HistoryFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    writer: csv::Writer<std::io::BufWriter<std::fs::File>>,
+    error: Option<std::io::Error>,
+    every: usize,
+    count: usize,
+    times: Vec<f64>,
+    states: Vec<f64>,
+    row: Vec<String>,
+}
+
+impl HistoryFile {
+    /// Opens the temporary file and writes the header.
+    fn create(path: &Path, model: &Model, opts: &SimulationOptions) -> Result<Self, CliError> {
+        let tmp = temp_path(path);
+        let fail = |e: std::io::Error| OutputError {
+            path: path.to_path_buf(),
+            source: e,
+        };
+        let file = std::fs::File::create(&tmp).map_err(fail)?;
+        let mut writer = csv::Writer::from_writer(std::io::BufWriter::new(file));
+        let mut header = vec!["t".to_string()];
+        header.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
+        header.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+        writer.write_record(&header).map_err(|e| fail(e.into()))?;
+        let samples = opts.output_step.map_or(1.0, |dt| opts.t_end / dt + 1.0);
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp,
+            writer,
+            error: None,
+            every: (samples / PLOTTED_SAMPLES).ceil().max(1.0) as usize,
+            count: 0,
+            times: Vec::new(),
+            states: Vec::new(),
+            row: Vec::with_capacity(header.len()),
+        })
+    }
+
+    /// Writes one sample; false (stop the simulation) once writing failed.
+    fn sample(&mut self, t: f64, state: &[f64]) -> bool {
+        self.row.clear();
+        self.row.push(number(Some(t)));
+        self.row.extend(state.iter().map(|&x| number(Some(x))));
+        if let Err(e) = self.writer.write_record(&self.row) {
+            self.error = Some(e.into());
+            return false;
+        }
+        if self.count % self.every == 0 {
+            self.times.push(t);
+            self.states.extend_from_slice(state);
+        }
+        self.count += 1;
+        true
+    }
+
+    /// Flushes and renames the file into place; returns the samples kept
+    /// for the figures. On a write error the temporary file is removed and
+    /// the error names the file.
+    fn finish(self) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+        let fail = |source: std::io::Error| {
+            let _ = std::fs::remove_file(&self.tmp);
+            CliError::from(OutputError {
+                path: self.path.clone(),
+                source,
+            })
+        };
+        if let Some(e) = self.error {
+            return Err(fail(e));
+        }
+        let file = self
+            .writer
+            .into_inner()
+            .map_err(|e| fail(e.into_error()))?
+            .into_inner()
+            .map_err(|e| fail(e.into_error()))?;
+        file.sync_all().map_err(fail)?;
+        commit_temp(&self.tmp, &self.path)?;
+        Ok((self.times, self.states))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The history file streams every sample to disk but keeps at most
+    /// about 20 000 for the figures, whatever the length of the run.
+    #[test]
+    fn history_file_streams_and_keeps_a_bounded_sample() {
+        let dir = std::env::temp_dir().join(format!("vi-history-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let model = vibroimpact::reference::r2(2, 1e-3, 7.0).unwrap();
+        let opts = SimulationOptions {
+            t_end: 1e6,
+            output_step: Some(1.0),
+            ..SimulationOptions::default()
+        };
+        let path = dir.join("history.csv");
+        let mut h = HistoryFile::create(&path, &model, &opts).unwrap();
+        assert_eq!(h.every, 51);
+        let n: usize = 100_000;
+        for k in 0..n {
+            assert!(h.sample(k as f64, &[0.5, -0.5, 1.0, -1.0]));
+        }
+        assert!(!path.exists(), "only the temporary file while running");
+        let (times, states) = h.finish().unwrap();
+        assert_eq!(times.len(), n.div_ceil(51));
+        assert_eq!(states.len(), 4 * times.len());
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.lines().count(), n + 1);
+        assert_eq!(text.lines().next().unwrap(), "t,u_p1,u_p2,v_p1,v_p2");
+        assert_eq!(text.lines().nth(2).unwrap(), "1e0,5e-1,-5e-1,1e0,-1e0");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

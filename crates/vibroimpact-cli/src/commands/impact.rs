@@ -9,6 +9,7 @@ use vibroimpact::impact::TwoBodies;
 use vibroimpact::reference;
 use vibroimpact::results::{impact_document, impact_rows, ImpactMethod, IMPACT_COLUMNS};
 
+use crate::args::parse_mass2;
 use crate::error::CliError;
 use crate::format::{print_rows, Format};
 
@@ -227,16 +228,6 @@ pub fn parse_velocities(spec: &str) -> Result<Vec<f64>, CliError> {
         return Err(bad(format!("impact velocities must be > 0 (got {v})")));
     }
     Ok(values)
-}
-
-/// Parses `--mass2`: a mass in kg, or `wall`/`inf` for a rigid wall.
-pub fn parse_mass2(text: &str) -> Result<f64, CliError> {
-    match text.trim() {
-        "wall" | "inf" | "infinity" => Ok(f64::INFINITY),
-        t => t
-            .parse()
-            .map_err(|_| CliError::new(format!("--mass2 `{t}` is not a mass in kg or `wall`"))),
-    }
 }
 
 /// Runs `vibroimpact impact`.

@@ -1,0 +1,8 @@
+//! The subcommands, one file each; none imports another (what several
+//! share lives in `args`, `format`, `measurements`, `plot`, …).
+
+pub mod branch;
+pub mod identify;
+pub mod impact;
+pub mod simulate;
+pub mod sweep;
