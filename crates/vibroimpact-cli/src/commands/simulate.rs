@@ -333,6 +333,8 @@ struct HistoryFile {
     error: Option<std::io::Error>,
     every: usize,
     count: usize,
+    /// The next sample kept for the figures.
+    next_kept: usize,
     times: Vec<f64>,
     states: Vec<f64>,
     row: Vec<String>,
@@ -360,6 +362,7 @@ impl HistoryFile {
             error: None,
             every: (samples / PLOTTED_SAMPLES).ceil().max(1.0) as usize,
             count: 0,
+            next_kept: 0,
             times: Vec::new(),
             states: Vec::new(),
             row: Vec::with_capacity(header.len()),
@@ -375,9 +378,10 @@ impl HistoryFile {
             self.error = Some(e.into());
             return false;
         }
-        if self.count % self.every == 0 {
+        if self.count == self.next_kept {
             self.times.push(t);
             self.states.extend_from_slice(state);
+            self.next_kept += self.every;
         }
         self.count += 1;
         true
