@@ -235,6 +235,17 @@ impl ModelError {
     }
 }
 
+/// The fastest free-flight rate of a model ([`Model::free_flight_rate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FreeFlightRate {
+    /// The rate (1/s).
+    pub rate: f64,
+    /// The body that sets it.
+    pub body: usize,
+    /// Whether its damping (`Σc/m`) sets it, else its stiffness (`sqrt(Σk/m)`).
+    pub damping: bool,
+}
+
 /// A complete, validated system.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Model {
@@ -489,6 +500,41 @@ impl Model {
     /// Initial velocities (m/s).
     pub fn initial_velocity(&self) -> &[f64] {
         &self.initial_velocity
+    }
+
+    /// The fastest rate (1/s) of the free-flight dynamics (springs and
+    /// dampers, contacts open) and the body and property that set it: the
+    /// largest of `sqrt(Σk/m)` and `Σc/m` over the bodies, with Σ over a
+    /// body's spring (damper) to the frame and twice its couplings
+    /// (Gershgorin bounds of M⁻¹K and M⁻¹C; for a heavily damped body the
+    /// fast eigenvalue is about −c/m). An explicit method's step is limited
+    /// by stability to about 6/rate.
+    pub fn free_flight_rate(&self) -> FreeFlightRate {
+        let mut k: Vec<f64> = self.bodies.iter().map(|b| b.stiffness).collect();
+        let mut c: Vec<f64> = self.bodies.iter().map(|b| b.damping).collect();
+        for cp in &self.couplings {
+            for i in [cp.a, cp.b] {
+                k[i] += 2.0 * cp.stiffness;
+                c[i] += 2.0 * cp.damping;
+            }
+        }
+        let mut fastest = FreeFlightRate {
+            rate: 0.0,
+            body: 0,
+            damping: false,
+        };
+        for (i, b) in self.bodies.iter().enumerate() {
+            for (rate, damping) in [((k[i] / b.mass).sqrt(), false), (c[i] / b.mass, true)] {
+                if rate > fastest.rate {
+                    fastest = FreeFlightRate {
+                        rate,
+                        body: i,
+                        damping,
+                    };
+                }
+            }
+        }
+        fastest
     }
 
     /// The forcing frequency Ω (rad/s) if the excitation is periodic with one

@@ -113,7 +113,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         symmetric: args.symmetric,
         ..ShootingOptions::default()
     };
-    if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic.is_multiple_of(2)) {
+    if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic % 2 == 0) {
         return Err(CliError::new(format!(
             "{}: --symmetric needs a mirror-symmetric model (mirrored bodies, contacts, walls and forcing) and an odd --subharmonic",
             args.model.display()

@@ -349,6 +349,35 @@ pub enum IntegrationError {
         /// Number of accepted steps since the last reset.
         steps: u64,
     },
+    /// The explicit method's step is limited by stability (its stiffness
+    /// test fired) so far below what the remaining interval needs that the
+    /// run would take `projected` more steps, beyond the step limit: an
+    /// implicit method is the remedy.
+    #[error("stiff at t = {t:e}: stability limits the explicit step to h = {h:e}, so {projected:.1e} more steps would be needed (limit {limit}); use the implicit method rodas (or auto)")]
+    Stiff {
+        /// Time reached.
+        t: f64,
+        /// The stability-limited step size.
+        h: f64,
+        /// Steps the rest of the interval would take at that size.
+        projected: f64,
+        /// The step limit.
+        limit: u64,
+    },
+    /// The run has advanced so little for its steps that finishing would
+    /// take far more than the step limit (checked by callers that know the
+    /// end time, e.g. simulation).
+    #[error("no progress: {steps} steps reached only t = {t:e}; at this pace the run needs {projected:.1e} steps, far beyond the limit {limit}: the model (a contact law or a body) is far stiffer or faster than its motion; check its parameters, or use the implicit method rodas")]
+    NoProgress {
+        /// Time reached.
+        t: f64,
+        /// Steps taken.
+        steps: u64,
+        /// Steps the whole run would take at this pace.
+        projected: f64,
+        /// The step limit.
+        limit: u64,
+    },
     /// The caller's [`Interrupt`] was requested; `t` is the time reached.
     #[error("interrupted at t = {t:e}")]
     Interrupted {

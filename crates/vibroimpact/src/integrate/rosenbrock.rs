@@ -214,6 +214,25 @@ impl Driver<RodasMethod> {
     }
 }
 
+impl Driver<RodasMethod> {
+    /// Gershgorin bound `max_i Σ_j |J_ij|` of the Jacobian of the last step
+    /// (an upper bound of its spectral radius; 0 before the first step).
+    /// `h · bound` well below the explicit methods' stability limit (about
+    /// 6) says an explicit method could take this step too.
+    pub fn jacobian_bound(&self) -> f64 {
+        let jac = &self.method.jac;
+        let n = jac.n();
+        let (kl, ku) = jac.bandwidths();
+        (0..n)
+            .map(|i| {
+                (i.saturating_sub(kl)..=(i + ku).min(n.saturating_sub(1)))
+                    .map(|j| jac.get(i, j).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
 impl StepMethod for RodasMethod {
     const ERROR_EXPONENT: f64 = 0.25;
     const SHRINK_LIMIT: f64 = 5.0;

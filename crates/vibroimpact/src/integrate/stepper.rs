@@ -221,6 +221,21 @@ impl Stepper {
         &self.opts
     }
 
+    /// The Gershgorin bound of RODAS's last Jacobian
+    /// ([`Driver::jacobian_bound`](super::Driver::jacobian_bound)) while
+    /// RODAS is active, else None.
+    pub fn rodas_jacobian_bound(&self) -> Option<f64> {
+        match &self.engines {
+            Engines::Rodas(r)
+            | Engines::Auto {
+                rodas: r,
+                on_rodas: true,
+                ..
+            } => Some(r.jacobian_bound()),
+            _ => None,
+        }
+    }
+
     /// Whether DOP853 is active and its stiffness test currently reports
     /// stiffness ([`Dop853::stiffness_detected`](super::Driver::stiffness_detected)); `false` while RODAS is
     /// active.
