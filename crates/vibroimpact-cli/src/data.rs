@@ -16,15 +16,41 @@ pub struct Table {
     pub lines: Vec<usize>,
 }
 
-/// 1-based line number of the first non-blank byte at or after `byte` in
-/// `text` (a record's position may point at the blank lines before it).
-fn line_of(text: &str, byte: usize) -> usize {
-    let bytes = text.as_bytes();
-    let mut at = byte.min(bytes.len());
-    while at < bytes.len() && (bytes[at] == b'\n' || bytes[at] == b'\r') {
-        at += 1;
+/// 1-based line numbers of byte offsets in `text`, for offsets that come in
+/// increasing order (the records of a CSV reader): each call counts only
+/// the newlines since the previous one, so a file costs one pass.
+struct LineCounter<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    line: usize,
+}
+
+impl<'a> LineCounter<'a> {
+    fn new(text: &'a str) -> Self {
+        Self {
+            bytes: text.as_bytes(),
+            at: 0,
+            line: 1,
+        }
     }
-    1 + bytes[..at].iter().filter(|&&b| b == b'\n').count()
+
+    /// Line of the first non-blank byte at or after `byte` (a record's
+    /// position may point at the blank lines before it).
+    fn line_of(&mut self, byte: usize) -> usize {
+        let bytes = self.bytes;
+        let mut at = byte.min(bytes.len());
+        while at < bytes.len() && (bytes[at] == b'\n' || bytes[at] == b'\r') {
+            at += 1;
+        }
+        if at < self.at {
+            // Out of order (not from the reader): count from the start.
+            self.at = 0;
+            self.line = 1;
+        }
+        self.line += bytes[self.at..at].iter().filter(|&&b| b == b'\n').count();
+        self.at = at;
+        self.line
+    }
 }
 
 /// Reads the named columns (other columns are ignored) from CSV text.
@@ -59,15 +85,16 @@ pub fn parse_csv(text: &str, source: &str, wanted: &[&str]) -> Result<Table, Cli
         columns: vec![Vec::new(); wanted.len()],
         lines: Vec::new(),
     };
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
         let record = record.map_err(|e| {
-            let line = e.position().map_or(0, |p| line_of(text, p.byte() as usize));
+            let line = e.position().map_or(0, |p| lines.line_of(p.byte() as usize));
             CliError::new(format!("{source}:{line}: malformed CSV row: {e}"))
         })?;
         // Line from the byte offset (the csv crate's own line count skips blank lines).
         let line = record
             .position()
-            .map_or(0, |p| line_of(text, p.byte() as usize));
+            .map_or(0, |p| lines.line_of(p.byte() as usize));
         for (k, &i) in index.iter().enumerate() {
             let cell = record.get(i).unwrap_or("");
             let value: f64 = cell.parse().map_err(|_| {

@@ -223,6 +223,21 @@ fn log_acceleration_model(u: f64, q: f64, mu_over_m1: f64) -> Result<(f64, f64),
     Ok((value, slope))
 }
 
+/// Samples the coarse grid searches use at most.
+const GRID_SAMPLES: usize = 2000;
+
+/// At most [`GRID_SAMPLES`] samples spread evenly over `samples` (all of
+/// them when there are fewer).
+fn spread<T: Clone>(samples: &[T]) -> Vec<T> {
+    let n = samples.len();
+    if n <= GRID_SAMPLES {
+        return samples.to_vec();
+    }
+    (0..GRID_SAMPLES)
+        .map(|k| samples[k * n / GRID_SAMPLES].clone())
+        .collect()
+}
+
 /// Grid of ln q candidates spanning V_median = U_median/q from 1e-4 to 1e4.
 fn log_q_grid(velocities: impl Iterator<Item = f64>) -> Vec<f64> {
     let mut logs: Vec<f64> = velocities.map(f64::ln).collect();
@@ -243,15 +258,26 @@ pub fn fit_a_over_b(samples: &[RestitutionSample]) -> Result<RestitutionFit, Ide
             Ok(acc + (s.restitution - e).powi(2))
         })
     };
-    // Coarse grid, then Levenberg–Marquardt on θ = ln q.
+    // Coarse grid (on at most GRID_SAMPLES evenly spread samples: the grid
+    // only brackets the minimum), then Levenberg–Marquardt on θ = ln q with
+    // every sample.
     let grid = log_q_grid(samples.iter().map(|s| s.impact_velocity));
+    let coarse = spread(samples);
+    let coarse_ssr = |theta: f64| -> Result<f64, ImpactError> {
+        let q = theta.exp();
+        coarse.iter().try_fold(0.0, |acc, s| {
+            let (e, _) = restitution_model(s.impact_velocity, q)?;
+            Ok(acc + (s.restitution - e).powi(2))
+        })
+    };
     let mut best = (0, f64::INFINITY);
     for (i, &t) in grid.iter().enumerate() {
-        let r = ssr(t)?;
+        let r = coarse_ssr(t)?;
         if r < best.1 {
             best = (i, r);
         }
     }
+    let best = (best.0, ssr(grid[best.0])?);
     if best.0 == 0 || best.0 == grid.len() - 1 {
         let direction = if best.0 == 0 {
             "a/b -> 0 (every e near 0)"
@@ -475,13 +501,16 @@ pub fn fit_joint(
     // Starting point and weights.
     let (mut theta, sigma_e) = if acceleration_only {
         let grid = log_q_grid(acceleration_samples.iter().map(|s| s.impact_velocity));
-        let mut best = (0, f64::INFINITY, 0.0);
+        let coarse = spread(acceleration_samples);
+        let mut best = (0, f64::INFINITY);
         for (i, &t) in grid.iter().enumerate() {
-            let (la, ssr) = profile_log_alpha(acceleration_samples, t.exp(), &bodies)?;
+            let (_, ssr) = profile_log_alpha(&coarse, t.exp(), &bodies)?;
             if ssr < best.1 {
-                best = (i, ssr, la);
+                best = (i, ssr);
             }
         }
+        let (la, _) = profile_log_alpha(acceleration_samples, grid[best.0].exp(), &bodies)?;
+        let best = (best.0, (), la);
         if best.0 == 0 || best.0 == grid.len() - 1 {
             return Err(IdentifyError::NotIdentifiable(
                 "a/b from accelerations alone: the fit runs off the range of V = U/(a/b) from 1e-4 to 1e4; give a/b or restitution data".into(),
@@ -709,6 +738,37 @@ mod tests {
         let j = fit_joint(&[], &a, bodies()).unwrap();
         assert!((j.a_over_b.value - q).abs() < 1e-6 * q, "{:?}", j.a_over_b);
         assert!((j.alpha.value - alpha).abs() < 1e-6 * alpha);
+    }
+
+    /// Large data sets: the coarse grid runs on 2000 spread samples, the
+    /// fit on all 50 000 (noisy, 1 %): the estimates agree with the truth
+    /// within three standard errors, which shrink like 1/sqrt(n).
+    #[test]
+    fn large_data_sets_fit_all_samples() {
+        let (q, alpha) = (1.2, 1.3e5);
+        let n = 50_000;
+        let u = |i: usize| 0.02 * (30.0f64).powf(i as f64 / n as f64);
+        let r: Vec<_> = (0..n)
+            .map(|i| RestitutionSample {
+                impact_velocity: u(i),
+                restitution: restitution(u(i) / q).unwrap() * (1.0 + 0.01 * noise(i)),
+            })
+            .collect();
+        let a: Vec<_> = (0..n)
+            .map(|i| AccelerationSample {
+                impact_velocity: u(i),
+                peak_acceleration: accel(u(i), q, alpha) * (1.0 + 0.01 * noise(n + i)),
+            })
+            .collect();
+        let j = fit_joint(&r, &a, bodies()).unwrap();
+        for (est, truth) in [(j.a_over_b, q), (j.alpha, alpha)] {
+            assert!(est.std_error < 1e-3 * truth, "{est:?}");
+            assert!(
+                (est.value - truth).abs() < 3.0 * est.std_error,
+                "{est:?} vs {truth}"
+            );
+        }
+        assert_eq!(j.acceleration_residuals.len(), n);
     }
 
     #[test]

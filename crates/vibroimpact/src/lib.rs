@@ -32,6 +32,9 @@
 //! The library does no I/O: callers hand it numbers and text and get
 //! numbers back.
 
+#![warn(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;
