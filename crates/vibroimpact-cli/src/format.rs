@@ -18,6 +18,17 @@ pub enum Format {
     Json,
 }
 
+/// Output format of the commands that print a summary rather than a table
+/// (`simulate`, `periodic`, `identify`): no `csv` (their tables are the
+/// CSV files of `--out`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SummaryFormat {
+    /// Text for reading.
+    Table,
+    /// A JSON document.
+    Json,
+}
+
 /// Formats a number for tables: full precision (shortest round-trip form).
 pub fn number(x: Option<f64>) -> String {
     match x {

@@ -1144,3 +1144,52 @@ fn interrupted_simulation_keeps_complete_outputs() {
         "more than 1e9",
     );
 }
+
+/// `--format csv` prints a table where the command has one (the same CSV as
+/// the file in `--out`) and is refused where it prints a summary.
+#[test]
+fn csv_format_prints_tables_or_is_refused() {
+    let model = repo_file("examples/fujita-row.toml");
+    let out = run(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "5.9",
+        "--to",
+        "8.9",
+        "--points",
+        "3",
+        "--transient",
+        "5",
+        "--record",
+        "2",
+        "--format",
+        "csv",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = text.lines().collect();
+    assert!(rows[0].starts_with("parameter,"), "{}", rows[0]);
+    assert!(
+        rows.len() > 3
+            && rows[1..]
+                .iter()
+                .all(|r| r.split(',').count() == rows[0].split(',').count())
+    );
+    for args in [
+        vec!["simulate", &model, "--periods", "1"],
+        vec!["periodic", &model],
+        vec!["identify", "--restitution", &model],
+    ] {
+        let command = args[0];
+        let out = run(&[args, vec!["--format", "csv"]].concat());
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("invalid value 'csv'") && err.contains("table, json"),
+            "{err}"
+        );
+    }
+}

@@ -220,9 +220,22 @@ pub(crate) struct BodySpec {
     pub(crate) initial_velocity: Option<f64>,
 }
 
+/// `between = ["left", "right"]`: exactly two names (a list of three is
+/// an error, not silently cut to two).
+fn two_names<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[String; 2], D::Error> {
+    let names = Vec::<String>::deserialize(d)?;
+    <[String; 2]>::try_from(names).map_err(|names| {
+        serde::de::Error::custom(format!(
+            "`between` needs exactly two names (a body or \"wall\" each), got {}: {names:?}",
+            names.len()
+        ))
+    })
+}
+
 #[derive(Serialize, Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct SpringSpec {
+    #[serde(deserialize_with = "two_names")]
     pub(crate) between: [String; 2],
     pub(crate) stiffness: Option<f64>,
     pub(crate) damping: Option<f64>,
@@ -231,6 +244,7 @@ pub(crate) struct SpringSpec {
 #[derive(Serialize, Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct ContactSpec {
+    #[serde(deserialize_with = "two_names")]
     pub(crate) between: [String; 2],
     pub(crate) clearance: f64,
     pub(crate) law: LawSpec,
@@ -365,6 +379,20 @@ impl ModelDocument {
             label: source,
             line_starts: &line_starts,
         };
+        // A control character says plainly what is wrong (TOML's own parser
+        // only reports what it expected instead).
+        if let Some((at, c)) = text
+            .char_indices()
+            .find(|&(_, c)| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+        {
+            return Err(cx.err_at(
+                at..at + c.len_utf8(),
+                format!(
+                    "control character U+{:04X}: a model file is text (TOML allows no control characters but tab)",
+                    u32::from(c)
+                ),
+            ));
+        }
         let file: ModelFile = toml::from_str(text).map_err(|e| {
             let msg = e.message().trim().replace('\n', " ");
             match e.span() {
@@ -914,6 +942,19 @@ frequency = 3.0
         assert!(e.contains("alpha"), "{e}");
         let e = err(&ROW.replace("clearance = 0.001", "clearance = -0.001"));
         assert!(e.contains("clearance"), "{e}");
+        let e = err("[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"wall\", \"b\"]\nclearance = 0.0\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+        assert!(
+            e.contains("m.toml:5") && e.contains("exactly two names") && e.contains("got 3"),
+            "{e}"
+        );
+        let e = err(&ROW.replace("count = 3", "count = 3 # \u{1} x"));
+        assert!(e.contains("control character U+0001"), "{e}");
+        let line = ROW
+            .lines()
+            .position(|l| l.starts_with("count = 3"))
+            .unwrap()
+            + 1;
+        assert!(e.starts_with(&format!("m.toml:{line}: ")), "{e}");
         let e = err("[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"zz\"]\nclearance = 0.0\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
         assert!(
             e.starts_with("m.toml:4:") && e.contains("unknown body `zz`"),

@@ -14,7 +14,7 @@ use vibroimpact::periodic::{
 
 use crate::error::CliError;
 use crate::figures::branch_figure;
-use crate::format::{history_csv, Format};
+use crate::format::{history_csv, Format, SummaryFormat};
 use crate::model_io::{read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
@@ -58,8 +58,8 @@ pub struct PeriodicArgs {
     #[arg(long)]
     symmetric: bool,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
+    format: SummaryFormat,
     /// Output folder: orbit.csv, summary.json, orbit figures.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -185,7 +185,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         render(&phase, &dir.join("orbit_phase"))?;
     }
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
         _ => {
             println!(
                 "{}: period {:.6} s, residual {:.2e} after {} iterations",
@@ -259,7 +259,9 @@ pub struct ContinueArgs {
     /// Periods simulated for the start guess.
     #[arg(long, default_value_t = 200.0)]
     guess_periods: f64,
-    /// Output folder: branch.csv, special_points.json, summary.json, figure.
+    /// Output folder: branch.csv, branch_special_points.json, branch.json and
+    /// the response figure branch_response.svg/.png (with --switch-at the
+    /// same for switched_branch).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Output format.
@@ -446,7 +448,12 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             };
             println!("{}", serde_json::to_string_pretty(&doc)?);
         }
-        _ => {
+        Format::Csv => {
+            for b in &branches {
+                print!("{}", branch_csv(b, &start_model)?);
+            }
+        }
+        Format::Table => {
             for (i, b) in branches.iter().enumerate() {
                 println!(
                     "{}: {} points from {} to {} ({:?})",

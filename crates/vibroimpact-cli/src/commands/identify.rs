@@ -10,7 +10,7 @@ use vibroimpact::impact::TwoBodies;
 
 use crate::args::parse_mass2;
 use crate::error::CliError;
-use crate::format::Format;
+use crate::format::SummaryFormat;
 use crate::measurements::Measurements;
 
 /// Options of `vibroimpact identify`.
@@ -37,8 +37,8 @@ pub struct IdentifyArgs {
     #[arg(long)]
     joint: bool,
     /// Output format (table or json).
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
+    format: SummaryFormat,
 }
 
 /// Runs `vibroimpact identify`.
@@ -57,7 +57,7 @@ pub fn run(args: &IdentifyArgs) -> Result<(), CliError> {
     let data = Measurements::read(args.restitution.as_deref(), args.acceleration.as_deref())?;
     let result = data.identify(bodies, args.a_over_b, args.joint)?;
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&result)?),
+        SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&result)?),
         _ => print!("{}", table_text(&result)),
     }
     Ok(())

@@ -8,7 +8,7 @@ use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
 
 use crate::args::MethodName;
 use crate::error::CliError;
-use crate::format::{number, Format};
+use crate::format::{number, SummaryFormat};
 use crate::model_io::read_model;
 use crate::output::{commit_temp, temp_path};
 use crate::output::{ensure_dir, write_atomic, OutputError};
@@ -38,8 +38,8 @@ pub struct SimulateArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Summary format on standard output.
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
+    format: SummaryFormat,
     /// Time-history sampling interval (s); default: 1/100 forcing period, or duration/2000.
     #[arg(long)]
     output_step: Option<f64>,
@@ -292,7 +292,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         write_outputs(dir, model, &sim, &s, phase_body)?;
     }
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&s)?),
+        SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&s)?),
         _ => print!("{}", summary_text(&s)),
     }
     if interrupt.requested() {

@@ -295,7 +295,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&summary)?),
-        _ => print!("{}", table_text(&summary)),
+        Format::Csv => print!("{}", sweep_csv(&summary)?),
+        Format::Table => print!("{}", table_text(&summary)),
     }
     let failed: Vec<String> = summary
         .points
