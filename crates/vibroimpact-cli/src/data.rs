@@ -121,7 +121,7 @@ pub fn parse_csv(text: &str, source: &str, wanted: &[&str]) -> Result<Table, Cli
 
 /// Reads the named columns from a CSV file.
 pub fn read_csv(path: &Path, wanted: &[&str]) -> Result<Table, CliError> {
-    let text = std::fs::read_to_string(path)
+    let text = crate::input::read_text(path)
         .map_err(|e| CliError::new(format!("{}: cannot read: {e}", path.display())))?;
     parse_csv(&text, &path.display().to_string(), wanted)
 }

@@ -9,6 +9,7 @@ mod data;
 mod error;
 mod figures;
 mod format;
+mod input;
 mod interrupt;
 mod measurements;
 mod model_io;

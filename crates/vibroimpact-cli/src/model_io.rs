@@ -8,10 +8,11 @@ use vibroimpact::model_file::{LoadedModel, ModelDocument};
 use vibroimpact::parameter::ParameterizedModel;
 
 use crate::error::CliError;
+use crate::input::read_text;
 
 /// Reads and parses a model file.
 pub fn read_document(path: &Path) -> Result<ModelDocument, CliError> {
-    Ok(ModelDocument::read(path, &|p| std::fs::read_to_string(p))?)
+    Ok(ModelDocument::read(path, &|p| read_text(p))?)
 }
 
 /// Reads a model file and builds its model.

@@ -105,8 +105,15 @@ impl PyModel {
                 path.display()
             )));
         }
-        let doc =
-            ModelDocument::read(&path, &|p| std::fs::read_to_string(p)).map_err(value_error)?;
+        // Regular files only: a FIFO would block and a device never end.
+        let regular = |p: &std::path::Path| match std::fs::metadata(p) {
+            Ok(m) if !m.is_file() => Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file (a directory, FIFO or device cannot be read as input)",
+            )),
+            _ => std::fs::read_to_string(p),
+        };
+        let doc = ModelDocument::read(&path, &regular).map_err(value_error)?;
         Self::new(doc)
     }
 

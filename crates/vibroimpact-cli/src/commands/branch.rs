@@ -70,7 +70,7 @@ fn read_guess(spec: &str, model: &Model, periods: f64, rtol: f64) -> Result<Vec<
         return guess_by_simulation(model, periods, rtol.max(1e-9))
             .map_err(|e| CliError::new(format!("guess by simulation: {e}")));
     }
-    let text = std::fs::read_to_string(spec)
+    let text = crate::input::read_text(Path::new(spec))
         .map_err(|e| CliError::new(format!("{spec}: cannot read the guess: {e}")))?;
     let doc: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| CliError::new(format!("{spec}: not JSON: {e}")))?;
