@@ -597,10 +597,11 @@ impl ModelDocument {
                 }
             }
             (None, false) => {
+                let mut seen = std::collections::HashSet::new();
                 for (i, b) in file.body.iter().enumerate() {
                     let span = b.span();
                     let spec = b.get_ref();
-                    if bodies.iter().any(|x| x.name == spec.name) || spec.name == "wall" {
+                    if !seen.insert(spec.name.as_str()) || spec.name == "wall" {
                         return Err(cx.err_at(
                             span,
                             format!(
@@ -639,7 +640,12 @@ impl ModelDocument {
                 }
             }
         }
-        let find = |name: &str| bodies.iter().position(|b| b.name == name);
+        let index: std::collections::HashMap<&str, usize> = bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.name.as_str(), i))
+            .collect();
+        let find = |name: &str| index.get(name).copied();
         let names = || {
             bodies
                 .iter()
