@@ -5,6 +5,49 @@
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Temporary files and folders being written (removed by a hard stop).
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// A temporary file or folder registered while it is written: a second
+/// Ctrl-C ([`crate::interrupt`]) removes it before the process quits, so no
+/// `*.tmp<PID>` is left behind. Dropping the guard unregisters it.
+#[derive(Debug)]
+pub struct Pending(PathBuf);
+
+impl Pending {
+    /// Registers `path`.
+    pub fn new(path: &Path) -> Self {
+        if let Ok(mut list) = PENDING.lock() {
+            list.push(path.to_path_buf());
+        }
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if let Ok(mut list) = PENDING.lock() {
+            if let Some(i) = list.iter().rposition(|p| *p == self.0) {
+                list.swap_remove(i);
+            }
+        }
+    }
+}
+
+/// Removes every registered temporary file and folder (before a hard stop).
+pub fn remove_pending() {
+    if let Ok(list) = PENDING.lock() {
+        for p in list.iter() {
+            let _ = if p.is_dir() {
+                fs::remove_dir_all(p)
+            } else {
+                fs::remove_file(p)
+            };
+        }
+    }
+}
 
 /// Error while writing an output file; names the file.
 #[derive(Debug, thiserror::Error)]
@@ -31,6 +74,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         source,
     };
     let tmp = temp_path(path);
+    let _pending = Pending::new(&tmp);
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
         f.write_all(bytes)?;

@@ -14,13 +14,14 @@ use vibroimpact::identify::Estimate;
 use vibroimpact::impact::closed_form::{peak_force_dimensionless, restitution, ExponentialImpact};
 use vibroimpact::impact::direct::{integrate_impact, DirectOptions};
 use vibroimpact::impact::TwoBodies;
+use vibroimpact::integrate::Interrupt;
 use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 use crate::error::CliError;
 use crate::format::csv_text;
 use crate::measurements::Measurements;
-use crate::output::{ensure_dir, write_atomic};
+use crate::output::{ensure_dir, write_atomic, OutputError, Pending};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use vibroimpact::identify::Identification;
 
@@ -61,12 +62,35 @@ struct Section {
     figures: Vec<FigureEntry>,
 }
 
-/// A report being written into a folder.
+/// A report being written: into a staging folder beside the target, which
+/// replaces the target only when the report is complete (an interrupted or
+/// failed run leaves the previous report as it was, never a mix).
 pub struct Report {
+    /// The staging folder every file is written into.
     dir: PathBuf,
+    /// The report folder it becomes.
+    target: PathBuf,
+    /// Registered for removal by a hard stop; None once committed.
+    staging: Option<Pending>,
     title: String,
     sections: Vec<Section>,
     summary: serde_json::Map<String, serde_json::Value>,
+}
+
+impl Drop for Report {
+    /// An unfinished report's staging folder is removed.
+    fn drop(&mut self) {
+        if self.staging.take().is_some() {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
+    }
+}
+
+/// `dir` with `suffix` appended to its name (a sibling).
+fn sibling(dir: &Path, suffix: &str) -> PathBuf {
+    let mut name = dir.file_name().unwrap_or_default().to_os_string();
+    name.push(suffix);
+    dir.with_file_name(name)
 }
 
 /// Escapes text for HTML.
@@ -78,15 +102,58 @@ pub fn html_escape(s: &str) -> String {
 }
 
 impl Report {
-    /// Starts a report in `dir` (created if missing).
+    /// Starts a report that will become the folder `dir`: refused up front
+    /// if `dir` exists and is not a report folder (a file, or a folder with
+    /// other content and no `index.html`), since it is replaced whole.
     pub fn new(dir: &Path, title: &str) -> Result<Self, CliError> {
-        ensure_dir(dir)?;
+        if dir.exists() {
+            let is_report = dir.join("index.html").is_file();
+            let empty = std::fs::read_dir(dir).map(|mut d| d.next().is_none());
+            if !dir.is_dir() || !(is_report || matches!(empty, Ok(true))) {
+                return Err(CliError::new(format!(
+                    "{}: exists and is not a report folder (no index.html); the report replaces its folder whole, so choose another --out",
+                    dir.display()
+                )));
+            }
+        }
+        let staging = sibling(dir, &format!(".partial{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&staging);
+        let pending = Pending::new(&staging);
+        ensure_dir(&staging)?;
         Ok(Self {
-            dir: dir.to_path_buf(),
+            dir: staging,
+            target: dir.to_path_buf(),
+            staging: Some(pending),
             title: title.to_string(),
             sections: Vec::new(),
             summary: serde_json::Map::new(),
         })
+    }
+
+    /// Replaces the target folder by the complete staging folder.
+    fn commit(&mut self) -> Result<(), CliError> {
+        let fail = |path: &Path, source| {
+            CliError::from(OutputError {
+                path: path.to_path_buf(),
+                source,
+            })
+        };
+        let old = sibling(&self.target, &format!(".old{}", std::process::id()));
+        let had_old = self.target.exists();
+        if had_old {
+            std::fs::rename(&self.target, &old).map_err(|e| fail(&self.target, e))?;
+        }
+        if let Err(e) = std::fs::rename(&self.dir, &self.target) {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.target);
+            }
+            return Err(fail(&self.target, e));
+        }
+        self.staging = None;
+        if had_old {
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Ok(())
     }
 
     /// Starts a section; `html` is its introduction (already HTML).
@@ -137,9 +204,12 @@ impl Report {
         Ok(())
     }
 
-    /// Writes `summary.json` and then `index.html`.
-    pub fn finish(self) -> Result<PathBuf, CliError> {
-        let summary = serde_json::to_string_pretty(&serde_json::Value::Object(self.summary))?;
+    /// Writes `summary.json` and then `index.html`, and puts the report in
+    /// place of its target folder.
+    pub fn finish(mut self) -> Result<PathBuf, CliError> {
+        let summary = serde_json::to_string_pretty(&serde_json::Value::Object(std::mem::take(
+            &mut self.summary,
+        )))?;
         write_atomic(&self.dir.join("summary.json"), summary.as_bytes())?;
         let mut h = String::new();
         let _ = write!(
@@ -193,9 +263,9 @@ impl Report {
             h.push_str("</section>\n");
         }
         h.push_str("<p><a href=\"summary.json\">summary.json</a> holds the key numbers of this report.</p>\n</body>\n</html>\n");
-        let index = self.dir.join("index.html");
-        write_atomic(&index, h.as_bytes())?;
-        Ok(index)
+        write_atomic(&self.dir.join("index.html"), h.as_bytes())?;
+        self.commit()?;
+        Ok(self.target.join("index.html"))
     }
 }
 
@@ -594,7 +664,7 @@ fn identification_figures(
 
 /// The seed's row (R2, N = 3) near resonance: time history and impact log,
 /// with the logged impacts over the two-body relations of part III.
-fn seed_row_time_history(report: &mut Report) -> Result<(), CliError> {
+fn seed_row_time_history(report: &mut Report, stop: &Interrupt) -> Result<(), CliError> {
     let (m, law) = (reference::MASS, reference::seed_law());
     let omega = 0.95 * reference::NATURAL_FREQUENCY;
     let model = reference::r2(3, reference::CLEARANCE, omega)?;
@@ -606,6 +676,7 @@ fn seed_row_time_history(report: &mut Report) -> Result<(), CliError> {
         atol: 1e-14,
         output_step: Some(period / 200.0),
         energy: true,
+        interrupt: Some(stop.clone()),
         ..SimulationOptions::default()
     };
     let sim = simulate(&model, &opts).map_err(|e| CliError::new(e.to_string()))?;
@@ -804,12 +875,12 @@ fn seed_row_time_history(report: &mut Report) -> Result<(), CliError> {
 /// The seed's parts I–II: frequency-response curves of the row (R2, N = 2
 /// and 3) by continuation, with Floquet stability, special points and a
 /// brute-force sweep over them.
-fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
+fn seed_row_frequency_response(report: &mut Report, stop: &Interrupt) -> Result<(), CliError> {
     use rayon::prelude::*;
     use vibroimpact::continuation::{
         branch_switch_start, continue_branch, Branch, ContinuationOptions,
     };
-    use vibroimpact::periodic::{guess_by_simulation, orbit_summary};
+    use vibroimpact::periodic::{guess_by_simulation_with, orbit_summary, ShootingOptions};
 
     let w0 = reference::NATURAL_FREQUENCY;
     let row =
@@ -845,11 +916,16 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
     let mut table = Vec::new();
     for n in [2usize, 3] {
         let start = row(n, 1.5 * w0).map_err(CliError::new)?;
-        let guess =
-            guess_by_simulation(&start, 200.0, 1e-9).map_err(|e| CliError::new(e.to_string()))?;
+        let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))
+            .map_err(|e| CliError::new(e.to_string()))?;
+        let defaults = ContinuationOptions::default();
         let opts = ContinuationOptions {
             max_points: 900,
-            ..ContinuationOptions::default()
+            shooting: ShootingOptions {
+                interrupt: Some(stop.clone()),
+                ..defaults.shooting.clone()
+            },
+            ..defaults
         };
         let t0 = Instant::now();
         let branch: Branch =
@@ -875,6 +951,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
                     rtol: 1e-9,
                     atol: 1e-13,
                     start: state.clone(),
+                    interrupt: Some(stop.clone()),
                     ..SimulationOptions::default()
                 };
                 let Ok(sim) = simulate(&model, &opts) else {
@@ -904,6 +981,7 @@ fn seed_row_frequency_response(report: &mut Report) -> Result<(), CliError> {
                             t_end: 150.0 * t,
                             rtol: 1e-9,
                             atol: 1e-13,
+                            interrupt: Some(stop.clone()),
                             ..SimulationOptions::default()
                         },
                     )
@@ -1135,9 +1213,21 @@ pub fn run(out: &Path) -> Result<(), CliError> {
         out,
         "vibroimpact default study: impact vibrations after T. Fujita (1977)",
     )?;
-    seed_part3(&mut report)?;
-    seed_row_time_history(&mut report)?;
-    seed_row_frequency_response(&mut report)?;
+    let stop = crate::interrupt::on_ctrl_c();
+    // After Ctrl-C a section's own error (an interrupted integration) is
+    // reported as the interruption it is.
+    let checked = |result: Result<(), CliError>| {
+        if stop.requested() {
+            Err(CliError::new(
+                "interrupted (Ctrl-C): no report was written (an earlier report in its folder is kept as it was)",
+            ))
+        } else {
+            result
+        }
+    };
+    checked(seed_part3(&mut report))?;
+    checked(seed_row_time_history(&mut report, &stop))?;
+    checked(seed_row_frequency_response(&mut report, &stop))?;
     let index = report.finish()?;
     println!(
         "report written: {} ({:.2} s)",

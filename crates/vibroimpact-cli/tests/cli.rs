@@ -1193,3 +1193,101 @@ fn csv_format_prints_tables_or_is_refused() {
         );
     }
 }
+
+/// Sends SIGINT to a child after `ms` milliseconds and returns its output.
+fn interrupt_after(mut cmd: Command, ms: u64) -> Output {
+    let child = cmd
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(ms));
+    // SAFETY: signalling our own child process.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Ctrl-C in `report` leaves the previous report untouched (the new one is
+/// built in a staging folder that is removed) and in `periodic` writes
+/// nothing; both exit 1 saying so. A folder that is not a report is not
+/// replaced.
+#[test]
+fn interrupted_report_and_periodic_leave_no_partial_output() {
+    let dir = temp_dir("report-interrupted");
+    let target = dir.join("report");
+    std::fs::create_dir_all(&target).unwrap();
+    std::fs::write(target.join("index.html"), "OLD").unwrap();
+    let mut cmd = bin();
+    cmd.args(["report", "--out"]).arg(&target);
+    let out = interrupt_after(cmd, 2500);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("interrupted (Ctrl-C): no report was written"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(target.join("index.html")).unwrap(),
+        "OLD"
+    );
+    let siblings: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(siblings, vec!["report".to_string()], "{siblings:?}");
+
+    let mut cmd = bin();
+    cmd.args(["periodic", &repo_file("examples/fujita-row.toml"), "--out"])
+        .arg(dir.join("orbit"));
+    let out = interrupt_after(cmd, 300);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted (Ctrl-C)"), "{stderr}");
+    assert!(!dir.join("orbit").exists());
+
+    let other = dir.join("notes");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("mine.txt"), "keep").unwrap();
+    assert_clean_error(
+        &["report", "--out", &other.display().to_string()],
+        "is not a report folder",
+    );
+    assert_eq!(
+        std::fs::read_to_string(other.join("mine.txt")).unwrap(),
+        "keep"
+    );
+}
+
+/// A second Ctrl-C quits at once (status 130) and removes the temporary
+/// files of the writes in progress: no `*.tmp<PID>` is left behind.
+#[test]
+fn second_ctrl_c_quits_without_temporary_files() {
+    let dir = temp_dir("simulate-twice");
+    let child = bin()
+        .args(["simulate", &repo_file("examples/fujita-row.toml")])
+        .args(["--periods", "1000000", "--out"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    for _ in 0..2 {
+        // SAFETY: signalling our own child process.
+        unsafe {
+            libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let out = child.wait_with_output().unwrap();
+    let code = out.status.code();
+    assert!(code == Some(130) || code == Some(1), "{code:?}");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}

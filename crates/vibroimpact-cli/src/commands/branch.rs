@@ -105,12 +105,30 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     if args.subharmonic == 0 {
         return Err(CliError::new("--subharmonic must be >= 1"));
     }
-    let guess = read_guess(&args.guess, &model, args.guess_periods, args.rtol)?;
+    let interrupt = crate::interrupt::on_ctrl_c();
+    let stopped = |e: &dyn std::fmt::Display| {
+        if interrupt.requested() {
+            CliError::new("interrupted (Ctrl-C): no periodic solution was written")
+        } else {
+            CliError::new(e.to_string())
+        }
+    };
+    let guess = match args.guess.as_str() {
+        "simulate" => guess_by_simulation_with(
+            &model,
+            args.guess_periods,
+            args.rtol.max(1e-9),
+            Some(interrupt.clone()),
+        )
+        .map_err(|e| stopped(&format!("guess by simulation: {e}")))?,
+        _ => read_guess(&args.guess, &model, args.guess_periods, args.rtol)?,
+    };
     let opts = ShootingOptions {
         subharmonic: args.subharmonic,
         rtol: args.rtol,
         tol: args.tol,
         symmetric: args.symmetric,
+        interrupt: Some(interrupt.clone()),
         ..ShootingOptions::default()
     };
     if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic % 2 == 0) {
@@ -125,7 +143,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     } else {
         shoot(&model, &guess, &opts)
     }
-    .map_err(|e| CliError::new(e.to_string()))?;
+    .map_err(|e| stopped(&e))?;
     let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)
         .map_err(|e| CliError::new(e.to_string()))?;
     let symmetric_orbit = args.symmetric

@@ -10,7 +10,7 @@ use crate::args::MethodName;
 use crate::error::CliError;
 use crate::format::{number, SummaryFormat};
 use crate::model_io::read_model;
-use crate::output::{commit_temp, temp_path};
+use crate::output::{commit_temp, temp_path, Pending};
 use crate::output::{ensure_dir, write_atomic, OutputError};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use vibroimpact::model_file::LoadedModel;
@@ -329,6 +329,7 @@ const PLOTTED_SAMPLES: f64 = 20_000.0;
 struct HistoryFile {
     path: PathBuf,
     tmp: PathBuf,
+    _pending: Pending,
     writer: csv::Writer<std::io::BufWriter<std::fs::File>>,
     error: Option<std::io::Error>,
     every: usize,
@@ -344,6 +345,7 @@ impl HistoryFile {
     /// Opens the temporary file and writes the header.
     fn create(path: &Path, model: &Model, opts: &SimulationOptions) -> Result<Self, CliError> {
         let tmp = temp_path(path);
+        let pending = Pending::new(&tmp);
         let fail = |e: std::io::Error| OutputError {
             path: path.to_path_buf(),
             source: e,
@@ -358,6 +360,7 @@ impl HistoryFile {
         Ok(Self {
             path: path.to_path_buf(),
             tmp,
+            _pending: pending,
             writer,
             error: None,
             every: (samples / PLOTTED_SAMPLES).ceil().max(1.0) as usize,

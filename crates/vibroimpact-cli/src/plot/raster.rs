@@ -10,7 +10,7 @@ use super::figure::*;
 use super::layout::*;
 use super::theme::*;
 use super::PlotError;
-use crate::output::{commit_temp, temp_path};
+use crate::output::{commit_temp, temp_path, Pending};
 
 // ---------------------------------------------------------------------------
 // Backends and files
@@ -82,6 +82,7 @@ pub(super) fn downsample(src: &[u8], w: u32, h: u32, k: u32) -> Vec<u8> {
 /// name ends in `.png`, as the encoder picks the format from it), synced, renamed.
 pub(super) fn write_png(pixels: &[u8], path: &Path) -> Result<(), PlotError> {
     let tmp = with_suffix(&temp_path(path), ".png");
+    let _pending = Pending::new(&tmp);
     let encoded = (|| {
         let mut backend = BitMapBackend::new(&tmp, (PNG_W, PNG_H));
         backend
