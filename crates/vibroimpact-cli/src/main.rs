@@ -9,6 +9,8 @@ mod data;
 mod error;
 mod figures;
 mod format;
+#[cfg(test)]
+mod fuzz_tests;
 mod input;
 mod interrupt;
 mod measurements;

@@ -756,6 +756,12 @@ impl ModelDocument {
                             cx.err_at(span.clone(), "[excitation] accelerogram: no record loaded")
                         })?;
                         let scale = scale.unwrap_or(1.0);
+                        if !scale.is_finite() {
+                            return Err(cx.err_at(
+                                span,
+                                format!("[excitation] scale = {scale}: must be finite"),
+                            ));
+                        }
                         BaseExcitation::Record(
                             Accelerogram::new(record.times.clone(), record.values.clone(), scale)
                                 .map_err(|e| ModelFileError(format!("{}: {e}", record.source)))?,

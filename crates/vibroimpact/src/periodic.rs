@@ -39,6 +39,11 @@ const TRUST: f64 = 0.5;
 /// largest multiplier is 1.274).
 pub const MIN_ARNOLDI: usize = 8;
 
+/// The largest state dimension (2N) of a dense period map: its variational
+/// equations hold 2N × 2N values (about 5 GB of integrator work space at
+/// this size); larger rows are refused up front in favour of Newton–Krylov.
+pub const MAX_DENSE_DIM: usize = 4096;
+
 /// Step budget of one period-map integration.
 const MAX_STEPS: u64 = 200_000;
 
@@ -218,6 +223,15 @@ pub fn period_map(
 ) -> Result<PeriodMap, IntegrationError> {
     let n = model.bodies().len();
     let d = 2 * n;
+    if d > MAX_DENSE_DIM {
+        // About 40 state-sized vectors of d(d + 1) values in the integrator.
+        let gb = 40.0 * (d * (d + 1)) as f64 * 8.0 / 1e9;
+        return Err(IntegrationError::InvalidOptions(format!(
+            "a dense period map of {n} bodies integrates {d}×{d} variational equations (about {gb:.0} GB); \
+             above {} bodies use Newton–Krylov shooting (matrix-free)",
+            MAX_DENSE_DIM / 2
+        )));
+    }
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
     let sys = ChainDynamics::new(model, false);
     let mut var = Variational::new(sys, d);

@@ -282,3 +282,13 @@ fn errors() {
         Err(PeriodicError::BadState { .. })
     ));
 }
+
+/// A dense period map of more than 2048 bodies is refused up front (its
+/// variational equations would need gigabytes), pointing to Newton–Krylov.
+#[test]
+fn dense_shooting_of_huge_rows_is_refused() {
+    let model = r2(2049, 1e-3, 0.5 * W0);
+    let err = shoot(&model, &vec![0.0; 2 * 2049], &ShootingOptions::default()).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("above 2048 bodies use Newton–Krylov"), "{msg}");
+}

@@ -1,0 +1,243 @@
+//! Fuzzing of every parser and of the model constructor: seeded,
+//! deterministic, bounded in `cargo test`; longer with
+//! `VIBROIMPACT_FUZZ_CASES=20000 cargo test --release -p vibroimpact --test fuzz`
+//! (and `VIBROIMPACT_FUZZ_SEED=<n>` for another sequence).
+//!
+//! Inputs are mutants of the repository's own examples (byte and token
+//! edits, extreme numbers, duplicated and swapped lines), so that they pass
+//! far enough through the parsers to reach validation, and random
+//! well-formed models. Every case must end in a result or an error — never a
+//! panic — and a model that builds must simulate a short time (bounded by a
+//! step limit) or fail with an error. Parse errors must name the source.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use vibroimpact::contact::{ContactLaw, ForceForm};
+use vibroimpact::integrate::Method;
+use vibroimpact::model::{BaseExcitation, Model};
+use vibroimpact::model_file::{
+    parse_accelerogram_csv, ModelDocument, ModelFileError, RecordSamples,
+};
+use vibroimpact::parameter::ParameterizedModel;
+use vibroimpact::simulate::{simulate, SimulationOptions};
+
+#[path = "support/mutate.rs"]
+mod mutate;
+use mutate::{cases, mutant, no_panics, seed, Rng, NUMBERS};
+
+const ROW: &str = include_str!("../../../examples/fujita-row.toml");
+const ROW2: &str = include_str!("../../../examples/fujita-row-n2.toml");
+const POUNDING: &str = include_str!("../../../examples/pounding-buildings.toml");
+const QUAKE: &str = include_str!("../../../examples/synthetic-quake.csv");
+/// Explicit bodies, springs, contacts, forces and an inline record.
+const EXPLICIT: &str = r#"
+[[body]]
+name = "a"
+mass = 1.0
+stiffness = 100.0
+damping_ratio = 0.02
+[[body]]
+name = "b"
+mass = 2.0
+natural_frequency = 5.0
+[[spring]]
+between = ["a", "b"]
+stiffness = 10.0
+damping = 0.1
+[[contact]]
+between = ["wall", "a"]
+clearance = 0.001
+law = { law = "hunt-crossley", stiffness = 1e7, chi = 0.5 }
+[[contact]]
+between = ["a", "b"]
+clearance = 0.002
+law = { law = "lankarani-nikravesh", stiffness = 1e7, restitution = 0.7 }
+[[force]]
+body = "b"
+amplitude = 1.0
+frequency = 5.0
+[excitation]
+type = "accelerogram"
+time = [0.0, 0.1, 0.2, 0.3]
+acceleration = [0.0, 1.0, -1.0, 0.0]
+"#;
+
+/// The record loader of the fuzzed model files: the example record, or an
+/// error for any other name.
+fn loader(name: &str) -> Result<RecordSamples, ModelFileError> {
+    if name == "synthetic-quake.csv" {
+        parse_accelerogram_csv(QUAKE, name)
+    } else {
+        Err(ModelFileError(format!(
+            "record:{name}: no such file in the fuzz corpus"
+        )))
+    }
+}
+
+/// A short simulation, bounded by a small step limit.
+fn short_run(model: &Model, method: Method) {
+    let t_end = model
+        .forcing_frequency()
+        .map_or(0.05, |w| (2.0 * std::f64::consts::PI / w).min(0.5));
+    let opts = SimulationOptions {
+        t_end,
+        max_steps: 20_000,
+        method,
+        ..SimulationOptions::default()
+    };
+    if let Ok(sim) = simulate(model, &opts) {
+        if sim.error.is_none() {
+            assert!(
+                sim.final_displacement.iter().all(|x| x.is_finite()),
+                "a completed run has a finite state"
+            );
+        }
+    }
+}
+
+#[test]
+fn model_file_mutants_parse_build_and_simulate_without_panics() {
+    let mut rng = Rng(seed());
+    let corpus = [ROW, ROW2, POUNDING, EXPLICIT];
+    let n = cases(1000);
+    let inputs: Vec<String> = (0..n).map(|_| mutant(&mut rng, &corpus)).collect();
+    no_panics(
+        "model file",
+        inputs.into_iter(),
+        |text| match ModelDocument::parse(text, "fuzz.toml", &mut |name| loader(name)) {
+            Err(e) => assert!(
+                e.0.starts_with("fuzz.toml") || e.0.starts_with("record:"),
+                "unnamed error: {e}"
+            ),
+            Ok(doc) => {
+                if let Ok(loaded) = doc.build() {
+                    if loaded.model.bodies().len() <= 50 {
+                        short_run(&loaded.model, Method::Auto);
+                    }
+                }
+            }
+        },
+    );
+}
+
+#[test]
+fn accelerogram_csv_mutants_never_panic() {
+    let mut rng = Rng(seed() ^ 1);
+    let corpus = [
+        QUAKE,
+        "time,acceleration\n0,0\n0.1,1\n",
+        "# c\n0 , 0\n1,2\n",
+    ];
+    let inputs: Vec<String> = (0..cases(1000))
+        .map(|_| mutant(&mut rng, &corpus))
+        .collect();
+    no_panics("accelerogram", inputs.into_iter(), |text| {
+        if let Err(e) = parse_accelerogram_csv(text, "fuzz.csv") {
+            assert!(e.0.starts_with("fuzz.csv"), "unnamed error: {e}");
+        }
+    });
+}
+
+/// Parameter keys and values, valid or not, on each example.
+#[test]
+fn parameters_set_or_refuse_without_panics() {
+    const KEYS: &[&str] = &[
+        "frequency",
+        "amplitude",
+        "row.clearance",
+        "row.count",
+        "row.mass",
+        "row.contact.alpha",
+        "row.contact.a_over_b",
+        "body.1.mass",
+        "body.2.stiffness",
+        "contact.1.clearance",
+        "contact.2.law.stiffness",
+        "spring.1.stiffness",
+        "force.1.amplitude",
+        "excitation.scale",
+        "row",
+        "",
+        ".",
+        "body.0.mass",
+        "body.99999999999999999999.mass",
+        "row.contact",
+        "row.colour",
+        "simulation.rtol",
+    ];
+    let mut rng = Rng(seed() ^ 2);
+    let docs: Vec<ModelDocument> = [ROW, ROW2, POUNDING, EXPLICIT]
+        .iter()
+        .map(|t| ModelDocument::parse(t, "m.toml", &mut |name| loader(name)).unwrap())
+        .collect();
+    let n = cases(400);
+    let inputs: Vec<String> = (0..n)
+        .map(|_| {
+            let value: f64 = rng.pick(NUMBERS).parse().unwrap_or(0.5);
+            format!("{}|{}|{value}", rng.below(docs.len()), *rng.pick(KEYS))
+        })
+        .collect();
+    no_panics("parameter", inputs.into_iter(), |case| {
+        let parts: Vec<&str> = case.split('|').collect();
+        let doc = docs[parts[0].parse::<usize>().unwrap()].clone();
+        let value: f64 = parts[2].parse().unwrap();
+        if let Ok(family) = ParameterizedModel::new(doc, parts[1]) {
+            let _ = family.model_at(value);
+        }
+    });
+}
+
+/// Random but well-formed rows (every law, wide parameter ranges): each
+/// simulates a short time or fails with an error.
+#[test]
+fn random_models_simulate_or_fail_cleanly() {
+    let mut rng = Rng(seed() ^ 3);
+    let n = cases(300);
+    for k in 0..n {
+        let form = if rng.below(2) == 0 {
+            ForceForm::Published
+        } else {
+            ForceForm::NonNegative
+        };
+        let stiffness = rng.log_uniform(3.0, 12.0);
+        let law = match rng.below(5) {
+            0 => ContactLaw::exponential_from_ratio(
+                rng.log_uniform(-2.0, 2.0),
+                rng.log_uniform(2.0, 7.0),
+                rng.log_uniform(-2.0, 2.0),
+                form,
+            ),
+            1 => ContactLaw::hertz(stiffness, 1.0 + rng.unit()),
+            2 => ContactLaw::kelvin_voigt(stiffness, rng.log_uniform(-3.0, 4.0), form),
+            3 => ContactLaw::hunt_crossley(stiffness, 1.5, rng.log_uniform(-3.0, 1.0), form),
+            _ => {
+                ContactLaw::lankarani_nikravesh(stiffness, 1.5, 0.05 + 0.9 * rng.unit(), 1e-3, form)
+            }
+        };
+        let Ok(law) = law else { continue };
+        let mass = rng.log_uniform(-3.0, 3.0);
+        let omega = rng.log_uniform(-1.0, 4.0);
+        let base = BaseExcitation::Harmonic {
+            amplitude: rng.log_uniform(-3.0, 3.0),
+            frequency: omega * rng.log_uniform(-0.5, 0.5),
+            phase: rng.unit(),
+        };
+        let model = Model::row(
+            1 + rng.below(5),
+            mass,
+            mass * omega * omega,
+            2.0 * rng.log_uniform(-4.0, 0.5) * mass * omega,
+            rng.log_uniform(-6.0, -2.0),
+            law,
+            (rng.below(4) != 0, rng.below(4) != 0),
+            base,
+        );
+        let Ok(model) = model else { continue };
+        let method = *rng.pick(&[Method::Dop853, Method::Rodas, Method::Auto]);
+        let ran = catch_unwind(AssertUnwindSafe(|| short_run(&model, method)));
+        assert!(
+            ran.is_ok(),
+            "random model {k} panicked: {model:?} with {method:?}"
+        );
+    }
+}
