@@ -14,13 +14,15 @@ const ACCELERATION: &str = include_str!("../../../examples/seed-impacts/accelera
 #[test]
 fn measurement_csv_mutants_never_panic() {
     let mut rng = Rng(seed() ^ 11);
-    let corpus = [RESTITUTION, ACCELERATION, "impact_velocity,restitution\n0.1,0.9\n"];
+    let corpus = [
+        RESTITUTION,
+        ACCELERATION,
+        "impact_velocity,restitution\n0.1,0.9\n",
+    ];
     let inputs: Vec<String> = (0..cases(600)).map(|_| mutant(&mut rng, &corpus)).collect();
     no_panics("measurement CSV", inputs.into_iter(), |text| {
-        let data = crate::measurements::Measurements::parse(
-            Some((text, "r.csv")),
-            Some((text, "a.csv")),
-        );
+        let data =
+            crate::measurements::Measurements::parse(Some((text, "r.csv")), Some((text, "a.csv")));
         match data {
             Err(e) => {
                 let m = e.to_string();
@@ -49,7 +51,9 @@ fn velocity_ranges_parse_or_refuse_without_panics() {
         "1e-3:1e1:200lin",
         "0.1:1:10000000",
     ];
-    let inputs: Vec<String> = (0..cases(3000)).map(|_| mutant(&mut rng, &corpus)).collect();
+    let inputs: Vec<String> = (0..cases(3000))
+        .map(|_| mutant(&mut rng, &corpus))
+        .collect();
     no_panics("velocity range", inputs.into_iter(), |spec| {
         match crate::commands::impact::parse_velocities(spec) {
             Ok(v) => assert!(v.len() <= 10_000_000 && v.iter().all(|x| x.is_finite())),

@@ -1291,3 +1291,58 @@ fn second_ctrl_c_quits_without_temporary_files() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+/// The same input gives the same bytes at 1 and 2 threads (the parallel
+/// commands: sweep, impact).
+#[test]
+fn outputs_are_the_same_bytes_at_one_and_two_threads() {
+    use std::collections::hash_map::DefaultHasher;
+    use std::hash::{Hash, Hasher};
+    let hash = |bytes: &[u8]| {
+        let mut h = DefaultHasher::new();
+        bytes.hash(&mut h);
+        h.finish()
+    };
+    let run_with = |threads: &str, out: &Path| {
+        let sweep = bin()
+            .env("RAYON_NUM_THREADS", threads)
+            .args(["sweep", &repo_file("examples/fujita-row.toml")])
+            .args(["--parameter", "frequency", "--from", "5.9", "--to", "8.9"])
+            .args([
+                "--points",
+                "8",
+                "--transient",
+                "10",
+                "--record",
+                "3",
+                "--up-down",
+                "--out",
+            ])
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(sweep.status.success());
+        let impact = bin()
+            .env("RAYON_NUM_THREADS", threads)
+            .args([
+                "impact",
+                "--velocity",
+                "0.001:10:5000log",
+                "--format",
+                "csv",
+            ])
+            .output()
+            .unwrap();
+        assert!(impact.status.success());
+        [
+            hash(&std::fs::read(out.join("sweep.csv")).unwrap()),
+            hash(&std::fs::read(out.join("summary.json")).unwrap()),
+            hash(&sweep.stdout),
+            hash(&impact.stdout),
+        ]
+    };
+    let dir = temp_dir("threads");
+    let one = run_with("1", &dir.join("one"));
+    let two = run_with("2", &dir.join("two"));
+    assert_eq!(one, two);
+}
