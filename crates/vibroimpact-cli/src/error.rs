@@ -23,7 +23,19 @@ macro_rules! from_display {
     )*};
 }
 
+impl From<csv::Error> for CliError {
+    fn from(e: csv::Error) -> Self {
+        Self(format!("cannot format CSV: {e}"))
+    }
+}
+
 from_display!(
+    std::string::FromUtf8Error,
+    vibroimpact::continuation::ContinuationError,
+    vibroimpact::continuation::SwitchError,
+    vibroimpact::integrate::IntegrationError,
+    vibroimpact::periodic::PeriodicError,
+    vibroimpact::simulate::OptionsError,
     crate::output::OutputError,
     crate::plot::PlotError,
     vibroimpact::contact::ContactLawError,

@@ -37,18 +37,42 @@ pub fn number(x: Option<f64>) -> String {
     }
 }
 
+/// CSV written into memory (quoting cells where needed).
+pub struct CsvText(csv::Writer<Vec<u8>>);
+
+impl CsvText {
+    /// An empty CSV text.
+    pub fn new() -> Self {
+        Self(csv::Writer::from_writer(Vec::new()))
+    }
+
+    /// Appends one record.
+    pub fn row<I, T>(&mut self, record: I) -> Result<(), CliError>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        Ok(self.0.write_record(record)?)
+    }
+
+    /// The text.
+    pub fn finish(self) -> Result<String, CliError> {
+        let bytes = self
+            .0
+            .into_inner()
+            .map_err(|e| CliError::new(format!("cannot format CSV: {}", e.error())))?;
+        Ok(String::from_utf8(bytes)?)
+    }
+}
+
 /// CSV text of a numeric table (empty cells for missing values).
 pub fn csv_text(columns: &[&str], rows: &[Vec<Option<f64>>]) -> Result<String, CliError> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let io = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
-    w.write_record(columns).map_err(io)?;
+    let mut w = CsvText::new();
+    w.row(columns)?;
     for row in rows {
-        w.write_record(row.iter().map(|x| number(*x))).map_err(io)?;
+        w.row(row.iter().map(|x| number(*x)))?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| CliError::new(format!("cannot format CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| CliError::new(e.to_string()))
+    w.finish()
 }
 
 /// Prints a table to standard output as aligned text or CSV.

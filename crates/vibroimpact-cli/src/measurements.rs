@@ -99,23 +99,18 @@ impl Measurements {
             "restitution" => self.restitution.as_ref().map(|(_, t, s)| (t, s)),
             _ => self.acceleration.as_ref().map(|(_, t, s)| (t, s)),
         };
-        match &e {
+        let located = match &e {
             IdentifyError::InvalidSample {
                 what,
                 index,
                 reason,
-            } => match find(what) {
-                Some((t, source)) => {
-                    CliError::new(format!("{source}:{}: {reason}", t.lines[*index]))
-                }
-                None => CliError::new(e.to_string()),
-            },
-            IdentifyError::TooFewPoints { what, .. } => match find(what) {
-                Some((_, source)) => CliError::new(format!("{source}: {e}")),
-                None => CliError::new(e.to_string()),
-            },
-            _ => CliError::new(e.to_string()),
-        }
+            } => find(what).map(|(t, source)| format!("{source}:{}: {reason}", t.lines[*index])),
+            IdentifyError::TooFewPoints { what, .. } => {
+                find(what).map(|(_, source)| format!("{source}: {e}"))
+            }
+            _ => None,
+        };
+        located.map_or_else(|| e.into(), CliError::new)
     }
 
     /// Runs the identification the options ask for.

@@ -679,7 +679,7 @@ fn seed_row_time_history(report: &mut Report, stop: &Interrupt) -> Result<(), Cl
         interrupt: Some(stop.clone()),
         ..SimulationOptions::default()
     };
-    let sim = simulate(&model, &opts).map_err(|e| CliError::new(e.to_string()))?;
+    let sim = simulate(&model, &opts)?;
     if let Some(e) = &sim.error {
         return Err(CliError::new(format!("default study, R2 simulation: {e}")));
     }
@@ -916,8 +916,7 @@ fn seed_row_frequency_response(report: &mut Report, stop: &Interrupt) -> Result<
     let mut table = Vec::new();
     for n in [2usize, 3] {
         let start = row(n, 1.5 * w0).map_err(CliError::new)?;
-        let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))
-            .map_err(|e| CliError::new(e.to_string()))?;
+        let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))?;
         let defaults = ContinuationOptions::default();
         let opts = ContinuationOptions {
             max_points: 900,
@@ -929,8 +928,7 @@ fn seed_row_frequency_response(report: &mut Report, stop: &Interrupt) -> Result<
         };
         let t0 = Instant::now();
         let branch: Branch =
-            continue_branch(|w| row(n, w), 1.5 * w0, &guess, 0.5 * w0, &opts, |_| true)
-                .map_err(|e| CliError::new(e.to_string()))?;
+            continue_branch(|w| row(n, w), 1.5 * w0, &guess, 0.5 * w0, &opts, |_| true)?;
         let seconds = t0.elapsed().as_secs_f64();
         eprintln!(
             "R2 N = {n}: branch of {} points in {seconds:.1} s",

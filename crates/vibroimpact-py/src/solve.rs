@@ -13,7 +13,7 @@ use vibroimpact::continuation::{
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::{ImpactError, TwoBodies};
-use vibroimpact::integrate::Method;
+use vibroimpact::integrate::{IntegrationError, Method};
 use vibroimpact::model_file::LawSpec;
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
@@ -105,7 +105,9 @@ pub fn impact<'py>(
             .par_chunks(CHUNK)
             .map(|chunk| {
                 if p.interrupt.requested() {
-                    return Err(ImpactError::Integration("interrupted".into()));
+                    return Err(ImpactError::Integration(IntegrationError::Interrupted {
+                        t: 0.0,
+                    }));
                 }
                 let mut cols = vec![Vec::with_capacity(chunk.len()); ncol];
                 for &u in chunk {

@@ -174,7 +174,10 @@ fn parameters_set_or_refuse_without_panics() {
     let inputs: Vec<String> = (0..n)
         .map(|_| {
             let value: f64 = rng.pick(NUMBERS).parse().unwrap_or(0.5);
-            format!("{}|{}|{value}", rng.below(docs.len()), *rng.pick(KEYS))
+            {
+                let key = *rng.pick(KEYS);
+                format!("{}|{key}|{value}", rng.below(docs.len()))
+            }
         })
         .collect();
     no_panics("parameter", inputs.into_iter(), |case| {

@@ -14,7 +14,7 @@ use vibroimpact::periodic::{
 
 use crate::error::CliError;
 use crate::figures::branch_figure;
-use crate::format::{history_csv, Format, SummaryFormat};
+use crate::format::{history_csv, CsvText, Format, SummaryFormat};
 use crate::model_io::{read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
@@ -144,8 +144,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         shoot(&model, &guess, &opts)
     }
     .map_err(|e| stopped(&e))?;
-    let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)
-        .map_err(|e| CliError::new(e.to_string()))?;
+    let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)?;
     let symmetric_orbit = args.symmetric
         || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts);
     let doc = periodic_document(
@@ -290,7 +289,7 @@ pub struct ContinueArgs {
 /// CSV of a branch.
 pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
     let n = model.bodies().len();
-    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut w = CsvText::new();
     let mut header = vec!["parameter".to_string()];
     header.extend(model.bodies().iter().map(|b| format!("max_u_{}", b.name)));
     header.extend(model.bodies().iter().map(|b| format!("max_v_{}", b.name)));
@@ -303,8 +302,7 @@ pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
         ]
         .map(String::from),
     );
-    let err = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
-    w.write_record(&header).map_err(err)?;
+    w.row(&header)?;
     for p in &branch.points {
         let mut row = vec![format!("{:e}", p.parameter)];
         row.extend((0..n).map(|i| format!("{:e}", p.max_displacement[i])));
@@ -313,10 +311,9 @@ pub fn branch_csv(branch: &Branch, model: &Model) -> Result<String, CliError> {
         row.push(format!("{:e}", p.spectral_radius()));
         row.push(p.stable.to_string());
         row.push(p.label.clone().unwrap_or_default());
-        w.write_record(&row).map_err(err)?;
+        w.row(&row)?;
     }
-    String::from_utf8(w.into_inner().map_err(|e| CliError::new(e.to_string()))?)
-        .map_err(|e| CliError::new(e.to_string()))
+    w.finish()
 }
 
 fn write_branch(
@@ -408,8 +405,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         !interrupt.requested()
     };
     let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-    let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)
-        .map_err(|e| CliError::new(e.to_string()))?;
+    let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)?;
     let mut branches = vec![branch];
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;

@@ -8,7 +8,7 @@ use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
 
 use crate::args::MethodName;
 use crate::error::CliError;
-use crate::format::{number, SummaryFormat};
+use crate::format::{number, CsvText, SummaryFormat};
 use crate::model_io::read_model;
 use crate::output::{commit_temp, temp_path, Pending};
 use crate::output::{ensure_dir, write_atomic, OutputError};
@@ -98,9 +98,8 @@ fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOption
 
 /// The impact log as CSV (quoted where a pair name needs it).
 fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
-    let io = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
+    let mut w = CsvText::new();
+    w.row([
         "start_time",
         "end_time",
         "pair",
@@ -109,8 +108,7 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
         "restitution",
         "peak_force",
         "duration",
-    ])
-    .map_err(io)?;
+    ])?;
     let f = |x: f64| {
         if x.is_finite() {
             format!("{x:e}")
@@ -119,7 +117,7 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
         }
     };
     for i in &sim.impacts {
-        w.write_record([
+        w.row([
             f(i.start_time),
             f(i.end_time),
             model.contact_name(i.contact),
@@ -128,11 +126,9 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
             f(i.restitution()),
             f(i.peak_force),
             f(i.duration()),
-        ])
-        .map_err(io)?;
+        ])?;
     }
-    let bytes = w.into_inner().map_err(|e| CliError::new(e.to_string()))?;
-    String::from_utf8(bytes).map_err(|e| CliError::new(e.to_string()))
+    w.finish()
 }
 
 /// Writes the impact log, summary and plots into `dir` (the time history
@@ -284,8 +280,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     let mut sim = simulate_streaming(model, &opts, |t, state| {
         history.as_mut().is_none_or(|h| h.sample(t, state))
-    })
-    .map_err(|e| CliError::new(e.to_string()))?;
+    })?;
     let s = simulation_summary(model, &sim);
     if let (Some(dir), Some(history)) = (&args.out, history) {
         (sim.times, sim.states) = history.finish()?;

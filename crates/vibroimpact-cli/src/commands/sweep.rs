@@ -8,7 +8,7 @@ use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, Sweep
 
 use crate::args::MethodName;
 use crate::error::CliError;
-use crate::format::Format;
+use crate::format::{CsvText, Format};
 use crate::model_io::read_family;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
@@ -77,12 +77,11 @@ fn parameter_label(name: &str) -> String {
 
 /// sweep.csv: one row per Poincaré sample.
 fn sweep_csv(summary: &SweepSummary) -> Result<String, CliError> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let io = |e: csv::Error| CliError::new(format!("cannot format CSV: {e}"));
+    let mut w = CsvText::new();
     let mut header: Vec<String> = vec!["parameter".into(), "direction".into(), "period".into()];
     header.extend(summary.bodies.iter().map(|b| format!("u_{b}")));
     header.extend(summary.bodies.iter().map(|b| format!("v_{b}")));
-    w.write_record(&header).map_err(io)?;
+    w.row(&header)?;
     for p in &summary.points {
         for (k, s) in p.sections.iter().enumerate() {
             let mut rec: Vec<String> = vec![
@@ -91,13 +90,10 @@ fn sweep_csv(summary: &SweepSummary) -> Result<String, CliError> {
                 (k + 1).to_string(),
             ];
             rec.extend(s.iter().map(|x| format!("{x:e}")));
-            w.write_record(&rec).map_err(io)?;
+            w.row(&rec)?;
         }
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| CliError::new(format!("cannot format CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| CliError::new(e.to_string()))
+    w.finish()
 }
 
 /// Writes sweep.csv, summary.json and the figures into `dir`.

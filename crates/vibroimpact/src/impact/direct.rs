@@ -154,9 +154,8 @@ fn walk(
         max_steps: opts.max_steps,
         ..IntegratorOptions::default()
     };
-    let err = |e: crate::integrate::IntegrationError| ImpactError::Integration(e.to_string());
-    let mut st = Dop853::new(2, int_opts).map_err(err)?;
-    st.reset(sys, 0.0, &[sigma0, 1.0]).map_err(err)?;
+    let mut st = Dop853::new(2, int_opts)?;
+    st.reset(sys, 0.0, &[sigma0, 1.0])?;
     let compact = sys.law.has_compact_support();
     let clamped = sys.law.form() == ForceForm::NonNegative;
     let raw = sys.law.with_form(ForceForm::Published);
@@ -181,12 +180,10 @@ fn walk(
     let mut rate_old = sys.force_rate(&y_old);
     let mut ind_old = level.map(|l| indicator(sys, &y_old, l));
     let located = |what: &'static str| {
-        move |e: crate::numeric::RootError| {
-            ImpactError::Integration(format!("locating the {what}: {e}"))
-        }
+        move |e: crate::numeric::RootError| ImpactError::Solver { what, source: e }
     };
     loop {
-        st.step(sys, f64::INFINITY).map_err(err)?;
+        st.step(sys, f64::INFINITY)?;
         let (t0, t1) = (st.t_prev(), st.t());
         let y_new = [st.y()[0], st.y()[1]];
         let state = |st: &mut Dop853, sys: &mut RelativeMotion, t| {
@@ -204,7 +201,7 @@ fn walk(
                     (t0, rate_old),
                     (t1, rate_new),
                 )
-                .map_err(located("peak force"))?;
+                .map_err(located("locating the peak force"))?;
             let y = state(&mut st, sys, tp);
             let f = sys.force(&y);
             if f > w.peak_force {
@@ -220,7 +217,7 @@ fn walk(
                     (t0, y_old[1]),
                     (t1, y_new[1]),
                 )
-                .map_err(located("maximum penetration"))?;
+                .map_err(located("locating the maximum penetration"))?;
             w.max_sigma = w.max_sigma.max(st.dense_component(sys, 0, tm));
         }
         // Contact indicator crossings.
@@ -236,7 +233,7 @@ fn walk(
                         (t0, io),
                         (t1, in_new),
                     )
-                    .map_err(located("contact boundary"))?;
+                    .map_err(located("locating the contact boundary"))?;
                 w.crossings.push((tc, in_new > 0.0));
             }
             ind_old = Some(in_new);
@@ -251,7 +248,7 @@ fn walk(
                     (t0, g_old),
                     (t1, g_new),
                 )
-                .map_err(located("separation"))?;
+                .map_err(located("locating the separation"))?;
             w.end_time = te;
             w.end_velocity = st.dense_component(sys, 1, te);
             return Ok((w, st.stats()));

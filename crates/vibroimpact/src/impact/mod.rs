@@ -51,7 +51,7 @@ pub enum ImpactError {
     },
     /// The direct integration failed.
     #[error("direct integration of the impact failed: {0}")]
-    Integration(String),
+    Integration(#[from] crate::integrate::IntegrationError),
     /// The law is not available for this computation.
     #[error("{0}")]
     Unsupported(String),

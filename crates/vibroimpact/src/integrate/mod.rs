@@ -323,7 +323,7 @@ impl fmt::Display for RejectReason {
 }
 
 /// Failure of an integration.
-#[derive(Debug, Clone, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IntegrationError {
     /// Repeated rejections shrank the step size below the minimum (see
     /// [`IntegratorOptions::h_min`]). `t` and `y` are the last accepted point,

@@ -127,7 +127,8 @@ pub fn mutate(rng: &mut Rng, text: &str) -> String {
         }
         1 => {
             let a = at(rng, &s);
-            s.insert_str(a, *rng.pick(TOKENS));
+            let token = *rng.pick(TOKENS);
+            s.insert_str(a, token);
         }
         2 => {
             // Replace one number with an extreme one.
@@ -143,7 +144,8 @@ pub fn mutate(rng: &mut Rng, text: &str) -> String {
                 let b = s[a..]
                     .find(|c: char| !(c.is_ascii_digit() || "eE+-.".contains(c)))
                     .map_or(s.len(), |k| a + k);
-                s.replace_range(a..b, *rng.pick(NUMBERS));
+                let number = *rng.pick(NUMBERS);
+                s.replace_range(a..b, number);
             }
         }
         3 | 4 => {
