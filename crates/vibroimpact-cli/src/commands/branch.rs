@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use vibroimpact::continuation::{continue_branch, switch_branch, Branch, ContinuationOptions};
 use vibroimpact::model::Model;
+use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary, shoot, shoot_krylov,
-    ShootingOptions,
+    OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
 use crate::error::CliError;
@@ -156,81 +157,11 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         krylov,
     );
     if let Some(dir) = &args.out {
-        ensure_dir(dir)?;
-        let n = model.bodies().len();
-        write_atomic(
-            &dir.join("orbit.csv"),
-            history_csv(&model, &orbit.times, &orbit.states)?.as_bytes(),
-        )?;
-        write_atomic(
-            &dir.join("summary.json"),
-            serde_json::to_string_pretty(&doc)?.as_bytes(),
-        )?;
-        let mut fig = Figure::new(
-            "Periodic orbit",
-            "time over one period  [s]",
-            "displacement u  [mm]",
-        )
-        .legend_at(LegendPosition::Best);
-        let mut phase = Figure::new(
-            "Periodic orbit in the phase plane",
-            "displacement u  [mm]",
-            "velocity v  [m/s]",
-        )
-        .legend_at(LegendPosition::Best);
-        for i in 0..n.min(8) {
-            let name = &model.bodies()[i].name;
-            fig.push(Series::line(
-                format!("u_{name}"),
-                orbit
-                    .times
-                    .iter()
-                    .enumerate()
-                    .map(|(j, &t)| (t, 1e3 * orbit.states[j * 2 * n + i])),
-            ));
-            phase.push(Series::line(
-                name.clone(),
-                (0..orbit.times.len()).map(|j| {
-                    (
-                        1e3 * orbit.states[j * 2 * n + i],
-                        orbit.states[j * 2 * n + n + i],
-                    )
-                }),
-            ));
-        }
-        render(&fig, &dir.join("orbit"))?;
-        render(&phase, &dir.join("orbit_phase"))?;
+        write_orbit(dir, &model, &orbit, &doc)?;
     }
     match args.format {
         SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
-        _ => {
-            println!(
-                "{}: period {:.6} s, residual {:.2e} after {} iterations",
-                if sol.converged {
-                    "converged"
-                } else {
-                    "NOT CONVERGED"
-                },
-                sol.period,
-                sol.residual_history.last().copied().unwrap_or(f64::NAN),
-                sol.residual_history.len() - 1
-            );
-            println!(
-                "{} (largest |multiplier| {:.6})",
-                if sol.stable() { "stable" } else { "unstable" },
-                sol.spectral_radius()
-            );
-            for m in &sol.multipliers {
-                println!("  multiplier {:+.6} {:+.6}i  |{:.6}|", m.re, m.im, m.norm());
-            }
-            for (i, b) in model.bodies().iter().enumerate() {
-                println!(
-                    "  {}: max|u| {:.6e} m, max|v| {:.6e} m/s",
-                    b.name, orbit.max_displacement[i], orbit.max_velocity[i]
-                );
-            }
-            println!("  impacts per period: {}", orbit.impacts_per_period());
-        }
+        SummaryFormat::Table => print!("{}", orbit_text(&model, &sol, &orbit)),
     }
     if sol.converged {
         Ok(())
@@ -244,6 +175,96 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
         )))
     }
+}
+
+/// Writes `orbit.csv`, `summary.json` and the orbit figures into `dir`.
+fn write_orbit(
+    dir: &Path,
+    model: &Model,
+    orbit: &OrbitSummary,
+    doc: &serde_json::Value,
+) -> Result<(), CliError> {
+    ensure_dir(dir)?;
+    let n = model.bodies().len();
+    write_atomic(
+        &dir.join("orbit.csv"),
+        history_csv(model, &orbit.times, &orbit.states)?.as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("summary.json"),
+        serde_json::to_string_pretty(doc)?.as_bytes(),
+    )?;
+    let mut fig = Figure::new(
+        "Periodic orbit",
+        "time over one period  [s]",
+        "displacement u  [mm]",
+    )
+    .legend_at(LegendPosition::Best);
+    let mut phase = Figure::new(
+        "Periodic orbit in the phase plane",
+        "displacement u  [mm]",
+        "velocity v  [m/s]",
+    )
+    .legend_at(LegendPosition::Best);
+    for i in 0..n.min(8) {
+        let name = &model.bodies()[i].name;
+        fig.push(Series::line(
+            format!("u_{name}"),
+            orbit
+                .times
+                .iter()
+                .enumerate()
+                .map(|(j, &t)| (t, 1e3 * orbit.states[j * 2 * n + i])),
+        ));
+        phase.push(Series::line(
+            name.clone(),
+            (0..orbit.times.len()).map(|j| {
+                (
+                    1e3 * orbit.states[j * 2 * n + i],
+                    orbit.states[j * 2 * n + n + i],
+                )
+            }),
+        ));
+    }
+    render(&fig, &dir.join("orbit"))?;
+    render(&phase, &dir.join("orbit_phase"))?;
+    Ok(())
+}
+
+/// The text summary of a shooting result.
+fn orbit_text(model: &Model, sol: &PeriodicSolution, orbit: &OrbitSummary) -> String {
+    let mut t = format!(
+        "{}: period {:.6} s, residual {:.2e} after {} iterations\n",
+        if sol.converged {
+            "converged"
+        } else {
+            "NOT CONVERGED"
+        },
+        sol.period,
+        sol.residual_history.last().copied().unwrap_or(f64::NAN),
+        sol.residual_history.len() - 1
+    );
+    t += &format!(
+        "{} (largest |multiplier| {:.6})\n",
+        if sol.stable() { "stable" } else { "unstable" },
+        sol.spectral_radius()
+    );
+    for m in &sol.multipliers {
+        t += &format!(
+            "  multiplier {:+.6} {:+.6}i  |{:.6}|\n",
+            m.re,
+            m.im,
+            m.norm()
+        );
+    }
+    for (i, b) in model.bodies().iter().enumerate() {
+        t += &format!(
+            "  {}: max|u| {:.6e} m, max|v| {:.6e} m/s\n",
+            b.name, orbit.max_displacement[i], orbit.max_velocity[i]
+        );
+    }
+    t += &format!("  impacts per period: {}\n", orbit.impacts_per_period());
+    t
 }
 
 /// Options of `vibroimpact continue`.
@@ -350,8 +371,10 @@ fn write_branch(
     Ok(())
 }
 
-/// Runs `vibroimpact continue`.
-pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
+/// The family and the start model of `continue`, after checking the range,
+/// the subharmonic and that the parameter is continuous and the start
+/// forced periodically.
+fn continuation_family(args: &ContinueArgs) -> Result<(ParameterizedModel, Model), CliError> {
     let pm = read_family(&args.model, &args.parameter)?;
     if !(args.from.is_finite() && args.to.is_finite()) || args.from == args.to {
         return Err(CliError::new(format!(
@@ -374,6 +397,63 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             "the model has no periodic forcing with one frequency at --from: nothing to continue",
         ));
     }
+    Ok((pm, start_model))
+}
+
+/// Prints the branches in the chosen format.
+fn print_branches(
+    args: &ContinueArgs,
+    branches: &[Branch],
+    start_model: &Model,
+) -> Result<(), CliError> {
+    let docs: Vec<serde_json::Value> = branches
+        .iter()
+        .map(|b| branch_document(b, start_model, &args.parameter))
+        .collect();
+    match args.format {
+        Format::Json => {
+            let doc = if docs.len() == 1 {
+                docs[0].clone()
+            } else {
+                let mut first = docs[0].clone();
+                first["switched_branch"] = docs[1].clone();
+                first
+            };
+            println!("{}", serde_json::to_string_pretty(&doc)?);
+        }
+        Format::Csv => {
+            for b in branches {
+                print!("{}", branch_csv(b, start_model)?);
+            }
+        }
+        Format::Table => {
+            for (i, b) in branches.iter().enumerate() {
+                println!(
+                    "{}: {} points from {} to {} ({:?})",
+                    if i == 0 { "branch" } else { "switched branch" },
+                    b.points.len(),
+                    b.points.first().map_or(f64::NAN, |p| p.parameter),
+                    b.points.last().map_or(f64::NAN, |p| p.parameter),
+                    b.stop
+                );
+                for s in &b.special {
+                    println!(
+                        "  {:<5} {:<16} {} = {:.10}",
+                        s.label,
+                        s.kind.name(),
+                        args.parameter,
+                        s.parameter
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Runs `vibroimpact continue`.
+pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
+    let (pm, start_model) = continuation_family(args)?;
     let interrupt = crate::interrupt::on_ctrl_c();
     let opts = ContinuationOptions {
         max_points: args.max_points,
@@ -424,71 +504,20 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         }
     }
     bar.finish_and_clear();
-    let scale = 1.0;
     if let Some(dir) = &args.out {
-        write_branch(
-            dir,
-            &start_model,
-            &branches[0],
-            &args.parameter,
-            "branch",
-            scale,
-            &args.parameter,
-        )?;
-        if let Some(b) = branches.get(1) {
+        for (b, stem) in branches.iter().zip(["branch", "switched_branch"]) {
             write_branch(
                 dir,
                 &start_model,
                 b,
                 &args.parameter,
-                "switched_branch",
-                scale,
+                stem,
+                1.0,
                 &args.parameter,
             )?;
         }
     }
-    let docs: Vec<serde_json::Value> = branches
-        .iter()
-        .map(|b| branch_document(b, &start_model, &args.parameter))
-        .collect();
-    match args.format {
-        Format::Json => {
-            let doc = if docs.len() == 1 {
-                docs[0].clone()
-            } else {
-                let mut first = docs[0].clone();
-                first["switched_branch"] = docs[1].clone();
-                first
-            };
-            println!("{}", serde_json::to_string_pretty(&doc)?);
-        }
-        Format::Csv => {
-            for b in &branches {
-                print!("{}", branch_csv(b, &start_model)?);
-            }
-        }
-        Format::Table => {
-            for (i, b) in branches.iter().enumerate() {
-                println!(
-                    "{}: {} points from {} to {} ({:?})",
-                    if i == 0 { "branch" } else { "switched branch" },
-                    b.points.len(),
-                    b.points.first().map_or(f64::NAN, |p| p.parameter),
-                    b.points.last().map_or(f64::NAN, |p| p.parameter),
-                    b.stop
-                );
-                for s in &b.special {
-                    println!(
-                        "  {:<5} {:<16} {} = {:.10}",
-                        s.label,
-                        s.kind.name(),
-                        args.parameter,
-                        s.parameter
-                    );
-                }
-            }
-        }
-    }
+    print_branches(args, &branches, &start_model)?;
     if let Some(e) = switch_error {
         return Err(e);
     }

@@ -143,11 +143,22 @@ pub(super) fn draw_figure<DB: DrawingBackend>(
     cv: Canvas,
 ) -> DrawResult {
     area.fill(&WHITE).map_err(de)?;
+    draw_grid(area, plan, cv)?;
+    draw_series(area, fig, plan, cv)?;
+    draw_frame(area, plan, cv)?;
+    draw_labels(area, fig, plan, cv)?;
+    draw_legend(area, fig, plan, cv)
+}
+
+/// Minor and major grid lines.
+fn draw_grid<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plan: &Plan,
+    cv: Canvas,
+) -> DrawResult {
     let (l, r, t, b) = (plan.left, plan.right, plan.top, plan.bottom);
     let x_at = |tx: f64| l + plan.x.frac(tx) * (r - l);
     let y_at = |ty: f64| b - plan.y.frac(ty) * (b - t);
-
-    // Grid.
     let minor = cv.stroke(GRID_MINOR, GRID_WIDTH);
     let major = cv.stroke(GRID_MAJOR, GRID_WIDTH);
     for &tx in &plan.x.minor {
@@ -163,7 +174,16 @@ pub(super) fn draw_figure<DB: DrawingBackend>(
         cv.line(area, &[(l, y_at(*ty)), (r, y_at(*ty))], major)?;
     }
 
-    // Series.
+    Ok(())
+}
+
+/// Every series: lines (clipped, dashed where asked) and markers.
+fn draw_series<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    fig: &Figure,
+    plan: &Plan,
+    cv: Canvas,
+) -> DrawResult {
     for (s, &color) in fig.series.iter().zip(&plan.colors) {
         let style = cv.stroke(color, LINE_WIDTH);
         let lines = match s.style {
@@ -197,7 +217,18 @@ pub(super) fn draw_figure<DB: DrawingBackend>(
         }
     }
 
-    // Frame and ticks.
+    Ok(())
+}
+
+/// The frame with its ticks and tick labels.
+fn draw_frame<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plan: &Plan,
+    cv: Canvas,
+) -> DrawResult {
+    let (l, r, t, b) = (plan.left, plan.right, plan.top, plan.bottom);
+    let x_at = |tx: f64| l + plan.x.frac(tx) * (r - l);
+    let y_at = |ty: f64| b - plan.y.frac(ty) * (b - t);
     let frame = cv.stroke(FRAME, FRAME_WIDTH);
     cv.line(area, &[(l, t), (r, t), (r, b), (l, b), (l, t)], frame)?;
     for &tx in &plan.x.minor {
@@ -228,7 +259,17 @@ pub(super) fn draw_figure<DB: DrawingBackend>(
         cv.text(area, label, TICK_EM, x, baseline, HPos::Right, false)?;
     }
 
-    // Axis labels and title.
+    Ok(())
+}
+
+/// Axis labels and title.
+fn draw_labels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    fig: &Figure,
+    plan: &Plan,
+    cv: Canvas,
+) -> DrawResult {
+    let (l, r, t, b) = (plan.left, plan.right, plan.top, plan.bottom);
     let (cx, cy) = (0.5 * (l + r), 0.5 * (t + b));
     let x_label_baseline = H - PAD - DESCENT * plan.x_label_em;
     let x_label_w = text_width(&fig.x_label, plan.x_label_em);
@@ -264,7 +305,7 @@ pub(super) fn draw_figure<DB: DrawingBackend>(
         false,
     )?;
 
-    draw_legend(area, fig, plan, cv)
+    Ok(())
 }
 
 /// Centre for a text of width `w` near `cx` that keeps it inside the figure.
