@@ -1,0 +1,226 @@
+//! End-to-end tests of the default study's report and of `simulate`.
+
+mod common;
+use common::*;
+
+/// The default study writes every figure as SVG and PNG with its data, an
+/// index.html and summary.json; the same run gives the same bytes.
+#[test]
+fn default_study_report_is_complete_and_deterministic() {
+    let a = temp_dir("report-a");
+    let b = temp_dir("report-b");
+    for dir in [&a, &b] {
+        let out = bin().arg("--out").arg(dir).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let index = std::fs::read_to_string(a.join("index.html")).unwrap();
+    for stem in [
+        "fig1_phase_trajectories",
+        "fig2_restitution",
+        "fig3_peak_force",
+        "fig4_identify_restitution",
+        "fig5_identify_alpha",
+    ] {
+        for ext in ["svg", "png"] {
+            let f = a.join(format!("{stem}.{ext}"));
+            assert!(
+                std::fs::metadata(&f)
+                    .map(|m| m.len() > 1000)
+                    .unwrap_or(false),
+                "{f:?}"
+            );
+        }
+        assert!(index.contains(&format!("{stem}.png")), "index lacks {stem}");
+    }
+    let mut names: Vec<_> = std::fs::read_dir(&a)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    names.sort();
+    assert!(names.iter().any(|n| n.to_string_lossy().ends_with(".csv")));
+    assert!(
+        !names.iter().any(|n| n.to_string_lossy().contains(".tmp")),
+        "temporary files left: {names:?}"
+    );
+    for n in &names {
+        assert_eq!(
+            std::fs::read(a.join(n)).unwrap(),
+            std::fs::read(b.join(n)).unwrap(),
+            "{n:?} differs between runs"
+        );
+    }
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("summary.json")).unwrap()).unwrap();
+    assert!(
+        summary["max_abs_restitution_difference_integrated_vs_closed_form"]
+            .as_f64()
+            .unwrap()
+            < 1e-9
+    );
+}
+
+#[test]
+fn simulate_example_row_json_and_outputs() {
+    let model = repo_file("examples/fujita-row.toml");
+    let doc = json(&["simulate", &model, "--periods", "5", "--format", "json"]);
+    for key in [
+        "final_time",
+        "impact_count",
+        "rhs_evaluations",
+        "steps",
+        "rejected_steps",
+    ] {
+        assert!(doc[key].is_number(), "missing {key}");
+    }
+    assert_eq!(doc["final_displacement"].as_array().unwrap().len(), 3);
+    assert_eq!(doc["final_velocity"].as_array().unwrap().len(), 3);
+    assert!(doc["impact_count"].as_u64().unwrap() > 10);
+    let period = 2.0 * std::f64::consts::PI / 7.0395;
+    assert!((doc["final_time"].as_f64().unwrap() - 5.0 * period).abs() < 1e-9);
+    let dir = temp_dir("simulate-out");
+    let out = run(&[
+        "simulate",
+        &model,
+        "--duration",
+        "2",
+        "--out",
+        &dir.display().to_string(),
+        "--energy",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "history.csv",
+        "impacts.csv",
+        "summary.json",
+        "displacements.png",
+        "phase_portrait.svg",
+        "impact_velocities.png",
+    ] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    assert!(history.starts_with("t,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3\n"));
+    let log = std::fs::read_to_string(dir.join("impacts.csv")).unwrap();
+    assert!(log.starts_with("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration\n"));
+    assert!(log.lines().count() > 5);
+}
+
+#[test]
+fn simulate_bad_models() {
+    let dir = temp_dir("simulate-bad");
+    let good = std::fs::read_to_string(repo_file("examples/fujita-row.toml")).unwrap();
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("unknown.toml", good.replace("count = 3", "count = 3\ncolour = 1"), "unknown field `colour`"),
+        ("missing.toml", good.replace("clearance = 0.001", ""), "missing field `clearance`"),
+        ("mass.toml", good.replace("mass = 0.227", "mass = 0"), "mass = 0"),
+        ("gap.toml", good.replace("clearance = 0.001 ", "clearance = -0.001 "), "clearance"),
+        ("alpha.toml", good.replace("alpha = 1.3e5", "alpha = -1.0"), "alpha"),
+        (
+            "body.toml",
+            "[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"b\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1e9 }\n".into(),
+            "unknown body `b`",
+        ),
+        (
+            "overlap.toml",
+            "[[body]]\nname = \"a\"\nmass = 1.0\ninitial_displacement = 0.002\n[[contact]]\nbetween = [\"a\", \"wall\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1e9 }\n".into(),
+            "overlap",
+        ),
+        (
+            "nofile.toml",
+            "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"missing.csv\"\n".into(),
+            "missing.csv: cannot read the accelerogram",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let path = write_model(&dir, name, &text);
+        let out_dir = dir.join(format!("{name}.out"));
+        assert_clean_error(
+            &[
+                "simulate",
+                &path,
+                "--duration",
+                "0.1",
+                "--out",
+                &out_dir.display().to_string(),
+            ],
+            needle,
+        );
+        assert!(
+            !out_dir.exists(),
+            "{name}: output written despite the error"
+        );
+    }
+    std::fs::write(dir.join("back.csv"), "0,0\n1,1\n0.5,0\n").unwrap();
+    let path = write_model(
+        &dir,
+        "back.toml",
+        "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"back.csv\"\n",
+    );
+    assert_clean_error(&["simulate", &path, "--duration", "0.1"], "back.csv:3:");
+    std::fs::write(dir.join("fwd.csv"), "0,0\n1,1\n2,0\n").unwrap();
+    let path = write_model(
+        &dir,
+        "fwd.toml",
+        &std::fs::read_to_string(&path)
+            .unwrap()
+            .replace("back.csv", "fwd.csv"),
+    );
+    assert_clean_error(
+        &["simulate", &path, "--periods", "1"],
+        "--periods needs a periodic excitation",
+    );
+    let ok = run(&["simulate", &path, "--duration", "3"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let model = repo_file("examples/fujita-row.toml");
+    assert_clean_error(&["simulate", &model, "--duration", "-1"], "duration");
+    assert_clean_error(
+        &["simulate", &model, "--duration", "1", "--rtol", "0"],
+        "rtol",
+    );
+    assert_clean_error(
+        &[
+            "simulate",
+            &dir.join("nope.toml").display().to_string(),
+            "--duration",
+            "1",
+        ],
+        "cannot read",
+    );
+}
+
+/// The explicit-form example (two buildings pounding under an accelerogram)
+/// runs with every method and gives the same impacts.
+#[test]
+fn pounding_example_with_each_method() {
+    let model = repo_file("examples/pounding-buildings.toml");
+    let counts: Vec<u64> = ["dop853", "auto"]
+        .iter()
+        .map(|m| {
+            let doc = json(&[
+                "simulate",
+                &model,
+                "--duration",
+                "20",
+                "--method",
+                m,
+                "--format",
+                "json",
+            ]);
+            assert_eq!(doc["completed"], true);
+            doc["impact_count"].as_u64().unwrap()
+        })
+        .collect();
+    assert!(counts[0] > 5 && counts[0] == counts[1], "{counts:?}");
+}

@@ -1,0 +1,543 @@
+//! End-to-end tests of `sweep`, `periodic` and `continue`.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+/// `sweep` on the example row: every value is reported, the outputs are
+/// complete, and the result does not depend on thread scheduling.
+#[test]
+fn sweep_example_row_json_and_outputs() {
+    let model = repo_file("examples/fujita-row.toml");
+    let dir = temp_dir("sweep-row");
+    let args = |out: &str| {
+        vec![
+            "sweep".to_string(),
+            model.clone(),
+            "--parameter".into(),
+            "frequency".into(),
+            "--from".into(),
+            "7.0".into(),
+            "--to".into(),
+            "8.0".into(),
+            "--points".into(),
+            "3".into(),
+            "--transient".into(),
+            "10".into(),
+            "--record".into(),
+            "4".into(),
+            "--up-down".into(),
+            "--format".into(),
+            "json".into(),
+            "--out".into(),
+            out.into(),
+        ]
+    };
+    let a = dir.join("a").display().to_string();
+    let b = dir.join("b").display().to_string();
+    let run_args = |v: &Vec<String>| json(&v.iter().map(String::as_str).collect::<Vec<_>>());
+    let doc = run_args(&args(&a));
+    let points = doc["points"].as_array().unwrap();
+    assert_eq!(points.len(), 6, "3 values, up and down");
+    let params: Vec<f64> = points
+        .iter()
+        .map(|p| p["parameter"].as_f64().unwrap())
+        .collect();
+    assert_eq!(params, vec![7.0, 7.0, 7.5, 7.5, 8.0, 8.0]);
+    for p in points {
+        assert_eq!(p["completed"], true);
+        assert_eq!(p["recorded_periods"], 4);
+        let d = p["distinct_section_points"].as_u64().unwrap();
+        assert!((1..=4).contains(&d), "{p}");
+        let u = p["max_displacement"].as_array().unwrap();
+        assert_eq!(u.len(), 3);
+        assert!(u.iter().all(|x| x.as_f64().unwrap() > 0.0), "{p}");
+        assert!(
+            p["impacts_per_period"].as_f64().unwrap() > 0.0,
+            "impacts at 1 mm gaps"
+        );
+    }
+    assert_eq!(points[0]["direction"], "up");
+    assert_eq!(points[1]["direction"], "down");
+    for f in [
+        "sweep.csv",
+        "summary.json",
+        "sweep.svg",
+        "sweep.png",
+        "sweep_amplitude.svg",
+        "sweep_amplitude.png",
+    ] {
+        assert!(Path::new(&a).join(f).is_file(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(Path::new(&a).join("sweep.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "parameter,direction,period,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3"
+    );
+    assert_eq!(lines.count(), 6 * 4, "one row per Poincaré sample");
+    // The same run again gives the same bytes.
+    run_args(&args(&b));
+    for f in ["sweep.csv", "summary.json", "sweep.svg"] {
+        assert_eq!(
+            std::fs::read(Path::new(&a).join(f)).unwrap(),
+            std::fs::read(Path::new(&b).join(f)).unwrap(),
+            "{f} differs between runs"
+        );
+    }
+    // Table output without --out.
+    let out = run(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "7",
+        "--to",
+        "7.2",
+        "--points",
+        "2",
+        "--transient",
+        "2",
+        "--record",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with(" parameter") || text.contains("max|u_p1|"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 3);
+}
+
+/// R3, the linear limit: with gaps of 1 m nothing touches, and the recorded
+/// max |u| is the exact steady-state amplitude
+/// A / sqrt((w0² - W²)² + (2 ζ w0 W)²) (the transient has decayed by
+/// exp(-ζ w0 t) ≈ e⁻⁵⁴ after 400 periods at W = 0.6 w0); one section point.
+#[test]
+fn sweep_linear_limit_matches_exact_amplitude() {
+    let dir = temp_dir("sweep-r3");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row.toml"))
+        .unwrap()
+        .replace("clearance = 0.001 ", "clearance = 1.0 ");
+    assert!(text.contains("clearance = 1.0"));
+    let model = write_model(&dir, "r3.toml", &text);
+    let (a, w0, zeta) = (0.05, 7.41, 0.013);
+    let (w1, w2) = (0.6 * w0, 0.65 * w0);
+    let doc = json(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        &w1.to_string(),
+        "--to",
+        &w2.to_string(),
+        "--points",
+        "2",
+        "--transient",
+        "400",
+        "--record",
+        "5",
+        "--format",
+        "json",
+    ]);
+    let points = doc["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    for (p, w) in points.iter().zip([w1, w2]) {
+        // (serde_json parses floats to within an ulp)
+        assert!((p["parameter"].as_f64().unwrap() - w).abs() < 1e-12);
+        let exact = a / ((w0 * w0 - w * w).powi(2) + (2.0 * zeta * w0 * w).powi(2)).sqrt();
+        for u in p["max_displacement"].as_array().unwrap() {
+            let u = u.as_f64().unwrap();
+            assert!(
+                ((u - exact) / exact).abs() < 1e-4,
+                "W = {w}: max|u| = {u}, exact {exact}"
+            );
+        }
+        assert_eq!(p["distinct_section_points"], 1, "{p}");
+        assert_eq!(p["impacts_per_period"].as_f64().unwrap(), 0.0);
+        assert_eq!(p["completed"], true);
+    }
+}
+
+/// Bad input to `sweep`: one clean error line, non-zero exit; an integration
+/// failure keeps the computed values and names the value that failed.
+#[test]
+fn sweep_bad_input_and_failures() {
+    let model = repo_file("examples/fujita-row.toml");
+    let base = |extra: &[&str]| -> Vec<String> {
+        let mut v: Vec<String> = ["sweep", &model, "--transient", "1", "--record", "1"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    let check = |extra: &[&str], needle: &str| {
+        let v = base(extra);
+        assert_clean_error(&v.iter().map(String::as_str).collect::<Vec<_>>(), needle);
+    };
+    let range = ["--from", "7", "--to", "8", "--points", "3"];
+    check(
+        &[&["--parameter", "row.colour"][..], &range].concat(),
+        "does not exist",
+    );
+    check(
+        &[
+            "--parameter",
+            "frequency",
+            "--from",
+            "7",
+            "--to",
+            "8",
+            "--points",
+            "1",
+        ],
+        "at least 2",
+    );
+    check(
+        &[
+            "--parameter",
+            "frequency",
+            "--from",
+            "7",
+            "--to",
+            "7",
+            "--points",
+            "3",
+        ],
+        "give a range",
+    );
+    check(
+        &[
+            "--parameter",
+            "frequency",
+            "--from",
+            "nan",
+            "--to",
+            "7",
+            "--points",
+            "3",
+        ],
+        "finite",
+    );
+    check(
+        &[
+            "--parameter",
+            "frequency",
+            "--from",
+            "7",
+            "--to",
+            "inf",
+            "--points",
+            "3",
+        ],
+        "finite",
+    );
+    check(
+        &[
+            "--parameter",
+            "row.mass",
+            "--from",
+            "0.2",
+            "--to",
+            "-0.2",
+            "--points",
+            "3",
+        ],
+        "row.mass = 0:",
+    );
+    check(
+        &[&["--parameter", "frequency", "--rtol", "0"][..], &range].concat(),
+        "rtol",
+    );
+    check(
+        &[&["--parameter", "row.contact.law"][..], &range].concat(),
+        "not a number",
+    );
+    // No periodic forcing.
+    let dir = temp_dir("sweep-bad");
+    std::fs::write(dir.join("q.csv"), "0,0\n1,1\n2,0\n").unwrap();
+    let quake = write_model(
+        &dir,
+        "quake.toml",
+        "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"q.csv\"\n",
+    );
+    let out = run(&[
+        "sweep",
+        &quake,
+        "--parameter",
+        "row.mass",
+        "--from",
+        "1",
+        "--to",
+        "2",
+        "--points",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("periodic") && err.contains("row.mass = 1"),
+        "{err}"
+    );
+    // An integration failure at one value (an impossible tolerance once the
+    // bodies move): the other value is kept, the failed one is named.
+    let out_dir = dir.join("fail");
+    let out = run(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "amplitude",
+        "--from",
+        "0",
+        "--to",
+        "0.05",
+        "--points",
+        "2",
+        "--transient",
+        "0",
+        "--record",
+        "2",
+        "--rtol",
+        "1e-18",
+        "--atol",
+        "1e-30",
+        "--format",
+        "json",
+        "--out",
+        &out_dir.display().to_string(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "should fail");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("amplitude = 0.05") && err.contains("1 of 2"),
+        "{err}"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("JSON is still printed");
+    assert_eq!(doc["points"][0]["completed"], true);
+    assert_eq!(doc["points"][0]["max_displacement"][0].as_f64(), Some(0.0));
+    assert_eq!(doc["points"][1]["completed"], false);
+    assert!(doc["points"][1]["error"]
+        .as_str()
+        .unwrap()
+        .contains("step size"));
+    assert!(out_dir.join("summary.json").is_file());
+}
+
+/// `periodic` and `continue` on the seed's row with N = 2: JSON contracts,
+/// output files, and clean errors.
+#[test]
+fn periodic_and_continue_contracts() {
+    let dir = temp_dir("branch");
+    let model = write_model(
+        &dir,
+        "r2n2.toml",
+        &std::fs::read_to_string(repo_file("examples/fujita-row.toml"))
+            .unwrap()
+            .replace("count = 3", "count = 2"),
+    );
+    let doc = json(&["periodic", &model, "--format", "json"]);
+    assert_eq!(doc["converged"], true);
+    assert_eq!(doc["newton_stop"], "converged");
+    // N = 3 at 0.95 ω0 has no period-1 orbit near the simulated guess: the
+    // failure says why Newton stopped and what to try, after the last
+    // iterate marked as such.
+    let out = run(&["periodic", &repo_file("examples/fujita-row.toml")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("Newton did not converge: the iteration budget ran out"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("NOT CONVERGED"));
+    for key in [
+        "period",
+        "initial_state",
+        "floquet_multipliers",
+        "stable",
+        "max_displacement",
+        "impacts_per_period",
+    ] {
+        assert!(!doc[key].is_null(), "missing {key}");
+    }
+    assert_eq!(doc["floquet_multipliers"].as_array().unwrap().len(), 4);
+    let out = dir.join("cont");
+    let doc = json(&[
+        "continue",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "8.0",
+        "--to",
+        "7.0",
+        "--format",
+        "json",
+        "--out",
+        &out.display().to_string(),
+    ]);
+    let points = doc["points"].as_array().unwrap();
+    assert!(points.len() > 5);
+    for p in points {
+        assert!(
+            p["parameter"].is_number()
+                && p["max_displacement"].is_array()
+                && p["stable"].is_boolean()
+        );
+        assert!(p["floquet_multipliers"].is_array());
+    }
+    let kinds: Vec<&str> = doc["special_points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["kind"].as_str().unwrap())
+        .collect();
+    assert!(kinds.contains(&"branch-point"), "{kinds:?}");
+    for f in [
+        "branch.csv",
+        "branch_special_points.json",
+        "branch_response.png",
+        "branch_response.svg",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    assert_clean_error(
+        &[
+            "continue",
+            &model,
+            "--parameter",
+            "colour",
+            "--from",
+            "7",
+            "--to",
+            "8",
+        ],
+        "does not exist",
+    );
+    assert_clean_error(
+        &[
+            "continue",
+            &model,
+            "--parameter",
+            "frequency",
+            "--from",
+            "7",
+            "--to",
+            "7",
+        ],
+        "empty",
+    );
+    let unforced = write_model(&dir, "free.toml", "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n");
+    assert_clean_error(&["periodic", &unforced], "no periodic forcing");
+}
+
+/// The brute-force sweep and shooting agree on R2 N = 2 at 1.5 ω0 (a stable
+/// impacting orbit): max |u| to 1e-8, although the largest displacement is
+/// a wall penetration far shorter than any output interval (both locate
+/// the extrema on the dense output; sampled maxima were 2e-3 low).
+#[test]
+fn sweep_and_periodic_agree_on_the_stable_orbit() {
+    let model = repo_file("examples/fujita-row-n2.toml");
+    let sweep = json(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "11.115",
+        "--to",
+        "11.1",
+        "--points",
+        "2",
+        "--transient",
+        "300",
+        "--record",
+        "5",
+        "--rtol",
+        "1e-10",
+        "--atol",
+        "1e-15",
+        "--format",
+        "json",
+    ]);
+    let dir = temp_dir("sweep-periodic");
+    let file = dir.join("m.toml");
+    let text = std::fs::read_to_string(&model)
+        .unwrap()
+        .replace("frequency = 7.0395", "frequency = 11.115");
+    std::fs::write(&file, text).unwrap();
+    let orbit = json(&["periodic", file.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(orbit["converged"], true);
+    assert_eq!(orbit["stable"], true);
+    for i in 0..2 {
+        let at = sweep["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["parameter"] == 11.115)
+            .unwrap();
+        let a = at["max_displacement"][i].as_f64().unwrap();
+        let b = orbit["max_displacement"][i].as_f64().unwrap();
+        assert!(
+            (a / b - 1.0).abs() < 1e-8,
+            "body {i}: sweep {a} vs periodic {b}"
+        );
+    }
+}
+
+/// `--format csv` prints a table where the command has one (the same CSV as
+/// the file in `--out`) and is refused where it prints a summary.
+#[test]
+fn csv_format_prints_tables_or_is_refused() {
+    let model = repo_file("examples/fujita-row.toml");
+    let out = run(&[
+        "sweep",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "5.9",
+        "--to",
+        "8.9",
+        "--points",
+        "3",
+        "--transient",
+        "5",
+        "--record",
+        "2",
+        "--format",
+        "csv",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = text.lines().collect();
+    assert!(rows[0].starts_with("parameter,"), "{}", rows[0]);
+    assert!(
+        rows.len() > 3
+            && rows[1..]
+                .iter()
+                .all(|r| r.split(',').count() == rows[0].split(',').count())
+    );
+    for args in [
+        vec!["simulate", &model, "--periods", "1"],
+        vec!["periodic", &model],
+        vec!["identify", "--restitution", &model],
+    ] {
+        let command = args[0];
+        let out = run(&[args, vec!["--format", "csv"]].concat());
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("invalid value 'csv'") && err.contains("table, json"),
+            "{err}"
+        );
+    }
+}
