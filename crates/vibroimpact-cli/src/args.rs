@@ -1,6 +1,8 @@
 //! Argument types shared by several commands.
 
-use clap::ValueEnum;
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
 use vibroimpact::integrate::Method;
 
 use crate::error::CliError;
@@ -35,4 +37,24 @@ pub fn parse_mass2(text: &str) -> Result<f64, CliError> {
             .parse()
             .map_err(|_| CliError::new(format!("--mass2 `{t}` is not a mass in kg or `wall`"))),
     }
+}
+
+/// The model file and the parameter range of `sweep` and `continue`.
+#[derive(Args, Debug)]
+pub struct ParameterRange {
+    /// Model file (TOML, see docs/model.md); its excitation must be periodic
+    /// with one frequency at every parameter value.
+    pub model: PathBuf,
+    /// The parameter: `frequency`, `amplitude` (of the excitation) or a
+    /// dotted numeric key of the model file such as `row.clearance` or
+    /// `body.1.mass`.
+    #[arg(long)]
+    pub parameter: String,
+    /// First parameter value (`continue` starts there from a simulated
+    /// guess).
+    #[arg(long)]
+    pub from: f64,
+    /// Last parameter value.
+    #[arg(long)]
+    pub to: f64,
 }

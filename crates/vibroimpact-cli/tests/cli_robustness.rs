@@ -38,25 +38,12 @@ fn closed_pipe_ends_quietly() {
 #[test]
 fn interrupted_sweep_keeps_complete_outputs() {
     let dir = temp_dir("sweep-interrupted");
-    let child = bin()
-        .args([
-            "sweep",
-            &repo_file("examples/fujita-row.toml"),
-            "--parameter",
-            "frequency",
-        ])
-        .args(["--from", "5.9", "--to", "8.9", "--points", "2000", "--out"])
-        .arg(&dir)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    // SAFETY: signalling our own child process.
-    unsafe {
-        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
-    }
-    let out = child.wait_with_output().unwrap();
+    let mut cmd = bin();
+    cmd.args(["sweep", &repo_file("examples/fujita-row.toml")])
+        .args(["--parameter", "frequency", "--from", "5.9", "--to", "8.9"])
+        .args(["--points", "2000", "--out"])
+        .arg(&dir);
+    let out = interrupt_after(cmd, 1500);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("interrupted (Ctrl-C)"), "{stderr}");
@@ -66,12 +53,7 @@ fn interrupted_sweep_keeps_complete_outputs() {
     let done = points.iter().filter(|p| p["completed"] == true).count();
     assert_eq!(points.len(), 2000, "every value is reported, run or not");
     assert!(done < 2000, "{done} values completed");
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
-        .collect();
-    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    assert_no_temporary_files(&dir);
 }
 
 /// Ctrl-C in `simulate --out` keeps a complete, valid history up to the
@@ -80,20 +62,11 @@ fn interrupted_sweep_keeps_complete_outputs() {
 #[test]
 fn interrupted_simulation_keeps_complete_outputs() {
     let dir = temp_dir("simulate-interrupted");
-    let child = bin()
-        .args(["simulate", &repo_file("examples/fujita-row.toml")])
+    let mut cmd = bin();
+    cmd.args(["simulate", &repo_file("examples/fujita-row.toml")])
         .args(["--periods", "1000000", "--format", "json", "--out"])
-        .arg(&dir)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    // SAFETY: signalling our own child process.
-    unsafe {
-        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
-    }
-    let out = child.wait_with_output().unwrap();
+        .arg(&dir);
+    let out = interrupt_after(cmd, 1500);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("interrupted (Ctrl-C) at t ="), "{stderr}");
@@ -123,12 +96,7 @@ fn interrupted_simulation_keeps_complete_outputs() {
     ] {
         assert!(dir.join(f).exists(), "{f}");
     }
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
-        .collect();
-    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    assert_no_temporary_files(&dir);
     assert_clean_error(
         &[
             "simulate",
@@ -219,12 +187,7 @@ fn second_ctrl_c_quits_without_temporary_files() {
     let out = child.wait_with_output().unwrap();
     let code = out.status.code();
     assert!(code == Some(130) || code == Some(1), "{code:?}");
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
-        .collect();
-    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    assert_no_temporary_files(&dir);
 }
 
 /// The same input gives the same bytes at 1 and 2 threads (the parallel

@@ -13,6 +13,7 @@ use vibroimpact::periodic::{
     OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
+use crate::args::ParameterRange;
 use crate::error::CliError;
 use crate::figures::branch_figure;
 use crate::format::{history_csv, CsvText, Format, SummaryFormat};
@@ -270,17 +271,8 @@ fn orbit_text(model: &Model, sol: &PeriodicSolution, orbit: &OrbitSummary) -> St
 /// Options of `vibroimpact continue`.
 #[derive(Args, Debug)]
 pub struct ContinueArgs {
-    /// Model file (TOML).
-    model: PathBuf,
-    /// The parameter: frequency, amplitude, or a dotted numeric key (row.clearance, body.1.mass, …).
-    #[arg(long)]
-    parameter: String,
-    /// Start value (the branch starts from a simulated guess there).
-    #[arg(long)]
-    from: f64,
-    /// End value.
-    #[arg(long)]
-    to: f64,
+    #[command(flatten)]
+    range: ParameterRange,
     /// Period multiple n of the branch.
     #[arg(long, default_value_t = 1)]
     subharmonic: u32,
@@ -375,11 +367,13 @@ fn write_branch(
 /// the subharmonic and that the parameter is continuous and the start
 /// forced periodically.
 fn continuation_family(args: &ContinueArgs) -> Result<(ParameterizedModel, Model), CliError> {
-    let pm = read_family(&args.model, &args.parameter)?;
-    if !(args.from.is_finite() && args.to.is_finite()) || args.from == args.to {
+    let pm = read_family(&args.range.model, &args.range.parameter)?;
+    if !(args.range.from.is_finite() && args.range.to.is_finite())
+        || args.range.from == args.range.to
+    {
         return Err(CliError::new(format!(
             "--from {} --to {}: the range is empty or not finite",
-            args.from, args.to
+            args.range.from, args.range.to
         )));
     }
     if args.subharmonic == 0 {
@@ -388,10 +382,10 @@ fn continuation_family(args: &ContinueArgs) -> Result<(ParameterizedModel, Model
     if pm.parameter.integer {
         return Err(CliError::new(format!(
             "--parameter {}: takes whole numbers; a branch needs a continuous parameter (use sweep)",
-            args.parameter
+            args.range.parameter
         )));
     }
-    let start_model = pm.model_at(args.from)?;
+    let start_model = pm.model_at(args.range.from)?;
     if start_model.forcing_frequency().is_none() {
         return Err(CliError::new(
             "the model has no periodic forcing with one frequency at --from: nothing to continue",
@@ -408,7 +402,7 @@ fn print_branches(
 ) -> Result<(), CliError> {
     let docs: Vec<serde_json::Value> = branches
         .iter()
-        .map(|b| branch_document(b, start_model, &args.parameter))
+        .map(|b| branch_document(b, start_model, &args.range.parameter))
         .collect();
     match args.format {
         Format::Json => {
@@ -441,7 +435,7 @@ fn print_branches(
                         "  {:<5} {:<16} {} = {:.10}",
                         s.label,
                         s.kind.name(),
-                        args.parameter,
+                        args.range.parameter,
                         s.parameter
                     );
                 }
@@ -477,7 +471,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         bar.inc(1);
         bar.set_message(format!(
             "{} = {:.8}  max|u| = {:.4e}  {}",
-            args.parameter,
+            args.range.parameter,
             p.parameter,
             p.max_displacement[0],
             if p.stable { "stable" } else { "unstable" }
@@ -485,7 +479,14 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         !interrupt.requested()
     };
     let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-    let branch = continue_branch(family, args.from, &guess, args.to, &opts, progress)?;
+    let branch = continue_branch(
+        family,
+        args.range.from,
+        &guess,
+        args.range.to,
+        &opts,
+        progress,
+    )?;
     let mut branches = vec![branch];
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;
@@ -495,7 +496,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             family,
             &branches[0],
             label,
-            (args.from, args.to),
+            (args.range.from, args.range.to),
             &opts,
             progress,
         ) {
@@ -510,10 +511,10 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
                 dir,
                 &start_model,
                 b,
-                &args.parameter,
+                &args.range.parameter,
                 stem,
                 1.0,
-                &args.parameter,
+                &args.range.parameter,
             )?;
         }
     }

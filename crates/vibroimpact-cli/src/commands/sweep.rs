@@ -7,6 +7,7 @@ use clap::Args;
 use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, SweepSummary};
 
 use crate::args::MethodName;
+use crate::args::ParameterRange;
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
 use crate::model_io::read_family;
@@ -16,19 +17,8 @@ use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 /// Options of `vibroimpact sweep`.
 #[derive(Args, Debug)]
 pub struct SweepArgs {
-    /// Model file (TOML, see docs/model.md); its excitation must be periodic
-    /// with one frequency at every parameter value.
-    model: PathBuf,
-    /// The parameter: `frequency`, `amplitude` (of the excitation) or a dotted
-    /// key of the model file such as `row.clearance`.
-    #[arg(long)]
-    parameter: String,
-    /// First parameter value.
-    #[arg(long)]
-    from: f64,
-    /// Last parameter value.
-    #[arg(long)]
-    to: f64,
+    #[command(flatten)]
+    range: ParameterRange,
     /// Number of parameter values (>= 2), evenly spaced, both ends included.
     #[arg(long)]
     points: usize,
@@ -241,16 +231,16 @@ fn table_text(summary: &SweepSummary) -> String {
 
 /// Runs `vibroimpact sweep`.
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
-    if !args.from.is_finite() || !args.to.is_finite() {
+    if !args.range.from.is_finite() || !args.range.to.is_finite() {
         return Err(CliError::new(format!(
             "--from {} --to {}: the values must be finite",
-            args.from, args.to
+            args.range.from, args.range.to
         )));
     }
-    if args.from == args.to {
+    if args.range.from == args.range.to {
         return Err(CliError::new(format!(
             "--from and --to are both {}: give a range",
-            args.from
+            args.range.from
         )));
     }
     if !(2..=10_000_000).contains(&args.points) {
@@ -263,8 +253,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         return Err(CliError::new("--record 0: record at least one period"));
     }
 
-    let family = read_family(&args.model, &args.parameter)?;
-    let values = parameter_values(args.from, args.to, args.points);
+    let family = read_family(&args.range.model, &args.range.parameter)?;
+    let values = parameter_values(args.range.from, args.range.to, args.points);
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = SweepOptions {
         transient: args.transient,

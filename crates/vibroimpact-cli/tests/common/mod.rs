@@ -72,3 +72,13 @@ pub fn interrupt_after(mut cmd: Command, ms: u64) -> Output {
     }
     child.wait_with_output().unwrap()
 }
+
+/// No `*.tmp<PID>` file is left in `dir`.
+pub fn assert_no_temporary_files(dir: &Path) {
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
