@@ -126,24 +126,36 @@ impl Accelerogram {
     pub fn new(times: Vec<f64>, values: Vec<f64>, scale: f64) -> Result<Self, ModelError> {
         if times.len() != values.len() || times.len() < 2 {
             return Err(ModelError::new(
+                ModelErrorKind::Missing,
+                "excitation.acceleration",
                 "accelerogram: needs at least two (time, acceleration) samples",
             ));
         }
         for (k, (t, a)) in times.iter().zip(&values).enumerate() {
             if !t.is_finite() || !a.is_finite() {
-                return Err(ModelError::new(format!(
-                    "accelerogram: sample {k} is not finite"
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    "excitation.acceleration",
+                    format!("accelerogram: sample {k} is not finite"),
+                ));
             }
             if k > 0 && *t <= times[k - 1] {
-                return Err(ModelError::new(format!(
-                    "accelerogram: time is not increasing at sample {k} (t = {t} after {})",
-                    times[k - 1]
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::Order,
+                    "excitation.time",
+                    format!(
+                        "accelerogram: time is not increasing at sample {k} (t = {t} after {})",
+                        times[k - 1]
+                    ),
+                ));
             }
         }
         if !scale.is_finite() {
-            return Err(ModelError::new("accelerogram: scale must be finite"));
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                "excitation.scale",
+                "accelerogram: scale must be finite",
+            ));
         }
         Ok(Self {
             times,
@@ -223,15 +235,44 @@ pub struct HarmonicForce {
     pub phase: f64,
 }
 
-/// An invalid model, with a message naming the offending item.
+/// What is wrong with a model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelErrorKind {
+    /// A value outside its domain (negative mass, non-finite amplitude, …).
+    InvalidValue,
+    /// A reference to a body that does not exist.
+    UnknownBody,
+    /// Items out of order (contact bodies not left first, times not
+    /// increasing).
+    Order,
+    /// Bodies overlapping at the start.
+    Overlap,
+    /// Something required is missing or of the wrong length.
+    Missing,
+}
+
+/// An invalid model: its kind, the dotted key path of the offending item
+/// (as in model files and parameters, 1-based: `body.2.mass`,
+/// `contact.1.clearance`, `excitation.scale`) and a message naming it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct ModelError(pub String);
+#[error("{message}")]
+pub struct ModelError {
+    /// What is wrong.
+    pub kind: ModelErrorKind,
+    /// Dotted key path of the offending item.
+    pub key: String,
+    /// The message for users.
+    pub message: String,
+}
 
 impl ModelError {
-    /// An error with this message.
-    pub fn new(message: impl Into<String>) -> Self {
-        Self(message.into())
+    /// An error of `kind` at `key` with this message.
+    pub fn new(kind: ModelErrorKind, key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            kind,
+            key: key.into(),
+            message: message.into(),
+        }
     }
 }
 
@@ -258,11 +299,16 @@ pub struct Model {
     initial_velocity: Vec<f64>,
 }
 
-fn nonneg(what: String, v: f64) -> Result<(), ModelError> {
+/// `v` must be finite and >= 0; `key` is its path, `what` names it.
+fn nonneg(key: String, what: String, v: f64) -> Result<(), ModelError> {
     if v >= 0.0 && v.is_finite() {
         Ok(())
     } else {
-        Err(ModelError(format!("{what} = {v}: must be finite and >= 0")))
+        Err(ModelError::new(
+            ModelErrorKind::InvalidValue,
+            key,
+            format!("{what} = {v}: must be finite and >= 0"),
+        ))
     }
 }
 
@@ -280,63 +326,114 @@ impl Model {
     ) -> Result<Self, ModelError> {
         let n = bodies.len();
         if n == 0 {
-            return Err(ModelError::new("the model has no bodies"));
+            return Err(ModelError::new(
+                ModelErrorKind::Missing,
+                "body",
+                "the model has no bodies",
+            ));
         }
-        for b in &bodies {
+        for (i, b) in bodies.iter().enumerate() {
+            let key = |what: &str| format!("body.{}.{what}", i + 1);
             if !(b.mass > 0.0 && b.mass.is_finite()) {
-                return Err(ModelError(format!(
-                    "body {}: mass = {}: must be finite and > 0",
-                    b.name, b.mass
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    key("mass"),
+                    format!("body {}: mass = {}: must be finite and > 0", b.name, b.mass),
+                ));
             }
-            nonneg(format!("body {}: stiffness", b.name), b.stiffness)?;
-            nonneg(format!("body {}: damping", b.name), b.damping)?;
+            nonneg(
+                key("stiffness"),
+                format!("body {}: stiffness", b.name),
+                b.stiffness,
+            )?;
+            nonneg(
+                key("damping"),
+                format!("body {}: damping", b.name),
+                b.damping,
+            )?;
         }
         for (k, c) in couplings.iter().enumerate() {
+            let key = |what: &str| format!("spring.{}.{what}", k + 1);
             if c.a >= n || c.b >= n || c.a == c.b {
-                return Err(ModelError(format!(
-                    "spring {k}: must join two different existing bodies"
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::UnknownBody,
+                    key("between"),
+                    format!("spring {}: must join two different existing bodies", k + 1),
+                ));
             }
-            nonneg(format!("spring {k}: stiffness"), c.stiffness)?;
-            nonneg(format!("spring {k}: damping"), c.damping)?;
+            nonneg(
+                key("stiffness"),
+                format!("spring {}: stiffness", k + 1),
+                c.stiffness,
+            )?;
+            nonneg(
+                key("damping"),
+                format!("spring {}: damping", k + 1),
+                c.damping,
+            )?;
         }
         let name = |i: usize| bodies[i].name.clone();
         for (k, c) in contacts.iter().enumerate() {
+            let between = format!("contact.{}.between", k + 1);
+            let unknown = || {
+                ModelError::new(
+                    ModelErrorKind::UnknownBody,
+                    between.clone(),
+                    format!("contact {}: unknown body", k + 1),
+                )
+            };
             match c.pair {
                 ContactPair::Bodies { left, right } => {
                     if left >= n || right >= n {
-                        return Err(ModelError(format!("contact {k}: unknown body")));
+                        return Err(unknown());
                     }
                     if left >= right {
-                        return Err(ModelError(format!(
-                            "contact {k}: bodies must be given left first in their order along the line ({} is not left of {})",
-                            name(left),
-                            name(right)
-                        )));
+                        return Err(ModelError::new(
+                            ModelErrorKind::Order,
+                            between,
+                            format!(
+                                "contact {}: bodies must be given left first in their order along the line ({} is not left of {})",
+                                k + 1,
+                                name(left),
+                                name(right)
+                            ),
+                        ));
                     }
                 }
                 ContactPair::LeftWall { body } | ContactPair::RightWall { body } => {
                     if body >= n {
-                        return Err(ModelError(format!("contact {k}: unknown body")));
+                        return Err(unknown());
                     }
                 }
             }
-            nonneg(format!("contact {k}: clearance"), c.clearance)?;
+            nonneg(
+                format!("contact.{}.clearance", k + 1),
+                format!("contact {}: clearance", k + 1),
+                c.clearance,
+            )?;
         }
-        for f in &forces {
+        for (k, f) in forces.iter().enumerate() {
+            let key = format!("force.{}", k + 1);
             if f.body >= n {
-                return Err(ModelError::new("harmonic force on an unknown body"));
+                return Err(ModelError::new(
+                    ModelErrorKind::UnknownBody,
+                    key,
+                    "harmonic force on an unknown body",
+                ));
             }
             if !(f.frequency > 0.0
                 && f.frequency.is_finite()
                 && f.amplitude.is_finite()
                 && f.phase.is_finite())
             {
-                return Err(ModelError(format!(
-                    "harmonic force on {}: needs finite amplitude and phase and frequency > 0",
-                    name(f.body)
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    key,
+                    format!(
+                        "harmonic force on {}: needs finite amplitude and phase and frequency > 0",
+                        name(f.body)
+                    ),
+                ));
             }
         }
         if let BaseExcitation::Harmonic {
@@ -351,20 +448,28 @@ impl Model {
                 && phase.is_finite())
             {
                 return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    "excitation",
                     "harmonic base excitation: needs finite amplitude and phase and frequency > 0",
                 ));
             }
         }
         let fill = |v: Vec<f64>, what: &str| -> Result<Vec<f64>, ModelError> {
+            let key = format!("initial.{what}");
             if v.is_empty() {
                 Ok(vec![0.0; n])
             } else if v.len() != n {
-                Err(ModelError(format!(
-                    "initial {what}: {} values for {n} bodies",
-                    v.len()
-                )))
+                Err(ModelError::new(
+                    ModelErrorKind::Missing,
+                    key,
+                    format!("initial {what}: {} values for {n} bodies", v.len()),
+                ))
             } else if v.iter().any(|x| !x.is_finite()) {
-                Err(ModelError(format!("initial {what}: values must be finite")))
+                Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    key,
+                    format!("initial {what}: values must be finite"),
+                ))
             } else {
                 Ok(v)
             }
@@ -381,10 +486,15 @@ impl Model {
         for k in 0..model.contacts.len() {
             let s = model.approach(k, &model.initial_displacement);
             if s > 0.0 {
-                return Err(ModelError(format!(
-                    "contact {k} ({}): the bodies overlap at the start by {s:e} m",
-                    model.contact_name(k)
-                )));
+                return Err(ModelError::new(
+                    ModelErrorKind::Overlap,
+                    format!("contact.{}", k + 1),
+                    format!(
+                        "contact {} ({}): the bodies overlap at the start by {s:e} m",
+                        k + 1,
+                        model.contact_name(k)
+                    ),
+                ));
             }
         }
         Ok(model)
@@ -404,7 +514,11 @@ impl Model {
         base: BaseExcitation,
     ) -> Result<Self, ModelError> {
         if count == 0 {
-            return Err(ModelError::new("row: count must be >= 1"));
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                "row.count",
+                "row: count must be >= 1",
+            ));
         }
         let bodies = (1..=count)
             .map(|i| Body {
@@ -664,7 +778,11 @@ mod tests {
             BaseExcitation::None,
         )
         .unwrap_err();
-        assert!(e.0.contains("mass = -1"), "{e}");
+        assert!(e.message.contains("mass = -1"), "{e}");
+        assert_eq!(
+            (e.kind, e.key.as_str()),
+            (ModelErrorKind::InvalidValue, "body.1.mass")
+        );
         let e = Model::row(
             2,
             1.0,
@@ -676,7 +794,7 @@ mod tests {
             BaseExcitation::None,
         )
         .unwrap_err();
-        assert!(e.0.contains("clearance"), "{e}");
+        assert!(e.message.contains("clearance"), "{e}");
         let m = Model::row(
             2,
             1.0,
@@ -689,7 +807,8 @@ mod tests {
         )
         .unwrap();
         let e = m.with_initial_state(vec![2e-3, 0.0], vec![]).unwrap_err();
-        assert!(e.0.contains("overlap"), "{e}");
+        assert!(e.message.contains("overlap"), "{e}");
+        assert_eq!(e.kind, ModelErrorKind::Overlap);
     }
 
     #[test]
