@@ -105,11 +105,20 @@ impl PyModel {
                 path.display()
             )));
         }
-        // Regular files only: a FIFO would block and a device never end.
+        // Regular files of at most 1 GiB (as the CLI): a FIFO would block,
+        // a device never end, a huge record exhaust memory.
+        const MAX_INPUT_BYTES: u64 = 1 << 30;
         let regular = |p: &std::path::Path| match std::fs::metadata(p) {
             Ok(m) if !m.is_file() => Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
                 "not a regular file (a directory, FIFO or device cannot be read as input)",
+            )),
+            Ok(m) if m.len() > MAX_INPUT_BYTES => Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "{} bytes, more than the input limit of {MAX_INPUT_BYTES} bytes",
+                    m.len()
+                ),
             )),
             _ => std::fs::read_to_string(p),
         };

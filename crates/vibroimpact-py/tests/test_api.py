@@ -114,6 +114,9 @@ def test_model_errors_name_the_key():
         vi.Model.from_dict({"row": {"count": 2, "mass": 1.0, "contact": {"law": "hertz", "stiffness": 1e9}}})
     with pytest.raises(OSError, match="nope.toml"):
         vi.Model.load("nope.toml")
+    # A device or a folder is refused without reading (a FIFO would block).
+    with pytest.raises(ValueError, match="not a regular file"):
+        vi.Model.load("/dev/zero")
 
 
 def test_models_from_python_values_and_pickling():
