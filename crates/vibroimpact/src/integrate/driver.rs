@@ -71,22 +71,26 @@ pub struct Point {
 
 impl Point {
     /// Dimension of the system.
+    #[inline]
     pub fn dim(&self) -> usize {
         self.y.len()
     }
 
     /// The options the integrator was created with.
+    #[inline]
     pub fn options(&self) -> &IntegratorOptions {
         &self.opts
     }
 
     /// Number of leading components that enter the error norm (see
     /// [`IntegratorOptions::error_components`]).
+    #[inline]
     pub fn error_components(&self) -> usize {
         self.n_err
     }
 
     /// Error weight `atol + rtol · max(|a|, |b|)`.
+    #[inline]
     pub fn weight(&self, a: f64, b: f64) -> f64 {
         self.opts.atol + self.opts.rtol * a.abs().max(b.abs())
     }
@@ -94,6 +98,7 @@ impl Point {
     /// Weighted RMS norm `sqrt(1/m Σ (err_i / sk_i)²)` of `err` over the
     /// error-controlled components, with weights from the current state and
     /// the candidate `y_new`.
+    #[inline]
     pub fn error_norm(&self, err: &[f64], y_new: &[f64]) -> f64 {
         let mut sum = 0.0;
         for i in 0..self.n_err {
@@ -124,6 +129,7 @@ pub type Attempt = Result<f64, (RejectReason, f64)>;
 pub(super) const NON_FINITE: (RejectReason, f64) = (RejectReason::NonFinite, SHRINK_HARD);
 
 /// Whether every value is finite.
+#[inline]
 pub(super) fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
