@@ -58,3 +58,17 @@ pub struct ParameterRange {
     #[arg(long)]
     pub to: f64,
 }
+
+/// How `continue` finds its first periodic orbit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum StartMethod {
+    /// A guess by simulation, then the homotopy if Newton does not converge
+    /// from it.
+    Auto,
+    /// The state after --guess-periods forcing periods from the model's
+    /// initial state.
+    Simulate,
+    /// A homotopy in the forcing amplitude from the rest state (an exact
+    /// periodic orbit at zero forcing): the primary branch at any N.
+    Homotopy,
+}

@@ -541,3 +541,38 @@ fn csv_format_prints_tables_or_is_refused() {
         );
     }
 }
+
+/// R2 with N = 4 from 1.5 ω0: a simulated guess does not lead Newton to a
+/// periodic orbit there; the default start falls back to the homotopy in
+/// the forcing amplitude from rest and the branch starts.
+#[test]
+fn continue_starts_by_homotopy_where_simulation_does_not() {
+    let dir = temp_dir("homotopy");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row.toml"))
+        .unwrap()
+        .replace("count = 3", "count = 4");
+    let model = write_model(&dir, "r2n4.toml", &text);
+    let args = |start: &'static str| -> Vec<&str> {
+        vec![
+            "continue",
+            &model,
+            "--parameter",
+            "frequency",
+            "--from",
+            "11.115",
+            "--to",
+            "3.705",
+            "--max-points",
+            "4",
+            "--format",
+            "json",
+            "--start",
+            start,
+        ]
+    };
+    for start in ["auto", "homotopy"] {
+        let doc = json(&args(start));
+        assert_eq!(doc["points"].as_array().unwrap().len(), 4, "{start}");
+        assert_eq!(doc["points"][0]["parameter"], 11.115);
+    }
+}

@@ -5,19 +5,23 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::continuation::{continue_branch, switch_branch, Branch, ContinuationOptions};
+use vibroimpact::continuation::{
+    amplitude_homotopy, continue_branch, switch_branch, Branch, ContinuationError,
+    ContinuationOptions,
+};
 use vibroimpact::model::Model;
+use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary, shoot, shoot_krylov,
     OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
-use crate::args::ParameterRange;
+use crate::args::{ParameterRange, StartMethod};
 use crate::error::CliError;
 use crate::figures::branch_figure;
 use crate::format::{history_csv, CsvText, Format, SummaryFormat};
-use crate::model_io::{read_family, read_model};
+use crate::model_io::{read_document, read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
 use vibroimpact::results::{branch_document, periodic_document};
@@ -31,8 +35,9 @@ pub struct PeriodicArgs {
     #[arg(long, default_value_t = 1)]
     subharmonic: u32,
     /// Start guess: `simulate` (the state after --guess-periods periods from
-    /// the model's initial state) or a JSON file with `initial_state`
-    /// (e.g. an earlier output).
+    /// the model's initial state), `homotopy` (continued in the forcing
+    /// amplitude from the rest state: the primary orbit) or a JSON file
+    /// with `initial_state` (e.g. an earlier output).
     #[arg(long, default_value = "simulate")]
     guess: String,
     /// Periods simulated for the guess.
@@ -123,6 +128,10 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
             Some(interrupt.clone()),
         )
         .map_err(|e| stopped(&format!("guess by simulation: {e}")))?,
+        "homotopy" => {
+            let family = homotopy_family(&read_document(&args.model)?)?;
+            homotopy_start(&family, &ContinuationOptions::default()).map_err(|e| stopped(&e))?
+        }
         _ => read_guess(&args.guess, &model, args.guess_periods, args.rtol)?,
     };
     let opts = ShootingOptions {
@@ -268,6 +277,26 @@ fn orbit_text(model: &Model, sol: &PeriodicSolution, orbit: &OrbitSummary) -> St
     t
 }
 
+/// The model at its own forcing amplitude as a family in the amplitude
+/// (`doc` with everything else fixed).
+fn homotopy_family(doc: &ModelDocument) -> Result<ParameterizedModel, CliError> {
+    ParameterizedModel::new(doc.clone(), "amplitude").map_err(|e| {
+        CliError::new(format!(
+            "the homotopy start needs a forcing amplitude to vary: {e}"
+        ))
+    })
+}
+
+/// The primary periodic orbit at the document's amplitude, by the
+/// homotopy in the amplitude from the rest state.
+fn homotopy_start(
+    family: &ParameterizedModel,
+    opts: &ContinuationOptions,
+) -> Result<Vec<f64>, CliError> {
+    let model = |a: f64| family.model_at(a).map_err(|e| e.to_string());
+    Ok(amplitude_homotopy(model, family.initial(), opts)?)
+}
+
 /// Options of `vibroimpact continue`.
 #[derive(Args, Debug)]
 pub struct ContinueArgs {
@@ -286,6 +315,9 @@ pub struct ContinueArgs {
     /// Largest arclength step (scaled units).
     #[arg(long, default_value_t = 0.05)]
     ds_max: f64,
+    /// How the first periodic orbit is found.
+    #[arg(long, value_enum, default_value_t = StartMethod::Auto)]
+    start: StartMethod,
     /// Periods simulated for the start guess.
     #[arg(long, default_value_t = 200.0)]
     guess_periods: f64,
@@ -459,13 +491,21 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         },
         ..ContinuationOptions::default()
     };
-    let guess = guess_by_simulation_with(
-        &start_model,
-        args.guess_periods,
-        1e-9,
-        Some(interrupt.clone()),
-    )
-    .map_err(|e| CliError::new(format!("start guess: {e}")))?;
+    let mut doc_at_start = pm.document.clone();
+    doc_at_start.set(&pm.parameter, args.range.from)?;
+    let homotopy = || -> Result<Vec<f64>, CliError> {
+        homotopy_start(&homotopy_family(&doc_at_start)?, &opts)
+    };
+    let guess = match args.start {
+        StartMethod::Homotopy => homotopy()?,
+        StartMethod::Auto | StartMethod::Simulate => guess_by_simulation_with(
+            &start_model,
+            args.guess_periods,
+            1e-9,
+            Some(interrupt.clone()),
+        )
+        .map_err(|e| CliError::new(format!("start guess: {e}")))?,
+    };
     let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
         bar.inc(1);
@@ -478,15 +518,28 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         ));
         !interrupt.requested()
     };
-    let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
-    let branch = continue_branch(
-        family,
-        args.range.from,
-        &guess,
-        args.range.to,
-        &opts,
-        progress,
-    )?;
+    let mut progress = progress;
+    let mut run = |guess: &[f64]| {
+        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
+        continue_branch(
+            family,
+            args.range.from,
+            guess,
+            args.range.to,
+            &opts,
+            &mut progress,
+        )
+    };
+    // Auto: a simulated guess from which Newton does not converge falls
+    // back to the homotopy (the simulated guess, where it converges, is the
+    // attractor the user sees; the homotopy's orbit lies on the branch that
+    // grows from rest, which at a given frequency may be another one).
+    let branch = match run(&guess) {
+        Err(ContinuationError::StartNotConverged(_)) if args.start == StartMethod::Auto => {
+            run(&homotopy()?)?
+        }
+        other => other?,
+    };
     let mut branches = vec![branch];
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;

@@ -362,6 +362,13 @@ fn validate(p0: f64, p_end: f64, opts: &ContinuationOptions) -> Result<(), Conti
             )));
         }
     }
+    if let Some(scale) = opts.parameter_scale {
+        if !(scale > 0.0 && scale.is_finite()) {
+            return Err(ContinuationError::Invalid(format!(
+                "parameter_scale = {scale}: must be finite and > 0"
+            )));
+        }
+    }
     if opts.max_points < 2 {
         return Err(ContinuationError::Invalid(format!(
             "max_points = {}: at least 2",

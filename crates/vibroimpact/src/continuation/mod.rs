@@ -44,12 +44,14 @@
 mod branch;
 mod events;
 mod problem;
+mod start;
 mod switching;
 #[cfg(test)]
 mod tests;
 
 pub use branch::{spectral_distance, BranchStep, Continuation};
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
+pub use start::amplitude_homotopy;
 pub use switching::{
     branch_switch_start, is_symmetric_orbit, period_doubled_start, switch_branch, SwitchError,
 };
@@ -137,6 +139,10 @@ pub struct ContinuationOptions {
     /// regular points of the half map, found by its eigenvalue -1 instead
     /// of a singular extended Jacobian.
     pub use_symmetry: bool,
+    /// Scale of the parameter in the arclength (default `|p0|`, the start
+    /// value): steps change the parameter by at most about
+    /// `ds_max · scale`.
+    pub parameter_scale: Option<f64>,
 }
 
 impl Default for ContinuationOptions {
@@ -160,6 +166,7 @@ impl Default for ContinuationOptions {
             max_multiplier_change: 0.25,
             bounds: None,
             use_symmetry: true,
+            parameter_scale: None,
         }
     }
 }
