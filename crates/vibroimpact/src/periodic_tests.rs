@@ -292,3 +292,23 @@ fn dense_shooting_of_huge_rows_is_refused() {
     let msg = err.to_string();
     assert!(msg.contains("above 2048 bodies use Newton–Krylov"), "{msg}");
 }
+
+/// R3 at default shooting settings: the Floquet multipliers equal
+/// exp(λT), λ = −ζω0 ± iω0 sqrt(1 − ζ²), to 1e-10 across the frequency range
+/// (the converged orbit's monodromy is recomputed at a tighter tolerance).
+#[test]
+fn r3_multipliers_at_default_settings() {
+    for ratio in [0.5, 0.74, 0.95, 1.21, 1.5] {
+        let omega = ratio * W0;
+        let model = r2(2, 1e3, omega);
+        let sol = shoot(&model, &[0.0; 4], &ShootingOptions::default()).unwrap();
+        assert!(sol.converged);
+        let t = 2.0 * std::f64::consts::PI / omega;
+        let lambda = nalgebra::Complex::new(-ZETA * W0, W0 * (1.0 - ZETA * ZETA).sqrt());
+        let exact = (lambda * t).exp();
+        for m in &sol.multipliers {
+            let err = (m - exact).norm().min((m - exact.conj()).norm());
+            assert!(err < 1e-10, "at {ratio} ω0: {m} vs {exact}: {err:e}");
+        }
+    }
+}
