@@ -85,12 +85,25 @@ pub trait BranchEvent {
     fn kind(&self) -> SpecialKind;
     /// Whether the event lies between the points `a` and `b`.
     fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool;
+
+    /// Whether deciding the event needs the orbit summary of a point (its
+    /// amplitudes and impacts per period), an integration more per
+    /// bisection step; default true.
+    fn needs_orbit(&self) -> bool {
+        true
+    }
 }
 
 /// The built-in special points, from the test values.
 impl BranchEvent for SpecialKind {
     fn kind(&self) -> SpecialKind {
         *self
+    }
+
+    /// Only grazing (impacts per period) and user conditions read the
+    /// orbit summary.
+    fn needs_orbit(&self) -> bool {
+        matches!(self, SpecialKind::Grazing | SpecialKind::User)
     }
 
     fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool {
@@ -181,7 +194,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
                 .map(|(z, t)| z + mid * t)
                 .collect();
             let (solved, _) = self.correct(&pred, &a.tangent)?;
-            let e = self.evaluate(solved, &a.tangent)?;
+            let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
             if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {
                 hi = mid;
                 p_hi = e.point.parameter;

@@ -184,22 +184,45 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         solved: Solved,
         previous_tangent: &[f64],
     ) -> Option<Evaluated> {
+        self.evaluate_with(solved, previous_tangent, true)
+    }
+
+    /// [`evaluate`](Self::evaluate), without the orbit summary (one more
+    /// integration of the period with its extrema and impacts) when
+    /// `with_orbit` is false: then the amplitudes are empty and the impacts
+    /// per period 0, which the tests of folds, branch points, period
+    /// doublings and Neimark–Sacker points do not read.
+    pub(super) fn evaluate_with(
+        &mut self,
+        solved: Solved,
+        previous_tangent: &[f64],
+        with_orbit: bool,
+    ) -> Option<Evaluated> {
         let tangent = self.tangent(&solved.jac, previous_tangent)?;
         let (x, p) = self.unscale(&solved.z);
         let model = self.model(p).ok()?;
         let period =
             forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
-        let orbit = orbit_summary(
-            &model,
-            &x,
-            period,
-            self.opts.orbit_samples,
-            self.opts.shooting.rtol,
-        )
-        .ok()?;
+        let orbit = if with_orbit {
+            Some(
+                orbit_summary(
+                    &model,
+                    &x,
+                    period,
+                    self.opts.orbit_samples,
+                    self.opts.shooting.rtol,
+                )
+                .ok()?,
+            )
+        } else {
+            None
+        };
         let symmetric = self.opts.shooting.symmetric;
         let multipliers = map_multipliers(&solved.monodromy, symmetric).ok()?;
-        let impacts = orbit.impacts_per_period();
+        let impacts = orbit.as_ref().map_or(0, |o| o.impacts_per_period());
+        let (max_displacement, max_velocity) = orbit.map_or((Vec::new(), Vec::new()), |o| {
+            (o.max_displacement, o.max_velocity)
+        });
         let tests = TestValues::at(
             &solved.jac,
             &tangent,
@@ -213,8 +236,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             state: x,
             stable: multipliers.first().is_none_or(|m| m.norm() < 1.0),
             multipliers,
-            max_displacement: orbit.max_displacement,
-            max_velocity: orbit.max_velocity,
+            max_displacement,
+            max_velocity,
             impacts_per_period: impacts,
             label: None,
         };
