@@ -772,16 +772,24 @@ pub fn orbit_summary(
     rtol: f64,
 ) -> Result<OrbitSummary, PeriodicError> {
     let n = model.bodies().len();
-    let opts = SimulationOptions {
-        t_end: 2.0 * period,
-        rtol,
-        atol: rtol * 1e-4,
-        output_step: Some(period / samples.max(10) as f64),
-        start: Some(state.to_vec()),
-        extrema_window: Some((0.0, period)),
-        ..SimulationOptions::default()
+    // One period; a second only when an impact is still under way at its
+    // end (its rebound and peak lie beyond).
+    let run = |periods: f64| {
+        let opts = SimulationOptions {
+            t_end: periods * period,
+            rtol,
+            atol: rtol * 1e-4,
+            output_step: Some(period / samples.max(10) as f64),
+            start: Some(state.to_vec()),
+            extrema_window: Some((0.0, period)),
+            ..SimulationOptions::default()
+        };
+        simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))
     };
-    let sim = simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))?;
+    let mut sim = run(1.0)?;
+    if sim.error.is_none() && sim.impacts.iter().any(|i| !i.complete()) {
+        sim = run(2.0)?;
+    }
     if let Some(e) = sim.error {
         return Err(PeriodicError::Integration {
             iteration: 0,
