@@ -7,8 +7,8 @@ use nalgebra::Complex;
 use super::events::{BranchEvent, BUILT_IN};
 use super::problem::{period_image, Evaluated, Problem};
 use super::{
-    is_symmetric_orbit, BranchPoint, ContinuationError, ContinuationOptions, SpecialPoint,
-    StopReason,
+    is_symmetric_orbit, model_at, BranchPoint, ContinuationError, ContinuationOptions,
+    SpecialPoint, StopReason,
 };
 use crate::model::Model;
 use crate::periodic::{shoot, ShootingOptions};
@@ -74,10 +74,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         opts: &ContinuationOptions,
     ) -> Result<Self, ContinuationError> {
         validate(p0, p_end, opts)?;
-        let model = family(p0).map_err(|message| ContinuationError::Model {
-            parameter: p0,
-            message,
-        })?;
+        let model = model_at(&mut family, p0)?;
         let start = shoot(&model, x0, &opts.shooting)?;
         if !start.converged {
             return Err(ContinuationError::StartNotConverged(

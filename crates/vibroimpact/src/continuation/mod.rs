@@ -369,6 +369,17 @@ pub enum ContinuationError {
     Integration(#[from] crate::integrate::IntegrationError),
 }
 
+/// The family's model at `p`, its error as a [`ContinuationError::Model`].
+fn model_at<F>(family: &mut F, p: f64) -> Result<Model, ContinuationError>
+where
+    F: FnMut(f64) -> Result<Model, String>,
+{
+    family(p).map_err(|message| ContinuationError::Model {
+        parameter: p,
+        message,
+    })
+}
+
 /// Continues the branch of nT-periodic solutions from `(x0, p0)` toward
 /// `p_end`, collecting the steps of [`Continuation`] into a [`Branch`].
 /// `family(p)` builds the model at parameter p; `on_point` sees every

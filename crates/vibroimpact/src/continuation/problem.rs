@@ -6,7 +6,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
-use super::{BranchPoint, ContinuationError, ContinuationOptions};
+use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
 use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
@@ -50,10 +50,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     }
 
     pub(super) fn model(&mut self, p: f64) -> Result<Model, ContinuationError> {
-        (self.family)(p).map_err(|message| ContinuationError::Model {
-            parameter: p,
-            message,
-        })
+        model_at(&mut self.family, p)
     }
 
     pub(super) fn unscale(&self, z: &[f64]) -> (Vec<f64>, f64) {

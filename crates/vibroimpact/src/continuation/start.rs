@@ -9,7 +9,7 @@
 //! orbit of the primary branch at any N, where a guess by simulation may
 //! land on another attractor or none.
 
-use super::{continue_branch, ContinuationError, ContinuationOptions, StopReason};
+use super::{continue_branch, model_at, ContinuationError, ContinuationOptions, StopReason};
 use crate::model::Model;
 
 /// Start of the homotopy, as a fraction of the target amplitude.
@@ -34,10 +34,7 @@ where
         )));
     }
     let a0 = START_FRACTION * amplitude;
-    let rest = family(a0).map_err(|message| ContinuationError::Model {
-        parameter: a0,
-        message,
-    })?;
+    let rest = model_at(&mut family, a0)?;
     // The caller's shooting and step control; its own point budget (the
     // caller's is for the branch that follows).
     let local = ContinuationOptions {

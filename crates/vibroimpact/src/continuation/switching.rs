@@ -6,8 +6,8 @@ use nalgebra::DMatrix;
 
 use super::problem::{period_image, Problem};
 use super::{
-    continue_branch, Branch, BranchPoint, ContinuationError, ContinuationOptions, SpecialKind,
-    SpecialPoint,
+    continue_branch, model_at, Branch, BranchPoint, ContinuationError, ContinuationOptions,
+    SpecialKind, SpecialPoint,
 };
 use crate::model::Model;
 use crate::periodic::{period_map, shoot, ShootingOptions};
@@ -43,10 +43,7 @@ pub fn period_doubled_start<F>(
 where
     F: FnMut(f64) -> Result<Model, String>,
 {
-    let model = family(point.parameter).map_err(|message| ContinuationError::Model {
-        parameter: point.parameter,
-        message,
-    })?;
+    let model = model_at(&mut family, point.parameter)?;
     let map = period_map(&model, &point.state, &opts.shooting)?;
     let d = point.state.len();
     // Null vector of Φ + I.
@@ -56,10 +53,7 @@ where
     let scale = doubled.displacement_scale;
     for dp in [1e-3, -1e-3, 1e-2, -1e-2] {
         let p = point.parameter * (1.0 + dp);
-        let model = family(p).map_err(|message| ContinuationError::Model {
-            parameter: p,
-            message,
-        })?;
+        let model = model_at(&mut family, p)?;
         for eps in [0.05, -0.05, 0.2, -0.2] {
             let guess: Vec<f64> = point
                 .state
@@ -128,10 +122,7 @@ pub fn branch_switch_start<F>(
 where
     F: FnMut(f64) -> Result<Model, String>,
 {
-    let model = family(point.parameter).map_err(|message| ContinuationError::Model {
-        parameter: point.parameter,
-        message,
-    })?;
+    let model = model_at(&mut family, point.parameter)?;
     // The predictor off the branch is poorer than along it: a larger
     // corrector budget, in the full period map (the crossing branch of a
     // symmetry-breaking point is asymmetric).
