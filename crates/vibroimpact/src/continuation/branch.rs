@@ -201,13 +201,18 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
             .collect();
         let tangent = cur.tangent.clone();
         let (solved, iterations) = self.problem.correct(&pred, &tangent)?;
-        let next = self.problem.evaluate(solved, &tangent)?;
+        // The cheap checks first: the orbit summary (an integration) only
+        // for a step that is kept.
+        let next = self.problem.evaluate_with(solved, &tangent, false)?;
         let cos: f64 = next.tangent.iter().zip(&tangent).map(|(a, b)| a * b).sum();
         let opts = &self.problem.opts;
         let spectrum_ok = 0.5 * ds < opts.ds_min
             || spectral_distance(&self.current.point.multipliers, &next.point.multipliers)
                 <= opts.max_multiplier_change;
-        (cos > opts.step.min_tangent_cos && spectrum_ok).then_some((next, iterations))
+        if !(cos > opts.step.min_tangent_cos && spectrum_ok) {
+            return None;
+        }
+        Some((self.problem.add_orbit(next)?, iterations))
     }
 
     /// Detects and locates the events between the current point and `next`.

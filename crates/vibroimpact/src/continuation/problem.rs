@@ -197,35 +197,14 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     ) -> Option<Evaluated> {
         let tangent = self.tangent(&solved.jac, previous_tangent)?;
         let (x, p) = self.unscale(&solved.z);
-        let model = self.model(p).ok()?;
-        let period =
-            forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
-        let orbit = if with_orbit {
-            Some(
-                orbit_summary(
-                    &model,
-                    &x,
-                    period,
-                    self.opts.orbit_samples,
-                    self.opts.shooting.rtol,
-                )
-                .ok()?,
-            )
-        } else {
-            None
-        };
         let symmetric = self.opts.shooting.symmetric;
         let multipliers = map_multipliers(&solved.monodromy, symmetric).ok()?;
-        let impacts = orbit.as_ref().map_or(0, |o| o.impacts_per_period());
-        let (max_displacement, max_velocity) = orbit.map_or((Vec::new(), Vec::new()), |o| {
-            (o.max_displacement, o.max_velocity)
-        });
         let tests = TestValues::at(
             &solved.jac,
             &tangent,
             &solved.monodromy,
             &multipliers,
-            impacts,
+            0,
             symmetric,
         );
         let point = BranchPoint {
@@ -233,17 +212,45 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             state: x,
             stable: multipliers.first().is_none_or(|m| m.norm() < 1.0),
             multipliers,
-            max_displacement,
-            max_velocity,
-            impacts_per_period: impacts,
+            max_displacement: Vec::new(),
+            max_velocity: Vec::new(),
+            impacts_per_period: 0,
             label: None,
         };
-        Some(Evaluated {
+        let e = Evaluated {
             solved,
             tangent,
             point,
             tests,
-        })
+        };
+        if with_orbit {
+            self.add_orbit(e)
+        } else {
+            Some(e)
+        }
+    }
+
+    /// Completes a point evaluated without its orbit summary: the
+    /// amplitudes over the period and the impacts per period.
+    pub(super) fn add_orbit(&mut self, mut e: Evaluated) -> Option<Evaluated> {
+        let p = e.point.parameter;
+        let model = self.model(p).ok()?;
+        let period =
+            forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
+        let orbit = orbit_summary(
+            &model,
+            &e.point.state,
+            period,
+            self.opts.orbit_samples,
+            self.opts.shooting.rtol,
+        )
+        .ok()?;
+        let impacts = orbit.impacts_per_period();
+        e.tests.impacts = impacts;
+        e.point.impacts_per_period = impacts;
+        e.point.max_displacement = orbit.max_displacement;
+        e.point.max_velocity = orbit.max_velocity;
+        Some(e)
     }
 
     /// The solution at parameter `bound`, between the solutions `a` and
