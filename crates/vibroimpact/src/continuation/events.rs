@@ -92,6 +92,14 @@ pub trait BranchEvent {
     fn needs_orbit(&self) -> bool {
         true
     }
+
+    /// A continuous test function that changes sign at the event between
+    /// `a` and `b`, if there is one: location then samples where its
+    /// secant through the bracket vanishes (Illinois' regula falsi) instead
+    /// of halving the bracket. Default None (bisection).
+    fn scalar(&self, _a: Observed<'_>, _b: Observed<'_>) -> Option<fn(&TestValues) -> f64> {
+        None
+    }
 }
 
 /// The built-in special points, from the test values.
@@ -104,6 +112,21 @@ impl BranchEvent for SpecialKind {
     /// orbit summary.
     fn needs_orbit(&self) -> bool {
         matches!(self, SpecialKind::Grazing | SpecialKind::User)
+    }
+
+    /// Folds: the tangent's parameter component; branch points: det(DG + I)
+    /// of the half map where it changes sign, else det [J; t]; period
+    /// doublings: det(Φ + I). Neimark–Sacker points and grazings are counts.
+    fn scalar(&self, a: Observed<'_>, b: Observed<'_>) -> Option<fn(&TestValues) -> f64> {
+        match self {
+            SpecialKind::Fold => Some(|t| t.tangent_p),
+            SpecialKind::BranchPoint if a.tests.det_sym.signum() != b.tests.det_sym.signum() => {
+                Some(|t| t.det_sym)
+            }
+            SpecialKind::BranchPoint => Some(|t| t.det_ext),
+            SpecialKind::PeriodDoubling => Some(|t| t.det_pd),
+            _ => None,
+        }
     }
 
     fn between(&self, a: Observed<'_>, b: Observed<'_>) -> bool {
@@ -168,8 +191,11 @@ impl Evaluated {
 }
 
 impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
-    /// Bisection of the arclength in (0, ds) from `a` for the event that
-    /// occurs before `b`; returns the located point.
+    /// Location of the event that occurs between `a` and `b` on the
+    /// arclength in (0, ds) from `a`: regula falsi (Illinois) on the event's
+    /// scalar test function where it has one, bisection otherwise, until
+    /// the parameter is bracketed to `locate_tol`; returns the located
+    /// point.
     pub(super) fn locate(
         &mut self,
         event: &dyn BranchEvent,
@@ -179,13 +205,25 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     ) -> Option<Evaluated> {
         let (mut lo, mut hi) = (0.0, ds);
         let (mut p_lo, mut p_hi) = (a.point.parameter, b.point.parameter);
+        let scalar = event.scalar(a.observed(), b.observed());
+        let (mut g_lo, mut g_hi) =
+            scalar.map_or((f64::NAN, f64::NAN), |f| (f(&a.tests), f(&b.tests)));
+        // Which end moved last (Illinois: the end kept twice has its value
+        // halved, so that the secant does not stall).
+        let mut moved_hi: Option<bool> = None;
         let mut best: Option<Evaluated> = None;
         let mut lo_point: Option<Evaluated> = None;
         for _ in 0..80 {
             if (p_hi - p_lo).abs() <= self.opts.locate_tol && best.is_some() {
                 break;
             }
-            let mid = 0.5 * (lo + hi);
+            let width = hi - lo;
+            let secant = lo - g_lo * width / (g_hi - g_lo);
+            let mid = if secant.is_finite() && g_lo * g_hi < 0.0 {
+                secant.clamp(lo + 0.02 * width, hi - 0.02 * width)
+            } else {
+                0.5 * (lo + hi)
+            };
             let pred: Vec<f64> = a
                 .solved
                 .z
@@ -195,13 +233,24 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
                 .collect();
             let (solved, _) = self.correct(&pred, &a.tangent)?;
             let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
+            let g = scalar.map_or(f64::NAN, |f| f(&e.tests));
             if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {
                 hi = mid;
                 p_hi = e.point.parameter;
+                g_hi = g;
+                if moved_hi == Some(true) {
+                    g_lo *= 0.5;
+                }
+                moved_hi = Some(true);
             } else {
                 lo = mid;
                 p_lo = e.point.parameter;
+                g_lo = g;
                 lo_point = Some(e.clone());
+                if moved_hi == Some(false) {
+                    g_hi *= 0.5;
+                }
+                moved_hi = Some(false);
             }
             best = Some(e);
             if hi - lo < 1e-14 {
