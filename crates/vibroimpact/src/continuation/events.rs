@@ -25,6 +25,9 @@ pub struct TestValues {
     pub det_pd: f64,
     /// Multipliers outside the unit circle.
     pub outside: usize,
+    /// Π (|μ| − 1) over the complex multipliers with Im μ > 0: changes sign
+    /// when a complex pair crosses the unit circle (1 without such pairs).
+    pub complex_margin: f64,
     /// Impacts per period.
     pub impacts: usize,
 }
@@ -63,6 +66,11 @@ impl TestValues {
             det_sym,
             det_pd: pd.determinant(),
             outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
+            complex_margin: multipliers
+                .iter()
+                .filter(|m| m.im > 0.0)
+                .map(|m| m.norm() - 1.0)
+                .product(),
             impacts,
         }
     }
@@ -116,7 +124,8 @@ impl BranchEvent for SpecialKind {
 
     /// Folds: the tangent's parameter component; branch points: det(DG + I)
     /// of the half map where it changes sign, else det [J; t]; period
-    /// doublings: det(Φ + I). Neimark–Sacker points and grazings are counts.
+    /// doublings: det(Φ + I); Neimark–Sacker points: the product of
+    /// |μ| − 1 over the complex pairs. Grazings (a count) have none.
     fn scalar(&self, a: Observed<'_>, b: Observed<'_>) -> Option<fn(&TestValues) -> f64> {
         match self {
             SpecialKind::Fold => Some(|t| t.tangent_p),
@@ -125,6 +134,7 @@ impl BranchEvent for SpecialKind {
             }
             SpecialKind::BranchPoint => Some(|t| t.det_ext),
             SpecialKind::PeriodDoubling => Some(|t| t.det_pd),
+            SpecialKind::NeimarkSacker => Some(|t| t.complex_margin),
             _ => None,
         }
     }
