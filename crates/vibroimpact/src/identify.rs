@@ -277,7 +277,12 @@ pub fn fit_a_over_b(samples: &[RestitutionSample]) -> Result<RestitutionFit, Ide
             best = (i, r);
         }
     }
-    let best = (best.0, ssr(grid[best.0])?);
+    // The grid's sum is that of every sample unless it ran on a spread.
+    let best = if coarse.len() < samples.len() {
+        (best.0, ssr(grid[best.0])?)
+    } else {
+        best
+    };
     if best.0 == 0 || best.0 == grid.len() - 1 {
         let direction = if best.0 == 0 {
             "a/b -> 0 (every e near 0)"
@@ -502,15 +507,16 @@ pub fn fit_joint(
     let (mut theta, sigma_e) = if acceleration_only {
         let grid = log_q_grid(acceleration_samples.iter().map(|s| s.impact_velocity));
         let coarse = spread(acceleration_samples);
-        let mut best = (0, f64::INFINITY);
+        let mut best = (0, f64::INFINITY, 0.0);
         for (i, &t) in grid.iter().enumerate() {
-            let (_, ssr) = profile_log_alpha(&coarse, t.exp(), &bodies)?;
+            let (la, ssr) = profile_log_alpha(&coarse, t.exp(), &bodies)?;
             if ssr < best.1 {
-                best = (i, ssr);
+                best = (i, ssr, la);
             }
         }
-        let (la, _) = profile_log_alpha(acceleration_samples, grid[best.0].exp(), &bodies)?;
-        let best = (best.0, (), la);
+        if coarse.len() < acceleration_samples.len() {
+            best.2 = profile_log_alpha(acceleration_samples, grid[best.0].exp(), &bodies)?.0;
+        }
         if best.0 == 0 || best.0 == grid.len() - 1 {
             return Err(IdentifyError::NotIdentifiable(
                 "a/b from accelerations alone: the fit runs off the range of V = U/(a/b) from 1e-4 to 1e4; give a/b or restitution data".into(),

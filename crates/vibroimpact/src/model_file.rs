@@ -756,15 +756,17 @@ impl ModelDocument {
                             cx.err_at(span.clone(), "[excitation] accelerogram: no record loaded")
                         })?;
                         let scale = scale.unwrap_or(1.0);
-                        if !scale.is_finite() {
-                            return Err(cx.err_at(
-                                span,
-                                format!("[excitation] scale = {scale}: must be finite"),
-                            ));
-                        }
+                        // The samples' errors belong to the record, the
+                        // scale's to the model file's [excitation].
                         BaseExcitation::Record(
                             Accelerogram::new(record.times.clone(), record.values.clone(), scale)
-                                .map_err(|e| ModelFileError(format!("{}: {e}", record.source)))?,
+                                .map_err(|e| match e.key.as_str() {
+                                "excitation.scale" => cx.err_at(
+                                    span.clone(),
+                                    format!("[excitation] scale = {scale}: must be finite"),
+                                ),
+                                _ => ModelFileError(format!("{}: {e}", record.source)),
+                            })?,
                         )
                     }
                 }

@@ -719,6 +719,7 @@ pub fn simulate_streaming(
         (Some(window), None) => Some(ExtremaScan::new(window, n2 / 2, &st)),
         _ => None,
     };
+    let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
             next_break += 1;
@@ -755,8 +756,8 @@ pub fn simulate_streaming(
         // Any method: a run that crawls (a nonsensical parameter, e.g. a
         // contact damping of 1e300) ends early with the reason instead of
         // grinding to the step limit.
-        let steps = st.stats().steps;
-        if steps % PROGRESS_CHECK == 0 && steps > 0 {
+        steps += 1;
+        if steps % PROGRESS_CHECK == 0 {
             let projected = steps as f64 * opts.t_end / st.t();
             if projected > CRAWL_FACTOR * opts.max_steps as f64 {
                 error = Some(IntegrationError::NoProgress {

@@ -191,15 +191,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
     /// correction failed, turned too sharply or moved the multipliers too
     /// far (two crossings of the unit circle could cancel in the tests).
     fn try_step(&mut self, ds: f64) -> Option<(Evaluated, usize)> {
-        let cur = &self.current;
-        let pred: Vec<f64> = cur
-            .solved
-            .z
-            .iter()
-            .zip(&cur.tangent)
-            .map(|(z, t)| z + ds * t)
-            .collect();
-        let tangent = cur.tangent.clone();
+        let pred = self.current.predict(ds);
+        let tangent = self.current.tangent.clone();
         let (solved, iterations) = self.problem.correct(&pred, &tangent)?;
         // The cheap checks first: the orbit summary (an integration) only
         // for a step that is kept.

@@ -173,6 +173,18 @@ pub(super) struct Evaluated {
     pub(super) tests: TestValues,
 }
 
+impl Evaluated {
+    /// The predictor `z + s t` at arclength `s` along the point's tangent.
+    pub(super) fn predict(&self, s: f64) -> Vec<f64> {
+        self.solved
+            .z
+            .iter()
+            .zip(&self.tangent)
+            .map(|(z, t)| z + s * t)
+            .collect()
+    }
+}
+
 impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     /// The point `solved` in full detail: tangent (oriented along
     /// `previous_tangent`), orbit summary, multipliers and test values.
