@@ -124,13 +124,19 @@ pub fn print_rows(
         .map_err(|e| CliError::new(format!("cannot write to standard output: {e}")))
 }
 
+/// The columns of a time history: `t, u_<body>…, v_<body>…`.
+pub fn history_header(model: &Model) -> Vec<String> {
+    let mut columns: Vec<String> = vec!["t".into()];
+    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
+    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+    columns
+}
+
 /// CSV of sampled states: `t, u_<body>…, v_<body>…` (rows of `states` are
 /// `[u.., v..]` at `times`).
 pub fn history_csv(model: &Model, times: &[f64], states: &[f64]) -> Result<String, CliError> {
     let n = model.bodies().len();
-    let mut columns: Vec<String> = vec!["t".into()];
-    columns.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
-    columns.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+    let columns = history_header(model);
     let rows: Vec<Vec<Option<f64>>> = times
         .iter()
         .enumerate()

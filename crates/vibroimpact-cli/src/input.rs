@@ -5,9 +5,7 @@
 use std::io::{self, Read};
 use std::path::Path;
 
-/// The largest input file read (1 GiB): a record or table beyond it is
-/// refused before reading rather than exhausting memory.
-pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+pub use vibroimpact::model_file::MAX_INPUT_BYTES;
 
 /// The text of the regular file `path`, refused (with the reason) if it is
 /// a directory, FIFO or device, or larger than [`MAX_INPUT_BYTES`].

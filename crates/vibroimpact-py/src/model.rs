@@ -105,9 +105,9 @@ impl PyModel {
                 path.display()
             )));
         }
-        // Regular files of at most 1 GiB (as the CLI): a FIFO would block,
-        // a device never end, a huge record exhaust memory.
-        const MAX_INPUT_BYTES: u64 = 1 << 30;
+        // Regular files of at most MAX_INPUT_BYTES (as the CLI): a FIFO
+        // would block, a device never end, a huge record exhaust memory.
+        use vibroimpact::model_file::MAX_INPUT_BYTES;
         let regular = |p: &std::path::Path| match std::fs::metadata(p) {
             Ok(m) if !m.is_file() => Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,

@@ -822,6 +822,11 @@ impl ModelDocument {
     }
 }
 
+/// The largest input file (model, record, measurements) the CLI and the
+/// Python package read (1 GiB): larger ones are refused before reading
+/// rather than exhausting memory. (The library itself reads no files.)
+pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+
 /// Parses a two-column accelerogram CSV (time s, acceleration m/s²); a
 /// header row and `#` comment lines are allowed. `source` names the text in
 /// messages, which give its line.

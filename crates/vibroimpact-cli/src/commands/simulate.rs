@@ -8,7 +8,7 @@ use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
 
 use crate::args::MethodName;
 use crate::error::CliError;
-use crate::format::{number, CsvText, SummaryFormat};
+use crate::format::{history_header, number, CsvText, SummaryFormat};
 use crate::model_io::read_model;
 use crate::output::{commit_temp, temp_path, Pending};
 use crate::output::{ensure_dir, write_atomic, OutputError};
@@ -347,9 +347,7 @@ impl HistoryFile {
         };
         let file = std::fs::File::create(&tmp).map_err(fail)?;
         let mut writer = csv::Writer::from_writer(std::io::BufWriter::new(file));
-        let mut header = vec!["t".to_string()];
-        header.extend(model.bodies().iter().map(|b| format!("u_{}", b.name)));
-        header.extend(model.bodies().iter().map(|b| format!("v_{}", b.name)));
+        let header = history_header(model);
         writer.write_record(&header).map_err(|e| fail(e.into()))?;
         let samples = opts.output_step.map_or(1.0, |dt| opts.t_end / dt + 1.0);
         Ok(Self {
