@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Build the continuation peer (AUTO-07p) and the sweep peer (SciPy) for R2, N = 2
+# (r2n2.exe) and any N (rn.exe)
 # (idempotent).
 #
 #   bench/auto/build.sh [OUT_DIR] [--no-python]
@@ -8,6 +9,7 @@
 #   OUT_DIR/r2n2.exe   AUTO-07p executable: r2n2.f90 compiled with gfortran and
 #                      linked with the AUTO-07p 0.9.2 library objects of the
 #                      Debian package auto-07p (/usr/lib/auto-07p/lib/*.o)
+#   OUT_DIR/rn.exe     the same from rn.f90 (any N, NDIM = 2N + 2)
 #   OUT_DIR/venv/      Python venv with requirements.txt (numpy, scipy) for
 #                      sweep_scipy.py and check_auto.py
 # Installs auto-07p and gfortran with apt-get if missing (needs root or sudo and
@@ -21,7 +23,7 @@ WITH_PYTHON=1
 for arg in "$@"; do
   case "$arg" in
     --no-python) WITH_PYTHON=0 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) OUT="$arg" ;;
   esac
 done
@@ -62,13 +64,18 @@ esac
 
 # ---- 2. compile and link (the flags of /usr/lib/auto-07p/cmds/cmds.make) ---
 FFLAGS="-O2 -fPIC -std=legacy -fopenmp"
-if [ ! -x "$OUT/r2n2.exe" ] || [ "$HERE/r2n2.f90" -nt "$OUT/r2n2.exe" ] || [ "$0" -nt "$OUT/r2n2.exe" ]; then
-  # shellcheck disable=SC2086
-  gfortran $FFLAGS -c "$HERE/r2n2.f90" -o "$OUT/r2n2.o" || die "compiling r2n2.f90 failed"
-  # shellcheck disable=SC2086
-  gfortran $FFLAGS "$OUT/r2n2.o" -o "$OUT/r2n2.exe.tmp" "$AUTO_LIB"/*.o || die "linking r2n2.exe failed"
-  mv -f "$OUT/r2n2.exe.tmp" "$OUT/r2n2.exe"
-fi
+build_exe() {  # build_exe NAME: NAME.f90 -> OUT/NAME.exe (if out of date)
+  local name="$1"
+  if [ ! -x "$OUT/$name.exe" ] || [ "$HERE/$name.f90" -nt "$OUT/$name.exe" ] || [ "$0" -nt "$OUT/$name.exe" ]; then
+    # shellcheck disable=SC2086
+    gfortran $FFLAGS -c "$HERE/$name.f90" -o "$OUT/$name.o" || die "compiling $name.f90 failed"
+    # shellcheck disable=SC2086
+    gfortran $FFLAGS "$OUT/$name.o" -o "$OUT/$name.exe.tmp" "$AUTO_LIB"/*.o || die "linking $name.exe failed"
+    mv -f "$OUT/$name.exe.tmp" "$OUT/$name.exe"
+  fi
+}
+build_exe r2n2   # N = 2
+build_exe rn     # any N, from NDIM = 2N + 2
 # smoke run: the amplitude homotopy (run 1 of run_auto.py), a fraction of a second
 SMOKE="$OUT/smoke"
 mkdir -p "$SMOKE"
@@ -96,10 +103,13 @@ DSMIN = 1e-07
 DSMAX = 0.1
 UZSTOP = {2: 0.5}
 CEOF
-( cd "$SMOKE" && OMP_NUM_THREADS=1 "$OUT/r2n2.exe" < c.smoke > smoke.log 2>&1 ) \
-  || die "smoke run of r2n2.exe failed (see $SMOKE/smoke.log)"
-grep -q " UZ " "$SMOKE/smoke.log" || die "smoke run did not reach its user point (see $SMOKE/smoke.log)"
-echo "build.sh: built $OUT/r2n2.exe (auto-07p $VERSION, $(gfortran --version | head -1))"
+for exe in r2n2 rn; do
+  sed "s/^e = .*/e = '$exe'/" "$SMOKE/c.smoke" > "$SMOKE/c.smoke.$exe"
+  ( cd "$SMOKE" && OMP_NUM_THREADS=1 "$OUT/$exe.exe" < "c.smoke.$exe" > "smoke.$exe.log" 2>&1 ) \
+    || die "smoke run of $exe.exe failed (see $SMOKE/smoke.$exe.log)"
+  grep -q " UZ " "$SMOKE/smoke.$exe.log" || die "smoke run of $exe.exe did not reach its user point (see $SMOKE/smoke.$exe.log)"
+done
+echo "build.sh: built $OUT/r2n2.exe and $OUT/rn.exe (auto-07p $VERSION, $(gfortran --version | head -1))"
 
 # ---- 3. Python venv for sweep_scipy.py / check_auto.py --------------------
 if [ "$WITH_PYTHON" -eq 1 ]; then
