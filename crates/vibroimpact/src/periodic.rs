@@ -26,7 +26,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 
 use crate::dynamics::{from_interleaved, interleaved_index, to_interleaved, ChainDynamics};
-use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, Interrupt};
+use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, Interrupt, OdeSystem};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::simulate::{simulate, OptionsError, SimulationOptions};
@@ -224,6 +224,20 @@ pub fn period_map(
     x: &[f64],
     opts: &ShootingOptions,
 ) -> Result<PeriodMap, IntegrationError> {
+    period_map_with(model, x, opts, None).map(|(map, _)| map)
+}
+
+/// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
+/// derivative `∂P/∂p` of the map with respect to the parameter p of the
+/// family: the sensitivity column of the variational equations at the
+/// end time plus the flow times the change of the end time,
+/// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map).
+pub(crate) fn period_map_with(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    shifted: Option<(&Model, f64)>,
+) -> Result<(PeriodMap, Option<Vec<f64>>), IntegrationError> {
     let n = model.bodies().len();
     let d = 2 * n;
     if d > MAX_DENSE_DIM {
@@ -235,9 +249,18 @@ pub fn period_map(
             MAX_DENSE_DIM / 2
         )));
     }
-    let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+    let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
+    let t = map_time(model, opts).map_err(invalid)?;
     let sys = ChainDynamics::new(model, false);
-    let mut var = Variational::new(sys, d);
+    let (mut var, dt_dp) = match shifted {
+        Some((model_p, dp)) => {
+            let t_p = map_time(model_p, opts).map_err(invalid)?;
+            let shifted_sys = ChainDynamics::new(model_p, false);
+            let var = Variational::with_parameter(sys, d, shifted_sys, dp);
+            (var, (t_p - t) / dp)
+        }
+        None => (Variational::new(sys, d), 0.0),
+    };
     let z0 = var.initial_state(&to_interleaved(x));
     // The state controls the steps: Φ rides along on the same steps, so a
     // period map costs O(N) steps × O(N² · bandwidth) per step.
@@ -253,17 +276,24 @@ pub fn period_map(
     let inter = |k: usize| interleaved_index(k, n);
     let image = from_interleaved(&z, n);
     let phi = var.sensitivity(&z);
+    let dp_column = var.parameter_sensitivity(&z).map(|s| {
+        let mut flow = vec![0.0; d];
+        var.system_mut().rhs(t, &z[..d], &mut flow);
+        let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
+        from_interleaved(&column, n)
+    });
     if opts.symmetric {
         // G = S P_{nT/2}: DG = S Φ_{1/2}, rows mirrored and negated.
         let monodromy =
             DMatrix::from_fn(d, d, |r, c| -phi[inter(c) * d + inter(mirror_index(r, n))]);
-        return Ok(PeriodMap {
+        let map = PeriodMap {
             image: mirror(&image),
             monodromy,
-        });
+        };
+        return Ok((map, dp_column.map(|c| mirror(&c))));
     }
     let monodromy = DMatrix::from_fn(d, d, |r, c| phi[inter(c) * d + inter(r)]);
-    Ok(PeriodMap { image, monodromy })
+    Ok((PeriodMap { image, monodromy }, dp_column))
 }
 
 /// Floquet multipliers from the Jacobian of the shooting map: its

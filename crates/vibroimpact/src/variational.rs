@@ -11,6 +11,12 @@
 //! [`ChainDynamics`](crate::dynamics::ChainDynamics): a right-hand side then
 //! costs O(dim · bandwidth · p)); a system without an analytic Jacobian gets
 //! one by forward differences of `f` (dim extra evaluations).
+//!
+//! With a parameter ([`Variational::with_parameter`]) one more column
+//! carries the sensitivity `s = ∂y(t)/∂p` to a parameter p of the system:
+//! `s' = J s + ∂f/∂p`, `s(0) = 0`, with `∂f/∂p` by a forward difference of
+//! the right-hand side against a copy of the system at `p + δp` (same t and
+//! y: one more right-hand side per stage instead of a second integration).
 //! Only the state enters the error norm by default
 //! ([`Variational::error_components`]); including the columns controls the
 //! accuracy of Φ itself.
@@ -27,6 +33,8 @@ pub struct Variational<S> {
     f0: Vec<f64>,
     f1: Vec<f64>,
     yp: Vec<f64>,
+    /// The system at `p + δp` and `δp`, for the parameter column.
+    parameter: Option<(S, f64)>,
 }
 
 impl<S: OdeSystem> Variational<S> {
@@ -46,7 +54,23 @@ impl<S: OdeSystem> Variational<S> {
             f0: vec![0.0; dim],
             f1: vec![0.0; dim],
             yp: vec![0.0; dim],
+            parameter: None,
         }
+    }
+
+    /// Extends `sys` by `columns` columns of Φ and, after them, the
+    /// sensitivity to a parameter p: `shifted` is the same system at
+    /// `p + dp` (`dp != 0`).
+    pub fn with_parameter(sys: S, columns: usize, shifted: S, dp: f64) -> Self {
+        Self {
+            parameter: Some((shifted, dp)),
+            ..Self::new(sys, columns)
+        }
+    }
+
+    /// Number of carried columns: the Φ columns, plus one with a parameter.
+    fn carried(&self) -> usize {
+        self.columns + usize::from(self.parameter.is_some())
     }
 
     /// The wrapped system.
@@ -75,9 +99,10 @@ impl<S: OdeSystem> Variational<S> {
         self.dim
     }
 
-    /// Extended initial state `[y0, e_1, …, e_p]`.
+    /// Extended initial state `[y0, e_1, …, e_p]` (and `s(0) = 0` with a
+    /// parameter).
     pub fn initial_state(&self, y0: &[f64]) -> Vec<f64> {
-        let mut z = vec![0.0; self.dim * (1 + self.columns)];
+        let mut z = vec![0.0; self.dim * (1 + self.carried())];
         z[..self.dim].copy_from_slice(y0);
         for c in 0..self.columns {
             z[self.dim * (1 + c) + c] = 1.0;
@@ -88,7 +113,7 @@ impl<S: OdeSystem> Variational<S> {
     /// Extended initial state `[y0, w_1, …, w_p]` with given initial columns
     /// (directional derivatives `Φ(t) w_j` instead of `Φ(t) e_j`).
     pub fn initial_state_with(&self, y0: &[f64], columns: &[&[f64]]) -> Vec<f64> {
-        let mut z = vec![0.0; self.dim * (1 + self.columns)];
+        let mut z = vec![0.0; self.dim * (1 + self.carried())];
         z[..self.dim].copy_from_slice(y0);
         for (c, w) in columns.iter().enumerate().take(self.columns) {
             z[self.dim * (1 + c)..self.dim * (2 + c)].copy_from_slice(w);
@@ -99,6 +124,13 @@ impl<S: OdeSystem> Variational<S> {
     /// Φ from an extended state, column-major (`dim × columns`).
     pub fn sensitivity<'a>(&self, z: &'a [f64]) -> &'a [f64] {
         &z[self.dim..self.dim * (1 + self.columns)]
+    }
+
+    /// The parameter sensitivity `∂y(t)/∂p` from an extended state, if
+    /// carried.
+    pub fn parameter_sensitivity<'a>(&self, z: &'a [f64]) -> Option<&'a [f64]> {
+        let start = self.dim * (1 + self.columns);
+        self.parameter.as_ref().map(|_| &z[start..start + self.dim])
     }
 
     /// Fills `self.jac` at (t, y): analytic if the system provides it, else
@@ -126,16 +158,24 @@ impl<S: OdeSystem> Variational<S> {
 
 impl<S: OdeSystem> OdeSystem for Variational<S> {
     fn dim(&self) -> usize {
-        self.dim * (1 + self.columns)
+        self.dim * (1 + self.carried())
     }
 
     fn rhs(&mut self, t: f64, z: &[f64], dzdt: &mut [f64]) {
         let d = self.dim;
         self.sys.rhs(t, &z[..d], &mut dzdt[..d]);
         self.jacobian_at(t, &z[..d]);
-        for c in 0..self.columns {
+        for c in 0..self.carried() {
             let range = d * (1 + c)..d * (2 + c);
             self.jac.mul_vec(&z[range.clone()], &mut dzdt[range]);
+        }
+        if let Some((shifted, dp)) = &mut self.parameter {
+            shifted.rhs(t, &z[..d], &mut self.f1);
+            let (f0, rest) = dzdt.split_at_mut(d);
+            let column = &mut rest[d * self.columns..];
+            for ((s, f1), f0) in column.iter_mut().zip(&self.f1).zip(&*f0) {
+                *s += (f1 - f0) / *dp;
+            }
         }
     }
 

@@ -234,7 +234,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             } else {
                 0.5 * (lo + hi)
             };
-            let (solved, _) = self.correct(&a.predict(mid), &a.tangent)?;
+            let (solved, _) = self.correct(&a.predict(mid), &a.tangent, Some(&a.solved.jac))?;
             let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
             let g = scalar.map_or(f64::NAN, |f| f(&e.tests));
             if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {

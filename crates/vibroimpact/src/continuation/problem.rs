@@ -11,7 +11,8 @@ use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
-    forcing_period, map_multipliers, map_time, mirror, orbit_summary, period_map, ShootingOptions,
+    forcing_period, map_multipliers, map_time, mirror, orbit_summary, period_map_with,
+    ShootingOptions,
 };
 
 /// A converged point of the extended system with its linearisation.
@@ -68,34 +69,63 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         z
     }
 
-    /// Ĝ(z) and its Jacobian [Ĵ_x, Ĝ_p] (d × (d+1)), and Φ.
-    pub(super) fn residual(&mut self, z: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>, DMatrix<f64>)> {
+    /// Ĝ(z) and, with `full`, its Jacobian [Ĵ_x, Ĝ_p] (d × (d+1)) and Φ,
+    /// from one integration of the variational equations with the
+    /// parameter column; without, from the state alone.
+    pub(super) fn residual(&mut self, z: &[f64], full: bool) -> Option<Residual> {
         let (x, p) = self.unscale(z);
         let d = self.d;
         let model = self.model(p).ok()?;
-        let map = period_map(&model, &x, &self.opts.shooting).ok()?;
-        let g: Vec<f64> = (0..d)
-            .map(|i| (map.image[i] - x[i]) / self.scale[i])
-            .collect();
+        let scaled = |image: &[f64], scale: &[f64]| -> Vec<f64> {
+            (0..d).map(|i| (image[i] - x[i]) / scale[i]).collect()
+        };
+        if !full {
+            let image = period_image(&model, &x, &self.opts.shooting)?;
+            return Some(Residual {
+                g: scaled(&image, &self.scale),
+                linear: None,
+            });
+        }
         let dp = 1e-6 * self.p_scale.max(p.abs());
         let model_p = self.model(p + dp).ok()?;
-        let image_p = period_image(&model_p, &x, &self.opts.shooting)?;
+        let (map, dp_column) =
+            period_map_with(&model, &x, &self.opts.shooting, Some((&model_p, dp))).ok()?;
+        let dp_column = dp_column?;
         let mut jac = DMatrix::zeros(d, d + 1);
         for r in 0..d {
             for c in 0..d {
                 let id = if r == c { 1.0 } else { 0.0 };
                 jac[(r, c)] = (map.monodromy[(r, c)] - id) * self.scale[c] / self.scale[r];
             }
-            jac[(r, d)] = (image_p[r] - map.image[r]) / dp * self.p_scale / self.scale[r];
+            jac[(r, d)] = dp_column[r] * self.p_scale / self.scale[r];
         }
-        Some((g, jac, map.monodromy))
+        Some(Residual {
+            g: scaled(&map.image, &self.scale),
+            linear: Some((jac, map.monodromy)),
+        })
     }
 
     /// Newton on [Ĝ(z) = 0, t·(z - z_pred) = 0] from `pred` (the shared
     /// damped Newton, no line search, steps damped to
     /// `step.corrector_max_step`, stagnation at the period map's noise
     /// floor accepted). Returns the solution and the evaluations used.
-    pub(super) fn correct(&mut self, pred: &[f64], t: &[f64]) -> Option<(Solved, usize)> {
+    ///
+    /// With `nearby`, the Jacobian of a solution close to `pred` (the point
+    /// the predictor left), the iteration starts as a chord iteration with
+    /// it: residuals of the state alone, a third of the cost of an
+    /// evaluation with the variational equations (docs/decisions.md D15).
+    /// The iterate the observed contraction predicts to converge is
+    /// evaluated in full (so the solution comes with its own Jacobian), as
+    /// is every iterate once the chord contracts poorly (ratio above 1/2):
+    /// Newton from there. The evaluations returned count the chord
+    /// iterations after the first as one (for the step control, a chord
+    /// iteration is not a sign of a hard correction).
+    pub(super) fn correct(
+        &mut self,
+        pred: &[f64],
+        t: &[f64],
+        nearby: Option<&DMatrix<f64>>,
+    ) -> Option<(Solved, usize)> {
         let opts = NewtonOptions {
             tol: self.opts.shooting.tol,
             max_iterations: self.opts.max_corrector.saturating_sub(1),
@@ -105,34 +135,47 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             // little above tol.
             stall: Some((1e-2, 100.0)),
         };
+        let chord = nearby.map(|jac| bordered(jac, t));
         let mut corrector = Corrector {
             problem: self,
             pred,
             t,
+            chord,
+            chord_norms: Vec::new(),
+            last: None,
+            full_seen: false,
         };
         let out = damped_newton(&mut corrector, pred, &opts).ok()?;
-        let (_, jac, monodromy, _) = out.point;
-        out.stop.eq(&NewtonStop::Converged).then_some((
-            Solved {
-                z: out.x,
-                jac,
-                monodromy,
-            },
-            out.evaluations,
+        let chord_extra = corrector.chord_norms.len().saturating_sub(1);
+        if out.stop != NewtonStop::Converged {
+            return None;
+        }
+        let (residual, c) = out.point;
+        let residual = match residual.linear {
+            Some(_) => residual,
+            // Converged at a chord iterate: its Jacobian is still needed.
+            None => self.residual(&out.x, true)?,
+        };
+        let (jac, monodromy) = residual.linear?;
+        // One more Newton step with the Jacobian just computed, without
+        // evaluating again: the residual tolerance bounds ‖Ĝ‖, and the
+        // state error is ‖Ĵ⁻¹‖ times that, large where a multiplier is near
+        // 1; the step takes it to the square of the residual.
+        let rhs = DVector::from_iterator(self.d + 1, residual.g.iter().map(|g| -g).chain([-c]));
+        let delta = bordered(&jac, t).lu().solve(&rhs)?;
+        let z = out.x.iter().zip(delta.iter()).map(|(z, d)| z + d).collect();
+        Some((
+            Solved { z, jac, monodromy },
+            out.evaluations - chord_extra.min(1),
         ))
     }
 
     /// Unit tangent at a solution, oriented along `previous`.
     pub(super) fn tangent(&self, jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
         let d = self.d;
-        let mut a = DMatrix::zeros(d + 1, d + 1);
-        a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
-        for c in 0..=d {
-            a[(d, c)] = previous[c];
-        }
         let mut e = DVector::zeros(d + 1);
         e[d] = 1.0;
-        let t = a.lu().solve(&e)?;
+        let t = bordered(jac, previous).lu().solve(&e)?;
         let norm = t.norm();
         let mut t: Vec<f64> = t.iter().map(|v| v / norm).collect();
         if t.iter().zip(previous).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
@@ -243,25 +286,38 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     }
 
     /// Completes a point evaluated without its orbit summary: the
-    /// amplitudes over the period and the impacts per period.
+    /// amplitudes over the period and the impacts per period. A symmetric
+    /// orbit (`u(t + nT/2) = S u(t)`) is summarised over its first half:
+    /// the second half is the mirror image, so max |u_i| over the period is
+    /// the larger of the half's max |u_i| and max |u_{N-1-i}|, and each
+    /// impact of the first half has its mirror image in the second.
     pub(super) fn add_orbit(&mut self, mut e: Evaluated) -> Option<Evaluated> {
         let p = e.point.parameter;
         let model = self.model(p).ok()?;
+        let symmetric = self.opts.shooting.symmetric;
         let period =
             forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
+        let span = if symmetric { 0.5 * period } else { period };
         let orbit = orbit_summary(
             &model,
             &e.point.state,
-            period,
+            span,
             self.opts.orbit_samples,
             self.opts.shooting.rtol,
         )
         .ok()?;
-        let impacts = orbit.impacts_per_period();
+        let mut impacts = orbit.impacts_per_period();
+        let (mut max_u, mut max_v) = (orbit.max_displacement, orbit.max_velocity);
+        if symmetric {
+            impacts *= 2;
+            let n = max_u.len();
+            max_u = (0..n).map(|i| max_u[i].max(max_u[n - 1 - i])).collect();
+            max_v = (0..n).map(|i| max_v[i].max(max_v[n - 1 - i])).collect();
+        }
         e.tests.impacts = impacts;
         e.point.impacts_per_period = impacts;
-        e.point.max_displacement = orbit.max_displacement;
-        e.point.max_velocity = orbit.max_velocity;
+        e.point.max_displacement = max_u;
+        e.point.max_velocity = max_v;
         Some(e)
     }
 
@@ -286,55 +342,109 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         pred[self.d] = bound / self.p_scale;
         let mut held = vec![0.0; self.d + 1];
         held[self.d] = 1.0;
-        let (solved, _) = self.correct(&pred, &held)?;
+        let (solved, _) = self.correct(&pred, &held, Some(&a.solved.jac))?;
         self.evaluate(solved, &a.tangent)
+    }
+}
+
+/// Ĝ at an iterate, with its linearisation when evaluated in full.
+pub(super) struct Residual {
+    /// Ĝ(z), scaled.
+    pub(super) g: Vec<f64>,
+    /// [Ĵ_x, Ĝ_p] and Φ.
+    pub(super) linear: Option<(DMatrix<f64>, DMatrix<f64>)>,
+}
+
+/// The bordered matrix `[J; tᵀ]` ((d+1) × (d+1)) of a d × (d+1) Jacobian.
+fn bordered(jac: &DMatrix<f64>, t: &[f64]) -> DMatrix<f64> {
+    let d = jac.nrows();
+    let mut a = DMatrix::zeros(d + 1, d + 1);
+    a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
+    for (col, &tc) in t.iter().enumerate() {
+        a[(d, col)] = tc;
+    }
+    a
+}
+
+/// Broyden's ("good") rank-one update of `b` for the secant condition
+/// `b (z1 − z0) = f1 − f0`. The border row is linear and exact, so the
+/// update leaves it unchanged.
+fn broyden_update(b: &mut DMatrix<f64>, z0: &[f64], f0: &[f64], z1: &[f64], f1: &[f64]) {
+    let dz = DVector::from_iterator(z0.len(), z1.iter().zip(z0).map(|(a, b)| a - b));
+    let df = DVector::from_iterator(f0.len(), f1.iter().zip(f0).map(|(a, b)| a - b));
+    let dz2 = dz.norm_squared();
+    if dz2 > 0.0 {
+        let u = (df - &*b * &dz) / dz2;
+        *b += u * dz.transpose();
     }
 }
 
 /// The pseudo-arclength corrector as a Newton system: unknowns z (scaled),
 /// residual `[Ĝ(z); t·(z − z_pred)]`, direction from the LU factors of
-/// `[Ĵ; tᵀ]`.
+/// `[Ĵ; tᵀ]` (at the iterate, or the chord factors for the first step).
 struct Corrector<'p, 'a, F> {
     problem: &'p mut Problem<F>,
     pred: &'a [f64],
     t: &'a [f64],
+    chord: Option<DMatrix<f64>>,
+    /// Residual norms of the chord iterates so far.
+    chord_norms: Vec<f64>,
+    /// The last chord iterate and its residual `[Ĝ; c]` (Broyden update).
+    last: Option<(Vec<f64>, Vec<f64>)>,
+    /// Whether an iterate was evaluated in full (Newton from then on).
+    full_seen: bool,
 }
 
 impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
-    /// Ĝ(z), its Jacobian, Φ and the constraint residual.
-    type Point = (Vec<f64>, DMatrix<f64>, DMatrix<f64>, f64);
+    /// Ĝ(z) (with its linearisation unless a chord step follows) and the
+    /// constraint residual.
+    type Point = (Residual, f64);
     /// Any failure (model, integration) ends the correction.
     type Error = ();
 
     fn evaluate(&mut self, z: &[f64]) -> Result<Self::Point, ()> {
-        let (g, jac, monodromy) = self.problem.residual(z).ok_or(())?;
+        let tol = self.problem.opts.shooting.tol;
+        let full = self.chord.is_none()
+            || self.full_seen
+            || match self.chord_norms[..] {
+                [.., a, b] => b > 0.5 * a || 10.0 * b * b / a <= tol,
+                _ => false,
+            };
+        self.full_seen |= full;
+        let r = self.problem.residual(z, full).ok_or(())?;
         let c = (0..z.len())
             .map(|i| self.t[i] * (z[i] - self.pred[i]))
             .sum::<f64>();
-        Ok((g, jac, monodromy, c))
-    }
-
-    fn residual_norm(&self, (g, _, _, c): &Self::Point) -> f64 {
-        g.iter().fold(c.abs(), |m, v| m.max(v.abs()))
-    }
-
-    fn direction(
-        &mut self,
-        _z: &[f64],
-        (g, jac, _, c): &Self::Point,
-    ) -> Result<Option<Vec<f64>>, ()> {
-        let d = self.problem.d;
-        let mut a = DMatrix::zeros(d + 1, d + 1);
-        a.view_mut((0, 0), (d, d + 1)).copy_from(jac);
-        for (col, &tc) in self.t.iter().enumerate() {
-            a[(d, col)] = tc;
+        let point = (r, c);
+        if !full {
+            let norm = self.residual_norm(&point);
+            self.chord_norms.push(norm);
+            let f: Vec<f64> = point.0.g.iter().copied().chain([c]).collect();
+            if let (Some((z0, f0)), Some(b)) = (&self.last, &mut self.chord) {
+                broyden_update(b, z0, f0, z, &f);
+            }
+            self.last = Some((z.to_vec(), f));
         }
+        Ok(point)
+    }
+
+    fn residual_norm(&self, (r, c): &Self::Point) -> f64 {
+        r.g.iter().fold(c.abs(), |m, v| m.max(v.abs()))
+    }
+
+    fn direction(&mut self, _z: &[f64], (r, c): &Self::Point) -> Result<Option<Vec<f64>>, ()> {
+        let d = self.problem.d;
         let mut rhs = DVector::zeros(d + 1);
-        for (r, gr) in g.iter().enumerate() {
-            rhs[r] = -gr;
+        for (row, gr) in r.g.iter().enumerate() {
+            rhs[row] = -gr;
         }
         rhs[d] = -c;
-        Ok(a.lu().solve(&rhs).map(|delta| delta.as_slice().to_vec()))
+        let delta = match (&r.linear, &self.chord) {
+            (Some((jac, _)), _) => bordered(jac, self.t).lu().solve(&rhs),
+            (None, Some(b)) => b.clone().lu().solve(&rhs),
+            (None, None) => None,
+        };
+        Ok(delta.map(|delta| delta.as_slice().to_vec()))
     }
 
     fn step_norm(&self, delta: &[f64]) -> f64 {

@@ -140,7 +140,7 @@ where
     for h in [step, 0.25 * step, 2.5 * step] {
         for sign in [1.0, -1.0] {
             let pred: Vec<f64> = z.iter().zip(&v).map(|(a, b)| a + sign * h * b).collect();
-            let Some((solved, _)) = problem.correct(&pred, &constraint) else {
+            let Some((solved, _)) = problem.correct(&pred, &constraint, None) else {
                 continue;
             };
             // A corrector that wandered off to some other branch far away.
@@ -189,8 +189,9 @@ fn switch_directions<F: FnMut(f64) -> Result<Model, String>>(
         dir.push(0.0);
         directions.push(dir);
     } else {
-        let (_, jac, _) = problem
-            .residual(z)
+        let (jac, _) = problem
+            .residual(z, true)
+            .and_then(|r| r.linear)
             .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the branch point".into()))?;
         // The two eigenvectors of JᵀJ of the smallest eigenvalues span the
         // null space of the d × (d+1) Jacobian at a simple branch point.
