@@ -371,6 +371,11 @@ fn r2_asymmetric_branch_connects_bp2_to_bp3() {
     let period = 2.0 * std::f64::consts::PI / last.parameter;
     let at = orbit_summary(&model, &last.state, period, 256, 1e-11).unwrap();
     let (u1, u2) = (at.max_displacement[0], at.max_displacement[1]);
-    assert!((u1 - u2).abs() < 1e-3 * u1, "{u1} vs {u2}");
+    // The asymmetry vanishes like the square root of the distance along
+    // the branch from the pitchfork, where the parameter is stationary:
+    // the fold, located to 1e-8 in the parameter, is 5e-4 (rtol 1e-11)
+    // to 1e-3 (rtol 1e-10) from symmetric; the branch itself is 30 %
+    // asymmetric.
+    assert!((u1 - u2).abs() < 2e-3 * u1, "{u1} vs {u2}");
     assert!(b.points.len() < 1500, "{} points", b.points.len());
 }
