@@ -103,6 +103,18 @@ def run_exe(exe, workdir, text, name, timeout=None):
     return dt, p.stdout
 
 
+_RE_FEXP = re.compile(r"(?<=[0-9.])([+-]\d{3})$")
+
+
+def fnum(x):
+    """A Fortran number: 1.5D-03, 1.5E-03 and, for three-digit exponents,
+    1.5-152 / 1.5+308 (no exponent letter)."""
+    x = x.replace("D", "E")
+    if "E" not in x and "e" not in x:
+        x = _RE_FEXP.sub(r"E\1", x)
+    return float(x)
+
+
 def parse_b(path):
     """Rows of a b-file: dict(br, pt, ty, lab, par1, l2, period, p21..p25 and,
     if printed (rn.exe), p26 as "defect")."""
@@ -113,7 +125,7 @@ def parse_b(path):
             continue
         try:
             br, pt, ty, lab = (int(x) for x in f[:4])
-            vals = [float(x.replace("D", "E")) for x in f[4:13]]
+            vals = [fnum(x) for x in f[4:13]]
         except ValueError:
             continue
         rows.append(dict(br=br, pt=pt, ty=ty, lab=lab, par1=vals[0], l2=vals[1], period=vals[2],
@@ -140,8 +152,7 @@ def parse_d(path):
             continue
         m = RE_MULT.match(line)
         if m and cur is not None and abs(int(m.group(2))) == cur:
-            out[cur][1].append(complex(float(m.group(4).replace("D", "E")),
-                                       float(m.group(5).replace("D", "E"))))
+            out[cur][1].append(complex(fnum(m.group(4)), fnum(m.group(5))))
     return out
 
 
@@ -198,6 +209,11 @@ def main(argv):
     ap.add_argument("--epss", type=float, default=1e-5)
     ap.add_argument("--nmx", type=int, default=20000)
     ap.add_argument("--wmax", type=float, default=1.5)
+    ap.add_argument("--wmin", type=float, default=0.45, help="lower stop of the branch run (UZSTOP)")
+    ap.add_argument("--start", type=float, default=0.5,
+                    help="Omega/omega0 of the homotopy (default 0.5); another value adds a run 'pre' "
+                         "that moves the rest solution (zero forcing) from 0.5 there first; a start "
+                         "above 1 continues the branch downwards (end: --wmin)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", default="1", help="OMP_NUM_THREADS for AUTO (default 1)")
     ap.add_argument("--bp-detection", action="store_true",
@@ -319,24 +335,26 @@ def locate(args, exe, exe_name, workdir, irs, icp_out, common, c_branch, candida
     for c in candidates:
         # the label nearest w_before
         lab = None
-        if uzrows:
-            r = min(uzrows, key=lambda r: abs(r["par1"] - c["w_before"]))
-            if abs(r["par1"] - c["w_before"]) < 1e-4:
-                lab = r["lab"]
+        # (on a folded branch the same Omega is crossed more than once: the
+        # crossing nearest in step number)
+        near = [r for r in uzrows if abs(r["par1"] - c["w_before"]) < 1e-4]
+        if near:
+            lab = min(near, key=lambda r: abs(abs(r["pt"]) - c["pt_before"]))["lab"]
         c["restart_label"] = lab
         if lab is None:
             continue
         name = "bp%d" % len(located_bps)
+        sgn = 1.0 if c["w_after"] >= c["w_before"] else -1.0
         text = constants(e=exe_name, s="branchuz", sv=name, IRS=lab,
-                         ICP=f"[1, 11, {icp_out}]", NMX=200, DS=args.ds_locate,
-                         DSMAX=args.dsmax, SP="['BP1']", UZSTOP="{1: [0.45, %.12g]}" % args.wmax,
-                         **common)
+                         ICP=f"[1, 11, {icp_out}]", NMX=200, DS=sgn * args.ds_locate,
+                         DSMAX=args.dsmax, SP="['BP1']",
+                         UZSTOP="{1: [%.12g, %.12g]}" % (args.wmin, args.wmax), **common)
         dt, _ = run_exe(exe, workdir, text, name, tmo)
         t_bp += dt
         found = [r for r in parse_b(os.path.join(workdir, f"b.{name}"))
                  if TYPES.get(r["ty"]) in ("BP", "LP", "PD", "TR")]
-        w_lim = c["w_after"] + 0.5 * (c["w_after"] - c["w_before"]) + 1e-6
-        if found and found[0]["par1"] <= w_lim:
+        w_lim = c["w_after"] + 0.5 * (c["w_after"] - c["w_before"]) + sgn * 1e-6
+        if found and sgn * found[0]["par1"] <= sgn * w_lim:
             f = found[0]
             t = TYPES[f["ty"]]
             located_bps.append({"kind": KINDS[t], "parameter_over_omega0": f["par1"],
@@ -355,12 +373,23 @@ def run_all(args, n_bodies, ndim, exe_name, exe, icp_out, workdir):
 
     common = dict(NDIM=ndim, NTST=args.ntst, NCOL=args.ncol, EPSL=args.eps, EPSU=args.eps, EPSS=args.epss,
                   DSMIN=args.dsmin)
-    c_hom = constants(e=exe_name, sv="hom", IRS=0, ICP=f"[2, 11, {ICP_OUT}]", NMX=500,
-                      DS=0.01, DSMAX=0.1, UZSTOP="{2: %.12g}" % AS, **common)
+    pre = abs(args.start - 0.5) > 1e-12
+    down = args.start > 1.0
+    sgn = -1.0 if down else 1.0
+    w_end = args.wmin if down else args.wmax
+    c_pre = constants(e=exe_name, sv="pre", IRS=0, ICP=f"[1, 11, {ICP_OUT}]", NMX=2000, ISP=0,
+                      DS=0.01, DSMAX=0.05, SP="['BP0']", UZSTOP="{1: %.12g}" % args.start, **common)
+    if pre:
+        c_hom = constants(e=exe_name, s="pre", sv="hom", IRS="PRE_LABEL", ICP=f"[2, 11, {ICP_OUT}]",
+                          NMX=500, DS=0.01, DSMAX=0.1, UZSTOP="{2: %.12g}" % AS, **common)
+    else:
+        c_hom = constants(e=exe_name, sv="hom", IRS=0, ICP=f"[2, 11, {ICP_OUT}]", NMX=500,
+                          DS=0.01, DSMAX=0.1, UZSTOP="{2: %.12g}" % AS, **common)
 
     def c_branch(name, uzr=None, irs=None, sp="['BP0']"):
         kw = dict(e=exe_name, s="hom", sv=name, IRS=irs, ICP=f"[1, 11, {ICP_OUT}]", NMX=args.nmx,
-                  DS=args.ds, DSMAX=args.dsmax, UZSTOP="{1: [0.45, %.12g]}" % args.wmax, **common)
+                  DS=sgn * args.ds, DSMAX=args.dsmax,
+                  UZSTOP="{1: [%.12g, %.12g]}" % (args.wmin, args.wmax), **common)
         if sp:
             kw["SP"] = sp
         if uzr:
@@ -370,20 +399,40 @@ def run_all(args, n_bodies, ndim, exe_name, exe, icp_out, workdir):
     # ---- runs 1 + 2, timed (and 3, with --repeat-location) ----------------------
     times = []
     totals = []
+    timed_out = False
     nrep = max(1, args.repeats)
     for rep_i in range(nrep):
-        t_hom, _ = run_exe(exe, workdir, c_hom, "hom", tmo)
+        t_pre = 0.0
+        if pre:
+            t_pre, _ = run_exe(exe, workdir, c_pre, "pre", tmo)
+            lab = label_of(parse_b(os.path.join(workdir, "b.pre")), "UZ")
+            if lab is None:
+                raise RuntimeError("the rest solution did not reach --start")
+            t_hom, _ = run_exe(exe, workdir, c_hom.replace("PRE_LABEL", str(lab)), "hom", tmo)
+            t_hom += t_pre
+        else:
+            t_hom, _ = run_exe(exe, workdir, c_hom, "hom", tmo)
         irs = label_of(parse_b(os.path.join(workdir, "b.hom")), "UZ")
         if irs is None:
             raise RuntimeError("homotopy in the amplitude did not reach A")
-        t_br, out_br = run_exe(exe, workdir, c_branch("branch", irs=irs,
-                                                      sp="['BP']" if args.bp_detection else "['BP0']"),
-                               "branch", tmo)
+        try:
+            t_br, out_br = run_exe(exe, workdir, c_branch("branch", irs=irs,
+                                                          sp="['BP']" if args.bp_detection else "['BP0']"),
+                                   "branch", tmo)
+        except AutoTimeout:
+            # keep what AUTO wrote so far (b/d files are written as it goes)
+            timed_out = True
+            t_br = tmo
+            times.append((t_hom + t_br, t_hom, t_br))
+            rows, mult, branch, special, candidates = analyse(workdir, ndim, n_bodies, args.sym_tol)
+            t_bp, located_bps = 0.0, []
+            totals.append(t_hom + t_br)
+            break
         times.append((t_hom + t_br, t_hom, t_br))
         if args.repeat_location or rep_i == nrep - 1:
             rows, mult, branch, special, candidates = analyse(workdir, ndim, n_bodies, args.sym_tol)
             t_bp, located_bps = 0.0, []
-            if candidates and not args.no_locate_bp and not args.bp_detection:
+            if candidates and not args.no_locate_bp and not args.bp_detection and not timed_out:
                 t_bp, located_bps = locate(args, exe, exe_name, workdir, irs, ICP_OUT, common,
                                            c_branch, candidates, tmo)
             totals.append(t_hom + t_br + t_bp)
@@ -439,7 +488,8 @@ def run_all(args, n_bodies, ndim, exe_name, exe, icp_out, workdir):
     peak = max(branch, key=lambda b: max(b["max_u1"], b[key_last]))
     defects = [defect_of(r) for r in rows]
     asym = [r["par1"] for r, d in zip(rows, defects) if not d < args.sym_tol]
-    reached = TYPES.get(last["ty"]) == "UZ" and abs(last["par1"] - args.wmax) < 1e-6
+    reached = (not timed_out and TYPES.get(last["ty"]) == "UZ"
+               and abs(last["par1"] - w_end) < 1e-6)
     stab_int = []
     for b in branch:
         if stab_int and stab_int[-1]["stable"] == b["stable"]:
@@ -461,13 +511,16 @@ def run_all(args, n_bodies, ndim, exe_name, exe, icp_out, workdir):
         "points_hom": abs(hom_rows[-1]["pt"]),
         "end": {"type": TYPES.get(last["ty"]), "omega_over_omega0": last["par1"]},
         "reached_wmax": reached,
-        "max_symmetry_defect": max(defects),
+        "timed_out": timed_out,
+        "nan_points": sum(1 for r in rows if r["par1"] != r["par1"]),
+        "max_symmetry_defect": max((d if d == d else float("inf")) for d in defects),
         "first_asymmetric_omega": asym[0] if asym else None,
         "symmetric_to_wmax": reached and not asym,
         "settings": {"NTST": args.ntst, "NCOL": args.ncol, "IAD": 3, "ISP": 2, "ILP": 1,
                      "DS": args.ds, "DSMIN": args.dsmin, "DSMAX": args.dsmax,
                      "EPSL": args.eps, "EPSU": args.eps, "EPSS": args.epss, "JAC": 1,
-                     "NMX": args.nmx, "SP": "['BP']" if args.bp_detection else "['BP0']"},
+                     "NMX": args.nmx, "SP": "['BP']" if args.bp_detection else "['BP0']",
+                     "start": args.start, "wmin": args.wmin, "wmax": args.wmax},
         "seconds_bp_location": t_bp,
         "seconds_total": min(totals),
         "seconds_total_all_repeats": totals,
