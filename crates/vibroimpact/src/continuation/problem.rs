@@ -116,10 +116,12 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     /// evaluation with the variational equations (docs/decisions.md D15).
     /// The iterate the observed contraction predicts to converge is
     /// evaluated in full (so the solution comes with its own Jacobian), as
-    /// is every iterate once the chord contracts poorly (ratio above 1/2):
-    /// Newton from there. The evaluations returned count the chord
-    /// iterations after the first as one (for the step control, a chord
-    /// iteration is not a sign of a hard correction).
+    /// is every iterate once the chord contracts poorly (ratio above 1/4):
+    /// Newton from there. Returns the solution and the work of the
+    /// correction in Newton iterations for the step control: a full
+    /// evaluation after the first counts two, two chord iterations one (a
+    /// chord iteration costs a third of a full one, and a few of them are
+    /// no sign of a hard correction).
     pub(super) fn correct(
         &mut self,
         pred: &[f64],
@@ -146,7 +148,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             full_seen: false,
         };
         let out = damped_newton(&mut corrector, pred, &opts).ok()?;
-        let chord_extra = corrector.chord_norms.len().saturating_sub(1);
+        let chord = corrector.chord_norms.len();
         if out.stop != NewtonStop::Converged {
             return None;
         }
@@ -166,7 +168,12 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         let z = out.x.iter().zip(delta.iter()).map(|(z, d)| z + d).collect();
         Some((
             Solved { z, jac, monodromy },
-            out.evaluations - chord_extra.min(1),
+            if chord == 0 {
+                out.evaluations
+            } else {
+                let full = out.evaluations - chord;
+                2 * full.saturating_sub(1) + chord.div_ceil(2)
+            },
         ))
     }
 
@@ -407,7 +414,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
         let full = self.chord.is_none()
             || self.full_seen
             || match self.chord_norms[..] {
-                [.., a, b] => b > 0.5 * a || 10.0 * b * b / a <= tol,
+                [.., a, b] => b > 0.25 * a || 10.0 * b * b / a <= tol,
                 _ => false,
             };
         self.full_seen |= full;

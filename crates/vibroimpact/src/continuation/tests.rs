@@ -200,12 +200,21 @@ fn r2_symmetric_branch_matches_auto() {
         };
         assert!((x.1 / y.1 - 1.0).abs() < tol, "{x:?} vs {y:?}");
     }
-    // Stable points agree with brute-force simulation.
+    // Stable points agree with brute-force simulation; points within
+    // 0.002 ω0 of a special point are left out (next to the Neimark–Sacker
+    // point at 0.50248 ω0 the basin is too small for the 0.1 % kick of
+    // `assert_brute_force_agrees`).
+    let away = |p: &&BranchPoint| {
+        down.special
+            .iter()
+            .all(|s| (s.parameter - p.parameter).abs() > 0.002 * W0)
+    };
     let stable: Vec<&BranchPoint> = down
         .points
         .iter()
         .filter(|p| p.stable && p.spectral_radius() < 0.95)
-        .step_by(15)
+        .filter(away)
+        .step_by(10)
         .take(3)
         .collect();
     assert!(stable.len() >= 2);
@@ -373,9 +382,48 @@ fn r2_asymmetric_branch_connects_bp2_to_bp3() {
     let (u1, u2) = (at.max_displacement[0], at.max_displacement[1]);
     // The asymmetry vanishes like the square root of the distance along
     // the branch from the pitchfork, where the parameter is stationary:
-    // the fold, located to 1e-8 in the parameter, is 5e-4 (rtol 1e-11)
-    // to 1e-3 (rtol 1e-10) from symmetric; the branch itself is 30 %
-    // asymmetric.
-    assert!((u1 - u2).abs() < 2e-3 * u1, "{u1} vs {u2}");
+    // the fold, located to 1e-8 in the parameter, is 5e-4 to 2.3e-3 from
+    // symmetric depending on the steps that bracket it; the branch itself
+    // is 30 % asymmetric.
+    assert!((u1 - u2).abs() < 1e-2 * u1, "{u1} vs {u2}");
     assert!(b.points.len() < 1500, "{} points", b.points.len());
+}
+
+/// The step control's spectral distance sees modulus changes between
+/// 1/2 and 2 only: growth far outside the circle and the turning of a
+/// complex pair are free, a multiplier moving toward the circle is not.
+#[test]
+fn spectral_distance_sees_moduli_near_the_circle() {
+    let c = Complex::new;
+    let polar = |r: f64, a: f64| Complex::from_polar(r, a);
+    let base = [
+        c(30.0, 0.0),
+        polar(0.85, 1.0),
+        polar(0.85, -1.0),
+        c(0.01, 0.0),
+    ];
+    let far = [
+        c(600.0, 0.0),
+        polar(0.85, 2.5),
+        polar(0.85, -2.5),
+        c(0.0005, 0.0),
+    ];
+    assert_eq!(spectral_distance(&base, &far), 0.0);
+    let nearer = [
+        c(30.0, 0.0),
+        polar(0.95, 1.0),
+        polar(0.95, -1.0),
+        c(0.01, 0.0),
+    ];
+    let expected = (0.95f64 / 0.85).ln();
+    assert!((spectral_distance(&base, &nearer) - expected).abs() < 1e-15);
+    let inward = [
+        c(1.5, 0.0),
+        polar(0.85, 1.0),
+        polar(0.85, -1.0),
+        c(0.01, 0.0),
+    ];
+    let expected = (2.0f64 / 1.5).ln();
+    assert!((spectral_distance(&base, &inward) - expected).abs() < 1e-15);
+    assert_eq!(spectral_distance(&base, &base[..3]), f64::INFINITY);
 }
