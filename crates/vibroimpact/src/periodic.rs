@@ -317,14 +317,22 @@ pub fn map_multipliers(
 /// row, whose eigenvalues come in ± pairs of equal modulus. Without
 /// convergence the spectrum is shifted by a fraction of the matrix's size
 /// (M + cI has eigenvalues λ + c, a pattern the iteration does not stall
-/// on) and shifted back, which costs at most ~ε|c| in accuracy.
+/// on) and shifted back, which costs at most ~ε|c| in accuracy. Each
+/// shift is first tried with 10 iterations per eigenvalue (a converging
+/// iteration needs 2–3), then all again with 200: a stall would otherwise
+/// burn the large budget before the shift (R2 N = 8 on the half map: 40 %
+/// of the spectra stall unshifted, 3 ms each with 200 per eigenvalue,
+/// against 20 µs for the shifted solve).
 pub fn floquet_multipliers(monodromy: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, PeriodicError> {
     let d = monodromy.nrows();
     let size = monodromy.amax().max(f64::MIN_POSITIVE);
-    for shift in [0.0, 0.3, -0.55] {
+    let attempts = [10, 200]
+        .into_iter()
+        .flat_map(|per| [0.0, 0.3, -0.55].map(|shift| (shift, per * d.max(10))));
+    for (shift, budget) in attempts {
         let c = shift * size;
         let m = monodromy + DMatrix::<f64>::identity(d, d) * c;
-        if let Some(schur) = nalgebra::linalg::Schur::try_new(m, f64::EPSILON, 200 * d.max(10)) {
+        if let Some(schur) = nalgebra::linalg::Schur::try_new(m, f64::EPSILON, budget) {
             let mut mu: Vec<Complex<f64>> =
                 schur.complex_eigenvalues().iter().map(|l| l - c).collect();
             mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
