@@ -156,11 +156,19 @@ def parse_d(path):
     return out
 
 
+def cabs(z):
+    """|z|, inf instead of an OverflowError (diverged runs print +-1.8e308)."""
+    try:
+        return abs(z)
+    except OverflowError:
+        return float("inf")
+
+
 def nontrivial(mults):
     """Drop the multiplier nearest +1 (the trivial one of an autonomous orbit)."""
     if not mults:
         return []
-    i = min(range(len(mults)), key=lambda j: abs(mults[j] - 1.0))
+    i = min(range(len(mults)), key=lambda j: cabs(mults[j] - 1.0))
     return mults[:i] + mults[i + 1:]
 
 
@@ -173,10 +181,10 @@ def crossing_kind(before, after, u_before, u_after):
     by ILP=1), real < 0 -> period-doubling."""
     lo, hi = min(u_before, u_after), max(u_before, u_after)
     mults = after if u_after > u_before else before
-    nt = sorted(nontrivial(mults), key=abs, reverse=True)
+    nt = sorted(nontrivial(mults), key=cabs, reverse=True)
     kinds = set()
     for z in nt[lo:hi]:
-        if abs(z.imag) > 1e-6 * max(1.0, abs(z)):
+        if abs(z.imag) > 1e-6 * max(1.0, cabs(z)):
             kinds.add("neimark-sacker")
         else:
             kinds.add("branch-point" if z.real > 0 else "period-doubling")
@@ -288,7 +296,7 @@ def analyse(workdir, ndim, n_bodies, sym_tol):
             "max_u1": GAP * max(abs(r["maxx1"]), abs(r["minx1"])),
             key_last: GAP * max(abs(r["maxx2"]), abs(r["minx2"])),
             "stable": r["pt"] < 0,
-            "max_abs_multiplier": max((abs(z) for z in nt), default=None),
+            "max_abs_multiplier": max((cabs(z) for z in nt), default=None),
             "unstable_multipliers": (ndim - mu[0]) if mu else None,
             "pt": pt,
         }
