@@ -700,6 +700,21 @@ impl Model {
                 same && ends
             })
         });
+        let contacts = self.mirror_contacts().is_some();
+        let forces = self.forces.iter().all(|f| {
+            self.forces
+                .iter()
+                .any(|o| o.body == m(f.body) && o.amplitude == f.amplitude && o.phase == f.phase)
+        });
+        bodies && couplings && contacts && forces
+    }
+
+    /// The contact that is the mirror image of each contact (body i ↔
+    /// N−1−i, left wall ↔ right wall; same clearance and law), if every
+    /// contact has one.
+    pub fn mirror_contacts(&self) -> Option<Vec<usize>> {
+        let n = self.bodies.len();
+        let m = |i: usize| n - 1 - i;
         let mirror_pair = |p: ContactPair| match p {
             ContactPair::Bodies { left, right } => ContactPair::Bodies {
                 left: m(right),
@@ -708,17 +723,14 @@ impl Model {
             ContactPair::LeftWall { body } => ContactPair::RightWall { body: m(body) },
             ContactPair::RightWall { body } => ContactPair::LeftWall { body: m(body) },
         };
-        let contacts = self.contacts.iter().all(|c| {
-            self.contacts.iter().any(|o| {
-                o.pair == mirror_pair(c.pair) && o.clearance == c.clearance && o.law == c.law
+        self.contacts
+            .iter()
+            .map(|c| {
+                self.contacts.iter().position(|o| {
+                    o.pair == mirror_pair(c.pair) && o.clearance == c.clearance && o.law == c.law
+                })
             })
-        });
-        let forces = self.forces.iter().all(|f| {
-            self.forces
-                .iter()
-                .any(|o| o.body == m(f.body) && o.amplitude == f.amplitude && o.phase == f.phase)
-        });
-        bodies && couplings && contacts && forces
+            .collect()
     }
 
     /// Name of contact k, e.g. `wall|p1`, `p1|p2`, `p3|wall`.

@@ -779,6 +779,9 @@ pub struct OrbitSummary {
     pub max_velocity: Vec<f64>,
     /// Impacts per period per contact.
     pub impacts: Vec<ContactImpacts>,
+    /// Per contact, how far the approach passed the impact threshold over
+    /// the period (m; [`Extrema::impact_margin`](crate::simulate::Extrema)).
+    pub impact_margin: Vec<f64>,
     /// Sampled orbit over one period: times and states (body order).
     pub times: Vec<f64>,
     /// States at `times`, `[u.., v..]` each.
@@ -865,6 +868,7 @@ pub fn orbit_summary(
         max_displacement: extrema.max_displacement,
         max_velocity: extrema.max_velocity,
         impacts,
+        impact_margin: extrema.impact_margin,
         times,
         states,
     })

@@ -199,6 +199,11 @@ pub struct Extrema {
     pub max_displacement: Vec<f64>,
     /// max |v_i| (m/s), body order.
     pub max_velocity: Vec<f64>,
+    /// Per contact, max (s − s_on): how far the approach s passed the
+    /// impact threshold s_on (positive: an impact in the window; it
+    /// crosses zero where an impact grazes into or out of existence).
+    /// Interior maxima where ṡ changes sign are located like those of |u_i|.
+    pub impact_margin: Vec<f64>,
 }
 
 /// Dense-output values of two components at time t.
@@ -219,11 +224,19 @@ struct ExtremaScan {
     t: f64,
     y: Vec<f64>,
     dydt: Vec<f64>,
+    /// The impact threshold s_on of every contact.
+    s_on: Vec<f64>,
     found: Extrema,
 }
 
 impl ExtremaScan {
-    fn new((from, to): (f64, f64), bodies: usize, st: &Stepper) -> Self {
+    fn new(
+        (from, to): (f64, f64),
+        bodies: usize,
+        s_on: Vec<f64>,
+        st: &Stepper,
+        sys: &ChainDynamics,
+    ) -> Self {
         let mut scan = Self {
             from,
             to,
@@ -233,15 +246,47 @@ impl ExtremaScan {
             found: Extrema {
                 max_displacement: vec![0.0; bodies],
                 max_velocity: vec![0.0; bodies],
+                impact_margin: vec![f64::NEG_INFINITY; s_on.len()],
             },
+            s_on,
         };
         if from <= scan.t && scan.t <= to {
             for i in 0..bodies {
                 scan.found.max_displacement[i] = scan.y[2 * i].abs();
                 scan.found.max_velocity[i] = scan.y[2 * i + 1].abs();
             }
+            for (k, m) in scan.found.impact_margin.iter_mut().enumerate() {
+                *m = sys.approach(k, &scan.y).0 - scan.s_on[k];
+            }
         }
         scan
+    }
+
+    /// The contacts' approach maxima on [a, b] within the step ending at
+    /// `st.t()`: at the ends, and inside where ṡ changes sign.
+    fn contact_step(&mut self, st: &mut Stepper, sys: &mut ChainDynamics, a: f64, b: f64) {
+        let t1 = st.t();
+        for k in 0..self.s_on.len() {
+            let (sa, sda) = if a == self.t {
+                sys.approach(k, &self.y)
+            } else {
+                contact_at(st, sys, k, a)
+            };
+            let (sb, sdb) = if b == t1 {
+                sys.approach(k, st.y())
+            } else {
+                contact_at(st, sys, k, b)
+            };
+            let mut max_s = sa.max(sb);
+            if sda > 0.0 && sdb < 0.0 {
+                let rate = |t| contact_at(st, sys, k, t).1;
+                if let Ok(t) = EventLocator::FINE.locate(rate, (a, sda), (b, sdb)) {
+                    max_s = max_s.max(contact_at(st, sys, k, t).0);
+                }
+            }
+            let m = &mut self.found.impact_margin[k];
+            *m = m.max(max_s - self.s_on[k]);
+        }
     }
 
     /// Processes the accepted step from the previous end to `st.t()`.
@@ -277,6 +322,7 @@ impl ExtremaScan {
                 f.max_displacement[i] = f.max_displacement[i].max(max_u);
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
+            self.contact_step(st, sys, a, b);
         }
         self.t = t1;
         self.y.copy_from_slice(st.y());
@@ -716,7 +762,10 @@ pub fn simulate_streaming(
         }
     }
     let mut extrema = match (opts.extrema_window, &error) {
-        (Some(window), None) => Some(ExtremaScan::new(window, n2 / 2, &st)),
+        (Some(window), None) => {
+            let s_on = scan.trackers.iter().map(|tr| tr.s_on).collect();
+            Some(ExtremaScan::new(window, n2 / 2, s_on, &st, &sys))
+        }
         _ => None,
     };
     let mut steps: u64 = 0;

@@ -30,6 +30,11 @@ pub struct TestValues {
     pub complex_margin: f64,
     /// Impacts per period.
     pub impacts: usize,
+    /// The impact margin (max (s − s_on) over the period) of the contact
+    /// nearest to grazing (smallest |margin|), signed: it crosses zero
+    /// where an impact appears or vanishes. NaN until the orbit is
+    /// summarised or without contacts.
+    pub grazing_margin: f64,
 }
 
 impl TestValues {
@@ -72,6 +77,7 @@ impl TestValues {
                 .map(|m| m.norm() - 1.0)
                 .product(),
             impacts,
+            grazing_margin: f64::NAN,
         }
     }
 }
@@ -125,7 +131,10 @@ impl BranchEvent for SpecialKind {
     /// Folds: the tangent's parameter component; branch points: det(DG + I)
     /// of the half map where it changes sign, else det [J; t]; period
     /// doublings: det(Φ + I); Neimark–Sacker points: the product of
-    /// |μ| − 1 over the complex pairs. Grazings (a count) have none.
+    /// |μ| − 1 over the complex pairs; grazings: the impact margin of the
+    /// contact nearest to grazing (the count decides the bracket; an
+    /// impact that splits in two does not change the margin's sign, and
+    /// the location falls back to bisection).
     fn scalar(&self, a: Observed<'_>, b: Observed<'_>) -> Option<fn(&TestValues) -> f64> {
         match self {
             SpecialKind::Fold => Some(|t| t.tangent_p),
@@ -135,7 +144,8 @@ impl BranchEvent for SpecialKind {
             SpecialKind::BranchPoint => Some(|t| t.det_ext),
             SpecialKind::PeriodDoubling => Some(|t| t.det_pd),
             SpecialKind::NeimarkSacker => Some(|t| t.complex_margin),
-            _ => None,
+            SpecialKind::Grazing => Some(|t| t.grazing_margin),
+            SpecialKind::User => None,
         }
     }
 

@@ -315,12 +315,22 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         .ok()?;
         let mut impacts = orbit.impacts_per_period();
         let (mut max_u, mut max_v) = (orbit.max_displacement, orbit.max_velocity);
+        let mut margin = orbit.impact_margin;
         if symmetric {
             impacts *= 2;
             let n = max_u.len();
             max_u = (0..n).map(|i| max_u[i].max(max_u[n - 1 - i])).collect();
             max_v = (0..n).map(|i| max_v[i].max(max_v[n - 1 - i])).collect();
+            let mirror = model.mirror_contacts()?;
+            margin = (0..margin.len())
+                .map(|k| margin[k].max(margin[mirror[k]]))
+                .collect();
         }
+        e.tests.grazing_margin = margin
+            .iter()
+            .copied()
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .unwrap_or(f64::NAN);
         e.tests.impacts = impacts;
         e.point.impacts_per_period = impacts;
         e.point.max_displacement = max_u;
