@@ -48,7 +48,7 @@ const MULTIPLIER_RTOL: f64 = 1e-13;
 pub const MAX_DENSE_DIM: usize = 4096;
 
 /// Step budget of one period-map integration.
-const MAX_STEPS: u64 = 200_000;
+pub(crate) const MAX_STEPS: u64 = 200_000;
 
 /// Options of the shooting method.
 #[derive(Clone, Debug, PartialEq)]
@@ -224,20 +224,22 @@ pub fn period_map(
     x: &[f64],
     opts: &ShootingOptions,
 ) -> Result<PeriodMap, IntegrationError> {
-    period_map_with(model, x, opts, None).map(|(map, _)| map)
+    period_map_with(model, x, opts, None, MAX_STEPS).map(|(map, _, _)| map)
 }
 
 /// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
 /// derivative `∂P/∂p` of the map with respect to the parameter p of the
 /// family: the sensitivity column of the variational equations at the
 /// end time plus the flow times the change of the end time,
-/// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map).
+/// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map); at
+/// most `max_steps` integration steps, and the steps taken.
 pub(crate) fn period_map_with(
     model: &Model,
     x: &[f64],
     opts: &ShootingOptions,
     shifted: Option<(&Model, f64)>,
-) -> Result<(PeriodMap, Option<Vec<f64>>), IntegrationError> {
+    max_steps: u64,
+) -> Result<(PeriodMap, Option<Vec<f64>>, u64), IntegrationError> {
     let n = model.bodies().len();
     let d = 2 * n;
     if d > MAX_DENSE_DIM {
@@ -267,12 +269,12 @@ pub(crate) fn period_map_with(
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,
         atol: opts.rtol * opts.displacement_scale,
-        max_steps: MAX_STEPS,
+        max_steps,
         error_components: Some(d),
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
-    let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+    let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
     let inter = |k: usize| interleaved_index(k, n);
     let image = from_interleaved(&z, n);
     let phi = var.sensitivity(&z);
@@ -290,10 +292,10 @@ pub(crate) fn period_map_with(
             image: mirror(&image),
             monodromy,
         };
-        return Ok((map, dp_column.map(|c| mirror(&c))));
+        return Ok((map, dp_column.map(|c| mirror(&c)), stats.steps));
     }
     let monodromy = DMatrix::from_fn(d, d, |r, c| phi[inter(c) * d + inter(r)]);
-    Ok((PeriodMap { image, monodromy }, dp_column))
+    Ok((PeriodMap { image, monodromy }, dp_column, stats.steps))
 }
 
 /// Floquet multipliers from the Jacobian of the shooting map: its
