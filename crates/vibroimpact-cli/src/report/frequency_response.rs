@@ -419,10 +419,9 @@ fn render_auto_comparison(report: &mut Report, branch: &Branch) {
     report.append_html(&format!(
         "<p>Special points of the N = 2 symmetric branch against AUTO-07p (bench/auto: orthogonal \
          collocation, NTST 300, NCOL 4, adaptive mesh, forcing made autonomous by an appended oscillator). \
-         The differences are within AUTO's discretisation error (~5e-6). Timing (docs/decisions.md D14): \
-         AUTO set up as its users would (NTST 400, DSMAX 0.05, branch points detected in the run) takes 1.67 s \
-         on one thread and 0.80 s on two for this branch, ours 0.47 s; a SciPy solve_ivp sweep of the same \
-         225 frequencies about 1100× ours.</p>\n{}",
+         The differences are within AUTO's discretisation error (~5e-6). Timing: the section on the \
+         continuation cost below; a SciPy solve_ivp sweep of as many frequencies as the branch has points \
+         costs about 1100× ours (bench/auto/compare_branch.py).</p>\n{}",
         html_table(&["kind", "AUTO-07p Ω/ω0", "ours", "Ω/ω0", "ours − AUTO"], &cmp)
     ));
 }

@@ -12,6 +12,7 @@
 mod frequency_response;
 mod identification;
 mod impacts;
+mod peer_speed;
 mod time_history;
 
 use std::fmt::Write as _;
@@ -326,6 +327,7 @@ pub fn run(out: &Path) -> Result<(), CliError> {
         frequency_response::compute(&stop)
             .and_then(|d| frequency_response::render(&mut report, &d)),
     )?;
+    peer_speed::render(&mut report)?;
     let index = report.finish()?;
     println!(
         "report written: {} ({:.2} s)",
