@@ -72,3 +72,30 @@ pub enum StartMethod {
     /// periodic orbit at zero forcing): the primary branch at any N.
     Homotopy,
 }
+
+/// Dense or matrix-free linear algebra for periodic orbits and branches
+/// (`periodic`, `continue`).
+#[derive(Args, Debug)]
+pub struct LinearAlgebra {
+    /// Matrix-free: Newton–Krylov with Arnoldi multipliers (default from
+    /// 200 bodies on; the dense monodromy costs O(N²) memory and work).
+    #[arg(long)]
+    pub krylov: bool,
+    /// Dense monodromy even for large N.
+    #[arg(long, conflicts_with = "krylov")]
+    pub dense: bool,
+    /// Dominant multipliers computed by Arnoldi (matrix-free).
+    #[arg(long, default_value_t = 20)]
+    pub arnoldi: usize,
+}
+
+impl LinearAlgebra {
+    /// Rows at least this long are matrix-free unless `--dense`.
+    pub const AUTO_KRYLOV_BODIES: usize = 200;
+
+    /// The Arnoldi dimension if matrix-free for a row of `bodies`, else
+    /// None.
+    pub fn krylov(&self, bodies: usize) -> Option<usize> {
+        (self.krylov || (!self.dense && bodies >= Self::AUTO_KRYLOV_BODIES)).then_some(self.arnoldi)
+    }
+}

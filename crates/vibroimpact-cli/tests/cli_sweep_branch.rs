@@ -576,3 +576,26 @@ fn continue_starts_by_homotopy_where_simulation_does_not() {
         assert_eq!(doc["points"][0]["parameter"], 11.115);
     }
 }
+
+/// Matrix-free continuation with an impossible Arnoldi dimension, and a
+/// row too long for dense continuation, are refused with the remedy.
+#[test]
+fn continue_krylov_options_checked() {
+    let model = repo_file("examples/fujita-row-n2.toml");
+    let range = ["--parameter", "frequency", "--from", "7", "--to", "8"];
+    let args = [
+        &["continue", &model, "--krylov", "--arnoldi", "10"][..],
+        &range,
+    ]
+    .concat();
+    assert_clean_error(&args, "Arnoldi dimension 10: between 4");
+    let dir = temp_dir("long-row");
+    let text = std::fs::read_to_string(&model).unwrap();
+    let long = write_model(
+        &dir,
+        "row.toml",
+        &text.replacen("count = 2", "count = 2100", 1),
+    );
+    let args = [&["continue", &long, "--dense"][..], &range].concat();
+    assert_clean_error(&args, "too large for dense continuation");
+}

@@ -38,6 +38,7 @@
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;
+pub mod eigen;
 pub mod identify;
 pub mod impact;
 pub mod integrate;

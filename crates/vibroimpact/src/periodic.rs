@@ -224,7 +224,7 @@ pub fn period_map(
     x: &[f64],
     opts: &ShootingOptions,
 ) -> Result<PeriodMap, IntegrationError> {
-    period_map_with(model, x, opts, None, MAX_STEPS).map(|(map, _, _)| map)
+    period_map_with(model, x, opts, None, true, MAX_STEPS).map(|(map, _, _)| map)
 }
 
 /// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
@@ -232,17 +232,20 @@ pub fn period_map(
 /// family: the sensitivity column of the variational equations at the
 /// end time plus the flow times the change of the end time,
 /// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map); at
-/// most `max_steps` integration steps, and the steps taken.
+/// most `max_steps` integration steps, and the steps taken. Without
+/// `dense` no column of Φ is carried (the monodromy is 0 × 0): the map and
+/// its parameter derivative for matrix-free continuation.
 pub(crate) fn period_map_with(
     model: &Model,
     x: &[f64],
     opts: &ShootingOptions,
     shifted: Option<(&Model, f64)>,
+    dense: bool,
     max_steps: u64,
 ) -> Result<(PeriodMap, Option<Vec<f64>>, u64), IntegrationError> {
     let n = model.bodies().len();
     let d = 2 * n;
-    if d > MAX_DENSE_DIM {
+    if dense && d > MAX_DENSE_DIM {
         // About 40 state-sized vectors of d(d + 1) values in the integrator.
         let gb = 40.0 * (d * (d + 1)) as f64 * 8.0 / 1e9;
         return Err(IntegrationError::InvalidOptions(format!(
@@ -254,14 +257,15 @@ pub(crate) fn period_map_with(
     let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
     let t = map_time(model, opts).map_err(invalid)?;
     let sys = ChainDynamics::new(model, false);
+    let columns = if dense { d } else { 0 };
     let (mut var, dt_dp) = match shifted {
         Some((model_p, dp)) => {
             let t_p = map_time(model_p, opts).map_err(invalid)?;
             let shifted_sys = ChainDynamics::new(model_p, false);
-            let var = Variational::with_parameter(sys, d, shifted_sys, dp);
+            let var = Variational::with_parameter(sys, columns, shifted_sys, dp);
             (var, (t_p - t) / dp)
         }
-        None => (Variational::new(sys, d), 0.0),
+        None => (Variational::new(sys, columns), 0.0),
     };
     let z0 = var.initial_state(&to_interleaved(x));
     // The state controls the steps: Φ rides along on the same steps, so a
@@ -284,17 +288,18 @@ pub(crate) fn period_map_with(
         let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
         from_interleaved(&column, n)
     });
+    let k = columns;
     if opts.symmetric {
         // G = S P_{nT/2}: DG = S Φ_{1/2}, rows mirrored and negated.
         let monodromy =
-            DMatrix::from_fn(d, d, |r, c| -phi[inter(c) * d + inter(mirror_index(r, n))]);
+            DMatrix::from_fn(k, k, |r, c| -phi[inter(c) * d + inter(mirror_index(r, n))]);
         let map = PeriodMap {
             image: mirror(&image),
             monodromy,
         };
         return Ok((map, dp_column.map(|c| mirror(&c)), stats.steps));
     }
-    let monodromy = DMatrix::from_fn(d, d, |r, c| phi[inter(c) * d + inter(r)]);
+    let monodromy = DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]);
     Ok((PeriodMap { image, monodromy }, dp_column, stats.steps))
 }
 
@@ -341,7 +346,11 @@ pub fn floquet_multipliers(monodromy: &DMatrix<f64>) -> Result<Vec<Complex<f64>>
             return Ok(mu);
         }
     }
-    Err(PeriodicError::Eigenvalues(d))
+    // nalgebra's iteration stalls on some spectra of clustered ± pairs:
+    // the EISPACK algorithm (crate::eigen) instead.
+    let mut mu = crate::eigen::eigenvalues(monodromy).ok_or(PeriodicError::Eigenvalues(d))?;
+    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+    Ok(mu)
 }
 
 fn scaled_norm(r: &[f64], scale: &[f64]) -> f64 {
@@ -464,7 +473,9 @@ impl NewtonSystem for KrylovShooting<'_> {
             products: 0,
         };
         let b: Vec<f64> = r.iter().map(|v| -v).collect();
-        let (delta, _, _) = gmres(&mut op, &b, self.scale, 60, 1e-3).map_err(|source| {
+        let noise = 1e3 * self.opts.rtol;
+        let mut apply = shifted_monodromy(&mut op, self.scale);
+        let (delta, _, _) = gmres(&mut apply, &b, 60, 1e-3, noise).map_err(|source| {
             PeriodicError::Integration {
                 iteration: self.iteration,
                 source,
@@ -583,18 +594,21 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// GMRES output: the solution, the Krylov basis and the Hessenberg matrix.
-type KrylovSolve = (Vec<f64>, Vec<Vec<f64>>, DMatrix<f64>);
+pub(crate) type KrylovSolve = (Vec<f64>, Vec<Vec<f64>>, DMatrix<f64>);
 
-/// GMRES (Saad–Schultz, no restart, at most `m` iterations) for
-/// `(Φ - I) δ = b` in scaled variables; returns δ and the Arnoldi data
-/// (the Krylov basis and Hessenberg matrix of Φ - I).
-fn gmres(
-    op: &mut MonodromyOperator<'_>,
+/// GMRES (Saad–Schultz, no restart, at most `m` iterations) for `A δ = b`
+/// with the matrix-free product `apply(v) = A v`; returns δ and the Arnoldi
+/// data (the Krylov basis and the Hessenberg matrix of A). It stops at a
+/// relative residual `rel_tol`, or at a breakdown: a new vector below
+/// `noise` times its product, i.e. the product lies in the span of the
+/// basis to the accuracy of the (integrated) product.
+pub(crate) fn gmres<E, A: FnMut(&[f64]) -> Result<Vec<f64>, E>>(
+    apply: &mut A,
     b: &[f64],
-    scale: &[f64],
     m: usize,
     rel_tol: f64,
-) -> Result<KrylovSolve, IntegrationError> {
+    noise: f64,
+) -> Result<KrylovSolve, E> {
     let d = b.len();
     let beta = dot(b, b).sqrt();
     let mut basis: Vec<Vec<f64>> =
@@ -602,13 +616,10 @@ fn gmres(
     let mut h = DMatrix::<f64>::zeros(m + 1, m);
     let mut k_used = 0;
     for k in 0..m {
-        // w = (Φ - I) v_k in scaled variables: Φ acts on unscaled vectors.
-        let v: Vec<f64> = basis[k].iter().zip(scale).map(|(a, s)| a * s).collect();
-        let (_, phi_v) = op.apply(&v)?;
-        let mut w: Vec<f64> = (0..d).map(|i| phi_v[i] / scale[i] - basis[k][i]).collect();
+        let mut w = apply(&basis[k])?;
         let applied = dot(&w, &w).sqrt();
         // Modified Gram–Schmidt, repeated once ("twice is enough"): after
-        // heavy cancellation (|w| ~ 1e-5 |(Φ - I) v_k| near a breakdown) one
+        // heavy cancellation (|w| ~ 1e-5 |A v_k| near a breakdown) one
         // pass can leave w visibly non-orthogonal to the basis.
         for _ in 0..2 {
             for (j, q) in basis.iter().enumerate() {
@@ -620,36 +631,19 @@ fn gmres(
         let norm = dot(&w, &w).sqrt();
         h[(k + 1, k)] = norm;
         k_used = k + 1;
-        // Least-squares residual of the small problem.
-        let hk = h.view((0, 0), (k + 2, k + 1)).clone_owned();
-        let mut e1 = DVector::zeros(k + 2);
-        e1[0] = beta;
-        let y = hk
-            .clone()
-            .svd(true, true)
-            .solve(&e1, 1e-14)
-            .unwrap_or_else(|_| DVector::zeros(k + 1));
-        let res = (&hk * &y - &e1).norm();
-        // Breakdown: (Φ - I) v_k lies in the span of the basis to the
-        // accuracy of the integrated product Φv (an invariant subspace, e.g.
-        // of identical uncoupled bodies); a further vector would be
-        // integration noise and give spurious Ritz values (N = 200 linear:
-        // a multiplier 4.6 on a stable orbit), so the basis stops here.
-        let noise = 1e3 * op.opts.rtol;
+        let res = least_squares(&h, k_used, beta).1;
+        // Breakdown: A v_k lies in the span of the basis to the accuracy
+        // of the product (an invariant subspace, e.g. of identical
+        // uncoupled bodies); a further vector would be integration noise
+        // and give spurious Ritz values (N = 200 linear: a multiplier 4.6
+        // on a stable orbit), so the basis stops here.
         if norm <= noise * applied || res <= rel_tol * beta {
             basis.push(w.iter().map(|x| x / norm.max(f64::MIN_POSITIVE)).collect());
             break;
         }
         basis.push(w.iter().map(|x| x / norm).collect());
     }
-    let hk = h.view((0, 0), (k_used + 1, k_used)).clone_owned();
-    let mut e1 = DVector::zeros(k_used + 1);
-    e1[0] = beta;
-    let y = hk
-        .clone()
-        .svd(true, true)
-        .solve(&e1, 1e-14)
-        .unwrap_or_else(|_| DVector::zeros(k_used));
+    let (y, _) = least_squares(&h, k_used, beta);
     let mut delta = vec![0.0; d];
     for (j, yj) in y.iter().enumerate() {
         delta
@@ -657,7 +651,53 @@ fn gmres(
             .zip(&basis[j])
             .for_each(|(a, q)| *a += yj * q);
     }
+    let hk = h.view((0, 0), (k_used + 1, k_used)).clone_owned();
     Ok((delta, basis, hk))
+}
+
+/// The least-squares solution y of `H_k y ≈ β e_1` (the first k columns of
+/// the Hessenberg matrix) and its residual.
+fn least_squares(h: &DMatrix<f64>, k: usize, beta: f64) -> (DVector<f64>, f64) {
+    let hk = h.view((0, 0), (k + 1, k)).clone_owned();
+    let mut e1 = DVector::zeros(k + 1);
+    e1[0] = beta;
+    let y = hk
+        .clone()
+        .svd(true, true)
+        .solve(&e1, 1e-14)
+        .unwrap_or_else(|_| DVector::zeros(k));
+    let res = (&hk * &y - &e1).norm();
+    (y, res)
+}
+
+/// `(Φ - I) v` in scaled variables (Φ acts on unscaled vectors), as a
+/// closure for [`gmres`].
+fn shifted_monodromy<'o, 'm: 'o>(
+    op: &'o mut MonodromyOperator<'m>,
+    scale: &'o [f64],
+) -> impl FnMut(&[f64]) -> Result<Vec<f64>, IntegrationError> + use<'o, 'm> {
+    move |v: &[f64]| {
+        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s).collect();
+        let (_, phi_v) = op.apply(&unscaled)?;
+        Ok((0..v.len()).map(|i| phi_v[i] / scale[i] - v[i]).collect())
+    }
+}
+
+/// `DG v` (Φ v for the full map) at the state `x` by one integration of the
+/// state with one tangent column, body order.
+pub(crate) fn map_product(
+    model: &Model,
+    x: &[f64],
+    v: &[f64],
+    opts: &ShootingOptions,
+) -> Result<Vec<f64>, IntegrationError> {
+    let mut op = MonodromyOperator {
+        model,
+        x: x.to_vec(),
+        opts,
+        products: 0,
+    };
+    op.apply(v).map(|(_, product)| product)
 }
 
 /// Newton–Krylov shooting for large systems (matrix-free; see
@@ -710,7 +750,9 @@ pub fn shoot_krylov(
     let start: Vec<f64> = (0..d)
         .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
         .collect();
-    let (_, basis, h) = gmres(&mut op, &start, &scale, arnoldi.min(d).max(1), 0.0)
+    let noise = 1e3 * opts.rtol;
+    let mut apply = shifted_monodromy(&mut op, &scale);
+    let (_, basis, h) = gmres(&mut apply, &start, arnoldi.min(d).max(1), 0.0, noise)
         .map_err(|source| PeriodicError::Integration { iteration, source })?;
     let k = h.ncols().min(basis.len() - 1);
     let square = h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k);

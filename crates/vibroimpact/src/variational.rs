@@ -38,10 +38,11 @@ pub struct Variational<S> {
 }
 
 impl<S: OdeSystem> Variational<S> {
-    /// Extends `sys` by `columns` columns of Φ (`1..=dim`).
+    /// Extends `sys` by `columns` columns of Φ (`0..=dim`; 0 with a
+    /// parameter: the state and its parameter sensitivity alone).
     pub fn new(sys: S, columns: usize) -> Self {
         let dim = sys.dim();
-        let columns = columns.clamp(1, dim.max(1));
+        let columns = columns.min(dim);
         let jac = match sys.jacobian_bandwidth() {
             Some((kl, ku)) => BandMatrix::new(dim, kl, ku),
             None => BandMatrix::dense(dim),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::continuation::{
-    amplitude_homotopy, continue_branch, switch_branch, Branch, ContinuationError,
+    amplitude_homotopy, continue_branch, switch_branch, validate_size, Branch, ContinuationError,
     ContinuationOptions,
 };
 use vibroimpact::model::Model;
@@ -17,7 +17,7 @@ use vibroimpact::periodic::{
     OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
-use crate::args::{ParameterRange, StartMethod};
+use crate::args::{LinearAlgebra, ParameterRange, StartMethod};
 use crate::error::CliError;
 use crate::figures::branch_figure;
 use crate::format::{history_csv, CsvText, Format, SummaryFormat};
@@ -49,16 +49,8 @@ pub struct PeriodicArgs {
     /// Newton tolerance (scaled residual).
     #[arg(long, default_value_t = 1e-9)]
     tol: f64,
-    /// Matrix-free Newton–Krylov shooting with Arnoldi multipliers (default
-    /// from 200 bodies on; the dense monodromy costs O(N²) memory and work).
-    #[arg(long)]
-    krylov: bool,
-    /// Dense shooting even for large N.
-    #[arg(long, conflicts_with = "krylov")]
-    dense: bool,
-    /// Dominant multipliers computed by Arnoldi (Krylov shooting).
-    #[arg(long, default_value_t = 20)]
-    arnoldi: usize,
+    #[command(flatten)]
+    linear: LinearAlgebra,
     /// Look for a mirror-symmetric orbit (u_i(t + nT/2) = -u_{N+1-i}(t)) with
     /// the half map S P_{nT/2}: half the integration per Newton step; needs
     /// a mirror-symmetric model and an odd --subharmonic.
@@ -148,9 +140,10 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
             args.model.display()
         )));
     }
-    let krylov = args.krylov || (!args.dense && model.bodies().len() >= 200);
-    let sol = if krylov {
-        shoot_krylov(&model, &guess, &opts, args.arnoldi)
+    let arnoldi = args.linear.krylov(model.bodies().len());
+    let krylov = arnoldi.is_some();
+    let sol = if let Some(arnoldi) = arnoldi {
+        shoot_krylov(&model, &guess, &opts, arnoldi)
     } else {
         shoot(&model, &guess, &opts)
     }
@@ -321,6 +314,8 @@ pub struct ContinueArgs {
     /// Periods simulated for the start guess.
     #[arg(long, default_value_t = 200.0)]
     guess_periods: f64,
+    #[command(flatten)]
+    linear: LinearAlgebra,
     /// Output folder: branch.csv, branch_special_points.json, branch.json and
     /// the response figure branch_response.svg/.png (with --switch-at the
     /// same for switched_branch).
@@ -484,6 +479,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let opts = ContinuationOptions {
         max_points: args.max_points,
         ds_max: args.ds_max,
+        krylov: args.linear.krylov(start_model.bodies().len()),
         shooting: ShootingOptions {
             subharmonic: args.subharmonic,
             interrupt: Some(interrupt.clone()),
@@ -491,6 +487,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         },
         ..ContinuationOptions::default()
     };
+    validate_size(&start_model, &opts)?;
     let mut doc_at_start = pm.document.clone();
     doc_at_start.set(&pm.parameter, args.range.from)?;
     let homotopy = || -> Result<Vec<f64>, CliError> {

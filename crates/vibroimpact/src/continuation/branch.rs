@@ -11,7 +11,7 @@ use super::{
     SpecialPoint, StopReason,
 };
 use crate::model::Model;
-use crate::periodic::{shoot, ShootingOptions};
+use crate::periodic::{shoot, shoot_krylov, ShootingOptions, MAX_DENSE_DIM, MIN_ARNOLDI};
 
 /// One step of a [`Continuation`].
 #[derive(Clone, Debug)]
@@ -78,7 +78,11 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
     ) -> Result<Self, ContinuationError> {
         validate(p0, p_end, opts)?;
         let model = model_at(&mut family, p0)?;
-        let start = shoot(&model, x0, &opts.shooting)?;
+        validate_size(&model, opts)?;
+        let start = match opts.krylov {
+            None => shoot(&model, x0, &opts.shooting)?,
+            Some(m) => shoot_krylov(&model, x0, &opts.shooting, m)?,
+        };
         if !start.converged {
             return Err(ContinuationError::StartNotConverged(
                 *start.residual_history.last().unwrap_or(&f64::NAN),
@@ -205,7 +209,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
                 .for_each(|(z, k)| *z += 0.5 * ds * ds * k);
         }
         let tangent = self.current.tangent.clone();
-        let nearby = Some(&self.current.solved.jac);
+        let nearby = Some(&self.current.solved.linear);
         let (solved, iterations) = self.problem.correct(&pred, &tangent, nearby).ok_or(fail)?;
         // The cheap checks first: the orbit summary (an integration) only
         // for a step that is kept.
@@ -370,6 +374,29 @@ impl<F: FnMut(f64) -> Result<Model, String>> Iterator for Continuation<F> {
     }
 }
 
+/// The size checks of [`Continuation::new`], for callers that want them
+/// before any work (e.g. a start by simulation): a dense period map of
+/// the row must fit (else the remedy is matrix-free continuation), and an
+/// Arnoldi dimension must lie between the minimum for a stability verdict
+/// and the state's size.
+pub fn validate_size(model: &Model, opts: &ContinuationOptions) -> Result<(), ContinuationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    match opts.krylov {
+        None if d > MAX_DENSE_DIM => Err(ContinuationError::Invalid(format!(
+            "a row of {n} bodies is too large for dense continuation (the monodromy matrix \
+             alone has {d}×{d} entries, integrated with {d} variational columns): continue \
+             matrix-free (--krylov, ContinuationOptions::krylov)"
+        ))),
+        Some(m) if m < MIN_ARNOLDI.min(d) || m > d => Err(ContinuationError::Invalid(format!(
+            "Arnoldi dimension {m}: between {} (for a stability verdict) and the state's \
+             size {d}",
+            MIN_ARNOLDI.min(d)
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// The checks of the range and the options before anything runs.
 fn validate(p0: f64, p_end: f64, opts: &ContinuationOptions) -> Result<(), ContinuationError> {
     if !(p0.is_finite() && p_end.is_finite()) || p0 == p_end || p0 == 0.0 {
@@ -455,10 +482,12 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 /// complex pair can turn by any angle, without coming near a crossing (on
 /// R2 N = 2 the largest multiplier grows from 1 to 600 and back within
 /// 0.05 ω0 while a pair at modulus 0.85 turns quickly; a distance in the
-/// complex plane resolved both with ~100 points). Spectra of different
-/// sizes are infinitely far apart.
+/// complex plane resolved both with ~100 points). Of spectra of different
+/// sizes (dominant multipliers from Arnoldi iterations that ended at
+/// different dimensions) the common number of dominant ones is compared;
+/// an empty one is infinitely far from any other.
 pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
-    if a.len() != b.len() {
+    if a.is_empty() != b.is_empty() {
         return f64::INFINITY;
     }
     let log_moduli = |s: &[Complex<f64>]| {

@@ -38,6 +38,45 @@ pub struct TestValues {
 }
 
 impl TestValues {
+    /// The test values from dominant eigenvalues (matrix-free
+    /// continuation): `map_eigenvalues` of Φ (or DG of the half map),
+    /// `multipliers` those of Φ. det(Ĵ_x) = Π(λ − 1) over the map's
+    /// eigenvalues, and det [J; t] = det(Ĵ_x) / t_p for a unit tangent;
+    /// likewise det(DG + I) and det(Φ + I) as products over the dominant
+    /// eigenvalues. The factors of the others keep their sign as long as
+    /// they stay inside the unit circle, so the sign changes are the same.
+    pub(super) fn from_spectrum(
+        tangent_p: f64,
+        map_eigenvalues: &[Complex<f64>],
+        multipliers: &[Complex<f64>],
+        symmetric: bool,
+    ) -> TestValues {
+        let one = Complex::new(1.0, 0.0);
+        let product = |s: &[Complex<f64>], shift: f64| {
+            s.iter()
+                .fold(one, |acc, l| acc * (l + Complex::new(shift, 0.0)))
+                .re
+        };
+        TestValues {
+            tangent_p,
+            det_ext: product(map_eigenvalues, -1.0) / tangent_p,
+            det_sym: if symmetric {
+                product(map_eigenvalues, 1.0)
+            } else {
+                1.0
+            },
+            det_pd: product(multipliers, 1.0),
+            outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
+            complex_margin: multipliers
+                .iter()
+                .filter(|m| m.im > 0.0)
+                .map(|m| m.norm() - 1.0)
+                .product(),
+            impacts: 0,
+            grazing_margin: f64::NAN,
+        }
+    }
+
     /// The test values from the extended Jacobian `jac`, the tangent `t`,
     /// the monodromy matrix (of the half map if `symmetric`), its
     /// multipliers and the impacts per period.
@@ -244,7 +283,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             } else {
                 0.5 * (lo + hi)
             };
-            let (solved, _) = self.correct(&a.predict(mid), &a.tangent, Some(&a.solved.jac))?;
+            let (solved, _) = self.correct(&a.predict(mid), &a.tangent, Some(&a.solved.linear))?;
             let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
             let g = scalar.map_or(f64::NAN, |f| f(&e.tests));
             if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {

@@ -43,13 +43,14 @@
 
 mod branch;
 mod events;
+mod krylov;
 mod problem;
 mod start;
 mod switching;
 #[cfg(test)]
 mod tests;
 
-pub use branch::{spectral_distance, BranchStep, Continuation};
+pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
 pub use switching::{
@@ -143,6 +144,14 @@ pub struct ContinuationOptions {
     /// value): steps change the parameter by at most about
     /// `ds_max · scale`.
     pub parameter_scale: Option<f64>,
+    /// Matrix-free continuation with this Arnoldi dimension (None: dense).
+    /// The corrector and the tangent solve their bordered systems by GMRES
+    /// on products Ĵ_x v (one integration of the state and one tangent
+    /// column each), the multipliers are the Ritz values of this many
+    /// Arnoldi vectors, and the test functions are taken from them (a
+    /// multiplier outside the Arnoldi space is not seen). Memory
+    /// O(N · dimension) instead of O(N²); for rows of hundreds of bodies.
+    pub krylov: Option<usize>,
 }
 
 impl Default for ContinuationOptions {
@@ -170,6 +179,7 @@ impl Default for ContinuationOptions {
             bounds: None,
             use_symmetry: true,
             parameter_scale: None,
+            krylov: None,
         }
     }
 }

@@ -6,6 +6,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
+use super::krylov::square_if;
 use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
 use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
@@ -15,12 +16,34 @@ use crate::periodic::{
     ShootingOptions, MAX_STEPS,
 };
 
+/// The linearisation of the extended system at a point.
+#[derive(Clone, Debug)]
+pub(super) enum Linear {
+    /// The Jacobian [Ĵ_x, Ĝ_p] (d × (d+1)) and Φ (or DG of the half map),
+    /// from the full variational equations.
+    Dense {
+        /// [Ĵ_x, Ĝ_p], scaled.
+        jac: DMatrix<f64>,
+        /// Φ, or DG of the half map (body order, unscaled).
+        monodromy: DMatrix<f64>,
+    },
+    /// Matrix-free: products Ĵ_x v from one tangent integration each at
+    /// the state `x` and parameter `p`, and the column Ĝ_p.
+    Krylov {
+        /// The state (body order, unscaled).
+        x: Vec<f64>,
+        /// The parameter.
+        p: f64,
+        /// Ĝ_p, scaled.
+        g_p: Vec<f64>,
+    },
+}
+
 /// A converged point of the extended system with its linearisation.
 #[derive(Clone, Debug)]
 pub(super) struct Solved {
     pub(super) z: Vec<f64>,
-    pub(super) jac: DMatrix<f64>,
-    pub(super) monodromy: DMatrix<f64>,
+    pub(super) linear: Linear,
 }
 
 /// The continuation problem in scaled variables: the family of models, the
@@ -72,9 +95,11 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         z
     }
 
-    /// Ĝ(z) and, with `full`, its Jacobian [Ĵ_x, Ĝ_p] (d × (d+1)) and Φ,
-    /// from one integration of the variational equations with the
-    /// parameter column; without, from the state alone.
+    /// Ĝ(z) and, with `full`, its linearisation: dense, the Jacobian
+    /// [Ĵ_x, Ĝ_p] (d × (d+1)) and Φ from one integration of the variational
+    /// equations with the parameter column; matrix-free
+    /// (`opts.krylov`), the parameter column alone. Without `full`, from
+    /// the state alone.
     pub(super) fn residual(&mut self, z: &[f64], full: bool) -> Option<Residual> {
         let (x, p) = self.unscale(z);
         let d = self.d;
@@ -102,10 +127,20 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         let dp = 1e-6 * self.p_scale.max(p.abs());
         let model_p = self.model(p + dp).ok()?;
         let shifted = Some((&model_p, dp));
+        let dense = self.opts.krylov.is_none();
         let (map, dp_column, steps) =
-            period_map_with(&model, &x, &self.opts.shooting, shifted, budget).ok()?;
+            period_map_with(&model, &x, &self.opts.shooting, shifted, dense, budget).ok()?;
         self.steps = steps;
         let dp_column = dp_column?;
+        if !dense {
+            let g_p = (0..d)
+                .map(|r| dp_column[r] * self.p_scale / self.scale[r])
+                .collect();
+            return Some(Residual {
+                g: scaled(&map.image, &self.scale),
+                linear: Some(Linear::Krylov { x, p, g_p }),
+            });
+        }
         let mut jac = DMatrix::zeros(d, d + 1);
         for r in 0..d {
             for c in 0..d {
@@ -116,7 +151,10 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         }
         Some(Residual {
             g: scaled(&map.image, &self.scale),
-            linear: Some((jac, map.monodromy)),
+            linear: Some(Linear::Dense {
+                jac,
+                monodromy: map.monodromy,
+            }),
         })
     }
 
@@ -141,7 +179,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         &mut self,
         pred: &[f64],
         t: &[f64],
-        nearby: Option<&DMatrix<f64>>,
+        nearby: Option<&Linear>,
     ) -> Option<(Solved, usize)> {
         let opts = NewtonOptions {
             tol: self.opts.shooting.tol,
@@ -152,7 +190,10 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             // little above tol.
             stall: Some((1e-2, 100.0)),
         };
-        let chord = nearby.map(|jac| bordered(jac, t));
+        let chord = match nearby {
+            Some(Linear::Dense { jac, .. }) => Some(bordered(jac, t)),
+            _ => None,
+        };
         let mut corrector = Corrector {
             problem: self,
             pred,
@@ -173,16 +214,22 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             // Converged at a chord iterate: its Jacobian is still needed.
             None => self.residual(&out.x, true)?,
         };
-        let (jac, monodromy) = residual.linear?;
-        // One more Newton step with the Jacobian just computed, without
+        let linear = residual.linear?;
+        // One more Newton step with a dense Jacobian just computed, without
         // evaluating again: the residual tolerance bounds ‖Ĝ‖, and the
         // state error is ‖Ĵ⁻¹‖ times that, large where a multiplier is near
         // 1; the step takes it to the square of the residual.
-        let rhs = DVector::from_iterator(self.d + 1, residual.g.iter().map(|g| -g).chain([-c]));
-        let delta = bordered(&jac, t).lu().solve(&rhs)?;
-        let z = out.x.iter().zip(delta.iter()).map(|(z, d)| z + d).collect();
+        let z = match &linear {
+            Linear::Dense { jac, .. } => {
+                let rhs =
+                    DVector::from_iterator(self.d + 1, residual.g.iter().map(|g| -g).chain([-c]));
+                let delta = bordered(jac, t).lu().solve(&rhs)?;
+                out.x.iter().zip(delta.iter()).map(|(z, d)| z + d).collect()
+            }
+            Linear::Krylov { .. } => out.x,
+        };
         Some((
-            Solved { z, jac, monodromy },
+            Solved { z, linear },
             if chord == 0 {
                 out.evaluations
             } else {
@@ -192,12 +239,18 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         ))
     }
 
-    /// Unit tangent at a solution, oriented along `previous`.
-    pub(super) fn tangent(&self, jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
+    /// Unit tangent at a solution, oriented along `previous`: the solution
+    /// of `[Ĵ; previousᵀ] t = e_{d+1}`, normalised.
+    pub(super) fn tangent(&mut self, linear: &Linear, previous: &[f64]) -> Option<Vec<f64>> {
         let d = self.d;
         let mut e = DVector::zeros(d + 1);
         e[d] = 1.0;
-        let t = bordered(jac, previous).lu().solve(&e)?;
+        let t = match linear {
+            Linear::Dense { jac, .. } => bordered(jac, previous).lu().solve(&e)?,
+            Linear::Krylov { .. } => {
+                DVector::from_vec(self.bordered_solve(linear, previous, e.as_slice(), 1e-8)?)
+            }
+        };
         let norm = t.norm();
         let mut t: Vec<f64> = t.iter().map(|v| v / norm).collect();
         if t.iter().zip(previous).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
@@ -283,18 +336,27 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         previous_tangent: &[f64],
         with_orbit: bool,
     ) -> Option<Evaluated> {
-        let tangent = self.tangent(&solved.jac, previous_tangent)?;
+        let tangent = self.tangent(&solved.linear, previous_tangent)?;
         let (x, p) = self.unscale(&solved.z);
         let symmetric = self.opts.shooting.symmetric;
-        let multipliers = map_multipliers(&solved.monodromy, symmetric).ok()?;
-        let tests = TestValues::at(
-            &solved.jac,
-            &tangent,
-            &solved.monodromy,
-            &multipliers,
-            0,
-            symmetric,
-        );
+        let (multipliers, tests) = match &solved.linear {
+            Linear::Dense { jac, monodromy } => {
+                let multipliers = map_multipliers(monodromy, symmetric).ok()?;
+                let tests = TestValues::at(jac, &tangent, monodromy, &multipliers, 0, symmetric);
+                (multipliers, tests)
+            }
+            Linear::Krylov { .. } => {
+                let map_eigenvalues = self.dominant_map_eigenvalues(&solved.linear)?;
+                let multipliers = square_if(&map_eigenvalues, symmetric);
+                let tests = TestValues::from_spectrum(
+                    tangent[self.d],
+                    &map_eigenvalues,
+                    &multipliers,
+                    symmetric,
+                );
+                (multipliers, tests)
+            }
+        };
         let point = BranchPoint {
             parameter: p,
             state: x,
@@ -385,7 +447,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         pred[self.d] = bound / self.p_scale;
         let mut held = vec![0.0; self.d + 1];
         held[self.d] = 1.0;
-        let (solved, _) = self.correct(&pred, &held, Some(&a.solved.jac))?;
+        let (solved, _) = self.correct(&pred, &held, Some(&a.solved.linear))?;
         self.evaluate(solved, &a.tangent)
     }
 }
@@ -394,8 +456,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
 pub(super) struct Residual {
     /// Ĝ(z), scaled.
     pub(super) g: Vec<f64>,
-    /// [Ĵ_x, Ĝ_p] and Φ.
-    pub(super) linear: Option<(DMatrix<f64>, DMatrix<f64>)>,
+    /// The linearisation, if evaluated in full.
+    pub(super) linear: Option<Linear>,
 }
 
 /// The bordered matrix `[J; tᵀ]` ((d+1) × (d+1)) of a d × (d+1) Jacobian.
@@ -482,12 +544,19 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
             rhs[row] = -gr;
         }
         rhs[d] = -c;
-        let delta = match (&r.linear, &self.chord) {
-            (Some((jac, _)), _) => bordered(jac, self.t).lu().solve(&rhs),
-            (None, Some(b)) => b.clone().lu().solve(&rhs),
+        Ok(match (&r.linear, &self.chord) {
+            (Some(Linear::Dense { jac, .. }), _) => bordered(jac, self.t)
+                .lu()
+                .solve(&rhs)
+                .map(|d| d.as_slice().to_vec()),
+            (Some(krylov @ Linear::Krylov { .. }), _) => {
+                // Inexact Newton: the direction to 1e-4 relative.
+                self.problem
+                    .bordered_solve(krylov, self.t, rhs.as_slice(), 1e-4)
+            }
+            (None, Some(b)) => b.clone().lu().solve(&rhs).map(|d| d.as_slice().to_vec()),
             (None, None) => None,
-        };
-        Ok(delta.map(|delta| delta.as_slice().to_vec()))
+        })
     }
 
     fn step_norm(&self, delta: &[f64]) -> f64 {

@@ -4,7 +4,7 @@
 
 use nalgebra::DMatrix;
 
-use super::problem::{period_image, Problem};
+use super::problem::{period_image, Linear, Problem};
 use super::{
     continue_branch, model_at, Branch, BranchPoint, ContinuationError, ContinuationOptions,
     SpecialKind, SpecialPoint,
@@ -189,10 +189,14 @@ fn switch_directions<F: FnMut(f64) -> Result<Model, String>>(
         dir.push(0.0);
         directions.push(dir);
     } else {
-        let (jac, _) = problem
-            .residual(z, true)
-            .and_then(|r| r.linear)
-            .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the branch point".into()))?;
+        let Some(Linear::Dense { jac, .. }) = problem.residual(z, true).and_then(|r| r.linear)
+        else {
+            return Err(ContinuationError::Invalid(
+                "cannot evaluate the branch point (branch switching needs the dense Jacobian: \
+                 continue without krylov)"
+                    .into(),
+            ));
+        };
         // The two eigenvectors of JᵀJ of the smallest eigenvalues span the
         // null space of the d × (d+1) Jacobian at a simple branch point.
         let eig = (jac.transpose() * &jac).symmetric_eigen();

@@ -425,5 +425,59 @@ fn spectral_distance_sees_moduli_near_the_circle() {
     ];
     let expected = (2.0f64 / 1.5).ln();
     assert!((spectral_distance(&base, &inward) - expected).abs() < 1e-15);
-    assert_eq!(spectral_distance(&base, &base[..3]), f64::INFINITY);
+    assert_eq!(spectral_distance(&base, &far[..3]), 0.0);
+    assert_eq!(spectral_distance(&base, &[]), f64::INFINITY);
+}
+
+/// Matrix-free continuation (GMRES on bordered products, Arnoldi
+/// multipliers) against dense on R2 N = 2 from 1.5 ω0 down to 0.5: the same
+/// special points to 1e-6 ω0 (measured: 3e-8) and the same largest
+/// multiplier at both ends (the same parameter) to 1e-6.
+#[test]
+fn krylov_branch_matches_dense() {
+    let family = |w: f64| r2(2, 1e-3, w);
+    let start = r2(2, 1e-3, 1.5 * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let dense = r2_branch(1.5, 0.5);
+    let opts = ContinuationOptions {
+        krylov: Some(4),
+        ..Default::default()
+    };
+    let krylov = continue_branch(family, 1.5 * W0, &guess, 0.5 * W0, &opts, |_| true).unwrap();
+    assert_eq!(krylov.stop, StopReason::ReachedEnd);
+    assert_eq!(krylov.special.len(), dense.special.len());
+    for (k, d) in krylov.special.iter().zip(&dense.special) {
+        assert_eq!(k.kind, d.kind);
+        assert!(
+            (k.parameter - d.parameter).abs() < 1e-6 * W0,
+            "{} {} vs {} {}",
+            k.label,
+            k.parameter / W0,
+            d.label,
+            d.parameter / W0
+        );
+    }
+    for (k, d) in [
+        (&krylov.points[0], &dense.points[0]),
+        (krylov.points.last().unwrap(), dense.points.last().unwrap()),
+    ] {
+        assert_eq!(k.parameter, d.parameter);
+        let (rk, rd) = (k.spectral_radius(), d.spectral_radius());
+        assert!((rk / rd - 1.0).abs() < 1e-6, "{rk} vs {rd}");
+    }
+}
+
+/// Matrix-free options that cannot work are refused before anything runs.
+#[test]
+fn krylov_dimension_is_checked() {
+    let family = |w: f64| r2(2, 1e-3, w);
+    for m in [1, 5] {
+        let opts = ContinuationOptions {
+            krylov: Some(m),
+            ..Default::default()
+        };
+        let err = continue_branch(family, 1.4 * W0, &[0.0; 4], 1.5 * W0, &opts, |_| true)
+            .expect_err("refused");
+        assert!(err.to_string().contains("Arnoldi"), "{err}");
+    }
 }

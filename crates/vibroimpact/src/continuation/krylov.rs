@@ -1,0 +1,90 @@
+//! Matrix-free continuation for long rows (docs/theory.md §5): the bordered
+//! systems of the corrector and the tangent solved by GMRES on products
+//! `Ĵ_x v` (one integration of the state with one tangent column each),
+//! and the dominant Floquet multipliers by Arnoldi, so that nothing of size
+//! d² is ever formed: memory O(d · Krylov dimension).
+
+use nalgebra::{Complex, DMatrix};
+
+use super::problem::{Linear, Problem};
+use crate::model::Model;
+use crate::periodic::{floquet_multipliers, gmres, map_product};
+
+/// Largest GMRES basis of a bordered solve.
+const MAX_GMRES: usize = 400;
+
+impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+    /// `Ĵ_x v` in scaled variables at the point of `linear`: `(DG v - v)`
+    /// with DG acting on unscaled vectors.
+    fn jacobian_product(&self, model: &Model, x: &[f64], v: &[f64]) -> Option<Vec<f64>> {
+        let unscaled: Vec<f64> = v.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
+        let product = map_product(model, x, &unscaled, &self.opts.shooting).ok()?;
+        Some(
+            (0..v.len())
+                .map(|i| product[i] / self.scale[i] - v[i])
+                .collect(),
+        )
+    }
+
+    /// Solves the bordered system `[Ĵ_x Ĝ_p; tᵀ] u = rhs` ((d+1)-vectors,
+    /// scaled) by GMRES to the relative residual `rel_tol`, matrix-free.
+    pub(super) fn bordered_solve(
+        &mut self,
+        linear: &Linear,
+        t: &[f64],
+        rhs: &[f64],
+        rel_tol: f64,
+    ) -> Option<Vec<f64>> {
+        let Linear::Krylov { x, p, g_p } = linear else {
+            return None;
+        };
+        let model = self.model(*p).ok()?;
+        let d = self.d;
+        let mut apply = |u: &[f64]| -> Result<Vec<f64>, ()> {
+            let mut out = self.jacobian_product(&model, x, &u[..d]).ok_or(())?;
+            out.iter_mut().zip(g_p).for_each(|(o, g)| *o += g * u[d]);
+            out.push(t.iter().zip(u).map(|(a, b)| a * b).sum());
+            Ok(out)
+        };
+        let noise = 1e3 * self.opts.shooting.rtol;
+        let (u, _, _) = gmres(&mut apply, rhs, (d + 1).min(MAX_GMRES), rel_tol, noise).ok()?;
+        u.iter().all(|v| v.is_finite()).then_some(u)
+    }
+
+    /// The dominant eigenvalues of the shooting map's Jacobian (Φ, or DG of
+    /// the half map) at the point of `linear`: Ritz values of an Arnoldi
+    /// iteration of `opts.krylov` vectors from a generic start, largest
+    /// modulus first.
+    pub(super) fn dominant_map_eigenvalues(
+        &mut self,
+        linear: &Linear,
+    ) -> Option<Vec<Complex<f64>>> {
+        let Linear::Krylov { x, p, .. } = linear else {
+            return None;
+        };
+        let model = self.model(*p).ok()?;
+        let d = self.d;
+        let m = self.opts.krylov?.min(d).max(1);
+        let start: Vec<f64> = (0..d)
+            .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
+            .collect();
+        let mut apply =
+            |v: &[f64]| -> Result<Vec<f64>, ()> { self.jacobian_product(&model, x, v).ok_or(()) };
+        let noise = 1e3 * self.opts.shooting.rtol;
+        let (_, basis, h) = gmres(&mut apply, &start, m, 0.0, noise).ok()?;
+        let k = h.ncols().min(basis.len() - 1);
+        let square = h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k);
+        floquet_multipliers(&square).ok()
+    }
+}
+
+/// The Floquet multipliers from the map's eigenvalues: squared for the
+/// half map (Φ = DG²), largest modulus first.
+pub(super) fn square_if(map_eigenvalues: &[Complex<f64>], symmetric: bool) -> Vec<Complex<f64>> {
+    let mut mu: Vec<Complex<f64>> = map_eigenvalues
+        .iter()
+        .map(|l| if symmetric { l * l } else { *l })
+        .collect();
+    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+    mu
+}
