@@ -66,14 +66,7 @@ impl TestValues {
                 1.0
             },
             det_pd: product(multipliers, 1.0),
-            outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
-            complex_margin: multipliers
-                .iter()
-                .filter(|m| m.im > 0.0)
-                .map(|m| m.norm() - 1.0)
-                .product(),
-            impacts: 0,
-            grazing_margin: f64::NAN,
+            ..Self::from_multipliers(multipliers, 0)
         }
     }
 
@@ -109,6 +102,19 @@ impl TestValues {
             det_ext: a.determinant(),
             det_sym,
             det_pd: pd.determinant(),
+            ..Self::from_multipliers(multipliers, impacts)
+        }
+    }
+
+    /// The values read from the multipliers alone (the count outside the
+    /// circle, the complex margin) and the impacts; the determinants and
+    /// the tangent left neutral for the callers to set.
+    fn from_multipliers(multipliers: &[Complex<f64>], impacts: usize) -> TestValues {
+        TestValues {
+            tangent_p: 1.0,
+            det_ext: 1.0,
+            det_sym: 1.0,
+            det_pd: 1.0,
             outside: multipliers.iter().filter(|m| m.norm() > 1.0).count(),
             complex_margin: multipliers
                 .iter()
