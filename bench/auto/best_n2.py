@@ -21,6 +21,8 @@ import subprocess
 import sys
 import time
 
+from run_auto import command_text
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OMEGA0 = 7.41
@@ -59,7 +61,7 @@ def auto(cfg, threads, repeats):
     seconds = d["seconds"] if cfg["mode"] == "detect" else d["seconds_total"]
     return {"threads": threads, "seconds": seconds, "steps": d["points"],
             "special_points": [(s["kind"], s["parameter_over_omega0"], s["located"])
-                               for s in d["special_points"]], "command": " ".join(cmd[1:])}
+                               for s in d["special_points"]], "command": command_text(cmd)}
 
 
 def main(argv):

@@ -39,6 +39,8 @@ import sys
 import tempfile
 import time
 
+from run_auto import command_text
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OMEGA0 = 7.41
@@ -75,7 +77,7 @@ def ours(n, repeats, workdir):
         "symmetric": out["symmetric"],
         "special_points": [{"label": s["label"], "omega_over_omega0": s["parameter"] / OMEGA0}
                            for s in out["special_points"]],
-        "command": " ".join(cmd[1:]),
+        "command": command_text(cmd),
     }
 
 

@@ -51,6 +51,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -81,6 +82,24 @@ def constants(**kw):
 
 class AutoTimeout(RuntimeError):
     pass
+
+
+def command_text(cmd):
+    """A command line as text for the results: the Python interpreter as
+    `python3`, paths in the repository relative to its root, temporary
+    paths under `$TMP` (results must not name this machine's folders)."""
+    root = os.path.dirname(os.path.dirname(HERE))
+    tmp = tempfile.gettempdir()
+    out = []
+    for i, tok in enumerate(cmd):
+        if i == 0 and tok == sys.executable:
+            tok = "python3"
+        elif os.path.isabs(tok) and tok.startswith(root + os.sep):
+            tok = os.path.relpath(tok, root)
+        elif os.path.isabs(tok) and tok.startswith(tmp + os.sep):
+            tok = "$TMP/" + os.path.relpath(tok, tmp)
+        out.append(tok)
+    return " ".join(out)
 
 
 def run_exe(exe, workdir, text, name, timeout=None):

@@ -48,6 +48,8 @@ import subprocess
 import sys
 import time
 
+from run_auto import command_text
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 RUN_AUTO = os.path.join(HERE, "run_auto.py")
 KINDS = {"LP": "fold", "BP": "branch-point", "PD": "period-doubling", "TR": "neimark-sacker"}
@@ -101,7 +103,7 @@ def run_config(cfg, args, workdir, repeats):
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t0
     rec = {"config": cfg, "loadavg_before": la0, "loadavg_after": loadavg(),
-           "wall_of_script": wall, "command": " ".join(cmd[1:])}
+           "wall_of_script": wall, "command": command_text(cmd)}
     if p.returncode not in (0, 3) or not p.stdout.strip():
         rec["error"] = (p.stderr or p.stdout)[-1500:]
         rec["pass"] = False
