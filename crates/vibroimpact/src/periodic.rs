@@ -309,12 +309,23 @@ pub fn map_multipliers(
     jacobian: &DMatrix<f64>,
     symmetric: bool,
 ) -> Result<Vec<Complex<f64>>, PeriodicError> {
-    let mut mu = floquet_multipliers(jacobian)?;
+    Ok(multipliers_of_map(
+        floquet_multipliers(jacobian)?,
+        symmetric,
+    ))
+}
+
+/// The Floquet multipliers from the eigenvalues of the shooting map's
+/// Jacobian: squared for the half map (Φ = DG²), largest modulus first.
+pub(crate) fn multipliers_of_map(
+    mut eigenvalues: Vec<Complex<f64>>,
+    symmetric: bool,
+) -> Vec<Complex<f64>> {
     if symmetric {
-        mu.iter_mut().for_each(|m| *m = *m * *m);
-        mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+        eigenvalues.iter_mut().for_each(|m| *m = *m * *m);
+        eigenvalues.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
     }
-    Ok(mu)
+    eigenvalues
 }
 
 /// Floquet multipliers (eigenvalues of the monodromy), largest modulus first.
@@ -655,6 +666,24 @@ pub(crate) fn gmres<E, A: FnMut(&[f64]) -> Result<Vec<f64>, E>>(
     Ok((delta, basis, hk))
 }
 
+/// The Arnoldi matrix of the map's Jacobian: `H_k + I` from `m` Arnoldi
+/// vectors (fewer at a breakdown) of `A = DG − I` (`apply`, scaled
+/// variables, dimension d) from a generic start vector; its eigenvalues
+/// are the Ritz values of DG, the dominant ones first to converge.
+pub(crate) fn arnoldi_matrix<E, A: FnMut(&[f64]) -> Result<Vec<f64>, E>>(
+    apply: &mut A,
+    d: usize,
+    m: usize,
+    noise: f64,
+) -> Result<DMatrix<f64>, E> {
+    let start: Vec<f64> = (0..d)
+        .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
+        .collect();
+    let (_, basis, h) = gmres(apply, &start, m.min(d).max(1), 0.0, noise)?;
+    let k = h.ncols().min(basis.len() - 1);
+    Ok(h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k))
+}
+
 /// The least-squares solution y of `H_k y ≈ β e_1` (the first k columns of
 /// the Hessenberg matrix) and its residual.
 fn least_squares(h: &DMatrix<f64>, k: usize, beta: f64) -> (DVector<f64>, f64) {
@@ -747,16 +776,11 @@ pub fn shoot_krylov(
         opts,
         products: 0,
     };
-    let start: Vec<f64> = (0..d)
-        .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
-        .collect();
     let noise = 1e3 * opts.rtol;
     let mut apply = shifted_monodromy(&mut op, &scale);
-    let (_, basis, h) = gmres(&mut apply, &start, arnoldi.min(d).max(1), 0.0, noise)
+    let ritz = arnoldi_matrix(&mut apply, d, arnoldi, noise)
         .map_err(|source| PeriodicError::Integration { iteration, source })?;
-    let k = h.ncols().min(basis.len() - 1);
-    let square = h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k);
-    let multipliers = map_multipliers(&square, opts.symmetric)?;
+    let multipliers = map_multipliers(&ritz, opts.symmetric)?;
     Ok(PeriodicSolution {
         converged: out.stop == NewtonStop::Converged,
         stop: out.stop,

@@ -4,11 +4,11 @@
 //! and the dominant Floquet multipliers by Arnoldi, so that nothing of size
 //! d² is ever formed: memory O(d · Krylov dimension).
 
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
 
 use super::problem::{Linear, Problem};
 use crate::model::Model;
-use crate::periodic::{floquet_multipliers, gmres, map_product};
+use crate::periodic::{arnoldi_matrix, floquet_multipliers, gmres, map_product};
 
 /// Largest GMRES basis of a bordered solve.
 const MAX_GMRES: usize = 400;
@@ -64,27 +64,11 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         };
         let model = self.model(*p).ok()?;
         let d = self.d;
-        let m = self.opts.krylov?.min(d).max(1);
-        let start: Vec<f64> = (0..d)
-            .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
-            .collect();
+        let m = self.opts.krylov?;
         let mut apply =
             |v: &[f64]| -> Result<Vec<f64>, ()> { self.jacobian_product(&model, x, v).ok_or(()) };
         let noise = 1e3 * self.opts.shooting.rtol;
-        let (_, basis, h) = gmres(&mut apply, &start, m, 0.0, noise).ok()?;
-        let k = h.ncols().min(basis.len() - 1);
-        let square = h.view((0, 0), (k, k)).clone_owned() + DMatrix::<f64>::identity(k, k);
-        floquet_multipliers(&square).ok()
+        let ritz = arnoldi_matrix(&mut apply, d, m, noise).ok()?;
+        floquet_multipliers(&ritz).ok()
     }
-}
-
-/// The Floquet multipliers from the map's eigenvalues: squared for the
-/// half map (Φ = DG²), largest modulus first.
-pub(super) fn square_if(map_eigenvalues: &[Complex<f64>], symmetric: bool) -> Vec<Complex<f64>> {
-    let mut mu: Vec<Complex<f64>> = map_eigenvalues
-        .iter()
-        .map(|l| if symmetric { l * l } else { *l })
-        .collect();
-    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
-    mu
 }

@@ -6,14 +6,13 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
-use super::krylov::square_if;
 use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
 use crate::integrate::{integrate_to, IntegratorOptions};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
-    forcing_period, map_multipliers, map_time, mirror, orbit_summary, period_map_with,
-    ShootingOptions, MAX_STEPS,
+    forcing_period, map_multipliers, map_time, mirror, multipliers_of_map, orbit_summary,
+    period_map_with, ShootingOptions, MAX_STEPS,
 };
 
 /// The linearisation of the extended system at a point.
@@ -347,7 +346,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             }
             Linear::Krylov { .. } => {
                 let map_eigenvalues = self.dominant_map_eigenvalues(&solved.linear)?;
-                let multipliers = square_if(&map_eigenvalues, symmetric);
+                let multipliers = multipliers_of_map(map_eigenvalues.clone(), symmetric);
                 let tests = TestValues::from_spectrum(
                     tangent[self.d],
                     &map_eigenvalues,
