@@ -17,6 +17,7 @@
 //! - [`variational`]: sensitivities and monodromy matrices (§5);
 //! - [`newton`]: the damped Newton method of every periodic solve;
 //! - [`periodic`]: periodic solutions by shooting, Floquet multipliers;
+//! - [`lyapunov`]: Lyapunov exponents by QR re-orthonormalisation;
 //! - [`continuation`]: branches of periodic solutions and their special
 //!   points;
 //! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
@@ -42,6 +43,7 @@ pub mod eigen;
 pub mod identify;
 pub mod impact;
 pub mod integrate;
+pub mod lyapunov;
 pub mod model;
 pub mod model_file;
 pub mod newton;

@@ -290,6 +290,19 @@ impl<M: StepMethod> Driver<M> {
         self.reset_with_step(sys, t0, y0, h0)
     }
 
+    /// Restarts at the current time with the state `y` (e.g. variational
+    /// columns re-orthonormalised, or an impulsive change), keeping the
+    /// proposed step size instead of estimating a new one: one evaluation
+    /// of `f`. Errors as [`reset`](Self::reset).
+    pub fn restart<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        y: &[f64],
+    ) -> Result<(), IntegrationError> {
+        let (t, h) = (self.at.t, self.h_next);
+        self.reset_with_step(sys, t, y, Some(h))
+    }
+
     /// [`reset`](Self::reset) with the initial step `h0` instead of the
     /// option `h_init` (`None`: `HINIT`).
     pub(super) fn reset_with_step<S: OdeSystem>(
