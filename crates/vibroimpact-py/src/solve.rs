@@ -491,10 +491,11 @@ pub fn parameter_values<'py>(
 }
 
 /// A brute-force sweep: the `sweep` document; every point also carries its
-/// Poincaré samples as a `record × 2N` array (`sections`). `threads`: the
-/// size of the thread pool (None: all cores).
+/// Poincaré samples as a `record × 2N` array (`sections`), and with
+/// `lyapunov = k` its k largest Lyapunov exponents. `threads`: the size of
+/// the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None))]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -511,6 +512,7 @@ pub fn sweep<'py>(
     threads: Option<usize>,
     only: Option<&str>,
     progress: Option<&Bound<'py, PyAny>>,
+    lyapunov: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
     let values = floats(&values, "values")?;
@@ -541,6 +543,7 @@ pub fn sweep<'py>(
             atol,
             method,
             cluster_tolerance,
+            lyapunov,
             interrupt: Some(p.interrupt.clone()),
         };
         pool.install(|| run_sweep(&family, &values, &options, &|| p.tick()))

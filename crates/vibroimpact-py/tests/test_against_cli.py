@@ -121,6 +121,21 @@ def test_sweep(cli):
         assert p.sections.shape == (5, 6)
 
 
+def test_sweep_lyapunov_matches_the_cli(cli):
+    m = EXAMPLES / "fujita-row-n2.toml"
+    doc = cli("sweep", m, "--parameter", "frequency", "--from", "7.0", "--to", "8.0",
+              "--points", "2", "--record", "30", "--lyapunov", "3")
+    r = vi.sweep(m, "frequency", from_=7.0, to=8.0, points=2, record=30, lyapunov=3)
+    for p, q in zip(r.points, doc["points"]):
+        assert len(p.lyapunov) == 3
+        close(p.lyapunov, q["lyapunov"])
+        close(p.lyapunov_uncertainty, q["lyapunov_uncertainty"])
+    with pytest.raises(ValueError, match="lyapunov"):
+        vi.sweep(m, "frequency", from_=7.0, to=8.0, points=2, lyapunov=0)
+    with pytest.raises(ValueError, match="lyapunov = 5"):
+        vi.sweep(m, "frequency", from_=7.0, to=8.0, points=2, lyapunov=5)
+
+
 def test_parameter_values_match_the_cli(cli):
     # (to - from) i / (k - 1) rounds differently from (to - from)(i / (k - 1))
     # at some i: the values must be the CLI's to the bit.

@@ -21,6 +21,7 @@
 //! - [`continuation`]: branches of periodic solutions and their special
 //!   points;
 //! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
+//! - [`chart`]: brute-force stability charts over two parameters;
 //! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
 //! - [`parameter`]: a numeric key of a model file made a parameter;
 //! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
@@ -36,6 +37,7 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod chart;
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;

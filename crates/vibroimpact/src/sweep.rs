@@ -24,7 +24,9 @@
 use serde::Serialize;
 
 use crate::integrate::{Interrupt, Method};
+use crate::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 use crate::model::{BaseExcitation, HarmonicForce, Model};
+use crate::model_file::LoadedModel;
 use crate::parameter::ParameterizedModel;
 use crate::simulate::{simulate, Simulation, SimulationOptions};
 
@@ -66,6 +68,10 @@ pub struct SweepOptions {
     /// default max(1e-5, 1000 rtol), above the integration noise of
     /// impacting orbits (measured 1–3e-6 at rtol 1e-8).
     pub cluster_tolerance: Option<f64>,
+    /// The `k` largest Lyapunov exponents of every value
+    /// ([`lyapunov_spectrum`]), averaged over the recorded periods from the
+    /// first Poincaré sample (`None`: not computed).
+    pub lyapunov: Option<usize>,
     /// Stop request (see [`Interrupt`]).
     pub interrupt: Option<Interrupt>,
 }
@@ -81,6 +87,7 @@ impl Default for SweepOptions {
             atol: None,
             method: Method::Dop853,
             cluster_tolerance: None,
+            lyapunov: None,
             interrupt: None,
         }
     }
@@ -137,6 +144,15 @@ pub struct SweepPoint {
     /// The failure, if any (also set when a completed value leaves no state
     /// to continue from, which ends its direction).
     pub error: Option<String>,
+    /// Lyapunov exponents over the recorded periods (1/s), largest first,
+    /// if requested ([`SweepOptions::lyapunov`]): a positive largest one
+    /// marks chaos.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lyapunov: Option<Vec<f64>>,
+    /// Convergence estimate of each exponent (1/s), see
+    /// [`LyapunovSpectrum::uncertainty`](crate::lyapunov::LyapunovSpectrum::uncertainty).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lyapunov_uncertainty: Option<Vec<f64>>,
     /// Poincaré samples `[u_1..u_N, v_1..v_N]`, one per recorded period
     /// (not in the JSON summary; `sweep.csv` holds them).
     #[serde(skip)]
@@ -173,18 +189,85 @@ pub struct SweepSummary {
 /// A state to start from: displacements, velocities and the forcing phase of
 /// its instant in 1/[`FINE`] of a period.
 #[derive(Clone, Debug)]
-struct Start {
-    u: Vec<f64>,
-    v: Vec<f64>,
-    phase: usize,
+pub(crate) struct Start {
+    pub(crate) u: Vec<f64>,
+    pub(crate) v: Vec<f64>,
+    pub(crate) phase: usize,
 }
 
-/// Settings shared by all values.
-struct Settings {
+/// Settings shared by all values (of a sweep, or all cells of a chart).
+pub(crate) struct Settings {
     transient: usize,
     record: usize,
+    lyapunov: Option<usize>,
     opts: SimulationOptions,
-    cluster_tolerance: f64,
+    pub(crate) cluster_tolerance: f64,
+}
+
+impl Settings {
+    /// The relative tolerance of the integration.
+    pub(crate) fn rtol(&self) -> f64 {
+        self.opts.rtol
+    }
+
+    /// The settings of `options` for models like `base` (its
+    /// `[simulation]` tolerances where the options leave them open),
+    /// checked.
+    pub(crate) fn new(base: &LoadedModel, options: &SweepOptions) -> Result<Self, SweepError> {
+        if options.record < 1 {
+            return Err(SweepError("record 0: record at least one period".into()));
+        }
+        if options.transient > 1_000_000_000 {
+            return Err(SweepError(format!(
+                "transient = {}: at most 1e9 periods",
+                options.transient
+            )));
+        }
+        let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
+        let atol = options.atol.or(base.simulation.atol).unwrap_or(rtol * 1e-4);
+        finite_positive("rtol", rtol)?;
+        let cluster_tolerance = options
+            .cluster_tolerance
+            .unwrap_or(1e-5_f64.max(1e3 * rtol));
+        finite_positive("cluster_tolerance", cluster_tolerance)?;
+        finite_positive("atol", atol)?;
+        let d = 2 * base.model.bodies().len();
+        let window = (options.record as f64 * FINE as f64 + 1.0) * (d + 1) as f64;
+        if window > crate::simulate::MAX_HISTORY_VALUES {
+            return Err(SweepError(format!(
+                "record = {}: the recorded window ({FINE} samples per period) would hold {window:.3e} values, more than {:e}",
+                options.record,
+                crate::simulate::MAX_HISTORY_VALUES
+            )));
+        }
+        if let Some(k) = options.lyapunov {
+            if k == 0 || k > d {
+                return Err(SweepError(format!(
+                    "lyapunov = {k}: between 1 and the state dimension {d}"
+                )));
+            }
+            if options.record < 2 {
+                return Err(SweepError(
+                    "record 1: Lyapunov exponents are averaged over at least 2 recorded periods"
+                        .into(),
+                ));
+            }
+        }
+        Ok(Self {
+            transient: options.transient,
+            record: options.record,
+            lyapunov: options.lyapunov,
+            opts: SimulationOptions {
+                rtol,
+                atol,
+                impact_force_threshold: base.simulation.impact_force_threshold.unwrap_or(1e-3),
+                method: options.method,
+                interrupt: options.interrupt.clone(),
+                ..SimulationOptions::default()
+            },
+            cluster_tolerance,
+        })
+    }
 }
 
 /// The parameter values: `k` evenly spaced from `from` to `to`, ends exact.
@@ -238,7 +321,7 @@ fn start_model(model: &Model, start: &Start) -> Result<Model, String> {
 }
 
 /// Whether no contact overlaps at displacements `u`.
-fn admissible(model: &Model, u: &[f64]) -> bool {
+pub(crate) fn admissible(model: &Model, u: &[f64]) -> bool {
     (0..model.contacts().len()).all(|k| model.approach(k, u) <= 0.0)
 }
 
@@ -310,7 +393,7 @@ fn spread(points: &[Vec<f64>], n: usize, scale_u: f64, scale_v: f64) -> f64 {
 /// Simulates one parameter value from `start` (None: the model's initial
 /// state). Returns the point and the state to continue from (None after a
 /// failure).
-fn run_value(
+pub(crate) fn run_value(
     model: &Model,
     parameter: f64,
     direction: Direction,
@@ -328,6 +411,8 @@ fn run_value(
         recorded_periods: 0,
         completed: false,
         error: None,
+        lyapunov: None,
+        lyapunov_uncertainty: None,
         sections: Vec::new(),
     };
     let fail = |mut point: SweepPoint, msg: String| {
@@ -437,6 +522,22 @@ fn run_value(
         );
         return fail(point, msg);
     }
+    if let Some(count) = settings.lyapunov {
+        let opts = LyapunovOptions {
+            count: Some(count),
+            transient: 0,
+            periods: settings.record,
+            rtol: settings.opts.rtol,
+            interrupt: settings.opts.interrupt.clone(),
+        };
+        match lyapunov_spectrum(&m, row(j0), j0 as f64 * dt, &opts) {
+            Ok(ly) => {
+                point.lyapunov = Some(ly.exponents);
+                point.lyapunov_uncertainty = Some(ly.uncertainty);
+            }
+            Err(e) => return fail(point, format!("Lyapunov exponents: {e}")),
+        }
+    }
     point.completed = true;
     let next = handover(&m, &sim, start.phase, 1, start.phase + j_end);
     (point, next)
@@ -501,35 +602,11 @@ pub fn sweep(
             "parameter value {x}: the values must be finite"
         )));
     }
-    if options.record < 1 {
-        return Err(SweepError("record 0: record at least one period".into()));
-    }
-    if options.transient > 1_000_000_000 {
-        return Err(SweepError(format!(
-            "transient = {}: at most 1e9 periods",
-            options.transient
-        )));
-    }
     let err = |e: crate::model_file::ModelFileError| SweepError(e.to_string());
     let base = family.loaded_at(family.initial()).map_err(err)?;
-    let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
-    let atol = options.atol.or(base.simulation.atol).unwrap_or(rtol * 1e-4);
-    finite_positive("rtol", rtol)?;
-    let cluster_tolerance = options
-        .cluster_tolerance
-        .unwrap_or(1e-5_f64.max(1e3 * rtol));
-    finite_positive("cluster_tolerance", cluster_tolerance)?;
-    finite_positive("atol", atol)?;
+    let settings = Settings::new(&base, options)?;
     let name = family.name();
     let bodies: Vec<String> = base.model.bodies().iter().map(|b| b.name.clone()).collect();
-    let window = (options.record as f64 * FINE as f64 + 1.0) * (2 * bodies.len() + 1) as f64;
-    if window > crate::simulate::MAX_HISTORY_VALUES {
-        return Err(SweepError(format!(
-            "record = {}: the recorded window ({FINE} samples per period) would hold {window:.3e} values, more than {:e}",
-            options.record,
-            crate::simulate::MAX_HISTORY_VALUES
-        )));
-    }
     let mut models: Vec<(f64, Model)> = Vec::with_capacity(values.len());
     for &p in values {
         let m = family.model_at(p).map_err(err)?;
@@ -548,19 +625,6 @@ pub fn sweep(
         }
         models.push((p, m));
     }
-    let settings = Settings {
-        transient: options.transient,
-        record: options.record,
-        opts: SimulationOptions {
-            rtol,
-            atol,
-            impact_force_threshold: base.simulation.impact_force_threshold.unwrap_or(1e-3),
-            method: options.method,
-            interrupt: options.interrupt.clone(),
-            ..SimulationOptions::default()
-        },
-        cluster_tolerance,
-    };
     let mut points: Vec<SweepPoint> = if options.up_down {
         let reversed: Vec<(f64, Model)> = models.iter().rev().cloned().collect();
         let up = || run_direction(&models, Direction::Up, &settings, progress);
@@ -597,9 +661,9 @@ pub fn sweep(
         transient_periods: options.transient,
         record_periods: options.record,
         up_down: options.up_down,
-        rtol,
-        atol,
-        cluster_tolerance,
+        rtol: settings.opts.rtol,
+        atol: settings.opts.atol,
+        cluster_tolerance: settings.cluster_tolerance,
         points,
     })
 }

@@ -47,6 +47,13 @@ pub struct SweepArgs {
     /// impacting orbits (measured 1–3e-6 at rtol 1e-8).
     #[arg(long)]
     cluster_tolerance: Option<f64>,
+    /// Also compute the K largest Lyapunov exponents of every value
+    /// (default K: all 2N, at most 8), averaged over the recorded periods
+    /// from the first Poincaré sample; summary.json gains `lyapunov` and
+    /// `lyapunov_uncertainty` per point, the table the largest exponent,
+    /// and a figure shows it under the diagram (a positive one: chaos).
+    #[arg(long, value_name = "K", num_args = 0..=1)]
+    lyapunov: Option<Option<usize>>,
     /// Output folder for sweep.csv, summary.json and the figures; without it
     /// only the summary is printed.
     #[arg(long)]
@@ -160,26 +167,64 @@ fn write_outputs(dir: &Path, summary: &SweepSummary) -> Result<(), CliError> {
         }
     }
     render(&fig, &dir.join("sweep_amplitude"))?;
+    if summary.points.iter().any(|p| p.lyapunov.is_some()) {
+        render(
+            &lyapunov_figure(summary, &directions),
+            &dir.join("sweep_lyapunov"),
+        )?;
+    }
     Ok(())
 }
 
-/// Human-readable table.
+/// The largest Lyapunov exponent against the parameter, the zero line
+/// dashed: the companion of the diagram (positive: chaos).
+fn lyapunov_figure(summary: &SweepSummary, directions: &[Direction]) -> Figure {
+    let mut fig = Figure::new(
+        "Largest Lyapunov exponent over the recorded periods",
+        parameter_label(&summary.parameter_name),
+        "λ1  [1/s]",
+    )
+    .legend_at(if summary.up_down {
+        LegendPosition::Best
+    } else {
+        LegendPosition::None
+    });
+    for (c, d) in directions.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = summary
+            .points
+            .iter()
+            .filter(|p| p.direction == *d)
+            .filter_map(|p| Some((p.parameter, *p.lyapunov.as_ref()?.first()?)))
+            .collect();
+        let label = if summary.up_down { d.name() } else { "" };
+        fig.push(Series::line(label, pts).with_color(c));
+    }
+    fig.push(Series::dashed("", vec![(summary.from, 0.0), (summary.to, 0.0)]).with_color(7));
+    fig
+}
+
+/// Human-readable table (with the largest Lyapunov exponent when
+/// computed).
 fn table_text(summary: &SweepSummary) -> String {
     let first = summary.bodies.first().cloned().unwrap_or_default();
-    let header = [
+    let lyapunov = summary.points.iter().any(|p| p.lyapunov.is_some());
+    let mut header = vec![
         "parameter".to_string(),
         "direction".to_string(),
         format!("max|u_{first}| [m]"),
         "distinct".to_string(),
         "spread".to_string(),
         "impacts/T".to_string(),
-        "status".to_string(),
     ];
-    let rows: Vec<[String; 7]> = summary
+    if lyapunov {
+        header.push("λ1 [1/s]".to_string());
+    }
+    header.push("status".to_string());
+    let rows: Vec<Vec<String>> = summary
         .points
         .iter()
         .map(|p| {
-            [
+            let mut row = vec![
                 format!("{:.6e}", p.parameter),
                 p.direction.name().to_string(),
                 p.max_displacement
@@ -197,15 +242,20 @@ fn table_text(summary: &SweepSummary) -> String {
                 } else {
                     "-".into()
                 },
-                if p.completed {
-                    "ok".into()
-                } else {
-                    "FAILED".into()
-                },
-            ]
+            ];
+            if lyapunov {
+                row.push(
+                    p.lyapunov
+                        .as_ref()
+                        .and_then(|l| l.first())
+                        .map_or("-".into(), |l| format!("{l:+.4}")),
+                );
+            }
+            row.push(if p.completed { "ok" } else { "FAILED" }.into());
+            row
         })
         .collect();
-    let widths: Vec<usize> = (0..7)
+    let widths: Vec<usize> = (0..header.len())
         .map(|c| {
             rows.iter()
                 .map(|r| r[c].chars().count())
@@ -255,6 +305,19 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
 
     let family = read_family(&args.range.model, &args.range.parameter)?;
     let values = parameter_values(args.range.from, args.range.to, args.points);
+    let lyapunov = match args.lyapunov {
+        Some(None) => Some(
+            family
+                .loaded_at(family.initial())?
+                .model
+                .bodies()
+                .len()
+                .min(4)
+                * 2,
+        ),
+        Some(k) => k,
+        None => None,
+    };
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = SweepOptions {
         transient: args.transient,
@@ -265,6 +328,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         atol: args.atol,
         method: args.method.method(),
         cluster_tolerance: args.cluster_tolerance,
+        lyapunov,
         interrupt: Some(interrupt.clone()),
     };
     let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
@@ -272,7 +336,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let summary = sweep(&family, &values, &options, &|| progress.inc(1)).map_err(|e| {
         CliError::new(
             e.to_string()
-                .replace("cluster_tolerance =", "--cluster-tolerance ="),
+                .replace("cluster_tolerance =", "--cluster-tolerance =")
+                .replace("lyapunov =", "--lyapunov"),
         )
     })?;
     progress.finish_and_clear();

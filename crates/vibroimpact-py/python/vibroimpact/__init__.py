@@ -611,6 +611,7 @@ def sweep(
     atol: Optional[float] = None,
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
+    lyapunov: Optional[int] = None,
     client: Any = None,
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
@@ -636,6 +637,11 @@ def sweep(
     ``impacts_per_period``, ``recorded_periods``, ``completed``, ``error``
     and ``sections``, the Poincaré samples as a record x 2N array). A value
     that fails numerically is kept with its ``error``.
+
+    ``lyapunov = k``: every point also gains ``lyapunov``, its k largest
+    Lyapunov exponents (1/s, largest first, averaged over the recorded
+    periods; a positive first one marks chaos) and
+    ``lyapunov_uncertainty``, their convergence estimates.
     """
     m = _model(model)
     if not isinstance(parameter, str):
@@ -649,6 +655,7 @@ def sweep(
         atol=_real(atol, "atol", positive=True, optional=True),
         method=_method(method, ("dop853", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        lyapunov=None if lyapunov is None else _count(lyapunov, "lyapunov", minimum=1, maximum=10**6),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -694,5 +701,6 @@ def _sweep_local(
         threads,
         only,
         _progress(progress),
+        options["lyapunov"],
     )
     return d if raw else Result(d)

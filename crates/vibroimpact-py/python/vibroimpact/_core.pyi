@@ -68,5 +68,5 @@ def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,
     rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], only: Optional[str] = None,
-    progress: Progress = None,
+    progress: Progress = None, lyapunov: Optional[int] = None,
 ) -> dict[str, Any]: ...
