@@ -25,7 +25,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{branch, identify, impact, simulate, sweep};
+use commands::{branch, chart, identify, impact, simulate, sweep};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -52,6 +52,10 @@ enum Command {
     /// Brute-force bifurcation diagram: Poincaré samples against a parameter.
     #[command(allow_negative_numbers = true)]
     Sweep(sweep::SweepArgs),
+    /// Brute-force stability chart over two parameters: the attractor's
+    /// period, impacts, Lyapunov exponent and coexistence per cell.
+    #[command(allow_negative_numbers = true)]
+    Chart(chart::ChartArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
     Periodic(branch::PeriodicArgs),
@@ -84,6 +88,7 @@ fn main() -> ExitCode {
         Some(Command::Periodic(args)) => branch::run_periodic(args),
         Some(Command::Continue(args)) => branch::run_continue(args),
         Some(Command::Sweep(args)) => sweep::run(args),
+        Some(Command::Chart(args)) => chart::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

@@ -700,3 +700,140 @@ fn continue_krylov_options_checked() {
     let args = [&["continue", &long, "--dense"][..], &range].concat();
     assert_clean_error(&args, "too large for dense continuation");
 }
+
+/// `chart`: a small (frequency, clearance) grid of the N = 2 row with two
+/// starts a cell writes chart.json (cells row by row, runs per start),
+/// chart.csv (a row per run) and the figure; start 0 of a cell is the
+/// sweep's run at that value (same max |u| and impacts); bad input is
+/// refused before any work.
+#[test]
+fn chart_grid_outputs_and_bad_input() {
+    let dir = temp_dir("chart");
+    let row = repo_file("examples/fujita-row-n2.toml");
+    let out = dir.join("c");
+    let doc = json(&[
+        "chart",
+        &row,
+        "--x",
+        "frequency",
+        "--x-from",
+        "6.5",
+        "--x-to",
+        "8.5",
+        "--x-points",
+        "3",
+        "--y",
+        "row.clearance",
+        "--y-from",
+        "1e-3",
+        "--y-to",
+        "2e-3",
+        "--y-points",
+        "2",
+        "--transient",
+        "20",
+        "--record",
+        "6",
+        "--starts",
+        "2",
+        "--format",
+        "json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let cells = doc["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 6);
+    assert_eq!(cells[1]["x"].as_f64().unwrap(), 7.5);
+    assert_eq!(cells[3]["y"].as_f64().unwrap(), 2e-3);
+    for c in cells {
+        assert_eq!(c["runs"].as_array().unwrap().len(), 2, "{c}");
+        assert!(c["attractors"].as_u64().unwrap() >= 1, "{c}");
+    }
+    let csv = std::fs::read_to_string(out.join("chart.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 12);
+    assert!(csv.starts_with("frequency,row.clearance,start,attractors,period"));
+    assert!(out.join("chart.svg").is_file() && out.join("chart.png").is_file());
+    let sweep = json(&[
+        "sweep",
+        &row,
+        "--parameter",
+        "frequency",
+        "--from",
+        "6.5",
+        "--to",
+        "8.5",
+        "--points",
+        "3",
+        "--transient",
+        "20",
+        "--record",
+        "6",
+        "--rtol",
+        "1e-6",
+        "--cluster-tolerance",
+        "1e-3",
+        "--format",
+        "json",
+    ]);
+    for (c, p) in cells[..3].iter().zip(sweep["points"].as_array().unwrap()) {
+        let max_u = p["max_displacement"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .fold(0.0, f64::max);
+        assert_eq!(c["runs"][0]["max_displacement"].as_f64().unwrap(), max_u);
+        assert_eq!(c["runs"][0]["impacts_per_period"], p["impacts_per_period"]);
+    }
+    let base = [
+        "chart",
+        &row,
+        "--x",
+        "frequency",
+        "--x-from",
+        "6.5",
+        "--x-to",
+        "8.5",
+        "--y-from",
+        "0.01",
+        "--y-to",
+        "0.1",
+    ];
+    let grid = ["--x-points", "3", "--y-points", "2"];
+    for (extra, needle) in [
+        (
+            &[&grid[..], &["--y", "excitation.frequency"]].concat(),
+            "the same key",
+        ),
+        (
+            &[&grid[..], &["--y", "row.colour"]].concat(),
+            "does not exist",
+        ),
+        (
+            &[&grid[..], &["--y", "amplitude", "--starts", "0"]].concat(),
+            "--starts 0",
+        ),
+        (
+            &vec!["--y", "amplitude", "--x-points", "3", "--y-points", "1"],
+            "--y-points 1",
+        ),
+        (
+            &vec![
+                "--y",
+                "amplitude",
+                "--x-points",
+                "100000",
+                "--y-points",
+                "100000",
+            ],
+            "coarser grid",
+        ),
+        (
+            &[&grid[..], &["--y", "row.count"]].concat(),
+            "whole numbers",
+        ),
+    ] {
+        let args = [&base[..], extra].concat();
+        assert_clean_error(&args, needle);
+    }
+}

@@ -18,12 +18,25 @@ use crate::sweep::{admissible, run_value, Direction, Settings, Start, SweepOptio
 /// ~200 bytes a run.
 pub const MAX_RUNS: usize = 50_000_000;
 
+/// Relative tolerance of a chart's integrations unless the options or the
+/// model's `[simulation]` give one: the classification needs the Poincaré
+/// samples to [`DEFAULT_CLUSTER_TOLERANCE`], a thousand times coarser.
+pub const DEFAULT_RTOL: f64 = 1e-6;
+
+/// Relative tolerance of two equal Poincaré samples unless the options
+/// give one: coarser than a sweep's 1e-5, since 100 transient periods leave
+/// a free oscillation of the lightly damped bodies (ζ = 0.013 in R2) of
+/// up to ~4e-3 of its initial size at 1.5 ω0.
+pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
+
 /// Options of a chart.
 #[derive(Clone, Debug)]
 pub struct ChartOptions {
     /// Transient, recorded periods, tolerances, method, cluster tolerance
-    /// and interruption as for a sweep; `lyapunov: Some(1)` adds each run's
-    /// largest Lyapunov exponent (`up_down`, `only` unused).
+    /// and interruption as for a sweep (with the defaults
+    /// [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`]);
+    /// `lyapunov: Some(1)` adds each run's largest Lyapunov exponent
+    /// (`up_down`, `only` unused).
     pub sweep: SweepOptions,
     /// Initial states per cell (≥ 1): the model's own, then points of a
     /// Halton sequence in |u_i| ≤ 0.9 g, |v_i| ≤ 0.9 g Ω (g the smallest
@@ -158,7 +171,19 @@ pub fn chart(
         Ok(doc.with_parameter(&px, vx).map_err(err)?.model)
     };
     let base = document.with_parameter(&px, x.1[0]).map_err(err)?;
-    let settings = Settings::new(&base, &options.sweep).map_err(|e| ChartError(e.0))?;
+    let sweep = SweepOptions {
+        rtol: options
+            .sweep
+            .rtol
+            .or(base.simulation.rtol)
+            .or(Some(DEFAULT_RTOL)),
+        cluster_tolerance: options
+            .sweep
+            .cluster_tolerance
+            .or(Some(DEFAULT_CLUSTER_TOLERANCE)),
+        ..options.sweep.clone()
+    };
+    let settings = Settings::new(&base, &sweep).map_err(|e| ChartError(e.0))?;
     let first = model_at(x.1[0], y.1[0])?;
     for (vx, vy) in
         x.1.iter()

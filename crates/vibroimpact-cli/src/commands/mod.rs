@@ -2,6 +2,7 @@
 //! share lives in `args`, `format`, `measurements`, `plot`, …).
 
 pub mod branch;
+pub mod chart;
 pub mod identify;
 pub mod impact;
 pub mod simulate;

@@ -132,6 +132,7 @@ impl Canvas {
 pub(super) fn series_markers(style: Style) -> Option<Marker> {
     match style {
         Style::Markers(m) => Some(m),
+        Style::Rectangles => Some(Marker::Square),
         Style::Line | Style::DashedLine => None,
     }
 }
@@ -193,6 +194,10 @@ fn draw_series<DB: DrawingBackend>(
                 .flat_map(|p| dashes(p, DASH))
                 .collect(),
             Style::Markers(_) => Vec::new(),
+            Style::Rectangles => {
+                draw_rectangles(area, plan, cv, &s.points, color)?;
+                continue;
+            }
         };
         for line in &lines {
             cv.line(area, line, style)?;
@@ -217,6 +222,34 @@ fn draw_series<DB: DrawingBackend>(
         }
     }
 
+    Ok(())
+}
+
+/// Filled rectangles from pairs of opposite corners, clipped to the plot
+/// area.
+fn draw_rectangles<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plan: &Plan,
+    cv: Canvas,
+    corners: &[(f64, f64)],
+    color: RGBColor,
+) -> DrawResult {
+    let clip = |(x, y): (f64, f64)| {
+        (
+            x.clamp(plan.left, plan.right),
+            y.clamp(plan.top, plan.bottom),
+        )
+    };
+    for pair in corners.chunks_exact(2) {
+        let (Some(a), Some(b)) = (plan.data_px(pair[0]), plan.data_px(pair[1])) else {
+            continue;
+        };
+        area.draw(&Rectangle::new(
+            [cv.pt(clip(a)), cv.pt(clip(b))],
+            color.filled(),
+        ))
+        .map_err(de)?;
+    }
     Ok(())
 }
 
@@ -377,7 +410,7 @@ pub(super) fn draw_legend<DB: DrawingBackend>(
                     cv.line(area, &d, style)?;
                 }
             }
-            Style::Markers(_) => {}
+            Style::Markers(_) | Style::Rectangles => {}
         }
         if let Some(m) = series_markers(s.style) {
             cv.marker(area, m, (0.5 * (sx0 + sx1), yc), *color)?;

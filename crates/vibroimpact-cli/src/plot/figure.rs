@@ -30,6 +30,9 @@ pub enum Style {
     DashedLine,
     /// Markers only.
     Markers(Marker),
+    /// Filled rectangles, one per pair of consecutive points (two opposite
+    /// corners): the cells of a chart.
+    Rectangles,
 }
 
 /// Where the legend box goes (inside the plot area).
@@ -97,6 +100,18 @@ impl Series {
         marker: Marker,
     ) -> Self {
         Self::new(label, points, Style::Markers(marker))
+    }
+
+    /// Filled rectangles given by `(x0, y0, x1, y1)` corners; an empty
+    /// `label` means no legend entry.
+    pub fn rectangles(
+        label: impl Into<String>,
+        corners: impl IntoIterator<Item = (f64, f64, f64, f64)>,
+    ) -> Self {
+        let points = corners
+            .into_iter()
+            .flat_map(|(x0, y0, x1, y1)| [(x0, y0), (x1, y1)]);
+        Self::new(label, points, Style::Rectangles)
     }
 
     /// Sets the palette index of the series colour.

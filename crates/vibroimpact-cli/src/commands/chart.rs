@@ -1,0 +1,322 @@
+//! `vibroimpact chart`: the brute-force stability chart of
+//! [`vibroimpact::chart`] over two parameters, its CSV, JSON, figure and
+//! table of classes.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use vibroimpact::chart::{chart, Chart, ChartCell, ChartOptions};
+use vibroimpact::sweep::{parameter_values, SweepOptions};
+
+use crate::args::MethodName;
+use crate::error::CliError;
+use crate::format::{CsvText, Format};
+use crate::model_io::read_document;
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+
+/// Options of `vibroimpact chart`.
+#[derive(Args, Debug)]
+pub struct ChartArgs {
+    /// Model file (TOML, see docs/model.md); its excitation must be periodic
+    /// with one frequency over the whole chart.
+    model: PathBuf,
+    /// Parameter of the horizontal axis (`frequency`, `amplitude` or a
+    /// dotted numeric key such as `row.clearance`).
+    #[arg(long)]
+    x: String,
+    /// First value of --x.
+    #[arg(long)]
+    x_from: f64,
+    /// Last value of --x.
+    #[arg(long)]
+    x_to: f64,
+    /// Number of --x values (>= 2), evenly spaced, both ends included.
+    #[arg(long)]
+    x_points: usize,
+    /// Parameter of the vertical axis (different from --x).
+    #[arg(long)]
+    y: String,
+    /// First value of --y.
+    #[arg(long)]
+    y_from: f64,
+    /// Last value of --y.
+    #[arg(long)]
+    y_to: f64,
+    /// Number of --y values (>= 2).
+    #[arg(long)]
+    y_points: usize,
+    /// Forcing periods simulated and discarded before recording.
+    #[arg(long, default_value_t = 100)]
+    transient: usize,
+    /// Forcing periods recorded (one Poincaré sample at the end of each).
+    #[arg(long, default_value_t = 20)]
+    record: usize,
+    /// Initial states per cell: the model's own, then points spread over
+    /// |u| ≤ 0.9 gap, |v| ≤ 0.9 gap × Ω; runs that end on different
+    /// attractors mark the cell as coexisting.
+    #[arg(long, default_value_t = 1)]
+    starts: usize,
+    /// Also compute each run's largest Lyapunov exponent (positive: chaos;
+    /// about twice the cost).
+    #[arg(long)]
+    lyapunov: bool,
+    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-6).
+    #[arg(long)]
+    rtol: Option<f64>,
+    /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
+    #[arg(long)]
+    atol: Option<f64>,
+    /// Integration method.
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    method: MethodName,
+    /// Relative tolerance under which two Poincaré samples are the same
+    /// point (default 1e-3: 100 transient periods leave up to ~4e-3 of a
+    /// lightly damped free oscillation).
+    #[arg(long)]
+    cluster_tolerance: Option<f64>,
+    /// Output folder for chart.csv, chart.json and the figure; without it
+    /// only the summary is printed.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Summary format on standard output: a table of the classes, the
+    /// cells as CSV, or the whole chart as JSON.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// The classes of the figure: periods 1–4, 5 and more, non-periodic (with
+/// Lyapunov exponents split into chaotic and not), failed.
+const CLASSES: [&str; 8] = [
+    "period 1",
+    "period 2",
+    "period 3",
+    "period 4",
+    "period ≥ 5",
+    "non-periodic",
+    "chaotic (λ1 > 0)",
+    "failed",
+];
+
+/// The class (index into [`CLASSES`]) of a cell: that of its first run.
+fn class(cell: &ChartCell) -> usize {
+    let Some(run) = cell.runs.first() else {
+        return 7;
+    };
+    match (run.error.is_some(), run.period, run.lyapunov) {
+        (true, _, _) => 7,
+        (false, Some(p), _) => (p.min(5)) - 1,
+        (false, None, Some(l)) if l > 0.0 => 6,
+        (false, None, _) => 5,
+    }
+}
+
+/// chart.csv: one row per run.
+fn chart_csv(chart: &Chart) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    let n = chart
+        .cells
+        .iter()
+        .flat_map(|c| c.runs.first())
+        .map(|r| r.start.len())
+        .max()
+        .unwrap_or(0);
+    let mut header: Vec<String> = vec![
+        chart.x_name.clone(),
+        chart.y_name.clone(),
+        "start".into(),
+        "attractors".into(),
+        "period".into(),
+        "impacts_per_period".into(),
+        "max_displacement".into(),
+        "lyapunov".into(),
+        "error".into(),
+    ];
+    header.extend((0..n).map(|i| format!("start_{i}")));
+    w.row(&header)?;
+    for cell in &chart.cells {
+        for (k, r) in cell.runs.iter().enumerate() {
+            let mut rec = vec![
+                format!("{:e}", cell.x),
+                format!("{:e}", cell.y),
+                k.to_string(),
+                cell.attractors.to_string(),
+                r.period.map_or(String::new(), |p| p.to_string()),
+                format!("{:e}", r.impacts_per_period),
+                format!("{:e}", r.max_displacement),
+                r.lyapunov.map_or(String::new(), |l| format!("{l:e}")),
+                r.error.clone().unwrap_or_default(),
+            ];
+            rec.extend(r.start.iter().map(|x| format!("{x:e}")));
+            w.row(&rec)?;
+        }
+    }
+    w.finish()
+}
+
+/// Half the spacing of `values` around index `i` (the cell's extent).
+fn half_widths(values: &[f64], i: usize) -> (f64, f64) {
+    let step = |a: usize, b: usize| 0.5 * (values[b] - values[a]);
+    let left = if i > 0 {
+        step(i - 1, i)
+    } else {
+        step(i, i + 1)
+    };
+    let right = if i + 1 < values.len() {
+        step(i, i + 1)
+    } else {
+        step(i - 1, i)
+    };
+    (left, right)
+}
+
+/// The chart's figure: a rectangle per cell coloured by its class (runs of
+/// equal cells along a row merged), cells with coexisting attractors
+/// marked.
+fn chart_figure(chart: &Chart) -> Figure {
+    let (xs, ys) = (&chart.x_values, &chart.y_values);
+    let mut fig = Figure::new(
+        "Attractor of the model's initial state",
+        chart.x_name.clone(),
+        chart.y_name.clone(),
+    )
+    .legend_at(LegendPosition::Best);
+    let mut rects: Vec<Vec<(f64, f64, f64, f64)>> = vec![Vec::new(); CLASSES.len()];
+    for (j, _) in ys.iter().enumerate() {
+        let row = &chart.cells[j * xs.len()..(j + 1) * xs.len()];
+        let (down, up) = half_widths(ys, j);
+        let mut i = 0;
+        while i < row.len() {
+            let c = class(&row[i]);
+            let mut k = i;
+            while k + 1 < row.len() && class(&row[k + 1]) == c {
+                k += 1;
+            }
+            let x0 = xs[i] - half_widths(xs, i).0;
+            let x1 = xs[k] + half_widths(xs, k).1;
+            rects[c].push((x0, ys[j] - down, x1, ys[j] + up));
+            i = k + 1;
+        }
+    }
+    for (c, r) in rects.into_iter().enumerate() {
+        if !r.is_empty() {
+            fig.push(Series::rectangles(CLASSES[c], r).with_color(c));
+        }
+    }
+    let coexisting: Vec<(f64, f64)> = chart
+        .cells
+        .iter()
+        .filter(|c| c.attractors > 1)
+        .map(|c| (c.x, c.y))
+        .collect();
+    if !coexisting.is_empty() {
+        fig.push(
+            Series::markers("coexisting attractors", coexisting, Marker::Triangle).with_color(9),
+        );
+    }
+    fig
+}
+
+/// Table of the classes: cells per class, and cells with coexisting
+/// attractors.
+fn table_text(chart: &Chart) -> String {
+    let mut counts = [0usize; CLASSES.len()];
+    for cell in &chart.cells {
+        counts[class(cell)] += 1;
+    }
+    let mut t = format!(
+        "{} × {} cells ({} × {}), {} runs\n",
+        chart.x_values.len(),
+        chart.y_values.len(),
+        chart.x_name,
+        chart.y_name,
+        chart.cells.iter().map(|c| c.runs.len()).sum::<usize>()
+    );
+    for (c, name) in CLASSES.iter().enumerate() {
+        if counts[c] > 0 {
+            t.push_str(&format!("{name:>20}  {:>8} cells\n", counts[c]));
+        }
+    }
+    let coexisting = chart.cells.iter().filter(|c| c.attractors > 1).count();
+    t.push_str(&format!("{:>20}  {coexisting:>8} cells\n", "coexisting"));
+    t
+}
+
+/// Writes chart.csv, chart.json and the figure into `dir`.
+fn write_outputs(dir: &Path, chart: &Chart) -> Result<(), CliError> {
+    ensure_dir(dir)?;
+    write_atomic(&dir.join("chart.csv"), chart_csv(chart)?.as_bytes())?;
+    write_atomic(
+        &dir.join("chart.json"),
+        serde_json::to_string(chart)?.as_bytes(),
+    )?;
+    render(&chart_figure(chart), &dir.join("chart"))?;
+    Ok(())
+}
+
+/// The values of one axis, checked.
+fn axis(name: &str, from: f64, to: f64, points: usize) -> Result<Vec<f64>, CliError> {
+    if !from.is_finite() || !to.is_finite() || from == to {
+        return Err(CliError::new(format!(
+            "--{name}-from {from} --{name}-to {to}: give a range of finite values"
+        )));
+    }
+    if !(2..=100_000).contains(&points) {
+        return Err(CliError::new(format!(
+            "--{name}-points {points}: from 2 to 100000"
+        )));
+    }
+    Ok(parameter_values(from, to, points))
+}
+
+/// Runs `vibroimpact chart`.
+pub fn run(args: &ChartArgs) -> Result<(), CliError> {
+    let xs = axis("x", args.x_from, args.x_to, args.x_points)?;
+    let ys = axis("y", args.y_from, args.y_to, args.y_points)?;
+    if args.record < 1 {
+        return Err(CliError::new("--record 0: record at least one period"));
+    }
+    let document = read_document(&args.model)?;
+    let interrupt = crate::interrupt::on_ctrl_c();
+    let options = ChartOptions {
+        sweep: SweepOptions {
+            transient: args.transient,
+            record: args.record,
+            rtol: args.rtol,
+            atol: args.atol,
+            method: args.method.method(),
+            cluster_tolerance: args.cluster_tolerance,
+            lyapunov: args.lyapunov.then_some(1),
+            interrupt: Some(interrupt.clone()),
+            ..SweepOptions::default()
+        },
+        starts: args.starts,
+    };
+    let progress = crate::progress::bar(xs.len() * ys.len(), "cells").with_prefix("chart");
+    let chart = chart(&document, (&args.x, &xs), (&args.y, &ys), &options, &|| {
+        progress.inc(1)
+    })
+    .map_err(|e| {
+        CliError::new(
+            e.to_string()
+                .replace("starts = ", "--starts ")
+                .replace("cluster_tolerance =", "--cluster-tolerance =")
+                .replace("lyapunov =", "--lyapunov"),
+        )
+    })?;
+    progress.finish_and_clear();
+    if interrupt.requested() {
+        return Err(CliError::new(
+            "interrupted (Ctrl-C): nothing written (a chart is written whole)",
+        ));
+    }
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &chart)?;
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&chart)?),
+        Format::Csv => print!("{}", chart_csv(&chart)?),
+        Format::Table => print!("{}", table_text(&chart)),
+    }
+    Ok(())
+}
