@@ -13,6 +13,7 @@
 //! ([`monitor::run`]); a request to stop reaches the integrators through
 //! [`vibroimpact::integrate::Interrupt`].
 
+mod chart;
 mod convert;
 mod model;
 mod monitor;
@@ -39,6 +40,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(solve::continue_branch, m)?)?;
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
     m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
     Ok(())
 }

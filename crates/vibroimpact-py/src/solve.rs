@@ -47,7 +47,8 @@ fn impact_error(e: ImpactError) -> PyErr {
     }
 }
 
-fn method(name: &str) -> PyResult<Method> {
+/// The integration method named `name`.
+pub(crate) fn method(name: &str) -> PyResult<Method> {
     match name {
         "dop853" => Ok(Method::Dop853),
         "rodas" => Ok(Method::Rodas),

@@ -136,6 +136,28 @@ def test_sweep_lyapunov_matches_the_cli(cli):
         vi.sweep(m, "frequency", from_=7.0, to=8.0, points=2, lyapunov=5)
 
 
+def test_chart_matches_the_cli(cli):
+    m = EXAMPLES / "fujita-row-n2.toml"
+    doc = cli("chart", m, "--x", "frequency", "--x-from", "6.5", "--x-to", "8.5", "--x-points", "3",
+              "--y", "row.clearance", "--y-from", "1e-3", "--y-to", "2e-3", "--y-points", "2",
+              "--transient", "20", "--record", "6", "--starts", "2", "--lyapunov")
+    r = vi.chart(m, "frequency", vi.parameter_values(6.5, 8.5, 3), "row.clearance",
+                 vi.parameter_values(1e-3, 2e-3, 2), transient=20, record=6, starts=2, lyapunov=True)
+    assert len(r.cells) == len(doc["cells"]) == 6
+    for c, d in zip(r.cells, doc["cells"]):
+        assert (c.x, c.y, c.attractors) == (d["x"], d["y"], d["attractors"])
+        for a, b in zip(c.runs, d["runs"]):
+            assert (a.period, a.error) == (b["period"], b["error"])
+            close(a.max_displacement, b["max_displacement"])
+            close(a.lyapunov, b["lyapunov"])
+    with pytest.raises(ValueError, match="the same key"):
+        vi.chart(m, "frequency", [7.0], "excitation.frequency", [7.0])
+    with pytest.raises(ValueError, match="starts = 0"):
+        vi.chart(m, "frequency", [7.0], "amplitude", [0.05], starts=0)
+    with pytest.raises(TypeError, match="x: expected a parameter name"):
+        vi.chart(m, 3, [7.0], "amplitude", [0.05])
+
+
 def test_parameter_values_match_the_cli(cli):
     # (to - from) i / (k - 1) rounds differently from (to - from)(i / (k - 1))
     # at some i: the values must be the CLI's to the bit.

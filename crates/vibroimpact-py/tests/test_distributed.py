@@ -46,6 +46,16 @@ def test_sweep_is_bit_identical_to_the_local_run(client):
     assert same(local, one_thread)
 
 
+def test_chart_is_bit_identical_to_the_local_run(client):
+    kw = dict(transient=10, record=4, starts=2)
+    xs, ys = [6.0, 7.0, 8.0], [0.03, 0.05, 0.07, 0.09]
+    local = vi.chart(ROW, "frequency", xs, "amplitude", ys, **kw)
+    for tasks in (None, 3):
+        remote = vi.chart(ROW, "frequency", xs, "amplitude", ys, client=client, tasks=tasks, **kw)
+        assert same(local, remote), tasks
+    assert same(local, vi.chart(ROW, "frequency", xs, "amplitude", ys, threads=1, **kw))
+
+
 def test_up_down_sweep_on_the_cluster(client):
     kw = dict(values=[6.0, 7.0, 8.0], transient=10, record=3, up_down=True)
     assert same(vi.sweep(ROW, "frequency", **kw), vi.sweep(ROW, "frequency", client=client, **kw))

@@ -35,6 +35,7 @@ __all__ = [
     "Model",
     "Result",
     "VibroimpactError",
+    "chart",
     "contact_force",
     "continue_",
     "identify",
@@ -702,5 +703,105 @@ def _sweep_local(
         only,
         _progress(progress),
         options["lyapunov"],
+    )
+    return d if raw else Result(d)
+
+
+def chart(
+    model: ModelLike,
+    x: str,
+    x_values: ArrayLike,
+    y: str,
+    y_values: ArrayLike,
+    *,
+    transient: int = 100,
+    record: int = 20,
+    starts: int = 1,
+    lyapunov: bool = False,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    method: str = "dop853",
+    cluster_tolerance: Optional[float] = None,
+    client: Any = None,
+    tasks: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+) -> Result:
+    """The brute-force stability chart (``vibroimpact chart``): every cell of
+    the grid ``x_values`` × ``y_values`` of the parameters ``x`` and ``y``
+    simulated from ``starts`` initial states for ``transient`` forcing
+    periods, then ``record`` periods; each run classified by the period of
+    its attractor on the Poincaré section (None: not periodic), its impacts
+    per period, its largest |u| and, with ``lyapunov``, its largest Lyapunov
+    exponent. Defaults as the CLI: ``rtol`` 1e-6 unless the model's
+    ``[simulation]`` gives one, ``cluster_tolerance`` 1e-3.
+
+    Without ``client`` the cells run on this machine's cores (``threads``:
+    pool size). With a ``dask.distributed.Client`` the rows of the grid run
+    on its workers in ``tasks`` chunks; the result is bit for bit the local
+    one.
+
+    Returns ``x_name``, ``y_name``, ``x_values``, ``y_values``,
+    ``transient_periods``, ``record_periods``, ``rtol``,
+    ``cluster_tolerance`` and ``cells`` (row by row: all x at the first y,
+    …), each with ``x``, ``y``, ``attractors`` (distinct attractors of its
+    runs) and ``runs`` (``start``, ``period``, ``impacts_per_period``,
+    ``max_displacement``, ``lyapunov``, ``error``).
+    """
+    m = _model(model)
+    for name, value in (("x", x), ("y", y)):
+        if not isinstance(value, str):
+            raise TypeError(f"{name}: expected a parameter name, got {type(value).__name__}")
+    xs = _floats(x_values, "x_values", allow_scalar=False)
+    ys = _floats(y_values, "y_values", allow_scalar=False)
+    for name, v in (("x_values", xs), ("y_values", ys)):
+        if v.size < 1:
+            raise ValueError(f"{name}: at least one value")
+    options = dict(
+        transient=_count(transient, "transient"),
+        record=_count(record, "record", minimum=1, maximum=10**7),
+        starts=_count(starts, "starts", minimum=1, maximum=10**6),
+        lyapunov=_flag(lyapunov, "lyapunov"),
+        rtol=_real(rtol, "rtol", positive=True, optional=True),
+        atol=_real(atol, "atol", positive=True, optional=True),
+        method=_method(method, ("dop853", "rodas", "auto")),
+        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+    )
+    if threads is not None:
+        threads = _count(threads, "threads", minimum=1, maximum=4096)
+        if client is not None:
+            raise ValueError("threads: applies to a local chart; with a client every task runs on one thread")
+    if tasks is not None:
+        if client is None:
+            raise ValueError("tasks: applies with a Dask client only")
+        tasks = _count(tasks, "tasks", minimum=1, maximum=10**6)
+    if client is not None:
+        from .distributed import chart_on
+
+        return chart_on(client, m, (x, xs), (y, ys), options, tasks=tasks, progress=progress)
+    return _chart_local(m, (x, xs), (y, ys), options, threads=threads, progress=progress)
+
+
+def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: Progress = None, raw: bool = False):
+    """One chart on this machine (also one Dask task's rows); ``raw``: the
+    plain document, for gathering."""
+    xs = np.require(x[1], np.float64, ["C", "A"])
+    ys = np.require(y[1], np.float64, ["C", "A"])
+    d = _core.chart(
+        model,
+        x[0],
+        xs,
+        y[0],
+        ys,
+        options["transient"],
+        options["record"],
+        options["starts"],
+        options["lyapunov"],
+        options["rtol"],
+        options["atol"],
+        options["method"],
+        options["cluster_tolerance"],
+        threads,
+        _progress(progress),
     )
     return d if raw else Result(d)

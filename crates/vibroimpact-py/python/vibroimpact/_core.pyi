@@ -70,3 +70,9 @@ def sweep(
     cluster_tolerance: Optional[float], threads: Optional[int], only: Optional[str] = None,
     progress: Progress = None, lyapunov: Optional[int] = None,
 ) -> dict[str, Any]: ...
+
+def chart(
+    model: Model, x: str, x_values: F64, y: str, y_values: F64, transient: int, record: int,
+    starts: int, lyapunov: bool, rtol: Optional[float], atol: Optional[float], method_name: str,
+    cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
+) -> dict[str, Any]: ...

@@ -98,6 +98,34 @@ def sweep_on(
     return Result(head)
 
 
+def _chart_task(model, x, y, options):
+    from . import _chart_local
+
+    return _chart_local(model, x, y, options, threads=1, raw=True)
+
+
+def chart_on(client, model, x, y, options: dict, *, tasks: Optional[int] = None, progress=None, retries: int = 2) -> Result:
+    """The chart of :func:`vibroimpact.chart` on the workers of ``client``:
+    the rows of the grid (values of ``y``) in ``tasks`` chunks (default four
+    per worker thread), gathered in order."""
+    if not hasattr(client, "submit") or not hasattr(client, "scheduler_info"):
+        raise TypeError(
+            f"client: expected a dask.distributed.Client, got {type(client).__name__}"
+        )
+    name, ys = y
+    chunks = _chunks(ys, tasks or 4 * _worker_threads(client))
+    [model_future] = client.scatter([model], broadcast=False, hash=False)
+    futures = [
+        client.submit(_chart_task, model_future, x, (name, c), options, retries=retries, pure=False)
+        for c in chunks
+    ]
+    docs = _gather(futures, progress, len(futures))
+    head = dict(docs[0])
+    head["y_values"] = [v for d in docs for v in d["y_values"]]
+    head["cells"] = [c for d in docs for c in d["cells"]]
+    return Result(head)
+
+
 def _ensemble_task(name: str, model, kwargs: dict):
     import vibroimpact
 

@@ -1,0 +1,69 @@
+//! The binding of [`vibroimpact::chart`]: a stability chart over two
+//! parameters as the `chart` document.
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact::chart::{chart as run_chart, ChartOptions};
+use vibroimpact::sweep::SweepOptions;
+
+use crate::convert::{document, floats, value_error};
+use crate::model::PyModel;
+use crate::monitor::{self, Progress};
+use crate::solve::method;
+
+/// A stability chart: the `chart` document of the CLI (`cells` row by row,
+/// each with its `runs`). `lyapunov`: each run's largest exponent;
+/// `threads`: the size of the thread pool (None: all cores).
+#[pyfunction]
+#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn chart<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    x: &str,
+    x_values: PyReadonlyArray1<'py, f64>,
+    y: &str,
+    y_values: PyReadonlyArray1<'py, f64>,
+    transient: usize,
+    record: usize,
+    starts: usize,
+    lyapunov: bool,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    method_name: &str,
+    cluster_tolerance: Option<f64>,
+    threads: Option<usize>,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let xs = floats(&x_values, "x_values")?;
+    let ys = floats(&y_values, "y_values")?;
+    let method = method(method_name)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(value_error)?;
+    let doc = model.document.clone();
+    let (x, y) = (x.to_string(), y.to_string());
+    let total = xs.len() * ys.len();
+    let out = monitor::run(py, progress, move |p: &Progress| {
+        p.set_total(total);
+        let options = ChartOptions {
+            sweep: SweepOptions {
+                transient,
+                record,
+                rtol,
+                atol,
+                method,
+                cluster_tolerance,
+                lyapunov: lyapunov.then_some(1),
+                interrupt: Some(p.interrupt.clone()),
+                ..SweepOptions::default()
+            },
+            starts,
+        };
+        pool.install(|| run_chart(&doc, (&x, &xs), (&y, &ys), &options, &|| p.tick()))
+    })?
+    .map_err(value_error)?;
+    document(py, &out)
+}
