@@ -10,9 +10,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
+use crate::attractor::{count_attractors, run_from, Recorded, Run};
 use crate::model::Model;
 use crate::model_file::ModelDocument;
-use crate::sweep::{admissible, run_value, Direction, Settings, Start, SweepOptions, SweepPoint};
+use crate::sweep::{admissible, Settings, SweepOptions};
 
 /// Largest number of runs (cells × starts) of one chart: the result keeps
 /// ~200 bytes a run.
@@ -53,26 +54,6 @@ impl Default for ChartOptions {
     }
 }
 
-/// The attractor one run reached.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ChartRun {
-    /// The initial state `[u.., v..]` (m, m/s).
-    pub start: Vec<f64>,
-    /// Period of the attractor in forcing periods: the number of distinct
-    /// Poincaré samples (clusters to the cluster tolerance, as a sweep
-    /// counts them) when at most half the recorded periods; null when the
-    /// samples do not repeat (quasi-periodic, chaotic, or not settled).
-    pub period: Option<usize>,
-    /// Impacts (all contacts) per forcing period.
-    pub impacts_per_period: f64,
-    /// Largest |u_i| over the bodies and the recorded periods (m).
-    pub max_displacement: f64,
-    /// The largest Lyapunov exponent (1/s), if requested.
-    pub lyapunov: Option<f64>,
-    /// The failure, if any.
-    pub error: Option<String>,
-}
-
 /// One cell of the grid.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ChartCell {
@@ -84,7 +65,7 @@ pub struct ChartCell {
     /// or by their Poincaré samples; the non-periodic ones count as one).
     pub attractors: usize,
     /// One run per initial state.
-    pub runs: Vec<ChartRun>,
+    pub runs: Vec<Run>,
 }
 
 /// A whole chart.
@@ -217,7 +198,7 @@ pub fn chart(
                     x: vx,
                     y: vy,
                     attractors: 0,
-                    runs: vec![failed_run(Vec::new(), e.0)],
+                    runs: vec![Run::failed(Vec::new(), e.0)],
                 },
             };
             progress();
@@ -237,109 +218,19 @@ pub fn chart(
     })
 }
 
-fn failed_run(start: Vec<f64>, error: String) -> ChartRun {
-    ChartRun {
-        start,
-        period: None,
-        impacts_per_period: f64::NAN,
-        max_displacement: f64::NAN,
-        lyapunov: None,
-        error: Some(error),
-    }
-}
-
 /// The runs of one cell and its attractor count.
 fn run_cell(model: &Model, x: f64, y: f64, starts: usize, settings: &Settings) -> ChartCell {
-    let n = model.bodies().len();
-    let omega = model.forcing_frequency().unwrap_or(1.0);
-    let mut runs = Vec::with_capacity(starts);
-    let mut samples: Vec<Samples> = Vec::with_capacity(starts);
-    for state in initial_states(model, starts) {
-        let start = Start {
-            u: state[..n].to_vec(),
-            v: state[n..].to_vec(),
-            phase: 0,
-        };
-        let (point, _) = run_value(model, x, Direction::None, Some(start), settings);
-        let (run, sections) = classify(state, point, omega);
-        runs.push(run);
-        samples.push(sections);
-    }
-    let attractors = count_attractors(&runs, &samples, settings.cluster_tolerance);
+    let (runs, recorded): (Vec<Run>, Vec<Recorded>) = initial_states(model, starts)
+        .into_iter()
+        .map(|state| run_from(model, x, state, settings))
+        .unzip();
+    let attractors = count_attractors(&runs, &recorded, settings.cluster_tolerance);
     ChartCell {
         x,
         y,
         attractors,
         runs,
     }
-}
-
-/// A run's summary from its sweep point, with its Poincaré samples and
-/// their scales (largest |u| over the window; largest |u| times the
-/// forcing frequency for the velocities).
-fn classify(start: Vec<f64>, point: SweepPoint, omega: f64) -> (ChartRun, Samples) {
-    if let Some(e) = point.error {
-        return (failed_run(start, e), (Vec::new(), (0.0, 0.0)));
-    }
-    let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
-    // The sweep's clusters of samples (to its tolerance): a period-n
-    // orbit leaves n of them.
-    let distinct = point.distinct_section_points;
-    let period = (distinct >= 1 && 2 * distinct <= point.recorded_periods).then_some(distinct);
-    let run = ChartRun {
-        start,
-        period,
-        impacts_per_period: point.impacts_per_period,
-        max_displacement: max_u,
-        lyapunov: point.lyapunov.and_then(|l| l.first().copied()),
-        error: None,
-    };
-    (run, (point.sections, (max_u, max_u * omega)))
-}
-
-/// Poincaré samples and the scales of their displacements and velocities.
-type Samples = (Vec<Vec<f64>>, (f64, f64));
-
-/// Whether two Poincaré samples are equal: every displacement within
-/// `tol` times the displacement scale, every velocity within `tol` times
-/// the velocity scale.
-fn same_sample(a: &[f64], b: &[f64], tol: f64, scale: (f64, f64)) -> bool {
-    let n = a.len() / 2;
-    (0..2 * n).all(|i| {
-        let s = if i < n { scale.0 } else { scale.1 };
-        (a[i] - b[i]).abs() <= tol * s
-    })
-}
-
-/// Distinct attractors among the runs of a cell: two periodic runs are the
-/// same when their periods agree and the last sample of one is among the
-/// last period of samples of the other; the non-periodic runs count as
-/// one; failed runs as none.
-fn count_attractors(runs: &[ChartRun], samples: &[Samples], tol: f64) -> usize {
-    let mut reps: Vec<usize> = Vec::new();
-    let mut non_periodic = false;
-    for (i, run) in runs.iter().enumerate() {
-        if run.error.is_some() {
-            continue;
-        }
-        let Some(p) = run.period else {
-            non_periodic = true;
-            continue;
-        };
-        let (s, scale) = &samples[i];
-        let same = |j: &usize| {
-            let (o, other) = &samples[*j];
-            let scale = (scale.0.max(other.0), scale.1.max(other.1));
-            runs[*j].period == Some(p)
-                && o[o.len() - p..]
-                    .iter()
-                    .any(|q| same_sample(&s[s.len() - 1], q, tol, scale))
-        };
-        if !reps.iter().any(same) {
-            reps.push(i);
-        }
-    }
-    reps.len() + usize::from(non_periodic)
 }
 
 /// The initial states of a cell: the model's own, then Halton points

@@ -2,6 +2,7 @@
 //! a sweep and with the linear limit, determinism, bad input.
 
 use super::*;
+use crate::attractor::{count_attractors, Recorded, Run};
 use crate::parameter::ParameterizedModel;
 use crate::sweep::sweep;
 
@@ -18,7 +19,7 @@ fn attractors_of_samples() {
         .map(|k| s(if k % 2 == 0 { 1.0 } else { -1.0 }))
         .collect();
     let fixed: Vec<Vec<f64>> = (0..10).map(|_| s(1.0)).collect();
-    let run = |period: Option<usize>| ChartRun {
+    let run = |period: Option<usize>| Run {
         start: vec![],
         period,
         impacts_per_period: 1.0,
@@ -38,9 +39,12 @@ fn attractors_of_samples() {
         run(None),
         run(None),
     ];
-    let samples: Vec<Samples> = [period2, shifted, fixed, other.clone(), other.clone(), other]
+    let samples: Vec<Recorded> = [period2, shifted, fixed, other.clone(), other.clone(), other]
         .into_iter()
-        .map(|x| (x, (1.0, 1.0)))
+        .map(|samples| Recorded {
+            samples,
+            scale: (1.0, 1.0),
+        })
         .collect();
     assert_eq!(count_attractors(&runs, &samples, 1e-6), 4);
     assert_eq!(count_attractors(&runs[..2], &samples[..2], 1e-6), 1);
@@ -58,6 +62,8 @@ fn cells_match_the_sweep_and_the_linear_limit() {
         sweep: SweepOptions {
             transient: 30,
             record: 8,
+            rtol: Some(DEFAULT_RTOL),
+            cluster_tolerance: Some(DEFAULT_CLUSTER_TOLERANCE),
             ..SweepOptions::default()
         },
         starts: 3,

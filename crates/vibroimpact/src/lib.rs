@@ -21,6 +21,8 @@
 //! - [`continuation`]: branches of periodic solutions and their special
 //!   points;
 //! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
+//! - [`attractor`]: the attractor a simulation reaches, and whether two
+//!   runs reached the same one;
 //! - [`chart`]: brute-force stability charts over two parameters;
 //! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
 //! - [`parameter`]: a numeric key of a model file made a parameter;
@@ -37,6 +39,7 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod attractor;
 pub mod chart;
 pub mod contact;
 pub mod continuation;
