@@ -99,3 +99,20 @@ impl LinearAlgebra {
         (self.krylov || (!self.dense && bodies >= Self::AUTO_KRYLOV_BODIES)).then_some(self.arnoldi)
     }
 }
+
+/// The `points` values of a grid axis `--NAME-from`, `--NAME-to`,
+/// `--NAME-points` (of `chart` and `basins`), checked: a finite range and
+/// 2 to 100 000 points.
+pub fn grid_axis(name: &str, from: f64, to: f64, points: usize) -> Result<Vec<f64>, CliError> {
+    if !from.is_finite() || !to.is_finite() || from == to {
+        return Err(CliError::new(format!(
+            "--{name}-from {from} --{name}-to {to}: give a range of finite values"
+        )));
+    }
+    if !(2..=100_000).contains(&points) {
+        return Err(CliError::new(format!(
+            "--{name}-points {points}: from 2 to 100000"
+        )));
+    }
+    Ok(vibroimpact::sweep::parameter_values(from, to, points))
+}

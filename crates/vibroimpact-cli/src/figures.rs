@@ -81,3 +81,54 @@ pub fn branch_figure(
     }
     fig
 }
+
+/// Half the spacing of `values` either side of index `i` (a cell's extent).
+fn half_widths(values: &[f64], i: usize) -> (f64, f64) {
+    let step = |a: usize, b: usize| 0.5 * (values[b] - values[a]);
+    let left = if i > 0 {
+        step(i - 1, i)
+    } else {
+        step(i, i + 1)
+    };
+    let right = if i + 1 < values.len() {
+        step(i, i + 1)
+    } else {
+        step(i - 1, i)
+    };
+    (left, right)
+}
+
+/// A grid of `xs` × `ys` cells (row by row) coloured by class: one series
+/// of rectangles per class that occurs, labelled `labels[class]` with
+/// palette colour `colors[class]` (runs of equal cells along a row merged
+/// into one rectangle). `ys.len() * xs.len()` classes, each `< labels.len()`.
+pub fn class_map(
+    fig: &mut Figure,
+    xs: &[f64],
+    ys: &[f64],
+    classes: &[usize],
+    labels: &[String],
+    colors: &[usize],
+) {
+    let mut rects: Vec<Vec<(f64, f64, f64, f64)>> = vec![Vec::new(); labels.len()];
+    for (j, &y) in ys.iter().enumerate() {
+        let row = &classes[j * xs.len()..(j + 1) * xs.len()];
+        let (down, up) = half_widths(ys, j);
+        let mut i = 0;
+        while i < row.len() {
+            let mut k = i;
+            while k + 1 < row.len() && row[k + 1] == row[i] {
+                k += 1;
+            }
+            let x0 = xs[i] - half_widths(xs, i).0;
+            let x1 = xs[k] + half_widths(xs, k).1;
+            rects[row[i]].push((x0, y - down, x1, y + up));
+            i = k + 1;
+        }
+    }
+    for ((r, label), &color) in rects.into_iter().zip(labels).zip(colors) {
+        if !r.is_empty() {
+            fig.push(Series::rectangles(label.clone(), r).with_color(color));
+        }
+    }
+}

@@ -25,7 +25,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{branch, chart, identify, impact, simulate, sweep};
+use commands::{basins, branch, chart, identify, impact, simulate, sweep};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -56,6 +56,10 @@ enum Command {
     /// period, impacts, Lyapunov exponent and coexistence per cell.
     #[command(allow_negative_numbers = true)]
     Chart(chart::ChartArgs),
+    /// Basins of attraction: a grid of initial states in a plane of state
+    /// space, each run to its attractor.
+    #[command(allow_negative_numbers = true)]
+    Basins(basins::BasinsArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
     Periodic(branch::PeriodicArgs),
@@ -89,6 +93,7 @@ fn main() -> ExitCode {
         Some(Command::Continue(args)) => branch::run_continue(args),
         Some(Command::Sweep(args)) => sweep::run(args),
         Some(Command::Chart(args)) => chart::run(args),
+        Some(Command::Basins(args)) => basins::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

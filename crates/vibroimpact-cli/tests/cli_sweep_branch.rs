@@ -769,7 +769,7 @@ fn chart_grid_outputs_and_bad_input() {
         "--record",
         "6",
         "--rtol",
-        "1e-6",
+        "1e-7",
         "--cluster-tolerance",
         "1e-3",
         "--format",
@@ -835,5 +835,87 @@ fn chart_grid_outputs_and_bad_input() {
     ] {
         let args = [&base[..], extra].concat();
         assert_clean_error(&args, needle);
+    }
+}
+
+/// `basins`: a small (u1, v1) grid of the N = 2 row writes basins.json
+/// (attractors with their fractions, one index per start), basins.csv and
+/// the figure; a start overlapping the wall is not run; bad components and
+/// a wrong --base are refused.
+#[test]
+fn basins_grid_outputs_and_bad_input() {
+    let dir = temp_dir("basins");
+    let row = repo_file("examples/fujita-row-n2.toml");
+    let out = dir.join("b");
+    let doc = json(&[
+        "basins",
+        &row,
+        "--x",
+        "u1",
+        "--x-from",
+        "-1.2e-3",
+        "--x-to",
+        "0.8e-3",
+        "--x-points",
+        "3",
+        "--y",
+        "v1",
+        "--y-from",
+        "-0.02",
+        "--y-to",
+        "0.02",
+        "--y-points",
+        "2",
+        "--transient",
+        "20",
+        "--record",
+        "6",
+        "--format",
+        "json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let cells = doc["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 6);
+    // u1 = −1.2 mm overlaps the left wall (gap 1 mm): not run.
+    assert!(cells[0].is_null() && cells[3].is_null());
+    assert_eq!(doc["inadmissible"], 2);
+    let fractions: f64 = doc["attractors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["fraction"].as_f64().unwrap())
+        .sum();
+    assert!((fractions - 1.0).abs() < 1e-12, "{doc}");
+    let csv = std::fs::read_to_string(out.join("basins.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 7);
+    assert!(csv.starts_with("u1,v1,attractor"));
+    assert!(out.join("basins.svg").is_file() && out.join("basins.png").is_file());
+    let base = [
+        "basins",
+        &row,
+        "--x-from",
+        "-1e-4",
+        "--x-to",
+        "1e-4",
+        "--x-points",
+        "2",
+        "--y-from",
+        "-0.01",
+        "--y-to",
+        "0.01",
+        "--y-points",
+        "2",
+    ];
+    for (extra, needle) in [
+        (&["--x", "u1", "--y", "u1"][..], "both u1"),
+        (&["--x", "w1", "--y", "v1"][..], "--x: component `w1`"),
+        (&["--x", "u1", "--y", "v3"][..], "--y: component `v3`"),
+        (
+            &["--x", "u1", "--y", "v1", "--base", "0,0,0"][..],
+            "--base: needs 4 values",
+        ),
+    ] {
+        assert_clean_error(&[&base[..], extra].concat(), needle);
     }
 }

@@ -14,10 +14,10 @@ use crate::sweep::{run_value, Direction, Settings, Start, SweepPoint};
 pub struct Run {
     /// The initial state `[u.., v..]` (m, m/s).
     pub start: Vec<f64>,
-    /// Period of the attractor in forcing periods: the number of distinct
-    /// Poincaré samples (clusters to the cluster tolerance, as a sweep
-    /// counts them) when at most half the recorded periods; null when the
-    /// samples do not repeat (quasi-periodic, chaotic, or not settled).
+    /// Period of the attractor in forcing periods: the smallest p, at most
+    /// half the recorded periods, with s_{k+p} = s_k (to the cluster
+    /// tolerance) for every pair of recorded Poincaré samples; null when
+    /// they do not repeat (quasi-periodic, chaotic, or not settled).
     pub period: Option<usize>,
     /// Impacts (all contacts) per forcing period.
     pub impacts_per_period: f64,
@@ -66,19 +66,23 @@ pub(crate) fn run_from(
         phase: 0,
     };
     let (point, _) = run_value(model, x, Direction::None, Some(start), settings);
-    classify(state, point, model.forcing_frequency().unwrap_or(1.0))
+    let omega = model.forcing_frequency().unwrap_or(1.0);
+    classify(state, point, omega, settings.cluster_tolerance)
 }
 
 /// A run's summary from its sweep point, with its samples.
-fn classify(start: Vec<f64>, point: SweepPoint, omega: f64) -> (Run, Recorded) {
+fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, Recorded) {
     if let Some(e) = point.error {
         return (Run::failed(start, e), Recorded::default());
     }
     let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
-    // The sweep's clusters of samples (to its tolerance): a period-n
-    // orbit leaves n of them.
-    let distinct = point.distinct_section_points;
-    let period = (distinct >= 1 && 2 * distinct <= point.recorded_periods).then_some(distinct);
+    let scale = (max_u, max_u * omega);
+    let s = &point.sections;
+    // Periodic: every sample equals the one p periods later (a slowly
+    // settling orbit, whose samples drift, is not: its greedy clusters
+    // could number a few).
+    let period = (1..=s.len() / 2)
+        .find(|&p| (0..s.len() - p).all(|k| same_sample(&s[k], &s[k + p], tol, scale)));
     let run = Run {
         start,
         period,
@@ -89,7 +93,7 @@ fn classify(start: Vec<f64>, point: SweepPoint, omega: f64) -> (Run, Recorded) {
     };
     let recorded = Recorded {
         samples: point.sections,
-        scale: (max_u, max_u * omega),
+        scale,
     };
     (run, recorded)
 }
@@ -105,58 +109,87 @@ fn same_sample(a: &[f64], b: &[f64], tol: f64, scale: (f64, f64)) -> bool {
     })
 }
 
-/// Whether two periodic runs reached the same attractor: their periods
-/// agree and the last sample of the first is among the last period of
-/// samples of the second (to `tol` of the larger scales). Non-periodic
-/// and failed runs are never the same as anything here.
+/// Whether two periodic runs reached the same attractor: every sample of
+/// the last cycle of each lies on the last cycle of the other (to `tol` of
+/// the larger scales). A run still spiralling into a fixed point with a
+/// third of a turn per period repeats every 3 periods while every sample
+/// lies on the fixed point: the same attractor as the settled run.
+/// Non-periodic and failed runs are never the same as anything here.
 pub(crate) fn same_attractor(a: (&Run, &Recorded), b: (&Run, &Recorded), tol: f64) -> bool {
     let (Some(p), Some(q)) = (a.0.period, b.0.period) else {
         return false;
     };
     let (s, o) = (&a.1.samples, &b.1.samples);
-    if p != q || s.is_empty() || o.len() < p {
+    if s.len() < p || o.len() < q {
         return false;
     }
     let scale = (a.1.scale.0.max(b.1.scale.0), a.1.scale.1.max(b.1.scale.1));
-    o[o.len() - p..]
-        .iter()
-        .any(|x| same_sample(&s[s.len() - 1], x, tol, scale))
+    let on = |x: &[f64], cycle: &[Vec<f64>]| cycle.iter().any(|y| same_sample(x, y, tol, scale));
+    let (ca, cb) = (&s[s.len() - p..], &o[o.len() - q..]);
+    ca.iter().all(|x| on(x, cb)) && cb.iter().all(|y| on(y, ca))
 }
 
 /// The attractor of every run: an index into the list of distinct
-/// attractors in order of first appearance (the representative run of
-/// each is returned too); all non-periodic runs share one index; failed
-/// runs get none.
+/// attractors (the representative run of each is returned too: of the
+/// shortest period among its runs). The periodic ones come first, in
+/// order of first appearance; a run that is
+/// not periodic over its window but whose last sample lies on one of them
+/// (a slowly settling transient) belongs to it; the other non-periodic
+/// runs share one index, last; failed runs get none.
 pub(crate) fn identify(
     runs: &[Run],
     recorded: &[Recorded],
     tol: f64,
 ) -> (Vec<Option<usize>>, Vec<usize>) {
     let mut reps: Vec<usize> = Vec::new();
-    let mut non_periodic: Option<usize> = None;
-    let ids = runs
-        .iter()
-        .enumerate()
-        .map(|(i, run)| {
-            if run.error.is_some() {
-                return None;
+    let mut ids: Vec<Option<usize>> = vec![None; runs.len()];
+    for (i, run) in runs.iter().enumerate() {
+        if run.error.is_some() || run.period.is_none() {
+            continue;
+        }
+        let found = reps
+            .iter()
+            .position(|&j| same_attractor((&runs[j], &recorded[j]), (run, &recorded[i]), tol));
+        ids[i] = Some(match found {
+            // The run of the shortest period represents the attractor.
+            Some(k) => {
+                if run.period < runs[reps[k]].period {
+                    reps[k] = i;
+                }
+                k
             }
-            if run.period.is_none() {
-                return Some(*non_periodic.get_or_insert_with(|| {
-                    reps.push(i);
-                    reps.len() - 1
-                }));
-            }
-            let found = reps.iter().position(|&j| {
-                same_attractor((&runs[j], &recorded[j]), (run, &recorded[i]), tol)
-                    || same_attractor((run, &recorded[i]), (&runs[j], &recorded[j]), tol)
-            });
-            Some(found.unwrap_or_else(|| {
+            None => {
                 reps.push(i);
                 reps.len() - 1
-            }))
-        })
-        .collect();
+            }
+        });
+    }
+    let periodic = reps.len();
+    for (i, run) in runs.iter().enumerate() {
+        if run.error.is_some() || run.period.is_some() {
+            continue;
+        }
+        let last = recorded[i].samples.last();
+        let on = (0..periodic).find(|&k| {
+            let (rep, rec) = (&runs[reps[k]], &recorded[reps[k]]);
+            let p = rep.period.unwrap_or(1);
+            let scale = (
+                rec.scale.0.max(recorded[i].scale.0),
+                rec.scale.1.max(recorded[i].scale.1),
+            );
+            last.is_some_and(|l| {
+                rec.samples[rec.samples.len() - p..]
+                    .iter()
+                    .any(|q| same_sample(l, q, tol, scale))
+            })
+        });
+        ids[i] = Some(on.unwrap_or_else(|| {
+            if reps.len() == periodic {
+                reps.push(i);
+            }
+            periodic
+        }));
+    }
     (ids, reps)
 }
 

@@ -24,6 +24,7 @@
 //! - [`attractor`]: the attractor a simulation reaches, and whether two
 //!   runs reached the same one;
 //! - [`chart`]: brute-force stability charts over two parameters;
+//! - [`basins`]: basins of attraction in a plane of initial states;
 //! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
 //! - [`parameter`]: a numeric key of a model file made a parameter;
 //! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
@@ -40,6 +41,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod attractor;
+pub mod basins;
 pub mod chart;
 pub mod contact;
 pub mod continuation;

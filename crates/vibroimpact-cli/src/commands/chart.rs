@@ -6,10 +6,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::chart::{chart, Chart, ChartCell, ChartOptions};
-use vibroimpact::sweep::{parameter_values, SweepOptions};
+use vibroimpact::sweep::SweepOptions;
 
-use crate::args::MethodName;
+use crate::args::{grid_axis, MethodName};
 use crate::error::CliError;
+use crate::figures::class_map;
 use crate::format::{CsvText, Format};
 use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
@@ -26,10 +27,10 @@ pub struct ChartArgs {
     #[arg(long)]
     x: String,
     /// First value of --x.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     x_from: f64,
     /// Last value of --x.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     x_to: f64,
     /// Number of --x values (>= 2), evenly spaced, both ends included.
     #[arg(long)]
@@ -38,10 +39,10 @@ pub struct ChartArgs {
     #[arg(long)]
     y: String,
     /// First value of --y.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     y_from: f64,
     /// Last value of --y.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     y_to: f64,
     /// Number of --y values (>= 2).
     #[arg(long)]
@@ -61,7 +62,7 @@ pub struct ChartArgs {
     /// about twice the cost).
     #[arg(long)]
     lyapunov: bool,
-    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-6).
+    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-7).
     #[arg(long)]
     rtol: Option<f64>,
     /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
@@ -154,55 +155,26 @@ fn chart_csv(chart: &Chart) -> Result<String, CliError> {
     w.finish()
 }
 
-/// Half the spacing of `values` around index `i` (the cell's extent).
-fn half_widths(values: &[f64], i: usize) -> (f64, f64) {
-    let step = |a: usize, b: usize| 0.5 * (values[b] - values[a]);
-    let left = if i > 0 {
-        step(i - 1, i)
-    } else {
-        step(i, i + 1)
-    };
-    let right = if i + 1 < values.len() {
-        step(i, i + 1)
-    } else {
-        step(i - 1, i)
-    };
-    (left, right)
-}
-
-/// The chart's figure: a rectangle per cell coloured by its class (runs of
-/// equal cells along a row merged), cells with coexisting attractors
-/// marked.
+/// The chart's figure: a rectangle per cell coloured by its class, cells
+/// with coexisting attractors marked.
 fn chart_figure(chart: &Chart) -> Figure {
-    let (xs, ys) = (&chart.x_values, &chart.y_values);
     let mut fig = Figure::new(
         "Attractor of the model's initial state",
         chart.x_name.clone(),
         chart.y_name.clone(),
     )
     .legend_at(LegendPosition::Best);
-    let mut rects: Vec<Vec<(f64, f64, f64, f64)>> = vec![Vec::new(); CLASSES.len()];
-    for (j, _) in ys.iter().enumerate() {
-        let row = &chart.cells[j * xs.len()..(j + 1) * xs.len()];
-        let (down, up) = half_widths(ys, j);
-        let mut i = 0;
-        while i < row.len() {
-            let c = class(&row[i]);
-            let mut k = i;
-            while k + 1 < row.len() && class(&row[k + 1]) == c {
-                k += 1;
-            }
-            let x0 = xs[i] - half_widths(xs, i).0;
-            let x1 = xs[k] + half_widths(xs, k).1;
-            rects[c].push((x0, ys[j] - down, x1, ys[j] + up));
-            i = k + 1;
-        }
-    }
-    for (c, r) in rects.into_iter().enumerate() {
-        if !r.is_empty() {
-            fig.push(Series::rectangles(CLASSES[c], r).with_color(c));
-        }
-    }
+    let classes: Vec<usize> = chart.cells.iter().map(class).collect();
+    let labels: Vec<String> = CLASSES.iter().map(|c| c.to_string()).collect();
+    let colors: Vec<usize> = (0..CLASSES.len()).collect();
+    class_map(
+        &mut fig,
+        &chart.x_values,
+        &chart.y_values,
+        &classes,
+        &labels,
+        &colors,
+    );
     let coexisting: Vec<(f64, f64)> = chart
         .cells
         .iter()
@@ -254,25 +226,10 @@ fn write_outputs(dir: &Path, chart: &Chart) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The values of one axis, checked.
-fn axis(name: &str, from: f64, to: f64, points: usize) -> Result<Vec<f64>, CliError> {
-    if !from.is_finite() || !to.is_finite() || from == to {
-        return Err(CliError::new(format!(
-            "--{name}-from {from} --{name}-to {to}: give a range of finite values"
-        )));
-    }
-    if !(2..=100_000).contains(&points) {
-        return Err(CliError::new(format!(
-            "--{name}-points {points}: from 2 to 100000"
-        )));
-    }
-    Ok(parameter_values(from, to, points))
-}
-
 /// Runs `vibroimpact chart`.
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
-    let xs = axis("x", args.x_from, args.x_to, args.x_points)?;
-    let ys = axis("y", args.y_from, args.y_to, args.y_points)?;
+    let xs = grid_axis("x", args.x_from, args.x_to, args.x_points)?;
+    let ys = grid_axis("y", args.y_from, args.y_to, args.y_points)?;
     if args.record < 1 {
         return Err(CliError::new("--record 0: record at least one period"));
     }

@@ -1,6 +1,7 @@
 //! The subcommands, one file each; none imports another (what several
 //! share lives in `args`, `format`, `measurements`, `plot`, …).
 
+pub mod basins;
 pub mod branch;
 pub mod chart;
 pub mod identify;

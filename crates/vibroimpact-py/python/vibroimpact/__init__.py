@@ -733,7 +733,7 @@ def chart(
     periods, then ``record`` periods; each run classified by the period of
     its attractor on the Poincaré section (None: not periodic), its impacts
     per period, its largest |u| and, with ``lyapunov``, its largest Lyapunov
-    exponent. Defaults as the CLI: ``rtol`` 1e-6 unless the model's
+    exponent. Defaults as the CLI: ``rtol`` 1e-7 unless the model's
     ``[simulation]`` gives one, ``cluster_tolerance`` 1e-3.
 
     Without ``client`` the cells run on this machine's cores (``threads``:

@@ -1,0 +1,232 @@
+//! `vibroimpact basins`: basins of attraction in a plane of initial states
+//! ([`vibroimpact::basins`]), their CSV, JSON, figure and table of
+//! attractors.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use vibroimpact::basins::{basins, Basins, Component};
+use vibroimpact::sweep::SweepOptions;
+
+use crate::args::{grid_axis, MethodName};
+use crate::error::CliError;
+use crate::figures::class_map;
+use crate::format::{CsvText, Format};
+use crate::model_io::read_model;
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition};
+
+/// Options of `vibroimpact basins`.
+#[derive(Args, Debug)]
+pub struct BasinsArgs {
+    /// Model file (TOML, see docs/model.md) with a periodic excitation.
+    model: PathBuf,
+    /// State component along the horizontal axis: u or v and a body number
+    /// (u1, v2, …).
+    #[arg(long)]
+    x: String,
+    /// First value of --x (m or m/s).
+    #[arg(long, allow_hyphen_values = true)]
+    x_from: f64,
+    /// Last value of --x.
+    #[arg(long, allow_hyphen_values = true)]
+    x_to: f64,
+    /// Number of --x values (>= 2).
+    #[arg(long)]
+    x_points: usize,
+    /// State component along the vertical axis (different from --x).
+    #[arg(long)]
+    y: String,
+    /// First value of --y.
+    #[arg(long, allow_hyphen_values = true)]
+    y_from: f64,
+    /// Last value of --y.
+    #[arg(long, allow_hyphen_values = true)]
+    y_to: f64,
+    /// Number of --y values (>= 2).
+    #[arg(long)]
+    y_points: usize,
+    /// The other components of the initial states, u then v, comma
+    /// separated (default: the model's initial state).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    base: Option<Vec<f64>>,
+    /// Forcing periods simulated and discarded before recording.
+    #[arg(long, default_value_t = 100)]
+    transient: usize,
+    /// Forcing periods recorded (one Poincaré sample at the end of each).
+    #[arg(long, default_value_t = 20)]
+    record: usize,
+    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-7).
+    #[arg(long)]
+    rtol: Option<f64>,
+    /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
+    #[arg(long)]
+    atol: Option<f64>,
+    /// Integration method.
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    method: MethodName,
+    /// Relative tolerance under which two Poincaré samples are the same
+    /// point (default 1e-3).
+    #[arg(long)]
+    cluster_tolerance: Option<f64>,
+    /// Output folder for basins.csv, basins.json and the figure; without it
+    /// only the table of attractors is printed.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Format on standard output: the table of attractors, the grid as CSV,
+    /// or the whole result as JSON.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// Legend text of attractor `k`.
+fn attractor_label(b: &Basins, k: usize) -> String {
+    let a = &b.attractors[k];
+    let kind = a
+        .period
+        .map_or("not periodic".to_string(), |p| format!("period {p}"));
+    format!(
+        "A{}: {kind}, {:.1} impacts/T ({:.1} %)",
+        k + 1,
+        a.impacts_per_period,
+        100.0 * a.fraction
+    )
+}
+
+/// basins.csv: one row per initial state.
+fn basins_csv(b: &Basins) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    w.row(&[
+        b.x_component.clone(),
+        b.y_component.clone(),
+        "attractor".into(),
+    ])?;
+    let nx = b.x_values.len();
+    for (k, cell) in b.cells.iter().enumerate() {
+        w.row(&[
+            format!("{:e}", b.x_values[k % nx]),
+            format!("{:e}", b.y_values[k / nx]),
+            cell.map_or(String::new(), |a| (a + 1).to_string()),
+        ])?;
+    }
+    w.finish()
+}
+
+/// The basins as coloured rectangles, grey where no attractor
+/// (overlapping or failed start).
+fn basins_figure(b: &Basins) -> Figure {
+    let unit = |c: &str| if c.starts_with('u') { "[m]" } else { "[m/s]" };
+    let mut fig = Figure::new(
+        "Basins of attraction",
+        format!("{} at t = 0  {}", b.x_component, unit(&b.x_component)),
+        format!("{} at t = 0  {}", b.y_component, unit(&b.y_component)),
+    )
+    .legend_at(LegendPosition::Best);
+    let none = b.attractors.len();
+    let classes: Vec<usize> = b.cells.iter().map(|c| c.unwrap_or(none)).collect();
+    let mut labels: Vec<String> = (0..none).map(|k| attractor_label(b, k)).collect();
+    labels.push("no attractor (overlap or failure)".into());
+    let mut colors: Vec<usize> = (0..none).map(|k| if k >= 7 { k + 1 } else { k }).collect();
+    colors.push(7);
+    class_map(
+        &mut fig,
+        &b.x_values,
+        &b.y_values,
+        &classes,
+        &labels,
+        &colors,
+    );
+    fig
+}
+
+/// Table of the attractors.
+fn table_text(b: &Basins) -> String {
+    let mut t = format!(
+        "{} × {} initial states ({} × {}), {} overlapping, {} failed\n",
+        b.x_values.len(),
+        b.y_values.len(),
+        b.x_component,
+        b.y_component,
+        b.inadmissible,
+        b.failed
+    );
+    for k in 0..b.attractors.len() {
+        let a = &b.attractors[k];
+        t.push_str(&format!(
+            "{}  {} states, max|u| {:.4e} m\n",
+            attractor_label(b, k),
+            a.cells,
+            a.max_displacement
+        ));
+    }
+    for e in &b.errors {
+        t.push_str(&format!("failed {e}\n"));
+    }
+    t
+}
+
+/// Writes basins.csv, basins.json and the figure into `dir`.
+fn write_outputs(dir: &Path, b: &Basins) -> Result<(), CliError> {
+    ensure_dir(dir)?;
+    write_atomic(&dir.join("basins.csv"), basins_csv(b)?.as_bytes())?;
+    write_atomic(
+        &dir.join("basins.json"),
+        serde_json::to_string_pretty(b)?.as_bytes(),
+    )?;
+    render(&basins_figure(b), &dir.join("basins"))?;
+    Ok(())
+}
+
+/// Runs `vibroimpact basins`.
+pub fn run(args: &BasinsArgs) -> Result<(), CliError> {
+    let xs = grid_axis("x", args.x_from, args.x_to, args.x_points)?;
+    let ys = grid_axis("y", args.y_from, args.y_to, args.y_points)?;
+    let loaded = read_model(&args.model)?;
+    let n = loaded.model.bodies().len();
+    let parse = |flag: &str, text: &str| {
+        Component::parse(text, n).map_err(|e| CliError::new(format!("--{flag}: {e}")))
+    };
+    let (cx, cy) = (parse("x", &args.x)?, parse("y", &args.y)?);
+    let interrupt = crate::interrupt::on_ctrl_c();
+    let options = SweepOptions {
+        transient: args.transient,
+        record: args.record,
+        rtol: args.rtol,
+        atol: args.atol,
+        method: args.method.method(),
+        cluster_tolerance: args.cluster_tolerance,
+        interrupt: Some(interrupt.clone()),
+        ..SweepOptions::default()
+    };
+    let progress = crate::progress::bar(xs.len() * ys.len(), "states").with_prefix("basins");
+    let result = basins(
+        &loaded,
+        (cx, &xs),
+        (cy, &ys),
+        args.base.as_deref(),
+        &options,
+        &|| progress.inc(1),
+    )
+    .map_err(|e| {
+        CliError::new(
+            e.to_string()
+                .replace("base state:", "--base:")
+                .replace("cluster_tolerance =", "--cluster-tolerance ="),
+        )
+    })?;
+    progress.finish_and_clear();
+    if interrupt.requested() {
+        return Err(CliError::new(
+            "interrupted (Ctrl-C): nothing written (basins are written whole)",
+        ));
+    }
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &result)?;
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&result)?),
+        Format::Csv => print!("{}", basins_csv(&result)?),
+        Format::Table => print!("{}", table_text(&result)),
+    }
+    Ok(())
+}
