@@ -482,10 +482,15 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 /// complex pair can turn by any angle, without coming near a crossing (on
 /// R2 N = 2 the largest multiplier grows from 1 to 600 and back within
 /// 0.05 ω0 while a pair at modulus 0.85 turns quickly; a distance in the
-/// complex plane resolved both with ~100 points). Of spectra of different
-/// sizes (dominant multipliers from Arnoldi iterations that ended at
-/// different dimensions) the common number of dominant ones is compared;
-/// an empty one is infinitely far from any other.
+/// complex plane resolved both with ~100 points). Spectra of different
+/// sizes (the Ritz values of two Arnoldi iterations that ended at
+/// different dimensions, which can resolve 4 or 8 multipliers of one
+/// cluster) are compared by the
+/// Hausdorff distance of their clamped log-moduli: every multiplier of
+/// one near some multiplier of the other (R2 N = 100 at 0.6445 ω0: the
+/// positions of the sorted lists compared a resolved 0.881 with 0.097
+/// and refused every step); an empty one is infinitely far from any
+/// other.
 pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
     if a.is_empty() != b.is_empty() {
         return f64::INFINITY;
@@ -498,10 +503,16 @@ pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
         m.sort_by(|x, y| y.total_cmp(x));
         m
     };
-    log_moduli(a)
-        .iter()
-        .zip(&log_moduli(b))
-        .fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+    let (a, b) = (log_moduli(a), log_moduli(b));
+    if a.len() == b.len() {
+        return a.iter().zip(&b).fold(0.0, |m, (x, y)| m.max((x - y).abs()));
+    }
+    let directed = |from: &[f64], to: &[f64]| {
+        from.iter().fold(0.0f64, |m, x| {
+            m.max(to.iter().fold(f64::INFINITY, |n, y| n.min((x - y).abs())))
+        })
+    };
+    directed(&a, &b).max(directed(&b, &a))
 }
 
 /// Modulus beyond which [`spectral_distance`] sees no change of a

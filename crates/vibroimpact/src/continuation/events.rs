@@ -25,8 +25,9 @@ pub struct TestValues {
     pub det_pd: f64,
     /// Multipliers outside the unit circle.
     pub outside: usize,
-    /// Π (|μ| − 1) over the complex multipliers with Im μ > 0: changes sign
-    /// when a complex pair crosses the unit circle (1 without such pairs).
+    /// Π (1 − |μ|) over the complex multipliers with Im μ > 0: changes sign
+    /// when a complex pair crosses the unit circle, and not when a pair is
+    /// born inside it (1 without such pairs).
     pub complex_margin: f64,
     /// Impacts per period.
     pub impacts: usize,
@@ -40,11 +41,13 @@ pub struct TestValues {
 impl TestValues {
     /// The test values from dominant eigenvalues (matrix-free
     /// continuation): `map_eigenvalues` of Φ (or DG of the half map),
-    /// `multipliers` those of Φ. det(Ĵ_x) = Π(λ − 1) over the map's
+    /// `multipliers` those of Φ. det(−Ĵ_x) = Π(1 − λ) over the map's
     /// eigenvalues, and det [J; t] = det(Ĵ_x) / t_p for a unit tangent;
     /// likewise det(DG + I) and det(Φ + I) as products over the dominant
-    /// eigenvalues. The factors of the others keep their sign as long as
-    /// they stay inside the unit circle, so the sign changes are the same.
+    /// eigenvalues. A factor 1 − λ (or 1 + λ) of a real eigenvalue inside
+    /// the circle, or of a complex pair, is positive: the sign changes only
+    /// where an eigenvalue crosses 1 (or −1), and not where the set of
+    /// converged Ritz values gains or loses an eigenvalue inside the circle.
     pub(super) fn from_spectrum(
         tangent_p: f64,
         map_eigenvalues: &[Complex<f64>],
@@ -52,11 +55,8 @@ impl TestValues {
         symmetric: bool,
     ) -> TestValues {
         let one = Complex::new(1.0, 0.0);
-        let product = |s: &[Complex<f64>], shift: f64| {
-            s.iter()
-                .fold(one, |acc, l| acc * (l + Complex::new(shift, 0.0)))
-                .re
-        };
+        let product =
+            |s: &[Complex<f64>], sign: f64| s.iter().fold(one, |acc, l| acc * (one + l * sign)).re;
         TestValues {
             tangent_p,
             det_ext: product(map_eigenvalues, -1.0) / tangent_p,
@@ -119,7 +119,7 @@ impl TestValues {
             complex_margin: multipliers
                 .iter()
                 .filter(|m| m.im > 0.0)
-                .map(|m| m.norm() - 1.0)
+                .map(|m| 1.0 - m.norm())
                 .product(),
             impacts,
             grazing_margin: f64::NAN,
@@ -176,7 +176,7 @@ impl BranchEvent for SpecialKind {
     /// Folds: the tangent's parameter component; branch points: det(DG + I)
     /// of the half map where it changes sign, else det [J; t]; period
     /// doublings: det(Φ + I); Neimark–Sacker points: the product of
-    /// |μ| − 1 over the complex pairs; grazings: the impact margin of the
+    /// 1 − |μ| over the complex pairs; grazings: the impact margin of the
     /// contact nearest to grazing (the count decides the bracket; an
     /// impact that splits in two does not change the margin's sign, and
     /// the location falls back to bisection).
