@@ -28,9 +28,13 @@ fn attractors_of_samples() {
         error: None,
     };
     // The same period-2 orbit at the other phase, a different fixed
-    // point, and two non-periodic runs: four attractors.
+    // point, and two non-periodic runs: four attractors; a non-periodic
+    // run that ends on the fixed point (still settling) belongs to it.
     let shifted: Vec<Vec<f64>> = period2[1..].to_vec();
     let other: Vec<Vec<f64>> = (0..10).map(|_| s(0.3)).collect();
+    let wandering: Vec<Vec<f64>> = (0..10).map(|k| s(2.0 + 0.1 * k as f64)).collect();
+    let mut settling = wandering.clone();
+    settling.push(s(0.3));
     let runs = [
         run(Some(2)),
         run(Some(2)),
@@ -38,15 +42,26 @@ fn attractors_of_samples() {
         run(Some(1)),
         run(None),
         run(None),
+        run(None),
     ];
-    let samples: Vec<Recorded> = [period2, shifted, fixed, other.clone(), other.clone(), other]
-        .into_iter()
-        .map(|samples| Recorded {
-            samples,
-            scale: (1.0, 1.0),
-        })
-        .collect();
+    let samples: Vec<Recorded> = [
+        period2,
+        shifted,
+        fixed,
+        other,
+        wandering.clone(),
+        wandering,
+        settling,
+    ]
+    .into_iter()
+    .map(|samples| Recorded {
+        samples,
+        scale: (1.0, 1.0),
+    })
+    .collect();
     assert_eq!(count_attractors(&runs, &samples, 1e-6), 4);
+    let (ids, _) = crate::attractor::identify(&runs, &samples, 1e-6);
+    assert_eq!(ids, [0, 0, 1, 2, 3, 3, 2].map(Some));
     assert_eq!(count_attractors(&runs[..2], &samples[..2], 1e-6), 1);
     assert_eq!(count_attractors(&runs[2..4], &samples[2..4], 1e-6), 2);
     // Within a tolerance of 0.8 the two fixed points are one.

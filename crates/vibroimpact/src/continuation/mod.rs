@@ -39,9 +39,12 @@
 //! - `events`: test values, the event trait, location;
 //! - `branch`: the [`Continuation`] iterator over the steps of a branch;
 //! - `switching`: starts on crossing and period-doubled branches;
+//! - `curve`: two-parameter curves of folds, period doublings and
+//!   symmetry-breaking points ([`continue_curve`]);
 //! - [`continue_branch`]: the iterator collected into a [`Branch`].
 
 mod branch;
+mod curve;
 mod events;
 mod krylov;
 mod problem;
@@ -51,6 +54,7 @@ mod switching;
 mod tests;
 
 pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
+pub use curve::{continue_curve, Curve, CurveKind, CurveOptions, CurvePoint, CurveStop};
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
 pub use switching::{
