@@ -5,6 +5,7 @@
 
 mod args;
 mod commands;
+mod curves;
 mod data;
 mod error;
 mod figures;

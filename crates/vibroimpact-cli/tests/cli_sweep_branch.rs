@@ -919,3 +919,87 @@ fn basins_grid_outputs_and_bad_input() {
         assert_clean_error(&[&base[..], extra].concat(), needle);
     }
 }
+
+/// `continue --parameter2`: on R2 N = 1 the two folds and the symmetry-
+/// breaking points are continued in (frequency, amplitude): the fold
+/// curves start at the branch's folds at the model's amplitude, the two
+/// branch points lie on one closed curve (followed once); curves.json and
+/// the figure are written; the same key twice and an unknown curve kind
+/// are refused.
+#[test]
+fn continue_two_parameter_curves() {
+    let dir = temp_dir("curves");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row-n2.toml"))
+        .unwrap()
+        .replace("count = 2", "count = 1");
+    let model = write_model(&dir, "n1.toml", &text);
+    let out = dir.join("c");
+    let doc = json(&[
+        "continue",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "3.705",
+        "--to",
+        "11.115",
+        "--parameter2",
+        "amplitude",
+        "--from2",
+        "0.001",
+        "--to2",
+        "0.1",
+        "--format",
+        "json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let special = doc["special_points"].as_array().unwrap();
+    let curves = doc["curves"].as_array().unwrap();
+    let kinds: Vec<&str> = curves.iter().map(|c| c["kind"].as_str().unwrap()).collect();
+    assert_eq!(
+        kinds,
+        ["fold", "fold", "fold", "fold", "branch-point"],
+        "{kinds:?}"
+    );
+    assert_eq!(curves[4]["stop"], "closed");
+    for c in &curves[..4] {
+        let label = c["from"].as_str().unwrap();
+        let s = special.iter().find(|s| s["label"] == label).unwrap();
+        let first = &c["points"][0];
+        let p = s["parameter"].as_f64().unwrap();
+        assert!(
+            (first["frequency"].as_f64().unwrap() - p).abs() < 1e-6 * p,
+            "{first} vs {s}"
+        );
+        assert_eq!(first["amplitude"].as_f64().unwrap(), 0.05);
+        assert_eq!(c["stop"], "left-bounds");
+    }
+    assert!(out.join("curves.json").is_file() && out.join("curves.svg").is_file());
+    let base = [
+        "continue",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "3.705",
+        "--to",
+        "11.115",
+    ];
+    for (extra, needle) in [
+        (
+            &["--parameter2", "excitation.frequency"][..],
+            "the same key",
+        ),
+        (
+            &["--parameter2", "amplitude", "--curves", "ns"][..],
+            "--curves ns",
+        ),
+        (
+            &["--parameter2", "amplitude", "--from2", "0.06"][..],
+            "--from2 0.06",
+        ),
+    ] {
+        assert_clean_error(&[&base[..], extra].concat(), needle);
+    }
+}

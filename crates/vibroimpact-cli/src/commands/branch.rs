@@ -18,6 +18,7 @@ use vibroimpact::periodic::{
 };
 
 use crate::args::{LinearAlgebra, ParameterRange, StartMethod};
+use crate::curves::{self, SecondParameter};
 use crate::error::CliError;
 use crate::figures::branch_figure;
 use crate::format::{history_csv, CsvText, Format, SummaryFormat};
@@ -311,6 +312,8 @@ pub struct ContinueArgs {
     /// How the first periodic orbit is found.
     #[arg(long, value_enum, default_value_t = StartMethod::Auto)]
     start: StartMethod,
+    #[command(flatten)]
+    second: SecondParameter,
     /// Periods simulated for the start guess.
     #[arg(long, default_value_t = 200.0)]
     guess_periods: f64,
@@ -426,6 +429,7 @@ fn print_branches(
     args: &ContinueArgs,
     branches: &[Branch],
     start_model: &Model,
+    curves: Option<serde_json::Value>,
 ) -> Result<(), CliError> {
     let docs: Vec<serde_json::Value> = branches
         .iter()
@@ -433,13 +437,13 @@ fn print_branches(
         .collect();
     match args.format {
         Format::Json => {
-            let doc = if docs.len() == 1 {
-                docs[0].clone()
-            } else {
-                let mut first = docs[0].clone();
-                first["switched_branch"] = docs[1].clone();
-                first
-            };
+            let mut doc = docs[0].clone();
+            if docs.len() > 1 {
+                doc["switched_branch"] = docs[1].clone();
+            }
+            if let Some(c) = curves {
+                doc["curves"] = c["curves"].clone();
+            }
             println!("{}", serde_json::to_string_pretty(&doc)?);
         }
         Format::Csv => {
@@ -475,6 +479,7 @@ fn print_branches(
 /// Runs `vibroimpact continue`.
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let (pm, start_model) = continuation_family(args)?;
+    let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
     let interrupt = crate::interrupt::on_ctrl_c();
     let opts = ContinuationOptions {
         max_points: args.max_points,
@@ -555,6 +560,20 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         }
     }
     bar.finish_and_clear();
+    let curves = match &second {
+        Some(q) => Some(curves::curves(
+            &pm.document,
+            (&pm.parameter, q),
+            &branches[0],
+            (args.range.from, args.range.to),
+            &args.second,
+            &opts.shooting,
+        )?),
+        None => None,
+    };
+    if let (Some(dir), Some(c), Some(q)) = (&args.out, &curves, &second) {
+        curves::write_curves(dir, c, &args.range.parameter, &q.name)?;
+    }
     if let Some(dir) = &args.out {
         for (b, stem) in branches.iter().zip(["branch", "switched_branch"]) {
             write_branch(
@@ -568,7 +587,21 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             )?;
         }
     }
-    print_branches(args, &branches, &start_model)?;
+    let curves_doc = curves
+        .as_ref()
+        .zip(second.as_ref())
+        .map(|(c, q)| curves::curves_document(c, &args.range.parameter, &q.name));
+    if let (Format::Table, Some(c)) = (args.format, &curves) {
+        for (label, curve) in c {
+            println!(
+                "{} curve from {label}: {} points ({:?})",
+                curve.kind.name(),
+                curve.points.len(),
+                curve.stop
+            );
+        }
+    }
+    print_branches(args, &branches, &start_model, curves_doc)?;
     if let Some(e) = switch_error {
         return Err(e);
     }

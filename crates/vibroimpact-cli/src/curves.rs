@@ -1,0 +1,209 @@
+//! `continue --parameter2`: the two-parameter curves through the special
+//! points of a one-parameter branch ([`vibroimpact::continuation::continue_curve`]),
+//! their JSON and figure.
+
+use std::path::Path;
+
+use clap::Args;
+use serde_json::{json, Value};
+use vibroimpact::continuation::{
+    continue_curve, Branch, Curve, CurveKind, CurveOptions, CurveStop, SpecialKind,
+};
+use vibroimpact::model_file::ModelDocument;
+use vibroimpact::parameter::ModelParameter;
+use vibroimpact::periodic::ShootingOptions;
+
+use crate::error::CliError;
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition, Series};
+
+/// The second parameter of `continue` and the curves to follow.
+#[derive(Args, Debug)]
+pub struct SecondParameter {
+    /// A second parameter: continue every fold, branch point and period
+    /// doubling of the branch (or those of --curves) as a curve in both
+    /// parameters (`curves.json`, figure `curves`).
+    #[arg(long)]
+    pub parameter2: Option<String>,
+    /// Lower bound of the second parameter (default: 0, or half its value
+    /// if negative).
+    #[arg(long, allow_hyphen_values = true)]
+    pub from2: Option<f64>,
+    /// Upper bound of the second parameter (default: twice its value).
+    #[arg(long, allow_hyphen_values = true)]
+    pub to2: Option<f64>,
+    /// Kinds of special points to continue, comma separated: fold, bp, pd.
+    #[arg(long, value_delimiter = ',', default_value = "fold,bp,pd")]
+    pub curves: Vec<String>,
+}
+
+/// The curve kind of a special point, if one is followed.
+fn kind_of(kind: SpecialKind, symmetry_breaking: bool, wanted: &[String]) -> Option<CurveKind> {
+    let (k, name) = match kind {
+        SpecialKind::Fold => (CurveKind::Fold, "fold"),
+        SpecialKind::BranchPoint if symmetry_breaking => (CurveKind::BranchPoint, "bp"),
+        SpecialKind::PeriodDoubling => (CurveKind::PeriodDoubling, "pd"),
+        _ => return None,
+    };
+    wanted.iter().any(|w| w == name).then_some(k)
+}
+
+/// Checks --curves and --parameter2 against the first parameter.
+pub fn validate(
+    second: &SecondParameter,
+    document: &ModelDocument,
+    first: &ModelParameter,
+) -> Result<Option<ModelParameter>, CliError> {
+    for c in &second.curves {
+        if !["fold", "bp", "pd"].contains(&c.as_str()) {
+            return Err(CliError::new(format!(
+                "--curves {c}: give fold, bp or pd (Neimark–Sacker and grazing curves are not continued yet)"
+            )));
+        }
+    }
+    let Some(name) = &second.parameter2 else {
+        return Ok(None);
+    };
+    let q = document.parameter(name)?;
+    if q.key == first.key {
+        return Err(CliError::new(format!(
+            "--parameter2 {name}: the same key as --parameter {}; give another",
+            first.name
+        )));
+    }
+    Ok(Some(q))
+}
+
+/// Every curve through the wanted special points of `branch` (both
+/// directions from each), within `[from, to]` of the first parameter and the
+/// second parameter's bounds.
+pub fn curves(
+    document: &ModelDocument,
+    (p, q): (&ModelParameter, &ModelParameter),
+    branch: &Branch,
+    (from, to): (f64, f64),
+    second: &SecondParameter,
+    shooting: &ShootingOptions,
+) -> Result<Vec<(String, Curve)>, CliError> {
+    let q0 = q.initial;
+    let lo = second
+        .from2
+        .unwrap_or(if q0 >= 0.0 { 0.0 } else { 2.0 * q0 });
+    let hi = second
+        .to2
+        .unwrap_or(if q0 >= 0.0 { 2.0 * q0 } else { 0.5 * q0 });
+    if !(lo < hi && lo <= q0 && q0 <= hi) {
+        return Err(CliError::new(format!(
+            "--from2 {lo} --to2 {hi}: a range around the model's {} = {q0}",
+            q.name
+        )));
+    }
+    let opts = CurveOptions {
+        shooting: ShootingOptions {
+            symmetric: branch.symmetric,
+            ..shooting.clone()
+        },
+        bounds: [(from.min(to), from.max(to)), (lo, hi)],
+        ..CurveOptions::default()
+    };
+    let mut out: Vec<(String, Curve)> = Vec::new();
+    for s in &branch.special {
+        let Some(kind) = kind_of(s.kind, s.symmetry_breaking, &second.curves) else {
+            continue;
+        };
+        // A special point that a curve already passed (both BPs of R2 N = 1
+        // lie on one closed curve) is not followed again.
+        if out
+            .iter()
+            .any(|(_, c)| c.kind == kind && passes(c, s.parameter, q0))
+        {
+            continue;
+        }
+        for direction in [1.0, -1.0] {
+            let family = |pv: f64, qv: f64| {
+                let mut doc = document.clone();
+                doc.set(q, qv).map_err(|e| e.to_string())?;
+                Ok(doc.with_parameter(p, pv).map_err(|e| e.to_string())?.model)
+            };
+            let curve = continue_curve(family, kind, (&s.state, s.parameter, q0), direction, &opts)
+                .map_err(|e| {
+                    CliError::new(format!("the {} curve from {}: {e}", kind.name(), s.label))
+                })?;
+            let closed = curve.stop == CurveStop::Closed;
+            out.push((s.label.clone(), curve));
+            if closed {
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Whether the curve crosses the second parameter's value `q0` at the
+/// first parameter `p0` (to 1e-4 relative, between consecutive points).
+fn passes(curve: &Curve, p0: f64, q0: f64) -> bool {
+    curve.points.windows(2).any(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        if (a.q - q0) * (b.q - q0) > 0.0 || a.q == b.q {
+            return false;
+        }
+        let p = a.p + (q0 - a.q) / (b.q - a.q) * (b.p - a.p);
+        (p - p0).abs() <= 1e-4 * p0.abs().max(1e-300)
+    })
+}
+
+/// The `curves` document: each curve with its kind, start label, stop and
+/// points (both parameters, max |u| per body, multipliers).
+pub fn curves_document(curves: &[(String, Curve)], p: &str, q: &str) -> Value {
+    let list: Vec<Value> = curves
+        .iter()
+        .map(|(label, c)| {
+            json!({
+                "kind": c.kind.name(),
+                "from": label,
+                "stop": c.stop,
+                "points": c.points.iter().map(|pt| json!({
+                    p: pt.p,
+                    q: pt.q,
+                    "max_displacement": pt.max_displacement,
+                    "floquet_multipliers": pt.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+                    "initial_state": pt.state,
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    json!({ "parameter": p, "parameter2": q, "curves": list })
+}
+
+/// Writes curves.json and the figure of the curves in the parameter plane.
+pub fn write_curves(
+    dir: &Path,
+    curves: &[(String, Curve)],
+    p: &str,
+    q: &str,
+) -> Result<(), CliError> {
+    ensure_dir(dir)?;
+    let doc = curves_document(curves, p, q);
+    write_atomic(
+        &dir.join("curves.json"),
+        serde_json::to_string_pretty(&doc)?.as_bytes(),
+    )?;
+    let mut fig = Figure::new("Curves of special points", p, q).legend_at(LegendPosition::Best);
+    let mut labelled = Vec::new();
+    for (_, c) in curves {
+        let color = match c.kind {
+            CurveKind::Fold => 0,
+            CurveKind::BranchPoint => 1,
+            CurveKind::PeriodDoubling => 2,
+        };
+        let label = if labelled.contains(&color) {
+            ""
+        } else {
+            c.kind.name()
+        };
+        labelled.push(color);
+        fig.push(Series::line(label, c.points.iter().map(|pt| (pt.p, pt.q))).with_color(color));
+    }
+    render(&fig, &dir.join("curves"))?;
+    Ok(())
+}
