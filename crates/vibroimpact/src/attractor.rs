@@ -82,7 +82,8 @@ fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, R
     // settling orbit, whose samples drift, is not: its greedy clusters
     // could number a few).
     let period = (1..=s.len() / 2)
-        .find(|&p| (0..s.len() - p).all(|k| same_sample(&s[k], &s[k + p], tol, scale)));
+        .find(|&p| (0..s.len() - p).all(|k| same_sample(&s[k], &s[k + p], tol, scale)))
+        .filter(|&p| p == 1 || !settling(s, scale));
     let run = Run {
         start,
         period,
@@ -96,6 +97,26 @@ fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, R
         scale,
     };
     (run, recorded)
+}
+
+/// Whether the samples still spiral into a fixed point: the steps between
+/// consecutive samples shrink by more than half from the first quarter of
+/// the window to the last. A lightly damped free oscillation sampled once
+/// per forcing period turns by 2π ω0/Ω a sample, so a residual near the
+/// cluster tolerance repeats every few samples (R2 N = 2 at Ω = 10 rad/s
+/// after 100 periods: "period 4"); a period-p orbit's steps repeat with
+/// period p and do not shrink.
+fn settling(s: &[Vec<f64>], scale: (f64, f64)) -> bool {
+    let n = s[0].len() / 2;
+    let step = |k: usize| {
+        (0..2 * n).fold(0.0f64, |m, i| {
+            let sc = if i < n { scale.0 } else { scale.1 };
+            m.max((s[k + 1][i] - s[k][i]).abs() / sc.max(f64::MIN_POSITIVE))
+        })
+    };
+    let q = ((s.len() - 1) / 4).max(1);
+    let mean = |ks: std::ops::Range<usize>| ks.clone().map(step).sum::<f64>() / ks.len() as f64;
+    mean(s.len() - 1 - q..s.len() - 1) < 0.5 * mean(0..q)
 }
 
 /// Whether two Poincaré samples are equal: every displacement within

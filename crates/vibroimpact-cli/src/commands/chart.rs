@@ -94,7 +94,7 @@ const CLASSES: [&str; 8] = [
     "period 3",
     "period 4",
     "period ≥ 5",
-    "non-periodic",
+    "not periodic (or settling)",
     "chaotic (λ1 > 0)",
     "failed",
 ];
