@@ -65,6 +65,9 @@ impl Component {
     }
 }
 
+/// One axis of the plane of initial states: the component and its values.
+pub type Axis<'a> = (Component, &'a [f64]);
+
 /// One attractor found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Attractor {
@@ -130,8 +133,8 @@ pub struct BasinError(pub String);
 /// is called after every initial state.
 pub fn basins(
     loaded: &LoadedModel,
-    x: (Component, &[f64]),
-    y: (Component, &[f64]),
+    x: Axis<'_>,
+    y: Axis<'_>,
     base: Option<&[f64]>,
     options: &SweepOptions,
     progress: &(dyn Fn() + Sync),
@@ -234,7 +237,7 @@ pub fn basins(
 /// The result from the runs of the admissible states and their attractor
 /// indices.
 fn summarise(
-    (x, y): ((Component, &[f64]), (Component, &[f64])),
+    (x, y): (Axis<'_>, Axis<'_>),
     base_state: Vec<f64>,
     options: &SweepOptions,
     (runs, recorded, ids, reps): (Vec<Run>, Vec<Recorded>, Vec<Option<usize>>, Vec<usize>),
