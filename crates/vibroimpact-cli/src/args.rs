@@ -116,3 +116,89 @@ pub fn grid_axis(name: &str, from: f64, to: f64, points: usize) -> Result<Vec<f6
     }
     Ok(vibroimpact::sweep::parameter_values(from, to, points))
 }
+
+/// The grid of `chart` (two parameters) and `basins` (two state
+/// components): a name and an evenly spaced range per axis.
+#[derive(Args, Debug)]
+pub struct GridAxes {
+    /// What varies along the horizontal axis: a model parameter
+    /// (`frequency`, `amplitude`, a dotted key) for `chart`, a state
+    /// component (u1, v2, …) for `basins`.
+    #[arg(long)]
+    pub x: String,
+    /// First value of --x.
+    #[arg(long, allow_hyphen_values = true)]
+    pub x_from: f64,
+    /// Last value of --x.
+    #[arg(long, allow_hyphen_values = true)]
+    pub x_to: f64,
+    /// Number of --x values (2 to 100000), evenly spaced, both ends included.
+    #[arg(long)]
+    pub x_points: usize,
+    /// What varies along the vertical axis (different from --x).
+    #[arg(long)]
+    pub y: String,
+    /// First value of --y.
+    #[arg(long, allow_hyphen_values = true)]
+    pub y_from: f64,
+    /// Last value of --y.
+    #[arg(long, allow_hyphen_values = true)]
+    pub y_to: f64,
+    /// Number of --y values (2 to 100000).
+    #[arg(long)]
+    pub y_points: usize,
+}
+
+impl GridAxes {
+    /// The values of both axes, checked.
+    pub fn values(&self) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+        Ok((
+            grid_axis("x", self.x_from, self.x_to, self.x_points)?,
+            grid_axis("y", self.y_from, self.y_to, self.y_points)?,
+        ))
+    }
+}
+
+/// How every cell of `chart` or start of `basins` is run to its attractor.
+#[derive(Args, Debug)]
+pub struct AttractorRuns {
+    /// Forcing periods simulated and discarded before recording.
+    #[arg(long, default_value_t = 100)]
+    pub transient: usize,
+    /// Forcing periods recorded (one Poincaré sample at the end of each).
+    #[arg(long, default_value_t = 20)]
+    pub record: usize,
+    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-7).
+    #[arg(long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
+    #[arg(long)]
+    pub atol: Option<f64>,
+    /// Integration method.
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    pub method: MethodName,
+    /// Relative tolerance under which two Poincaré samples are the same
+    /// point (default 1e-3: 100 transient periods leave up to ~4e-3 of a
+    /// lightly damped free oscillation).
+    #[arg(long)]
+    pub cluster_tolerance: Option<f64>,
+}
+
+impl AttractorRuns {
+    /// The sweep options of these settings.
+    pub fn options(
+        &self,
+        interrupt: vibroimpact::integrate::Interrupt,
+    ) -> vibroimpact::sweep::SweepOptions {
+        vibroimpact::sweep::SweepOptions {
+            transient: self.transient,
+            record: self.record,
+            rtol: self.rtol,
+            atol: self.atol,
+            method: self.method.method(),
+            cluster_tolerance: self.cluster_tolerance,
+            interrupt: Some(interrupt),
+            ..vibroimpact::sweep::SweepOptions::default()
+        }
+    }
+}

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::basins::{basins, Basins, Component};
-use vibroimpact::sweep::SweepOptions;
 
-use crate::args::{grid_axis, MethodName};
+use crate::args::{AttractorRuns, GridAxes};
 use crate::error::CliError;
 use crate::figures::class_map;
 use crate::format::{CsvText, Format};
@@ -21,54 +20,14 @@ use crate::plot::{render, Figure, LegendPosition};
 pub struct BasinsArgs {
     /// Model file (TOML, see docs/model.md) with a periodic excitation.
     model: PathBuf,
-    /// State component along the horizontal axis: u or v and a body number
-    /// (u1, v2, …).
-    #[arg(long)]
-    x: String,
-    /// First value of --x (m or m/s).
-    #[arg(long, allow_hyphen_values = true)]
-    x_from: f64,
-    /// Last value of --x.
-    #[arg(long, allow_hyphen_values = true)]
-    x_to: f64,
-    /// Number of --x values (>= 2).
-    #[arg(long)]
-    x_points: usize,
-    /// State component along the vertical axis (different from --x).
-    #[arg(long)]
-    y: String,
-    /// First value of --y.
-    #[arg(long, allow_hyphen_values = true)]
-    y_from: f64,
-    /// Last value of --y.
-    #[arg(long, allow_hyphen_values = true)]
-    y_to: f64,
-    /// Number of --y values (>= 2).
-    #[arg(long)]
-    y_points: usize,
+    #[command(flatten)]
+    grid: GridAxes,
     /// The other components of the initial states, u then v, comma
     /// separated (default: the model's initial state).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     base: Option<Vec<f64>>,
-    /// Forcing periods simulated and discarded before recording.
-    #[arg(long, default_value_t = 100)]
-    transient: usize,
-    /// Forcing periods recorded (one Poincaré sample at the end of each).
-    #[arg(long, default_value_t = 20)]
-    record: usize,
-    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-7).
-    #[arg(long)]
-    rtol: Option<f64>,
-    /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
-    #[arg(long)]
-    atol: Option<f64>,
-    /// Integration method.
-    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
-    method: MethodName,
-    /// Relative tolerance under which two Poincaré samples are the same
-    /// point (default 1e-3).
-    #[arg(long)]
-    cluster_tolerance: Option<f64>,
+    #[command(flatten)]
+    runs: AttractorRuns,
     /// Output folder for basins.csv, basins.json and the figure; without it
     /// only the table of attractors is printed.
     #[arg(long)]
@@ -179,25 +138,15 @@ fn write_outputs(dir: &Path, b: &Basins) -> Result<(), CliError> {
 
 /// Runs `vibroimpact basins`.
 pub fn run(args: &BasinsArgs) -> Result<(), CliError> {
-    let xs = grid_axis("x", args.x_from, args.x_to, args.x_points)?;
-    let ys = grid_axis("y", args.y_from, args.y_to, args.y_points)?;
+    let (xs, ys) = args.grid.values()?;
     let loaded = read_model(&args.model)?;
     let n = loaded.model.bodies().len();
     let parse = |flag: &str, text: &str| {
         Component::parse(text, n).map_err(|e| CliError::new(format!("--{flag}: {e}")))
     };
-    let (cx, cy) = (parse("x", &args.x)?, parse("y", &args.y)?);
+    let (cx, cy) = (parse("x", &args.grid.x)?, parse("y", &args.grid.y)?);
     let interrupt = crate::interrupt::on_ctrl_c();
-    let options = SweepOptions {
-        transient: args.transient,
-        record: args.record,
-        rtol: args.rtol,
-        atol: args.atol,
-        method: args.method.method(),
-        cluster_tolerance: args.cluster_tolerance,
-        interrupt: Some(interrupt.clone()),
-        ..SweepOptions::default()
-    };
+    let options = args.runs.options(interrupt.clone());
     let progress = crate::progress::bar(xs.len() * ys.len(), "states").with_prefix("basins");
     let result = basins(
         &loaded,

@@ -8,7 +8,7 @@ use clap::Args;
 use vibroimpact::chart::{chart, Chart, ChartCell, ChartOptions};
 use vibroimpact::sweep::SweepOptions;
 
-use crate::args::{grid_axis, MethodName};
+use crate::args::{AttractorRuns, GridAxes};
 use crate::error::CliError;
 use crate::figures::class_map;
 use crate::format::{CsvText, Format};
@@ -22,37 +22,10 @@ pub struct ChartArgs {
     /// Model file (TOML, see docs/model.md); its excitation must be periodic
     /// with one frequency over the whole chart.
     model: PathBuf,
-    /// Parameter of the horizontal axis (`frequency`, `amplitude` or a
-    /// dotted numeric key such as `row.clearance`).
-    #[arg(long)]
-    x: String,
-    /// First value of --x.
-    #[arg(long, allow_hyphen_values = true)]
-    x_from: f64,
-    /// Last value of --x.
-    #[arg(long, allow_hyphen_values = true)]
-    x_to: f64,
-    /// Number of --x values (>= 2), evenly spaced, both ends included.
-    #[arg(long)]
-    x_points: usize,
-    /// Parameter of the vertical axis (different from --x).
-    #[arg(long)]
-    y: String,
-    /// First value of --y.
-    #[arg(long, allow_hyphen_values = true)]
-    y_from: f64,
-    /// Last value of --y.
-    #[arg(long, allow_hyphen_values = true)]
-    y_to: f64,
-    /// Number of --y values (>= 2).
-    #[arg(long)]
-    y_points: usize,
-    /// Forcing periods simulated and discarded before recording.
-    #[arg(long, default_value_t = 100)]
-    transient: usize,
-    /// Forcing periods recorded (one Poincaré sample at the end of each).
-    #[arg(long, default_value_t = 20)]
-    record: usize,
+    #[command(flatten)]
+    grid: GridAxes,
+    #[command(flatten)]
+    runs: AttractorRuns,
     /// Initial states per cell: the model's own, then points spread over
     /// |u| ≤ 0.9 gap, |v| ≤ 0.9 gap × Ω; runs that end on different
     /// attractors mark the cell as coexisting.
@@ -62,20 +35,6 @@ pub struct ChartArgs {
     /// about twice the cost).
     #[arg(long)]
     lyapunov: bool,
-    /// Relative tolerance (default: the model's [simulation] rtol, else 1e-7).
-    #[arg(long)]
-    rtol: Option<f64>,
-    /// Absolute tolerance in m and m/s (default: [simulation] atol, else rtol × 1e-4).
-    #[arg(long)]
-    atol: Option<f64>,
-    /// Integration method.
-    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
-    method: MethodName,
-    /// Relative tolerance under which two Poincaré samples are the same
-    /// point (default 1e-3: 100 transient periods leave up to ~4e-3 of a
-    /// lightly damped free oscillation).
-    #[arg(long)]
-    cluster_tolerance: Option<f64>,
     /// Output folder for chart.csv, chart.json and the figure; without it
     /// only the summary is printed.
     #[arg(long)]
@@ -228,31 +187,27 @@ fn write_outputs(dir: &Path, chart: &Chart) -> Result<(), CliError> {
 
 /// Runs `vibroimpact chart`.
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
-    let xs = grid_axis("x", args.x_from, args.x_to, args.x_points)?;
-    let ys = grid_axis("y", args.y_from, args.y_to, args.y_points)?;
-    if args.record < 1 {
+    let (xs, ys) = args.grid.values()?;
+    if args.runs.record < 1 {
         return Err(CliError::new("--record 0: record at least one period"));
     }
     let document = read_document(&args.model)?;
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = ChartOptions {
         sweep: SweepOptions {
-            transient: args.transient,
-            record: args.record,
-            rtol: args.rtol,
-            atol: args.atol,
-            method: args.method.method(),
-            cluster_tolerance: args.cluster_tolerance,
             lyapunov: args.lyapunov.then_some(1),
-            interrupt: Some(interrupt.clone()),
-            ..SweepOptions::default()
+            ..args.runs.options(interrupt.clone())
         },
         starts: args.starts,
     };
     let progress = crate::progress::bar(xs.len() * ys.len(), "cells").with_prefix("chart");
-    let chart = chart(&document, (&args.x, &xs), (&args.y, &ys), &options, &|| {
-        progress.inc(1)
-    })
+    let chart = chart(
+        &document,
+        (&args.grid.x, &xs),
+        (&args.grid.y, &ys),
+        &options,
+        &|| progress.inc(1),
+    )
     .map_err(|e| {
         CliError::new(
             e.to_string()
