@@ -179,19 +179,26 @@ def test_gil_is_released():
 
 
 def test_ctrl_c_interrupts_a_long_call():
-    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        vi.simulate(ROW, periods=1e6, output_step=0)
-    assert time.perf_counter() - start < 5.0
-    # Impacts by integration stop between chunks of velocities.
-    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        vi.impact(np.linspace(0.01, 1.0, 400_000), method="integrate")
-    assert time.perf_counter() - start < 5.0
+    # A process started in the background by a non-interactive shell
+    # inherits SIGINT ignored, and Python then installs no handler: the
+    # test installs Python's own, as an interactive session has it.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+        start = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            vi.simulate(ROW, periods=1e6, output_step=0)
+        assert time.perf_counter() - start < 5.0
+        # Impacts by integration stop between chunks of velocities.
+        timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+        start = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            vi.impact(np.linspace(0.01, 1.0, 400_000), method="integrate")
+        assert time.perf_counter() - start < 5.0
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def test_progress_is_reported():
