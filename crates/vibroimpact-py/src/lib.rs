@@ -13,6 +13,7 @@
 //! ([`monitor::run`]); a request to stop reaches the integrators through
 //! [`vibroimpact::integrate::Interrupt`].
 
+mod basins;
 mod chart;
 mod convert;
 mod model;
@@ -41,6 +42,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::continue_branch, m)?)?;
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
+    m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
     m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
     Ok(())
 }

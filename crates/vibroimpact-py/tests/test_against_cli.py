@@ -158,6 +158,26 @@ def test_chart_matches_the_cli(cli):
         vi.chart(m, 3, [7.0], "amplitude", [0.05])
 
 
+def test_basins_match_the_cli(cli):
+    m = EXAMPLES / "fujita-row-n2.toml"
+    doc = cli("basins", m, "--x", "u1", "--x-from=-1.2e-3", "--x-to", "0.8e-3", "--x-points", "3",
+              "--y", "v1", "--y-from=-0.02", "--y-to", "0.02", "--y-points", "2",
+              "--transient", "20", "--record", "6")
+    r = vi.basins(m, "u1", vi.parameter_values(-1.2e-3, 0.8e-3, 3), "v1",
+                  vi.parameter_values(-0.02, 0.02, 2), transient=20, record=6)
+    # (None where no attractor: NaN in the result's array)
+    expected = [np.nan if c is None else c for c in doc["cells"]]
+    np.testing.assert_array_equal(np.asarray(r.cells, dtype=float), expected)
+    assert r.inadmissible == doc["inadmissible"] == 2
+    assert len(r.attractors) == len(doc["attractors"])
+    for a, b in zip(r.attractors, doc["attractors"]):
+        assert (a.period, a.cells) == (b["period"], b["cells"])
+    with pytest.raises(ValueError, match="x: component `w1`"):
+        vi.basins(m, "w1", [0.0, 1e-4], "v1", [0.0, 0.01])
+    with pytest.raises(ValueError, match="base: needs 4 values"):
+        vi.basins(m, "u1", [0.0, 1e-4], "v1", [0.0, 0.01], base=[0.0, 0.0, 0.0])
+
+
 def test_parameter_values_match_the_cli(cli):
     # (to - from) i / (k - 1) rounds differently from (to - from)(i / (k - 1))
     # at some i: the values must be the CLI's to the bit.

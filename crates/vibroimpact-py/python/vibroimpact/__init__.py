@@ -35,6 +35,7 @@ __all__ = [
     "Model",
     "Result",
     "VibroimpactError",
+    "basins",
     "chart",
     "contact_force",
     "continue_",
@@ -805,3 +806,63 @@ def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: P
         _progress(progress),
     )
     return d if raw else Result(d)
+
+
+def basins(
+    model: ModelLike,
+    x: str,
+    x_values: ArrayLike,
+    y: str,
+    y_values: ArrayLike,
+    *,
+    base: Optional[ArrayLike] = None,
+    transient: int = 100,
+    record: int = 20,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    method: str = "dop853",
+    cluster_tolerance: Optional[float] = None,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+) -> Result:
+    """Basins of attraction (``vibroimpact basins``): every initial state of
+    the grid ``x_values`` × ``y_values`` of the state components ``x`` and
+    ``y`` (``"u1"``, ``"v2"``, …; the other components from ``base``, u then
+    v, default the model's initial state) run to its attractor in parallel
+    (``transient`` periods, then ``record`` recorded ones). Defaults as
+    :func:`chart`.
+
+    Returns ``x_component``, ``y_component``, ``x_values``, ``y_values``,
+    ``base_state``, ``transient_periods``, ``record_periods``,
+    ``attractors`` (each with ``period``, ``impacts_per_period``,
+    ``max_displacement``, ``section`` — one cycle of Poincaré samples —
+    ``cells`` and ``fraction``), ``cells`` (the attractor index of every
+    start, row by row; None where the start overlaps a contact or failed),
+    ``inadmissible``, ``failed`` and ``errors``.
+    """
+    m = _model(model)
+    for name, value in (("x", x), ("y", y)):
+        if not isinstance(value, str):
+            raise TypeError(f"{name}: expected a state component such as 'u1', got {type(value).__name__}")
+    xs = np.require(_floats(x_values, "x_values", allow_scalar=False), np.float64, ["C", "A"])
+    ys = np.require(_floats(y_values, "y_values", allow_scalar=False), np.float64, ["C", "A"])
+    b = None if base is None else np.require(_floats(base, "base", allow_scalar=False), np.float64, ["C", "A"])
+    if threads is not None:
+        threads = _count(threads, "threads", minimum=1, maximum=4096)
+    d = _core.basins(
+        m,
+        x,
+        xs,
+        y,
+        ys,
+        b,
+        _count(transient, "transient"),
+        _count(record, "record", minimum=1, maximum=10**7),
+        _real(rtol, "rtol", positive=True, optional=True),
+        _real(atol, "atol", positive=True, optional=True),
+        _method(method, ("dop853", "rodas", "auto")),
+        _real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        threads,
+        _progress(progress),
+    )
+    return Result(d)

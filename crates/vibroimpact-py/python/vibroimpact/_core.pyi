@@ -76,3 +76,9 @@ def chart(
     starts: int, lyapunov: bool, rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
 ) -> dict[str, Any]: ...
+
+def basins(
+    model: Model, x: str, x_values: F64, y: str, y_values: F64, base: Optional[F64],
+    transient: int, record: int, rtol: Optional[float], atol: Optional[float], method_name: str,
+    cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
+) -> dict[str, Any]: ...
