@@ -976,6 +976,55 @@ fn continue_two_parameter_curves() {
         assert_eq!(c["stop"], "left-bounds");
     }
     assert!(out.join("curves.json").is_file() && out.join("curves.svg").is_file());
+    // The curves over a chart of the same plane; a chart in another plane
+    // refuses them.
+    let curves_file = out.join("curves.json");
+    let chart_dir = dir.join("chart");
+    let grid = [
+        "chart",
+        &model,
+        "--x-from",
+        "4",
+        "--x-to",
+        "8",
+        "--x-points",
+        "3",
+        "--y-from",
+        "0.01",
+        "--y-to",
+        "0.05",
+        "--y-points",
+        "2",
+        "--transient",
+        "5",
+        "--record",
+        "4",
+        "--overlay",
+        curves_file.to_str().unwrap(),
+    ];
+    let ok = run(&[
+        &grid[..],
+        &[
+            "--x",
+            "frequency",
+            "--y",
+            "amplitude",
+            "--out",
+            chart_dir.to_str().unwrap(),
+        ],
+    ]
+    .concat());
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let svg = std::fs::read_to_string(chart_dir.join("chart.svg")).unwrap();
+    assert!(svg.contains("fold curve") && svg.contains("branch-point curve"));
+    assert_clean_error(
+        &[&grid[..], &["--x", "amplitude", "--y", "frequency"]].concat(),
+        "curves in (frequency, amplitude), the chart is in (amplitude, frequency)",
+    );
     let base = [
         "continue",
         &model,

@@ -39,6 +39,10 @@ pub struct ChartArgs {
     /// only the summary is printed.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Curves of special points to draw over the chart: the `curves.json`
+    /// of `continue --parameter2` in the same two parameters.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
     /// Summary format on standard output: a table of the classes, the
     /// cells as CSV, or the whole chart as JSON.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -174,15 +178,74 @@ fn table_text(chart: &Chart) -> String {
 }
 
 /// Writes chart.csv, chart.json and the figure into `dir`.
-fn write_outputs(dir: &Path, chart: &Chart) -> Result<(), CliError> {
+fn write_outputs(dir: &Path, chart: &Chart, overlay: &[Series]) -> Result<(), CliError> {
     ensure_dir(dir)?;
     write_atomic(&dir.join("chart.csv"), chart_csv(chart)?.as_bytes())?;
     write_atomic(
         &dir.join("chart.json"),
         serde_json::to_string(chart)?.as_bytes(),
     )?;
-    render(&chart_figure(chart), &dir.join("chart"))?;
+    let mut fig = chart_figure(chart);
+    for s in overlay {
+        fig.push(s.clone());
+    }
+    render(&fig, &dir.join("chart"))?;
     Ok(())
+}
+
+/// The curves of a `curves.json` (from `continue --parameter2`) as line
+/// series in the chart's (x, y) plane; the file must name the chart's two
+/// parameters.
+fn overlay_series(path: &Path, x: &str, y: &str) -> Result<Vec<Series>, CliError> {
+    let text = crate::input::read_text(path)
+        .map_err(|e| CliError::new(format!("{}: {e}", path.display())))?;
+    let doc: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| CliError::new(format!("{}: not a curves document: {e}", path.display())))?;
+    let (p, q) = (doc["parameter"].as_str(), doc["parameter2"].as_str());
+    if (p, q) != (Some(x), Some(y)) {
+        return Err(CliError::new(format!(
+            "{}: curves in ({}, {}), the chart is in ({x}, {y})",
+            path.display(),
+            p.unwrap_or("?"),
+            q.unwrap_or("?")
+        )));
+    }
+    let Some(curves) = doc["curves"].as_array() else {
+        return Err(CliError::new(format!(
+            "{}: no `curves` list",
+            path.display()
+        )));
+    };
+    let mut labelled: Vec<String> = Vec::new();
+    let mut out = Vec::new();
+    for (k, c) in curves.iter().enumerate() {
+        let kind = c["kind"].as_str().unwrap_or("curve").to_string();
+        let points: Option<Vec<(f64, f64)>> = c["points"].as_array().map(|pts| {
+            pts.iter()
+                .filter_map(|pt| Some((pt[x].as_f64()?, pt[y].as_f64()?)))
+                .collect()
+        });
+        let Some(points) = points else {
+            return Err(CliError::new(format!(
+                "{}: curve {k} has no `points`",
+                path.display()
+            )));
+        };
+        let label = if labelled.contains(&kind) {
+            String::new()
+        } else {
+            labelled.push(kind.clone());
+            format!("{kind} curve")
+        };
+        // Black over the coloured cells: folds solid, branch points
+        // dashed; period doublings dashed vermillion.
+        out.push(match kind.as_str() {
+            "fold" => Series::line(label, points).with_color(6),
+            "branch-point" => Series::dashed(label, points).with_color(6),
+            _ => Series::dashed(label, points).with_color(1),
+        });
+    }
+    Ok(out)
 }
 
 /// Runs `vibroimpact chart`.
@@ -192,6 +255,10 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         return Err(CliError::new("--record 0: record at least one period"));
     }
     let document = read_document(&args.model)?;
+    let overlay = match &args.overlay {
+        Some(path) => overlay_series(path, &args.grid.x, &args.grid.y)?,
+        None => Vec::new(),
+    };
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = ChartOptions {
         sweep: SweepOptions {
@@ -223,7 +290,7 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         ));
     }
     if let Some(dir) = &args.out {
-        write_outputs(dir, &chart)?;
+        write_outputs(dir, &chart, &overlay)?;
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&chart)?),
