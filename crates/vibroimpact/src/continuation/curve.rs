@@ -8,14 +8,13 @@
 //! where `g` is the last component of the solution of the bordered system
 //! `[A b; cᵀ 0] (v, g) = (0, 1)` with `A = DG − I` (fold), `DG + I` (period
 //! doubling on the full map, branch point on the half map) or `DG² + I`
-//! (period doubling on the half map), and b, c the right and left null
+//! (period doubling on the half map), and b, c the left and right null
 //! vectors of the previous point. `g` vanishes exactly where A is
 //! singular, and is regular there, so the curve is a regular solution
 //! curve: pseudo-arclength continuation with Newton on
-//! `[G; g; tᵀ(z − z_pred)] = 0`. The Jacobian's first d rows are the
-//! variational equations' `[DG − I, G_p]` with `G_q` by a forward
-//! difference of the map; the row of g by forward differences of g (d + 2
-//! monodromy matrices: the dense form, for rows of a few bodies).
+//! `[G; g; tᵀ(z − z_pred)] = 0`. The Jacobian is taken by forward
+//! differences of `[G; g]` (d + 2 period maps with their monodromy: the
+//! dense form, for rows of a few bodies).
 
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
@@ -165,7 +164,6 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
     let mut points = vec![sys.point(&z0)?];
     let mut z = z0.clone();
     let mut ds = opts.ds;
-    let d = z.len() - 2;
     let stop = loop {
         if points.len() >= opts.max_points {
             break CurveStop::MaxPoints;
@@ -206,7 +204,6 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
         if points.len() > 3 && back < 0.5 * ds {
             break CurveStop::Closed;
         }
-        let _ = d;
         ds = (1.5 * ds).min(opts.ds_max);
     };
     Ok(Curve { kind, points, stop })
