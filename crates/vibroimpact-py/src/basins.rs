@@ -7,7 +7,7 @@ use pyo3::types::PyDict;
 use vibroimpact::basins::{basins as run_basins, Component};
 use vibroimpact::sweep::SweepOptions;
 
-use crate::convert::{document, floats, value_error};
+use crate::convert::{document, floats, thread_pool, value_error};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
 use crate::solve::method;
@@ -49,10 +49,7 @@ pub fn basins<'py>(
         Component::parse(name, n).map_err(|e| value_error(format!("{arg}: {e}")))
     };
     let (cx, cy) = (component(x, "x")?, component(y, "y")?);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(value_error)?;
+    let pool = thread_pool(threads)?;
     let total = xs.len() * ys.len();
     let out = monitor::run(py, progress, move |p: &Progress| {
         p.set_total(total);

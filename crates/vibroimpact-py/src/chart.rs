@@ -7,7 +7,7 @@ use pyo3::types::PyDict;
 use vibroimpact::chart::{chart as run_chart, ChartOptions};
 use vibroimpact::sweep::SweepOptions;
 
-use crate::convert::{document, floats, value_error};
+use crate::convert::{document, floats, thread_pool, value_error};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
 use crate::solve::method;
@@ -39,10 +39,7 @@ pub fn chart<'py>(
     let xs = floats(&x_values, "x_values")?;
     let ys = floats(&y_values, "y_values")?;
     let method = method(method_name)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(value_error)?;
+    let pool = thread_pool(threads)?;
     let doc = model.document.clone();
     let (x, y) = (x.to_string(), y.to_string());
     let total = xs.len() * ys.len();

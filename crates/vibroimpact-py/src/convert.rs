@@ -88,3 +88,12 @@ pub fn value_error(e: impl std::fmt::Display) -> PyErr {
 pub fn numerical_error(e: impl std::fmt::Display) -> PyErr {
     VibroimpactError::new_err(e.to_string())
 }
+
+/// A rayon pool of `threads` threads (None: one per core) for the calls
+/// that run cells or values in parallel.
+pub fn thread_pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(numerical_error)
+}

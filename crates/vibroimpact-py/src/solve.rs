@@ -26,7 +26,9 @@ use vibroimpact::results::{
 use vibroimpact::simulate::SimulationOptions;
 use vibroimpact::sweep::{sweep as run_sweep, Direction, SweepOptions};
 
-use crate::convert::{array1, array2, document, floats, numerical_error, to_python, value_error};
+use crate::convert::{
+    array1, array2, document, floats, numerical_error, thread_pool, to_python, value_error,
+};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
 
@@ -518,10 +520,7 @@ pub fn sweep<'py>(
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
     let values = floats(&values, "values")?;
     let method = method(method_name)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(numerical_error)?;
+    let pool = thread_pool(threads)?;
     let only = match only {
         None => None,
         Some("up") => Some(Direction::Up),

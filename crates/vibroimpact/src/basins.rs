@@ -9,10 +9,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::attractor::{identify, run_from, Recorded, Run};
-use crate::model::Model;
+use crate::attractor::{check_axis, identify, run_from, settings, Recorded, Run};
 use crate::model_file::LoadedModel;
-use crate::sweep::{admissible, Settings, SweepOptions};
+use crate::sweep::{admissible, SweepOptions};
 
 /// Largest number of initial states of one basin computation.
 pub const MAX_CELLS: usize = 50_000_000;
@@ -148,15 +147,7 @@ pub fn basins(
         )));
     }
     for (c, values) in [x, y] {
-        if values.is_empty() {
-            return Err(BasinError(format!("{}: no values", c.name())));
-        }
-        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-            return Err(BasinError(format!(
-                "{} = {v}: the values must be finite",
-                c.name()
-            )));
-        }
+        check_axis(&c.name(), values).map_err(BasinError)?;
     }
     let cells = x.1.len().saturating_mul(y.1.len());
     if cells > MAX_CELLS {
@@ -189,17 +180,7 @@ pub fn basins(
             "the model has no periodic excitation with one frequency (attractors are recognised once per forcing period)".into(),
         ));
     };
-    let sweep = SweepOptions {
-        rtol: options
-            .rtol
-            .or(loaded.simulation.rtol)
-            .or(Some(crate::chart::DEFAULT_RTOL)),
-        cluster_tolerance: options
-            .cluster_tolerance
-            .or(Some(crate::chart::DEFAULT_CLUSTER_TOLERANCE)),
-        ..options.clone()
-    };
-    let settings = Settings::new(loaded, &sweep).map_err(|e| BasinError(e.0))?;
+    let settings = settings(loaded, options).map_err(BasinError)?;
     let states: Vec<Vec<f64>> =
         y.1.iter()
             .flat_map(|&vy| {
@@ -221,16 +202,29 @@ pub fn basins(
             out
         })
         .collect();
-    let inadmissible = results.iter().filter(|r| r.is_none()).count();
+    let ran: Vec<bool> = results.iter().map(Option::is_some).collect();
     let (runs, recorded): (Vec<Run>, Vec<Recorded>) = results.into_iter().flatten().unzip();
     let (ids, reps) = identify(&runs, &recorded, settings.cluster_tolerance);
+    // The attractor of every state of the grid: the runs are those of the
+    // admissible states, in order.
+    let mut next = ids.iter();
+    let cells = ran
+        .iter()
+        .map(|&r| {
+            if r {
+                next.next().copied().flatten()
+            } else {
+                None
+            }
+        })
+        .collect();
     Ok(summarise(
         (x, y),
         base_state,
-        &sweep,
-        (runs, recorded, ids, reps),
-        inadmissible,
-        model,
+        options,
+        (runs, recorded, reps),
+        cells,
+        ran.iter().filter(|r| !**r).count(),
     ))
 }
 
@@ -240,28 +234,12 @@ fn summarise(
     (x, y): (Axis<'_>, Axis<'_>),
     base_state: Vec<f64>,
     options: &SweepOptions,
-    (runs, recorded, ids, reps): (Vec<Run>, Vec<Recorded>, Vec<Option<usize>>, Vec<usize>),
+    (runs, recorded, reps): (Vec<Run>, Vec<Recorded>, Vec<usize>),
+    cells: Vec<Option<usize>>,
     inadmissible: usize,
-    model: &Model,
 ) -> Basins {
-    let n = model.bodies().len();
-    // The grid again: the runs are those of the admissible states, in order.
-    let mut cells = Vec::with_capacity(x.1.len() * y.1.len());
-    let mut next = ids.iter();
-    for &vy in y.1 {
-        for &vx in x.1 {
-            let mut s = base_state.clone();
-            s[x.0.index(n)] = vx;
-            s[y.0.index(n)] = vy;
-            cells.push(if admissible(model, &s[..n]) {
-                next.next().copied().flatten()
-            } else {
-                None
-            });
-        }
-    }
     let mut counts = vec![0usize; reps.len()];
-    for id in ids.iter().flatten() {
+    for id in cells.iter().flatten() {
         counts[*id] += 1;
     }
     let completed: usize = counts.iter().sum();

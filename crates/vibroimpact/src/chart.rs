@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::attractor::{count_attractors, run_from, Recorded, Run};
+use crate::attractor::{check_axis, count_attractors, run_from, settings, Recorded, Run};
 use crate::model::Model;
 use crate::model_file::ModelDocument;
 use crate::sweep::{admissible, Settings, SweepOptions};
@@ -19,20 +19,7 @@ use crate::sweep::{admissible, Settings, SweepOptions};
 /// ~200 bytes a run.
 pub const MAX_RUNS: usize = 50_000_000;
 
-/// Relative tolerance of a chart's (and basins') integrations unless the
-/// options or the model's `[simulation]` give one. The Poincaré samples of
-/// an impacting orbit under the seed's stiff law carry an integration
-/// noise of ~1e3 × rtol: at 1e-6 it reaches [`DEFAULT_CLUSTER_TOLERANCE`]
-/// (R2 N = 2 at 1.1 ω0: the period-3 orbit classed not periodic; of a 20 ×
-/// 20 (frequency, amplitude) chart, 46 period-1 cells against 90 at 1e-8),
-/// at 1e-7 the classes are those of 1e-8.
-pub const DEFAULT_RTOL: f64 = 1e-7;
-
-/// Relative tolerance of two equal Poincaré samples unless the options
-/// give one: coarser than a sweep's 1e-5, since 100 transient periods leave
-/// a free oscillation of the lightly damped bodies (ζ = 0.013 in R2) of
-/// up to ~4e-3 of its initial size at 1.5 ω0.
-pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
+pub use crate::attractor::{DEFAULT_CLUSTER_TOLERANCE, DEFAULT_RTOL};
 
 /// Options of a chart.
 #[derive(Clone, Debug)]
@@ -124,14 +111,7 @@ pub fn chart(
         )));
     }
     for (name, values) in [x, y] {
-        if values.is_empty() {
-            return Err(ChartError(format!("{name}: no values")));
-        }
-        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-            return Err(ChartError(format!(
-                "{name} = {v}: the values must be finite"
-            )));
-        }
+        check_axis(name, values).map_err(ChartError)?;
     }
     if options.starts == 0 {
         return Err(ChartError(
@@ -156,19 +136,7 @@ pub fn chart(
         Ok(doc.with_parameter(&px, vx).map_err(err)?.model)
     };
     let base = document.with_parameter(&px, x.1[0]).map_err(err)?;
-    let sweep = SweepOptions {
-        rtol: options
-            .sweep
-            .rtol
-            .or(base.simulation.rtol)
-            .or(Some(DEFAULT_RTOL)),
-        cluster_tolerance: options
-            .sweep
-            .cluster_tolerance
-            .or(Some(DEFAULT_CLUSTER_TOLERANCE)),
-        ..options.sweep.clone()
-    };
-    let settings = Settings::new(&base, &sweep).map_err(|e| ChartError(e.0))?;
+    let settings = settings(&base, &options.sweep).map_err(ChartError)?;
     let first = model_at(x.1[0], y.1[0])?;
     for (vx, vy) in
         x.1.iter()
