@@ -7,7 +7,8 @@ use std::path::Path;
 use clap::Args;
 use serde_json::{json, Value};
 use vibroimpact::continuation::{
-    continue_curve, Branch, Curve, CurveKind, CurveOptions, CurveStop, SpecialKind,
+    continue_curve, grazing_margin, starts_grazing, Branch, Curve, CurveKind, CurveOptions,
+    CurveStop, SpecialKind,
 };
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ModelParameter;
@@ -15,14 +16,15 @@ use vibroimpact::periodic::ShootingOptions;
 
 use crate::error::CliError;
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition, Series};
+use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 
 /// The second parameter of `continue` and the curves to follow.
 #[derive(Args, Debug)]
 pub struct SecondParameter {
-    /// A second parameter: continue every fold, branch point and period
-    /// doubling of the branch (or those of --curves) as a curve in both
-    /// parameters (`curves.json`, figure `curves`).
+    /// A second parameter: continue every fold, branch point, period
+    /// doubling, Neimark–Sacker point and grazing of the branch (or those
+    /// of --curves) as a curve in both parameters, with the
+    /// codimension-two points on it (`curves.json`, figure `curves`).
     #[arg(long)]
     pub parameter2: Option<String>,
     /// Lower bound of the second parameter (default: 0, or half its value
@@ -32,10 +34,14 @@ pub struct SecondParameter {
     /// Upper bound of the second parameter (default: twice its value).
     #[arg(long, allow_hyphen_values = true)]
     pub to2: Option<f64>,
-    /// Kinds of special points to continue, comma separated: fold, bp, pd.
-    #[arg(long, value_delimiter = ',', default_value = "fold,bp,pd")]
+    /// Kinds of special points to continue, comma separated: fold, bp, pd,
+    /// ns, grazing.
+    #[arg(long, value_delimiter = ',', default_value = "fold,bp,pd,ns,grazing")]
     pub curves: Vec<String>,
 }
+
+/// The names --curves takes.
+const CURVE_NAMES: [&str; 5] = ["fold", "bp", "pd", "ns", "grazing"];
 
 /// The curve kind of a special point, if one is followed.
 fn kind_of(kind: SpecialKind, symmetry_breaking: bool, wanted: &[String]) -> Option<CurveKind> {
@@ -43,7 +49,9 @@ fn kind_of(kind: SpecialKind, symmetry_breaking: bool, wanted: &[String]) -> Opt
         SpecialKind::Fold => (CurveKind::Fold, "fold"),
         SpecialKind::BranchPoint if symmetry_breaking => (CurveKind::BranchPoint, "bp"),
         SpecialKind::PeriodDoubling => (CurveKind::PeriodDoubling, "pd"),
-        _ => return None,
+        SpecialKind::NeimarkSacker => (CurveKind::NeimarkSacker, "ns"),
+        SpecialKind::Grazing => (CurveKind::Grazing, "grazing"),
+        SpecialKind::BranchPoint | SpecialKind::User => return None,
     };
     wanted.iter().any(|w| w == name).then_some(k)
 }
@@ -55,9 +63,10 @@ pub fn validate(
     first: &ModelParameter,
 ) -> Result<Option<ModelParameter>, CliError> {
     for c in &second.curves {
-        if !["fold", "bp", "pd"].contains(&c.as_str()) {
+        if !CURVE_NAMES.contains(&c.as_str()) {
             return Err(CliError::new(format!(
-                "--curves {c}: give fold, bp or pd (Neimark–Sacker and grazing curves are not continued yet)"
+                "--curves {c}: give any of {}",
+                CURVE_NAMES.join(", ")
             )));
         }
     }
@@ -74,6 +83,16 @@ pub fn validate(
     Ok(Some(q))
 }
 
+/// The curves of a branch's special points.
+#[derive(Debug)]
+pub struct Curves {
+    /// Each curve with the label of the special point it starts from.
+    pub followed: Vec<(String, Curve)>,
+    /// Special points without a curve (label, why): a change of the impact
+    /// count that is an impact splitting in two, not a grazing.
+    pub skipped: Vec<(String, String)>,
+}
+
 /// Every curve through the wanted special points of `branch` (both
 /// directions from each), within `[from, to]` of the first parameter and the
 /// second parameter's bounds.
@@ -84,7 +103,7 @@ pub fn curves(
     (from, to): (f64, f64),
     second: &SecondParameter,
     shooting: &ShootingOptions,
-) -> Result<Vec<(String, Curve)>, CliError> {
+) -> Result<Curves, CliError> {
     let q0 = q.initial;
     let lo = second
         .from2
@@ -107,6 +126,12 @@ pub fn curves(
         ..CurveOptions::default()
     };
     let mut out: Vec<(String, Curve)> = Vec::new();
+    let mut skipped = Vec::new();
+    let family = |pv: f64, qv: f64| {
+        let mut doc = document.clone();
+        doc.set(q, qv).map_err(|e| e.to_string())?;
+        Ok(doc.with_parameter(p, pv).map_err(|e| e.to_string())?.model)
+    };
     for s in &branch.special {
         let Some(kind) = kind_of(s.kind, s.symmetry_breaking, &second.curves) else {
             continue;
@@ -119,12 +144,18 @@ pub fn curves(
         {
             continue;
         }
+        if kind == CurveKind::Grazing {
+            let model = family(s.parameter, q0).map_err(CliError::new)?;
+            let margin = grazing_margin(&model, &s.state, &opts.shooting).map_err(CliError::new)?;
+            if !starts_grazing(margin, &opts.shooting) {
+                skipped.push((
+                    s.label.clone(),
+                    format!("an impact splits in two: no contact's closest approach grazes (margin {margin:.2e} m)"),
+                ));
+                continue;
+            }
+        }
         for direction in [1.0, -1.0] {
-            let family = |pv: f64, qv: f64| {
-                let mut doc = document.clone();
-                doc.set(q, qv).map_err(|e| e.to_string())?;
-                Ok(doc.with_parameter(p, pv).map_err(|e| e.to_string())?.model)
-            };
             let curve = continue_curve(family, kind, (&s.state, s.parameter, q0), direction, &opts)
                 .map_err(|e| {
                     CliError::new(format!("the {} curve from {}: {e}", kind.name(), s.label))
@@ -136,11 +167,15 @@ pub fn curves(
             }
         }
     }
-    Ok(out)
+    Ok(Curves {
+        followed: out,
+        skipped,
+    })
 }
 
 /// Whether the curve crosses the second parameter's value `q0` at the
-/// first parameter `p0` (to 1e-4 relative, between consecutive points).
+/// first parameter `p0`: within 1e-4 relative, or a quarter of the chord's
+/// extent in p (the chord between two points misses a bending curve).
 fn passes(curve: &Curve, p0: f64, q0: f64) -> bool {
     curve.points.windows(2).any(|w| {
         let (a, b) = (&w[0], &w[1]);
@@ -148,20 +183,26 @@ fn passes(curve: &Curve, p0: f64, q0: f64) -> bool {
             return false;
         }
         let p = a.p + (q0 - a.q) / (b.q - a.q) * (b.p - a.p);
-        (p - p0).abs() <= 1e-4 * p0.abs().max(1e-300)
+        (p - p0).abs() <= (1e-4 * p0.abs()).max(0.25 * (b.p - a.p).abs())
     })
 }
 
-/// The `curves` document: each curve with its kind, start label, stop and
-/// points (both parameters, max |u| per body, multipliers).
-pub fn curves_document(curves: &[(String, Curve)], p: &str, q: &str) -> Value {
+/// The `curves` document: each curve with its kind, start label, stop,
+/// points (both parameters, max |u| per body, multipliers) and its
+/// codimension-two points (kind, index in `points`, both parameters).
+pub fn curves_document(curves: &Curves, p: &str, q: &str) -> Value {
     let list: Vec<Value> = curves
+        .followed
         .iter()
         .map(|(label, c)| {
             json!({
                 "kind": c.kind.name(),
                 "from": label,
                 "stop": c.stop,
+                "special": c.special.iter().map(|sp| {
+                    let pt = &c.points[sp.point];
+                    json!({ "kind": sp.kind.name(), "point": sp.point, p: pt.p, q: pt.q })
+                }).collect::<Vec<_>>(),
                 "points": c.points.iter().map(|pt| json!({
                     p: pt.p,
                     q: pt.q,
@@ -172,16 +213,16 @@ pub fn curves_document(curves: &[(String, Curve)], p: &str, q: &str) -> Value {
             })
         })
         .collect();
-    json!({ "parameter": p, "parameter2": q, "curves": list })
+    let skipped: Vec<Value> = curves
+        .skipped
+        .iter()
+        .map(|(label, why)| json!({ "from": label, "reason": why }))
+        .collect();
+    json!({ "parameter": p, "parameter2": q, "curves": list, "skipped": skipped })
 }
 
 /// Writes curves.json and the figure of the curves in the parameter plane.
-pub fn write_curves(
-    dir: &Path,
-    curves: &[(String, Curve)],
-    p: &str,
-    q: &str,
-) -> Result<(), CliError> {
+pub fn write_curves(dir: &Path, curves: &Curves, p: &str, q: &str) -> Result<(), CliError> {
     ensure_dir(dir)?;
     let doc = curves_document(curves, p, q);
     write_atomic(
@@ -190,11 +231,13 @@ pub fn write_curves(
     )?;
     let mut fig = Figure::new("Curves of special points", p, q).legend_at(LegendPosition::Best);
     let mut labelled = Vec::new();
-    for (_, c) in curves {
+    for (_, c) in &curves.followed {
         let color = match c.kind {
             CurveKind::Fold => 0,
             CurveKind::BranchPoint => 1,
             CurveKind::PeriodDoubling => 2,
+            CurveKind::NeimarkSacker => 3,
+            CurveKind::Grazing => 4,
         };
         let label = if labelled.contains(&color) {
             ""
@@ -203,6 +246,18 @@ pub fn write_curves(
         };
         labelled.push(color);
         fig.push(Series::line(label, c.points.iter().map(|pt| (pt.p, pt.q))).with_color(color));
+    }
+    let codim2: Vec<(f64, f64)> = curves
+        .followed
+        .iter()
+        .flat_map(|(_, c)| {
+            c.special
+                .iter()
+                .map(|sp| (c.points[sp.point].p, c.points[sp.point].q))
+        })
+        .collect();
+    if !codim2.is_empty() {
+        fig.push(Series::markers("codimension two", codim2, Marker::Square).with_color(5));
     }
     render(&fig, &dir.join("curves"))?;
     Ok(())

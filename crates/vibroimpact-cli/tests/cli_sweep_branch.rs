@@ -923,9 +923,10 @@ fn basins_grid_outputs_and_bad_input() {
 /// `continue --parameter2`: on R2 N = 1 the two folds and the symmetry-
 /// breaking points are continued in (frequency, amplitude): the fold
 /// curves start at the branch's folds at the model's amplitude, the two
-/// branch points lie on one closed curve (followed once); curves.json and
-/// the figure are written; the same key twice and an unknown curve kind
-/// are refused.
+/// branch points lie on one closed curve (followed once); the change of
+/// the impact count at GR1 (an impact splitting in two, no contact
+/// grazing) is listed as skipped; curves.json and the figure are written;
+/// the same key twice and an unknown curve kind are refused.
 #[test]
 fn continue_two_parameter_curves() {
     let dir = temp_dir("curves");
@@ -963,6 +964,13 @@ fn continue_two_parameter_curves() {
         "{kinds:?}"
     );
     assert_eq!(curves[4]["stop"], "closed");
+    let skipped = doc["curves_skipped"].as_array().unwrap();
+    assert_eq!(skipped.len(), 1, "{skipped:?}");
+    assert_eq!(skipped[0]["from"], "GR1");
+    assert!(skipped[0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("splits in two"));
     for c in &curves[..4] {
         let label = c["from"].as_str().unwrap();
         let s = special.iter().find(|s| s["label"] == label).unwrap();
@@ -1041,8 +1049,8 @@ fn continue_two_parameter_curves() {
             "the same key",
         ),
         (
-            &["--parameter2", "amplitude", "--curves", "ns"][..],
-            "--curves ns",
+            &["--parameter2", "amplitude", "--curves", "torus"][..],
+            "--curves torus",
         ),
         (
             &["--parameter2", "amplitude", "--from2", "0.06"][..],

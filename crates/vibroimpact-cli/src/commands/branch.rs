@@ -443,6 +443,7 @@ fn print_branches(
             }
             if let Some(c) = curves {
                 doc["curves"] = c["curves"].clone();
+                doc["curves_skipped"] = c["skipped"].clone();
             }
             println!("{}", serde_json::to_string_pretty(&doc)?);
         }
@@ -592,13 +593,26 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         .zip(second.as_ref())
         .map(|(c, q)| curves::curves_document(c, &args.range.parameter, &q.name));
     if let (Format::Table, Some(c)) = (args.format, &curves) {
-        for (label, curve) in c {
+        for (label, curve) in &c.followed {
+            let special: Vec<String> = curve
+                .special
+                .iter()
+                .map(|sp| {
+                    let pt = &curve.points[sp.point];
+                    format!("{} at ({:.8}, {:.8})", sp.kind.name(), pt.p, pt.q)
+                })
+                .collect();
             println!(
-                "{} curve from {label}: {} points ({:?})",
+                "{} curve from {label}: {} points ({:?}){}{}",
                 curve.kind.name(),
                 curve.points.len(),
-                curve.stop
+                curve.stop,
+                if special.is_empty() { "" } else { "; " },
+                special.join(", ")
             );
+        }
+        for (label, why) in &c.skipped {
+            println!("no curve from {label}: {why}");
         }
     }
     print_branches(args, &branches, &start_model, curves_doc)?;

@@ -238,10 +238,13 @@ fn overlay_series(path: &Path, x: &str, y: &str) -> Result<Vec<Series>, CliError
             format!("{kind} curve")
         };
         // Black over the coloured cells: folds solid, branch points
-        // dashed; period doublings dashed vermillion.
+        // dashed; period doublings dashed and Neimark–Sacker points solid
+        // in vermillion; grazings solid blue.
         out.push(match kind.as_str() {
             "fold" => Series::line(label, points).with_color(6),
             "branch-point" => Series::dashed(label, points).with_color(6),
+            "neimark-sacker" => Series::line(label, points).with_color(1),
+            "grazing" => Series::line(label, points).with_color(4),
             _ => Series::dashed(label, points).with_color(1),
         });
     }

@@ -54,7 +54,10 @@ mod switching;
 mod tests;
 
 pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
-pub use curve::{continue_curve, Curve, CurveKind, CurveOptions, CurvePoint, CurveStop};
+pub use curve::{
+    continue_curve, grazing_margin, starts_grazing, Codim2Kind, Curve, CurveKind, CurveOptions,
+    CurvePoint, CurveSpecial, CurveStop,
+};
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
 pub use switching::{
