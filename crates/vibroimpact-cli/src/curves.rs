@@ -38,6 +38,12 @@ pub struct SecondParameter {
     /// ns, grazing.
     #[arg(long, value_delimiter = ',', default_value = "fold,bp,pd,ns,grazing")]
     pub curves: Vec<String>,
+    /// Largest step along a curve (arclength in scaled variables: the
+    /// orbit in displacement scales, the parameters relative to their
+    /// start values); larger is faster and coarser, the special points on
+    /// the curves are located all the same.
+    #[arg(long, default_value_t = 0.05)]
+    pub curve_step: f64,
 }
 
 /// The names --curves takes.
@@ -62,6 +68,12 @@ pub fn validate(
     document: &ModelDocument,
     first: &ModelParameter,
 ) -> Result<Option<ModelParameter>, CliError> {
+    if !(second.curve_step.is_finite() && second.curve_step > 0.0) {
+        return Err(CliError::new(format!(
+            "--curve-step {}: give a positive step",
+            second.curve_step
+        )));
+    }
     for c in &second.curves {
         if !CURVE_NAMES.contains(&c.as_str()) {
             return Err(CliError::new(format!(
@@ -123,6 +135,8 @@ pub fn curves(
             ..shooting.clone()
         },
         bounds: [(from.min(to), from.max(to)), (lo, hi)],
+        ds_max: second.curve_step,
+        ds: second.curve_step.min(CurveOptions::default().ds),
         ..CurveOptions::default()
     };
     let mut out: Vec<(String, Curve)> = Vec::new();

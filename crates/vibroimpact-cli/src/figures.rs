@@ -1,6 +1,9 @@
 //! Figures drawn by more than one command or by a command and the report.
 
+use vibroimpact::basins::Basins;
+use vibroimpact::chart::{Chart, ChartCell};
 use vibroimpact::continuation::{Branch, SpecialKind};
+use vibroimpact::sweep::{Direction, SweepSummary};
 
 use crate::plot::{Figure, LegendPosition, Marker, Series};
 
@@ -130,5 +133,155 @@ pub fn class_map(
         if !r.is_empty() {
             fig.push(Series::rectangles(label.clone(), r).with_color(color));
         }
+    }
+}
+
+/// The classes of the figure: periods 1–4, 5 and more, non-periodic (with
+/// Lyapunov exponents split into chaotic and not), failed.
+pub const CLASSES: [&str; 8] = [
+    "period 1",
+    "period 2",
+    "period 3",
+    "period 4",
+    "period ≥ 5",
+    "not periodic (or settling)",
+    "chaotic (λ1 > 0)",
+    "failed",
+];
+
+/// The class (index into [`CLASSES`]) of a cell: that of its first run.
+pub fn class(cell: &ChartCell) -> usize {
+    let Some(run) = cell.runs.first() else {
+        return 7;
+    };
+    match (run.error.is_some(), run.period, run.lyapunov) {
+        (true, _, _) => 7,
+        (false, Some(p), _) => (p.min(5)) - 1,
+        (false, None, Some(l)) if l > 0.0 => 6,
+        (false, None, _) => 5,
+    }
+}
+
+/// The chart's figure: a rectangle per cell coloured by its class, cells
+/// with coexisting attractors marked.
+pub fn chart_figure(chart: &Chart) -> Figure {
+    let mut fig = Figure::new(
+        "Attractor of the model's initial state",
+        chart.x_name.clone(),
+        chart.y_name.clone(),
+    )
+    .legend_at(LegendPosition::Best);
+    let classes: Vec<usize> = chart.cells.iter().map(class).collect();
+    let labels: Vec<String> = CLASSES.iter().map(|c| c.to_string()).collect();
+    let colors: Vec<usize> = (0..CLASSES.len()).collect();
+    class_map(
+        &mut fig,
+        &chart.x_values,
+        &chart.y_values,
+        &classes,
+        &labels,
+        &colors,
+    );
+    let coexisting: Vec<(f64, f64)> = chart
+        .cells
+        .iter()
+        .filter(|c| c.attractors > 1)
+        .map(|c| (c.x, c.y))
+        .collect();
+    if !coexisting.is_empty() {
+        fig.push(
+            Series::markers("coexisting attractors", coexisting, Marker::Triangle).with_color(9),
+        );
+    }
+    fig
+}
+
+/// A continued curve of special points over a chart, by kind: black folds
+/// (solid) and branch points (dashed), vermillion period doublings
+/// (dashed) and Neimark–Sacker points (solid), blue grazings.
+pub fn curve_series(kind: &str, label: String, points: Vec<(f64, f64)>) -> Series {
+    match kind {
+        "fold" => Series::line(label, points).with_color(6),
+        "branch-point" => Series::dashed(label, points).with_color(6),
+        "neimark-sacker" => Series::line(label, points).with_color(1),
+        "grazing" => Series::line(label, points).with_color(4),
+        _ => Series::dashed(label, points).with_color(1),
+    }
+}
+
+/// Legend text of attractor `k`.
+pub fn attractor_label(b: &Basins, k: usize) -> String {
+    let a = &b.attractors[k];
+    let kind = a
+        .period
+        .map_or("not periodic".to_string(), |p| format!("period {p}"));
+    format!(
+        "A{}: {kind}, {:.1} impacts/T ({:.1} %)",
+        k + 1,
+        a.impacts_per_period,
+        100.0 * a.fraction
+    )
+}
+
+/// The basins as coloured rectangles, grey where no attractor
+/// (overlapping or failed start).
+pub fn basins_figure(b: &Basins) -> Figure {
+    let unit = |c: &str| if c.starts_with('u') { "[m]" } else { "[m/s]" };
+    let mut fig = Figure::new(
+        "Basins of attraction",
+        format!("{} at t = 0  {}", b.x_component, unit(&b.x_component)),
+        format!("{} at t = 0  {}", b.y_component, unit(&b.y_component)),
+    )
+    .legend_at(LegendPosition::Best);
+    let none = b.attractors.len();
+    let classes: Vec<usize> = b.cells.iter().map(|c| c.unwrap_or(none)).collect();
+    let mut labels: Vec<String> = (0..none).map(|k| attractor_label(b, k)).collect();
+    labels.push("no attractor (overlap or failure)".into());
+    let mut colors: Vec<usize> = (0..none).map(|k| if k >= 7 { k + 1 } else { k }).collect();
+    colors.push(7);
+    class_map(
+        &mut fig,
+        &b.x_values,
+        &b.y_values,
+        &classes,
+        &labels,
+        &colors,
+    );
+    fig
+}
+
+/// The largest Lyapunov exponent against the parameter, the zero line
+/// dashed: the companion of the diagram (positive: chaos).
+pub fn lyapunov_figure(summary: &SweepSummary, directions: &[Direction]) -> Figure {
+    let mut fig = Figure::new(
+        "Largest Lyapunov exponent over the recorded periods",
+        parameter_label(&summary.parameter_name),
+        "λ1  [1/s]",
+    )
+    .legend_at(if summary.up_down {
+        LegendPosition::Best
+    } else {
+        LegendPosition::None
+    });
+    for (c, d) in directions.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = summary
+            .points
+            .iter()
+            .filter(|p| p.direction == *d)
+            .filter_map(|p| Some((p.parameter, *p.lyapunov.as_ref()?.first()?)))
+            .collect();
+        let label = if summary.up_down { d.name() } else { "" };
+        fig.push(Series::line(label, pts).with_color(c));
+    }
+    fig.push(Series::dashed("", vec![(summary.from, 0.0), (summary.to, 0.0)]).with_color(7));
+    fig
+}
+
+/// Axis label of a swept parameter.
+pub fn parameter_label(name: &str) -> String {
+    match name {
+        "frequency" | "excitation.frequency" => "forcing frequency Ω  [rad/s]".into(),
+        "amplitude" | "excitation.amplitude" => "excitation amplitude".into(),
+        other => other.to_string(),
     }
 }

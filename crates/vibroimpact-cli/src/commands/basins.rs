@@ -9,11 +9,11 @@ use vibroimpact::basins::{basins, Basins, Component};
 
 use crate::args::{AttractorRuns, GridAxes};
 use crate::error::CliError;
-use crate::figures::class_map;
+use crate::figures::{attractor_label, basins_figure};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_model;
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition};
+use crate::plot::render;
 
 /// Options of `vibroimpact basins`.
 #[derive(Args, Debug)]
@@ -38,20 +38,6 @@ pub struct BasinsArgs {
     format: Format,
 }
 
-/// Legend text of attractor `k`.
-fn attractor_label(b: &Basins, k: usize) -> String {
-    let a = &b.attractors[k];
-    let kind = a
-        .period
-        .map_or("not periodic".to_string(), |p| format!("period {p}"));
-    format!(
-        "A{}: {kind}, {:.1} impacts/T ({:.1} %)",
-        k + 1,
-        a.impacts_per_period,
-        100.0 * a.fraction
-    )
-}
-
 /// basins.csv: one row per initial state.
 fn basins_csv(b: &Basins) -> Result<String, CliError> {
     let mut w = CsvText::new();
@@ -69,33 +55,6 @@ fn basins_csv(b: &Basins) -> Result<String, CliError> {
         ])?;
     }
     w.finish()
-}
-
-/// The basins as coloured rectangles, grey where no attractor
-/// (overlapping or failed start).
-fn basins_figure(b: &Basins) -> Figure {
-    let unit = |c: &str| if c.starts_with('u') { "[m]" } else { "[m/s]" };
-    let mut fig = Figure::new(
-        "Basins of attraction",
-        format!("{} at t = 0  {}", b.x_component, unit(&b.x_component)),
-        format!("{} at t = 0  {}", b.y_component, unit(&b.y_component)),
-    )
-    .legend_at(LegendPosition::Best);
-    let none = b.attractors.len();
-    let classes: Vec<usize> = b.cells.iter().map(|c| c.unwrap_or(none)).collect();
-    let mut labels: Vec<String> = (0..none).map(|k| attractor_label(b, k)).collect();
-    labels.push("no attractor (overlap or failure)".into());
-    let mut colors: Vec<usize> = (0..none).map(|k| if k >= 7 { k + 1 } else { k }).collect();
-    colors.push(7);
-    class_map(
-        &mut fig,
-        &b.x_values,
-        &b.y_values,
-        &classes,
-        &labels,
-        &colors,
-    );
-    fig
 }
 
 /// Table of the attractors.

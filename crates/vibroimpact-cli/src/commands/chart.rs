@@ -5,16 +5,16 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::chart::{chart, Chart, ChartCell, ChartOptions};
+use vibroimpact::chart::{chart, Chart, ChartOptions};
 use vibroimpact::sweep::SweepOptions;
 
 use crate::args::{AttractorRuns, GridAxes};
 use crate::error::CliError;
-use crate::figures::class_map;
+use crate::figures::{chart_figure, class, curve_series, CLASSES};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use crate::plot::{render, Series};
 
 /// Options of `vibroimpact chart`.
 #[derive(Args, Debug)]
@@ -47,32 +47,6 @@ pub struct ChartArgs {
     /// cells as CSV, or the whole chart as JSON.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-}
-
-/// The classes of the figure: periods 1–4, 5 and more, non-periodic (with
-/// Lyapunov exponents split into chaotic and not), failed.
-const CLASSES: [&str; 8] = [
-    "period 1",
-    "period 2",
-    "period 3",
-    "period 4",
-    "period ≥ 5",
-    "not periodic (or settling)",
-    "chaotic (λ1 > 0)",
-    "failed",
-];
-
-/// The class (index into [`CLASSES`]) of a cell: that of its first run.
-fn class(cell: &ChartCell) -> usize {
-    let Some(run) = cell.runs.first() else {
-        return 7;
-    };
-    match (run.error.is_some(), run.period, run.lyapunov) {
-        (true, _, _) => 7,
-        (false, Some(p), _) => (p.min(5)) - 1,
-        (false, None, Some(l)) if l > 0.0 => 6,
-        (false, None, _) => 5,
-    }
 }
 
 /// chart.csv: one row per run.
@@ -116,40 +90,6 @@ fn chart_csv(chart: &Chart) -> Result<String, CliError> {
         }
     }
     w.finish()
-}
-
-/// The chart's figure: a rectangle per cell coloured by its class, cells
-/// with coexisting attractors marked.
-fn chart_figure(chart: &Chart) -> Figure {
-    let mut fig = Figure::new(
-        "Attractor of the model's initial state",
-        chart.x_name.clone(),
-        chart.y_name.clone(),
-    )
-    .legend_at(LegendPosition::Best);
-    let classes: Vec<usize> = chart.cells.iter().map(class).collect();
-    let labels: Vec<String> = CLASSES.iter().map(|c| c.to_string()).collect();
-    let colors: Vec<usize> = (0..CLASSES.len()).collect();
-    class_map(
-        &mut fig,
-        &chart.x_values,
-        &chart.y_values,
-        &classes,
-        &labels,
-        &colors,
-    );
-    let coexisting: Vec<(f64, f64)> = chart
-        .cells
-        .iter()
-        .filter(|c| c.attractors > 1)
-        .map(|c| (c.x, c.y))
-        .collect();
-    if !coexisting.is_empty() {
-        fig.push(
-            Series::markers("coexisting attractors", coexisting, Marker::Triangle).with_color(9),
-        );
-    }
-    fig
 }
 
 /// Table of the classes: cells per class, and cells with coexisting
@@ -237,16 +177,7 @@ fn overlay_series(path: &Path, x: &str, y: &str) -> Result<Vec<Series>, CliError
             labelled.push(kind.clone());
             format!("{kind} curve")
         };
-        // Black over the coloured cells: folds solid, branch points
-        // dashed; period doublings dashed and Neimark–Sacker points solid
-        // in vermillion; grazings solid blue.
-        out.push(match kind.as_str() {
-            "fold" => Series::line(label, points).with_color(6),
-            "branch-point" => Series::dashed(label, points).with_color(6),
-            "neimark-sacker" => Series::line(label, points).with_color(1),
-            "grazing" => Series::line(label, points).with_color(4),
-            _ => Series::dashed(label, points).with_color(1),
-        });
+        out.push(curve_series(&kind, label, points));
     }
     Ok(out)
 }

@@ -9,6 +9,7 @@ use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, Sweep
 use crate::args::MethodName;
 use crate::args::ParameterRange;
 use crate::error::CliError;
+use crate::figures::{lyapunov_figure, parameter_label};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_family;
 use crate::output::{ensure_dir, write_atomic};
@@ -64,15 +65,6 @@ pub struct SweepArgs {
 }
 
 /// Axis label of the parameter.
-fn parameter_label(name: &str) -> String {
-    match name {
-        "frequency" | "excitation.frequency" => "forcing frequency Ω  [rad/s]".into(),
-        "amplitude" | "excitation.amplitude" => "excitation amplitude".into(),
-        other => other.to_string(),
-    }
-}
-
-/// sweep.csv: one row per Poincaré sample.
 fn sweep_csv(summary: &SweepSummary) -> Result<String, CliError> {
     let mut w = CsvText::new();
     let mut header: Vec<String> = vec!["parameter".into(), "direction".into(), "period".into()];
@@ -174,33 +166,6 @@ fn write_outputs(dir: &Path, summary: &SweepSummary) -> Result<(), CliError> {
         )?;
     }
     Ok(())
-}
-
-/// The largest Lyapunov exponent against the parameter, the zero line
-/// dashed: the companion of the diagram (positive: chaos).
-fn lyapunov_figure(summary: &SweepSummary, directions: &[Direction]) -> Figure {
-    let mut fig = Figure::new(
-        "Largest Lyapunov exponent over the recorded periods",
-        parameter_label(&summary.parameter_name),
-        "λ1  [1/s]",
-    )
-    .legend_at(if summary.up_down {
-        LegendPosition::Best
-    } else {
-        LegendPosition::None
-    });
-    for (c, d) in directions.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = summary
-            .points
-            .iter()
-            .filter(|p| p.direction == *d)
-            .filter_map(|p| Some((p.parameter, *p.lyapunov.as_ref()?.first()?)))
-            .collect();
-        let label = if summary.up_down { d.name() } else { "" };
-        fig.push(Series::line(label, pts).with_color(c));
-    }
-    fig.push(Series::dashed("", vec![(summary.from, 0.0), (summary.to, 0.0)]).with_color(7));
-    fig
 }
 
 /// Human-readable table (with the largest Lyapunov exponent when

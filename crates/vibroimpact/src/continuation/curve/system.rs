@@ -372,7 +372,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     ) -> Result<Vec<f64>, String> {
         let opts = NewtonOptions {
             tol: CURVE_TOL,
-            max_iterations: 8,
+            max_iterations: 12,
             max_step: 0.5,
             line_search: false,
             stall: Some((1.0, 10.0)),
@@ -381,6 +381,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
             sys: self,
             pred,
             constraint,
+            chord: None,
         };
         let out = damped_newton(&mut corr, pred, &opts)?;
         if out.converged() {
@@ -461,10 +462,15 @@ pub(super) enum Constraint<'a> {
 }
 
 /// The corrector as a Newton system: `[G; g; constraint]`.
+/// A chord method: the Jacobian of the first iterate is kept while the
+/// residual falls by 4× or more per iteration, and taken again otherwise
+/// (each Jacobian costs d + 2 or d + 3 period maps, a residual one).
 struct Corrector<'a, 's, F> {
     sys: &'s mut Augmented<F>,
     pred: &'a [f64],
     constraint: Constraint<'a>,
+    /// The Jacobian in use (the corrector's rows) and the last residual.
+    chord: Option<(DMatrix<f64>, f64)>,
 }
 
 impl<F: FnMut(f64, f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
@@ -472,8 +478,23 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> NewtonSystem for Corrector<'_,
     type Error = String;
 
     fn evaluate(&mut self, z: &[f64]) -> Result<Self::Point, String> {
-        let (r, jac) = self.sys.linearise(z)?;
-        let (r, jac) = self.sys.select(&r, &jac);
+        let (r, jac) = match self.chord.take() {
+            Some((jac, last)) => {
+                let full = self.sys.residual_full(z)?;
+                let (r, _) = self.sys.select(&full, &DMatrix::zeros(full.len(), 0));
+                if r.amax() <= 0.25 * last {
+                    (r, jac)
+                } else {
+                    let (r, jac) = self.sys.linearise(z)?;
+                    self.sys.select(&r, &jac)
+                }
+            }
+            None => {
+                let (r, jac) = self.sys.linearise(z)?;
+                self.sys.select(&r, &jac)
+            }
+        };
+        self.chord = Some((jac.clone(), r.amax()));
         let n = z.len();
         let last = match self.constraint {
             Constraint::Arclength(t) => (0..n).map(|i| t[i] * (z[i] - self.pred[i])).sum(),
