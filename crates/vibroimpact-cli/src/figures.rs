@@ -167,8 +167,8 @@ pub fn class(cell: &ChartCell) -> usize {
 pub fn chart_figure(chart: &Chart) -> Figure {
     let mut fig = Figure::new(
         "Attractor of the model's initial state",
-        chart.x_name.clone(),
-        chart.y_name.clone(),
+        parameter_label(&chart.x_name),
+        parameter_label(&chart.y_name),
     )
     .legend_at(LegendPosition::Best);
     let classes: Vec<usize> = chart.cells.iter().map(class).collect();

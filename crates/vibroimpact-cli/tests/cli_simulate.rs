@@ -24,6 +24,11 @@ fn default_study_report_is_complete_and_deterministic() {
         "fig3_peak_force",
         "fig4_identify_restitution",
         "fig5_identify_alpha",
+        "fig_map_chart_n1",
+        "fig_map_chart_n2",
+        "fig_map_diagram_n2",
+        "fig_map_lyapunov_n2",
+        "fig_map_basins_n2",
     ] {
         for ext in ["svg", "png"] {
             let f = a.join(format!("{stem}.{ext}"));
@@ -60,6 +65,29 @@ fn default_study_report_is_complete_and_deterministic() {
             .as_f64()
             .unwrap()
             < 1e-9
+    );
+    // The maps: R2 N = 1's two folds give four fold curves (both ways from
+    // each), its two branch points one closed curve; the basin fractions
+    // add up to one.
+    let kinds: Vec<&str> = summary["curves_n1"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["fold", "fold", "fold", "fold", "branch-point"]);
+    let fractions: f64 = summary["basins_n2_fractions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_f64().unwrap())
+        .sum();
+    assert!((fractions - 1.0).abs() < 1e-12, "{fractions}");
+    assert!(
+        summary["chart_n2_cells_per_class"]["period 1"]
+            .as_u64()
+            .unwrap()
+            > 100
     );
 }
 

@@ -12,6 +12,7 @@
 mod frequency_response;
 mod identification;
 mod impacts;
+mod maps;
 mod peer_speed;
 mod time_history;
 
@@ -327,6 +328,7 @@ pub fn run(out: &Path) -> Result<(), CliError> {
         frequency_response::compute(&stop)
             .and_then(|d| frequency_response::render(&mut report, &d)),
     )?;
+    checked(maps::compute(&stop).and_then(|d| maps::render(&mut report, &d)))?;
     peer_speed::render(&mut report)?;
     let index = report.finish()?;
     println!(
