@@ -455,3 +455,120 @@ fn neimark_sacker_curve_ends_at_a_double_branch_point() {
     assert!((sum + 2.0).norm() < 1e-6, "{eig:?}");
     assert!((product - 1.0).norm() < 1e-6, "{eig:?}");
 }
+
+/// The run settings of charts (transient, record) for the rows above.
+fn chart_settings(transient: usize, record: usize) -> crate::sweep::Settings {
+    let text = include_str!("../../../../../examples/fujita-row-n2.toml");
+    let loaded = crate::model_file::ModelDocument::from_toml(text, "fujita-row-n2.toml")
+        .unwrap()
+        .build()
+        .unwrap();
+    crate::attractor::settings(
+        &loaded,
+        &crate::sweep::SweepOptions {
+            transient,
+            record,
+            ..crate::sweep::SweepOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+/// The chart's cells agree with the curves. Either side of the
+/// period-doubling curve of the one-wall oscillator (2 % in frequency), a
+/// cell run from the period-1 orbit there, displaced by 1 % of its size
+/// (300 transient, 20 recorded periods), shows period 1 where shooting
+/// finds that orbit stable, and period 2 where its multiplier has passed
+/// −1 (down to −2: further out the flip's period-2 orbit need not be the
+/// attractor). Either side of the fold curve LP1 of R2 N = 1: 2 % below,
+/// where shooting from the fold's orbit finds a stable orbit (not the
+/// saddle; at 3 points or more), a cell run from it (displaced by 1 %)
+/// returns to it (period 1, to 1e-3 of its size); 2 % above, where no
+/// orbit continues the fold's, the run from the fold's orbit ends more
+/// than one orbit size away (on the other branch).
+#[test]
+fn chart_cells_agree_with_the_curves() {
+    let settings = chart_settings(300, 20);
+    let walls = (false, true);
+    let b = branch(1, walls, 0.05);
+    let pd = special(&b, SpecialKind::PeriodDoubling, false);
+    let opts = CurveOptions {
+        bounds: [(0.3 * W0, 1.7 * W0), (0.04, 0.06)],
+        ..CurveOptions::default()
+    };
+    let curve = continue_curve(
+        |p, q| row(1, walls, p, q),
+        CurveKind::PeriodDoubling,
+        (&pd.state, pd.parameter, 0.05),
+        1.0,
+        &opts,
+    )
+    .unwrap();
+    let (mut period1, mut period2) = (0, 0);
+    for pt in curve.points.iter().step_by(2) {
+        for f in [0.98, 1.02] {
+            let m = row(1, walls, f * pt.p, pt.q).unwrap();
+            let orbit = crate::periodic::shoot(&m, &pt.state, &ShootingOptions::default()).unwrap();
+            assert!(orbit.converged);
+            let start: Vec<f64> = orbit.initial_state.iter().map(|x| 1.01 * x).collect();
+            let (run, _) = crate::attractor::run_from(&m, f * pt.p, start, &settings);
+            let flip = orbit.multipliers.iter().map(|m| m.re).fold(0.0, f64::min);
+            if orbit.stable() {
+                assert_eq!(run.period, Some(1), "at ({}, {})", f * pt.p, pt.q);
+                period1 += 1;
+            } else if flip > -2.0 {
+                assert_eq!(run.period, Some(2), "at ({}, {}): {flip}", f * pt.p, pt.q);
+                period2 += 1;
+            }
+        }
+    }
+    assert!(period1 >= 3 && period2 >= 3, "{period1} {period2}");
+    let walls = (true, true);
+    let b = branch(1, walls, 0.05);
+    let lp = special(&b, SpecialKind::Fold, true);
+    let fold = continue_curve(
+        |p, q| row(1, walls, p, q),
+        CurveKind::Fold,
+        (&lp.state, lp.parameter, 0.05),
+        1.0,
+        &CurveOptions {
+            shooting: ShootingOptions {
+                symmetric: b.symmetric,
+                ..ShootingOptions::default()
+            },
+            bounds: [(0.3 * W0, 1.7 * W0), (0.05, 0.07)],
+            ..CurveOptions::default()
+        },
+    )
+    .unwrap();
+    let mut stable = 0;
+    for pt in fold.points.iter().step_by(3) {
+        let size = pt.max_displacement[0];
+        // Distance (in orbit sizes, u and v/Ω) of a state from another.
+        let dist = |a: &[f64], b: &[f64]| {
+            (0..2).fold(0.0f64, |m, i| {
+                m.max((a[i] - b[i]).abs() / if i == 0 { size } else { size * pt.p })
+            })
+        };
+        let inside = row(1, walls, 0.98 * pt.p, pt.q).unwrap();
+        let orbit =
+            crate::periodic::shoot(&inside, &pt.state, &ShootingOptions::default()).unwrap();
+        // Shooting may land on the saddle of the pair instead, or nowhere
+        // (its Newton is nearly singular by the fold).
+        if !(orbit.converged && orbit.stable()) {
+            continue;
+        }
+        stable += 1;
+        let start: Vec<f64> = orbit.initial_state.iter().map(|x| 1.01 * x).collect();
+        let (run, rec) = crate::attractor::run_from(&inside, 0.98 * pt.p, start, &settings);
+        assert_eq!(run.period, Some(1));
+        let back = dist(rec.samples.last().unwrap(), &orbit.initial_state);
+        assert!(back < 1e-3, "at ({}, {}): {back}", pt.p, pt.q);
+        let outside = row(1, walls, 1.02 * pt.p, pt.q).unwrap();
+        let (_, rec) =
+            crate::attractor::run_from(&outside, 1.02 * pt.p, pt.state.clone(), &settings);
+        let jump = dist(rec.samples.last().unwrap(), &pt.state);
+        assert!(jump > 1.0, "at ({}, {}): {jump}", pt.p, pt.q);
+    }
+    assert!(stable >= 3, "{stable}");
+}
