@@ -2,13 +2,13 @@
 //! points of a one-parameter branch ([`vibroimpact::continuation::continue_curve`]),
 //! their JSON and figure.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde_json::{json, Value};
 use vibroimpact::continuation::{
-    continue_curve, grazing_margin, starts_grazing, Branch, Curve, CurveKind, CurveOptions,
-    CurveStop, SpecialKind,
+    continue_curve, grazing_margin, starts_grazing, Curve, CurveKind, CurveOptions, CurveStop,
+    SpecialKind, SpecialPoint,
 };
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ModelParameter;
@@ -44,6 +44,84 @@ pub struct SecondParameter {
     /// the curves are located all the same.
     #[arg(long, default_value_t = 0.05)]
     pub curve_step: f64,
+    /// Start the curves from the special points of an earlier run's
+    /// `branch.json` (`continue --out`: its `special_points`, `symmetric`
+    /// and `subharmonic`) instead of computing the branch again.
+    #[arg(long)]
+    pub special_points: Option<PathBuf>,
+}
+
+/// The special points of a `branch.json`, whether the branch is on the
+/// half map, and its period multiple; its parameter must be `first`.
+pub fn read_special_points(
+    path: &Path,
+    document: &ModelDocument,
+    first: &ModelParameter,
+) -> Result<(Vec<SpecialPoint>, bool, u32), CliError> {
+    let at = |what: String| CliError::new(format!("{}: {what}", path.display()));
+    let text = crate::input::read_text(path).map_err(|e| at(e.to_string()))?;
+    let doc: Value = serde_json::from_str(&text)
+        .map_err(|e| at(format!("not a branch.json of `continue --out`: {e}")))?;
+    let name = doc["parameter_name"]
+        .as_str()
+        .ok_or_else(|| at("no `parameter_name`".into()))?;
+    let key = document.parameter(name).map(|p| p.key).ok();
+    if key.as_ref() != Some(&first.key) {
+        return Err(at(format!(
+            "a branch in `{name}`, not in --parameter {}",
+            first.name
+        )));
+    }
+    let symmetric = doc["symmetric"]
+        .as_bool()
+        .ok_or_else(|| at("no `symmetric`".into()))?;
+    let subharmonic = doc["subharmonic"]
+        .as_u64()
+        .and_then(|n| u32::try_from(n).ok())
+        .filter(|&n| n >= 1)
+        .ok_or_else(|| at("no `subharmonic` (a whole number ≥ 1)".into()))?;
+    let list = doc["special_points"]
+        .as_array()
+        .ok_or_else(|| at("no `special_points` list".into()))?;
+    let mut out = Vec::new();
+    for (k, s) in list.iter().enumerate() {
+        let field = |f: &str| at(format!("special_points[{k}]: no valid `{f}`"));
+        let kind = match s["kind"].as_str() {
+            Some("fold") => SpecialKind::Fold,
+            Some("branch-point") => SpecialKind::BranchPoint,
+            Some("period-doubling") => SpecialKind::PeriodDoubling,
+            Some("neimark-sacker") => SpecialKind::NeimarkSacker,
+            Some("grazing") => SpecialKind::Grazing,
+            Some("user") => SpecialKind::User,
+            _ => return Err(field("kind")),
+        };
+        let state: Vec<f64> = s["initial_state"]
+            .as_array()
+            .ok_or_else(|| field("initial_state"))?
+            .iter()
+            .map(|v| v.as_f64().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(|| field("initial_state"))?;
+        out.push(SpecialPoint {
+            kind,
+            label: s["label"]
+                .as_str()
+                .ok_or_else(|| field("label"))?
+                .to_string(),
+            parameter: s["parameter"]
+                .as_f64()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| field("parameter"))?,
+            state,
+            multipliers: Vec::new(),
+            tangent: Vec::new(),
+            after_point: 0,
+            symmetry_breaking: s["symmetry_breaking"]
+                .as_bool()
+                .ok_or_else(|| field("symmetry_breaking"))?,
+        });
+    }
+    Ok((out, symmetric, subharmonic))
 }
 
 /// The names --curves takes.
@@ -83,6 +161,11 @@ pub fn validate(
         }
     }
     let Some(name) = &second.parameter2 else {
+        if second.special_points.is_some() {
+            return Err(CliError::new(
+                "--special-points: give --parameter2 too (the curves' second parameter)",
+            ));
+        }
         return Ok(None);
     };
     let q = document.parameter(name)?;
@@ -105,13 +188,13 @@ pub struct Curves {
     pub skipped: Vec<(String, String)>,
 }
 
-/// Every curve through the wanted special points of `branch` (both
-/// directions from each), within `[from, to]` of the first parameter and the
-/// second parameter's bounds.
+/// Every curve through the wanted special points (both directions from
+/// each) of a branch (on the half map if `symmetric`), within `[from, to]`
+/// of the first parameter and the second parameter's bounds.
 pub fn curves(
     document: &ModelDocument,
     (p, q): (&ModelParameter, &ModelParameter),
-    branch: &Branch,
+    (special, symmetric): (&[SpecialPoint], bool),
     (from, to): (f64, f64),
     second: &SecondParameter,
     shooting: &ShootingOptions,
@@ -131,7 +214,7 @@ pub fn curves(
     }
     let opts = CurveOptions {
         shooting: ShootingOptions {
-            symmetric: branch.symmetric,
+            symmetric,
             ..shooting.clone()
         },
         bounds: [(from.min(to), from.max(to)), (lo, hi)],
@@ -146,7 +229,7 @@ pub fn curves(
         doc.set(q, qv).map_err(|e| e.to_string())?;
         Ok(doc.with_parameter(p, pv).map_err(|e| e.to_string())?.model)
     };
-    for s in &branch.special {
+    for s in special {
         let Some(kind) = kind_of(s.kind, s.symmetry_breaking, &second.curves) else {
             continue;
         };

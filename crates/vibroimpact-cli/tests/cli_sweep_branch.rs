@@ -984,6 +984,38 @@ fn continue_two_parameter_curves() {
         assert_eq!(c["stop"], "left-bounds");
     }
     assert!(out.join("curves.json").is_file() && out.join("curves.svg").is_file());
+    // The same curves from the branch.json of that run, without the branch.
+    let again = dir.join("again");
+    let branch_file = out.join("branch.json");
+    let from_file = run(&[
+        "continue",
+        &model,
+        "--parameter",
+        "frequency",
+        "--from",
+        "3.705",
+        "--to",
+        "11.115",
+        "--parameter2",
+        "amplitude",
+        "--from2",
+        "0.001",
+        "--to2",
+        "0.1",
+        "--special-points",
+        branch_file.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert!(
+        from_file.status.success(),
+        "{}",
+        String::from_utf8_lossy(&from_file.stderr)
+    );
+    assert_eq!(
+        std::fs::read(out.join("curves.json")).unwrap(),
+        std::fs::read(again.join("curves.json")).unwrap()
+    );
     // The curves over a chart of the same plane; a chart in another plane
     // refuses them.
     let curves_file = out.join("curves.json");
@@ -1055,6 +1087,14 @@ fn continue_two_parameter_curves() {
         (
             &["--parameter2", "amplitude", "--from2", "0.06"][..],
             "--from2 0.06",
+        ),
+        (
+            &["--special-points", &model][..],
+            "--special-points: give --parameter2 too",
+        ),
+        (
+            &["--parameter2", "amplitude", "--special-points", &model][..],
+            "not a branch.json",
         ),
     ] {
         assert_clean_error(&[&base[..], extra].concat(), needle);

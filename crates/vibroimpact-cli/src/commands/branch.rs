@@ -477,11 +477,77 @@ fn print_branches(
     Ok(())
 }
 
+/// `continue --parameter2 … --special-points branch.json`: the curves of
+/// an earlier branch's special points, without the branch.
+fn curves_from_file(
+    args: &ContinueArgs,
+    pm: &ParameterizedModel,
+    q: &vibroimpact::parameter::ModelParameter,
+    path: &std::path::Path,
+    interrupt: &vibroimpact::integrate::Interrupt,
+) -> Result<(), CliError> {
+    let (special, symmetric, subharmonic) =
+        curves::read_special_points(path, &pm.document, &pm.parameter)?;
+    let shooting = ShootingOptions {
+        subharmonic,
+        interrupt: Some(interrupt.clone()),
+        ..ContinuationOptions::default().shooting
+    };
+    let c = curves::curves(
+        &pm.document,
+        (&pm.parameter, q),
+        (&special, symmetric),
+        (args.range.from, args.range.to),
+        &args.second,
+        &shooting,
+    )?;
+    if interrupt.requested() {
+        return Err(CliError::new("interrupted (Ctrl-C): nothing written"));
+    }
+    if let Some(dir) = &args.out {
+        curves::write_curves(dir, &c, &args.range.parameter, &q.name)?;
+    }
+    let doc = curves::curves_document(&c, &args.range.parameter, &q.name);
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        _ => print_curves(&c),
+    }
+    Ok(())
+}
+
+/// The curves, one line each, with their codimension-two points.
+fn print_curves(c: &curves::Curves) {
+    for (label, curve) in &c.followed {
+        let special: Vec<String> = curve
+            .special
+            .iter()
+            .map(|sp| {
+                let pt = &curve.points[sp.point];
+                format!("{} at ({:.8}, {:.8})", sp.kind.name(), pt.p, pt.q)
+            })
+            .collect();
+        println!(
+            "{} curve from {label}: {} points ({:?}){}{}",
+            curve.kind.name(),
+            curve.points.len(),
+            curve.stop,
+            if special.is_empty() { "" } else { "; " },
+            special.join(", ")
+        );
+    }
+    for (label, why) in &c.skipped {
+        println!("no curve from {label}: {why}");
+    }
+}
+
 /// Runs `vibroimpact continue`.
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let (pm, start_model) = continuation_family(args)?;
     let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
     let interrupt = crate::interrupt::on_ctrl_c();
+    if let (Some(path), Some(q)) = (&args.second.special_points, &second) {
+        return curves_from_file(args, &pm, q, path, &interrupt);
+    }
     let opts = ContinuationOptions {
         max_points: args.max_points,
         ds_max: args.ds_max,
@@ -565,7 +631,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         Some(q) => Some(curves::curves(
             &pm.document,
             (&pm.parameter, q),
-            &branches[0],
+            (&branches[0].special, branches[0].symmetric),
             (args.range.from, args.range.to),
             &args.second,
             &opts.shooting,
@@ -593,27 +659,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         .zip(second.as_ref())
         .map(|(c, q)| curves::curves_document(c, &args.range.parameter, &q.name));
     if let (Format::Table, Some(c)) = (args.format, &curves) {
-        for (label, curve) in &c.followed {
-            let special: Vec<String> = curve
-                .special
-                .iter()
-                .map(|sp| {
-                    let pt = &curve.points[sp.point];
-                    format!("{} at ({:.8}, {:.8})", sp.kind.name(), pt.p, pt.q)
-                })
-                .collect();
-            println!(
-                "{} curve from {label}: {} points ({:?}){}{}",
-                curve.kind.name(),
-                curve.points.len(),
-                curve.stop,
-                if special.is_empty() { "" } else { "; " },
-                special.join(", ")
-            );
-        }
-        for (label, why) in &c.skipped {
-            println!("no curve from {label}: {why}");
-        }
+        print_curves(c);
     }
     print_branches(args, &branches, &start_model, curves_doc)?;
     if let Some(e) = switch_error {

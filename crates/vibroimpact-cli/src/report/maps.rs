@@ -177,8 +177,16 @@ fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, C
         to2: Some(AMPLITUDE.1),
         curves: ["fold", "bp", "pd", "ns"].map(String::from).to_vec(),
         curve_step: CURVE_STEP,
+        special_points: None,
     };
-    let curves = curves(doc, (&p, &q), &branch, FREQUENCY, &second, &opts.shooting)?;
+    let curves = curves(
+        doc,
+        (&p, &q),
+        (&branch.special, branch.symmetric),
+        FREQUENCY,
+        &second,
+        &opts.shooting,
+    )?;
     Ok((branch, curves))
 }
 
