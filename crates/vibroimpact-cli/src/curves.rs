@@ -197,7 +197,7 @@ pub fn curves(
     (special, symmetric): (&[SpecialPoint], bool),
     (from, to): (f64, f64),
     second: &SecondParameter,
-    shooting: &ShootingOptions,
+    (shooting, krylov): (&ShootingOptions, Option<usize>),
 ) -> Result<Curves, CliError> {
     let q0 = q.initial;
     let lo = second
@@ -220,6 +220,7 @@ pub fn curves(
         bounds: [(from.min(to), from.max(to)), (lo, hi)],
         ds_max: second.curve_step,
         ds: second.curve_step.min(CurveOptions::default().ds),
+        krylov,
         ..CurveOptions::default()
     };
     let mut out: Vec<(String, Curve)> = Vec::new();
@@ -239,6 +240,16 @@ pub fn curves(
             .iter()
             .any(|(_, c)| c.kind == kind && passes(c, s.parameter, q0))
         {
+            continue;
+        }
+        if krylov.is_some() && matches!(kind, CurveKind::NeimarkSacker | CurveKind::Grazing) {
+            skipped.push((
+                s.label.clone(),
+                format!(
+                    "{} curves have no matrix-free form yet (the dense form takes rows up to 2048 bodies: --dense)",
+                    kind.name()
+                ),
+            ));
             continue;
         }
         if kind == CurveKind::Grazing {

@@ -595,7 +595,7 @@ impl MonodromyOperator<'_> {
             rtol: self.opts.rtol,
             atol: self.opts.rtol * self.opts.displacement_scale,
             max_steps: MAX_STEPS,
-            error_components: Some(d),
+            error_components: (!self.opts.control_monodromy).then_some(d),
             interrupt: self.opts.interrupt.clone(),
             ..IntegratorOptions::default()
         };
@@ -728,13 +728,24 @@ pub(crate) fn map_product(
     v: &[f64],
     opts: &ShootingOptions,
 ) -> Result<Vec<f64>, IntegrationError> {
+    map_and_product(model, x, v, opts).map(|(_, product)| product)
+}
+
+/// `(G(x), DG v)` (the map and a product with its Jacobian) by one
+/// integration of the state with one tangent column, body order.
+pub(crate) fn map_and_product(
+    model: &Model,
+    x: &[f64],
+    v: &[f64],
+    opts: &ShootingOptions,
+) -> Result<(Vec<f64>, Vec<f64>), IntegrationError> {
     let mut op = MonodromyOperator {
         model,
         x: x.to_vec(),
         opts,
         products: 0,
     };
-    op.apply(v).map(|(_, product)| product)
+    op.apply(v)
 }
 
 /// Newton–Krylov shooting for large systems (matrix-free; see

@@ -493,13 +493,14 @@ fn curves_from_file(
         interrupt: Some(interrupt.clone()),
         ..ContinuationOptions::default().shooting
     };
+    let bodies = pm.model_at(args.range.from)?.bodies().len();
     let c = curves::curves(
         &pm.document,
         (&pm.parameter, q),
         (&special, symmetric),
         (args.range.from, args.range.to),
         &args.second,
-        &shooting,
+        (&shooting, args.linear.krylov(bodies)),
     )?;
     if interrupt.requested() {
         return Err(CliError::new("interrupted (Ctrl-C): nothing written"));
@@ -634,7 +635,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             (&branches[0].special, branches[0].symmetric),
             (args.range.from, args.range.to),
             &args.second,
-            &opts.shooting,
+            (&opts.shooting, opts.krylov),
         )?),
         None => None,
     };

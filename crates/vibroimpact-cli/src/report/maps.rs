@@ -185,7 +185,7 @@ fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, C
         (&branch.special, branch.symmetric),
         FREQUENCY,
         &second,
-        &opts.shooting,
+        (&opts.shooting, None),
     )?;
     Ok((branch, curves))
 }

@@ -20,6 +20,7 @@
 //! detected and located ([`Codim2Kind`], `codim2.rs`).
 
 mod codim2;
+mod krylov;
 mod system;
 
 use nalgebra::Complex;
@@ -29,7 +30,29 @@ use crate::model::Model;
 use crate::periodic::ShootingOptions;
 pub use codim2::Codim2Kind;
 use codim2::{changed, test_values, CIRCLE_TEST};
-use system::{null_direction, Augmented, Constraint, Observation};
+use krylov::KrylovSystem;
+use system::{Augmented, Constraint, Observation};
+
+/// A curve's augmented system as the continuation loop sees it: the dense
+/// minimally augmented form ([`Augmented`]) or the matrix-free extended
+/// form ([`KrylovSystem`]). `z` holds the orbit (and auxiliaries), then p
+/// and q at [`CurveSystem::p_index`] and the next index.
+trait CurveSystem {
+    /// The index of p in z (q follows).
+    fn p_index(&self) -> usize;
+    /// z at the start (state, p, q), corrected with q held.
+    fn start(&mut self, state: &[f64], p: f64, q: f64) -> Result<Vec<f64>, String>;
+    /// Newton from `pred` with the last equation `constraint`.
+    fn correct(&mut self, pred: &[f64], constraint: Constraint<'_>) -> Result<Vec<f64>, String>;
+    /// The unit tangent at z, oriented along `previous`.
+    fn tangent(&mut self, z: &[f64], previous: Option<&[f64]>) -> Result<Vec<f64>, String>;
+    /// The point at z as the tests see it.
+    fn observe(&mut self, z: &[f64]) -> Result<Observation, String>;
+    /// The bound (index in z, scaled value) the step to z crossed.
+    fn bound_crossed(&self, z: &[f64], bounds: &[(f64, f64); 2]) -> Option<(usize, f64)>;
+    /// Follows the accepted point z (borders, normalisation, windows).
+    fn move_to(&mut self, z: &[f64]) -> Result<(), String>;
+}
 
 /// The codimension-one points a curve follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -86,6 +109,9 @@ pub struct CurveOptions {
     pub ds_max: f64,
     /// Points at most.
     pub max_points: usize,
+    /// `Some(m)`: the matrix-free form (folds, flips and branch points;
+    /// multipliers from m Arnoldi vectors), for long rows; None: dense.
+    pub krylov: Option<usize>,
 }
 
 impl Default for CurveOptions {
@@ -97,6 +123,7 @@ impl Default for CurveOptions {
             ds_min: 1e-7,
             ds_max: 0.05,
             max_points: 500,
+            krylov: None,
         }
     }
 }
@@ -175,20 +202,31 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
     if kind == CurveKind::BranchPoint && !opts.shooting.symmetric {
         return Err("a branch-point curve follows symmetry-breaking points of the half map: set shooting.symmetric".into());
     }
-    let symmetric = opts.shooting.symmetric;
-    let mut sys = Augmented::new(family, kind, opts, &model, (p, q));
-    let mut z0 = sys.scale_in(state, p, q, 0.0);
-    if kind == CurveKind::NeimarkSacker {
-        z0[d + 2] = critical_kappa(&sys.observe(&z0)?.eigenvalues)?;
+    match opts.krylov {
+        None => {
+            let mut sys = Augmented::new(family, kind, opts, &model, (p, q));
+            follow(&mut sys, kind, (state, p, q), direction, opts)
+        }
+        Some(m) => {
+            let mut sys = KrylovSystem::new(family, kind, opts, &model, (p, q), m)?;
+            follow(&mut sys, kind, (state, p, q), direction, opts)
+        }
     }
-    sys.init(&z0)?;
-    let (_, jac) = sys.linearise(&z0)?;
-    sys.choose_rows(&jac);
-    // Refine the start on the augmented system with q fixed (the tangent
-    // then follows from its Jacobian).
+}
+
+/// The continuation loop of [`continue_curve`] on either form.
+fn follow<S: CurveSystem>(
+    sys: &mut S,
+    kind: CurveKind,
+    (state, p, q): (&[f64], f64, f64),
+    direction: f64,
+    opts: &CurveOptions,
+) -> Result<Curve, String> {
+    let symmetric = opts.shooting.symmetric;
+    let d = sys.p_index();
     let q_index = d + 1;
-    let z0 = sys.correct(&z0, Constraint::Fixed(q_index, z0[q_index]))?;
-    let mut t = tangent(&mut sys, &z0, None)?;
+    let z0 = sys.start(state, p, q)?;
+    let mut t = sys.tangent(&z0, None)?;
     if t[q_index] * direction < 0.0 {
         t.iter_mut().for_each(|v| *v = -*v);
     }
@@ -205,7 +243,7 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
         let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + ds * b).collect();
         // A failed step (the corrector, or an integration of a trial
         // point) is retried at half the step.
-        let step = advance(&mut sys, (&z, &t), &pred, &opts.bounds);
+        let step = advance(sys, (&z, &t), &pred, &opts.bounds);
         let (next, tn, seen) = match step {
             Ok(Advance::Next(next, tn, seen)) => (next, tn, seen),
             Ok(Advance::End(point)) => {
@@ -227,7 +265,7 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
                 test_values(kind, symmetric, &o.eigenvalues, o.kappa)[k].1
             };
             let ends = (tests[k].1, next_tests[k].1);
-            if let Some((s, f, o)) = locate(&mut sys, (&z, &t, ds), ends, false, test) {
+            if let Some((s, f, o)) = locate(sys, (&z, &t, ds), ends, false, test) {
                 // The circle test jumps where a pair turns real outside
                 // the circle: a zero, not a jump, is a crossing.
                 if k != CIRCLE_TEST || f.abs() <= 1e-3 * ends.0.abs().max(ends.1.abs()) {
@@ -238,7 +276,7 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
         if kind == CurveKind::Fold && reverses(&t, &tn, d) {
             let test = |_: &Observation, ts: &[f64]| pq_dot(ts, &t, d);
             let ends = (pq_dot(&t, &t, d), pq_dot(&tn, &t, d));
-            if let Some((s, _, o)) = locate(&mut sys, (&z, &t, ds), ends, true, test) {
+            if let Some((s, _, o)) = locate(sys, (&z, &t, ds), ends, true, test) {
                 found.push((s, Codim2Kind::Cusp, o.point));
             }
         }
@@ -311,8 +349,8 @@ enum Advance {
 
 /// One step from z (tangent t) with the predictor `pred`: corrected, and
 /// ended exactly on a parameter bound it crossed.
-fn advance<F: FnMut(f64, f64) -> Result<Model, String>>(
-    sys: &mut Augmented<F>,
+fn advance<S: CurveSystem>(
+    sys: &mut S,
     (z, t): (&[f64], &[f64]),
     pred: &[f64],
     bounds: &[(f64, f64); 2],
@@ -324,40 +362,30 @@ fn advance<F: FnMut(f64, f64) -> Result<Model, String>>(
         let end = sys.correct(&guess, Constraint::Fixed(k, bound))?;
         return Ok(Advance::End(sys.observe(&end)?.point));
     }
-    let tn = tangent(sys, &next, Some(t))?;
+    let tn = sys.tangent(&next, Some(t))?;
     let seen = sys.observe(&next)?;
     Ok(Advance::Next(next, tn, seen))
 }
 
-/// κ = cos θ of the pair e^{±iθ} nearest the unit circle (the start of a
-/// Neimark–Sacker curve).
-fn critical_kappa(eigenvalues: &[Complex<f64>]) -> Result<f64, String> {
-    eigenvalues
-        .iter()
-        .filter(|l| l.im > 0.0)
-        .min_by(|a, b| (a.norm() - 1.0).abs().total_cmp(&(b.norm() - 1.0).abs()))
-        .map(|l| l.re / l.norm())
-        .ok_or_else(|| {
-            "no complex pair of multipliers at the start of a Neimark–Sacker curve".into()
-        })
-}
-
-/// The unit tangent at an accepted z (oriented along `previous`).
-fn tangent<F: FnMut(f64, f64) -> Result<Model, String>>(
-    sys: &mut Augmented<F>,
+/// The parameter bound (index in z and scaled value) that z crossed, if
+/// any: p at `p_index`, q after it, scaled by `scales`.
+fn bound_crossed(
     z: &[f64],
-    previous: Option<&[f64]>,
-) -> Result<Vec<f64>, String> {
-    let (r, jac) = sys.linearise(z)?;
-    sys.choose_rows(&jac);
-    let (_, jac) = sys.select(&r, &jac);
-    let mut t = null_direction(&jac, previous).ok_or("the augmented system is singular")?;
-    if let Some(prev) = previous {
-        if t.iter().zip(prev).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
-            t.iter_mut().for_each(|v| *v = -*v);
+    p_index: usize,
+    scales: [f64; 2],
+    bounds: &[(f64, f64); 2],
+) -> Option<(usize, f64)> {
+    (0..2).find_map(|i| {
+        let v = z[p_index + i] * scales[i];
+        let (lo, hi) = bounds[i];
+        if v < lo {
+            Some((p_index + i, lo / scales[i]))
+        } else if v > hi {
+            Some((p_index + i, hi / scales[i]))
+        } else {
+            None
         }
-    }
-    Ok(t)
+    })
 }
 
 /// The (p, q) components of two tangents, dotted.
@@ -377,8 +405,8 @@ fn reverses(a: &[f64], b: &[f64], d: usize) -> bool {
 /// ds), given the values at both ends: regula falsi (Illinois) on the
 /// arclength, each trial corrected onto the curve: the arclength, the
 /// test's value and the point. None if a correction fails.
-fn locate<F: FnMut(f64, f64) -> Result<Model, String>>(
-    sys: &mut Augmented<F>,
+fn locate<S: CurveSystem>(
+    sys: &mut S,
     (z, t, ds): (&[f64], &[f64], f64),
     (f0, f1): (f64, f64),
     with_tangent: bool,
@@ -392,7 +420,7 @@ fn locate<F: FnMut(f64, f64) -> Result<Model, String>>(
         let pred: Vec<f64> = z.iter().zip(t).map(|(zi, ti)| zi + s * ti).collect();
         let zs = sys.correct(&pred, Constraint::Arclength(t)).ok()?;
         let ts = if with_tangent {
-            tangent(sys, &zs, Some(t)).ok()?
+            sys.tangent(&zs, Some(t)).ok()?
         } else {
             Vec::new()
         };

@@ -4,7 +4,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::{CurveKind, CurveOptions, CurvePoint};
+use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonSystem};
 use crate::periodic::{
@@ -365,11 +365,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
 
     /// Newton on `[G; g; constraint] = 0` from `pred`, to a residual of
     /// [`CURVE_TOL`].
-    pub(super) fn correct(
-        &mut self,
-        pred: &[f64],
-        constraint: Constraint<'_>,
-    ) -> Result<Vec<f64>, String> {
+    fn correct(&mut self, pred: &[f64], constraint: Constraint<'_>) -> Result<Vec<f64>, String> {
         let opts = NewtonOptions {
             tol: CURVE_TOL,
             max_iterations: 12,
@@ -391,31 +387,9 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
         }
     }
 
-    /// The parameter bound (index in z and scaled value) that the step to
-    /// `z` crossed, if any.
-    pub(super) fn bound_crossed(
-        &self,
-        z: &[f64],
-        bounds: &[(f64, f64); 2],
-    ) -> Option<(usize, f64)> {
-        let d = self.dim();
-        let scales = [self.p_scale, self.q_scale];
-        (0..2).find_map(|i| {
-            let v = z[d + i] * scales[i];
-            let (lo, hi) = bounds[i];
-            if v < lo {
-                Some((d + i, lo / scales[i]))
-            } else if v > hi {
-                Some((d + i, hi / scales[i]))
-            } else {
-                None
-            }
-        })
-    }
-
     /// Follows the accepted point z: new borders (the null vectors of A
     /// there, orthonormalised), or the grazing window re-centred.
-    pub(super) fn move_to(&mut self, z: &[f64]) -> Result<(), String> {
+    fn move_to(&mut self, z: &[f64]) -> Result<(), String> {
         if self.kind == CurveKind::Grazing {
             return self.centre_window(z);
         }
@@ -428,7 +402,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
 
     /// The point at z with its multipliers, amplitudes and the map's
     /// eigenvalues.
-    pub(super) fn observe(&mut self, z: &[f64]) -> Result<Observation, String> {
+    fn observe(&mut self, z: &[f64]) -> Result<Observation, String> {
         let (x, p, q, kappa) = self.unscale(z);
         let model = (self.family)(p, q)?;
         let map = period_map(&model, &x, &self.opts).map_err(|e| e.to_string())?;
@@ -450,6 +424,66 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
             kappa,
         })
     }
+}
+
+impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for Augmented<F> {
+    fn p_index(&self) -> usize {
+        self.dim()
+    }
+
+    fn start(&mut self, state: &[f64], p: f64, q: f64) -> Result<Vec<f64>, String> {
+        let d = self.dim();
+        let mut z0 = self.scale_in(state, p, q, 0.0);
+        if self.kind == CurveKind::NeimarkSacker {
+            z0[d + 2] = critical_kappa(&self.observe(&z0)?.eigenvalues)?;
+        }
+        self.init(&z0)?;
+        let (_, jac) = self.linearise(&z0)?;
+        self.choose_rows(&jac);
+        self.correct(&z0, Constraint::Fixed(d + 1, z0[d + 1]))
+    }
+
+    fn correct(&mut self, pred: &[f64], constraint: Constraint<'_>) -> Result<Vec<f64>, String> {
+        Augmented::correct(self, pred, constraint)
+    }
+
+    fn tangent(&mut self, z: &[f64], previous: Option<&[f64]>) -> Result<Vec<f64>, String> {
+        let (r, jac) = self.linearise(z)?;
+        self.choose_rows(&jac);
+        let (_, jac) = self.select(&r, &jac);
+        let mut t = null_direction(&jac, previous).ok_or("the augmented system is singular")?;
+        if let Some(prev) = previous {
+            if t.iter().zip(prev).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+                t.iter_mut().for_each(|v| *v = -*v);
+            }
+        }
+        Ok(t)
+    }
+
+    fn observe(&mut self, z: &[f64]) -> Result<Observation, String> {
+        Augmented::observe(self, z)
+    }
+
+    fn bound_crossed(&self, z: &[f64], bounds: &[(f64, f64); 2]) -> Option<(usize, f64)> {
+        super::bound_crossed(z, self.dim(), [self.p_scale, self.q_scale], bounds)
+    }
+
+    fn move_to(&mut self, z: &[f64]) -> Result<(), String> {
+        Augmented::move_to(self, z)
+    }
+}
+
+/// κ = cos θ of the pair e^{±iθ} nearest the unit circle (the start of a
+/// Neimark–Sacker curve).
+fn critical_kappa(eigenvalues: &[Complex<f64>]) -> Result<f64, String> {
+    eigenvalues
+        .iter()
+        .filter(|l| l.im > 0.0)
+        .min_by(|a, b| (a.norm() - 1.0).abs().total_cmp(&(b.norm() - 1.0).abs()))
+        .map(|l| l.re / l.norm())
+        .ok_or_else(|| {
+            "no complex pair of multipliers at the start of a Neimark–Sacker curve".into()
+        })
 }
 
 /// The last equation of the corrector.

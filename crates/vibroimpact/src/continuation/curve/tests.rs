@@ -573,3 +573,54 @@ fn chart_cells_agree_with_the_curves() {
     }
     assert!(stable >= 3, "{stable}");
 }
+
+/// The matrix-free form follows the same curves as the dense one: R2
+/// N = 1's fold curve from LP1 and R2 N = 4's branch-point curve from its
+/// highest branch point end on the same bound at the same first parameter
+/// to 1e-7 (relative), with the same largest multiplier to 1e-6.
+#[test]
+fn krylov_curves_match_dense() {
+    for (n, kind, special_kind) in [
+        (1, CurveKind::Fold, SpecialKind::Fold),
+        (4, CurveKind::BranchPoint, SpecialKind::BranchPoint),
+    ] {
+        let walls = (true, true);
+        let b = branch(n, walls, 0.05);
+        let sp = special(&b, special_kind, true);
+        let dense_opts = CurveOptions {
+            shooting: ShootingOptions {
+                symmetric: b.symmetric,
+                ..ShootingOptions::default()
+            },
+            bounds: [(0.3 * W0, 1.7 * W0), (0.05, 0.052)],
+            ..CurveOptions::default()
+        };
+        let krylov_opts = CurveOptions {
+            krylov: Some(2 * n),
+            ..dense_opts.clone()
+        };
+        let mut ends = Vec::new();
+        for opts in [&dense_opts, &krylov_opts] {
+            let c = continue_curve(
+                |p, q| row(n, walls, p, q),
+                kind,
+                (&sp.state, sp.parameter, 0.05),
+                1.0,
+                opts,
+            )
+            .unwrap();
+            assert_eq!(c.stop, CurveStop::LeftBounds);
+            ends.push(c.points.last().unwrap().clone());
+        }
+        let (a, k) = (&ends[0], &ends[1]);
+        assert_eq!(a.q, k.q);
+        assert!(
+            (a.p - k.p).abs() < 1e-7 * a.p,
+            "N = {n}: {} vs {}",
+            a.p,
+            k.p
+        );
+        let (ma, mk) = (a.multipliers[0].norm(), k.multipliers[0].norm());
+        assert!((ma - mk).abs() < 1e-6, "N = {n}: {ma} vs {mk}");
+    }
+}
