@@ -26,7 +26,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{basins, branch, chart, identify, impact, simulate, sweep};
+use commands::{basins, branch, chart, identify, impact, simulate, spectrum, sweep};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -61,6 +61,10 @@ enum Command {
     /// space, each run to its attractor.
     #[command(allow_negative_numbers = true)]
     Basins(basins::BasinsArgs),
+    /// Elastic response spectra of a ground-motion record (AT2, two
+    /// columns, CSV): pseudo-acceleration, pseudo-velocity, displacement.
+    #[command(allow_negative_numbers = true)]
+    Spectrum(spectrum::SpectrumArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
     Periodic(branch::PeriodicArgs),
@@ -95,6 +99,7 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep::run(args),
         Some(Command::Chart(args)) => chart::run(args),
         Some(Command::Basins(args)) => basins::run(args),
+        Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

@@ -18,6 +18,7 @@ mod chart;
 mod convert;
 mod model;
 mod monitor;
+mod records;
 mod solve;
 
 use pyo3::prelude::*;
@@ -43,6 +44,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(records::parse_record, m)?)?;
+    m.add_function(wrap_pyfunction!(records::response_spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
     Ok(())
 }

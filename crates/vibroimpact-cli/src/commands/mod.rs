@@ -7,4 +7,5 @@ pub mod chart;
 pub mod identify;
 pub mod impact;
 pub mod simulate;
+pub mod spectrum;
 pub mod sweep;

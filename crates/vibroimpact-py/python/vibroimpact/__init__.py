@@ -43,6 +43,8 @@ __all__ = [
     "impact",
     "parameter_values",
     "periodic",
+    "read_record",
+    "response_spectrum",
     "simulate",
     "sweep",
 ]
@@ -866,3 +868,70 @@ def basins(
         _progress(progress),
     )
     return Result(d)
+
+
+def read_record(path: Union[str, "os.PathLike[str]"], *, units: Optional[str] = None) -> Result:
+    """A ground-motion record: a PEER NGA ``.AT2`` file, two columns (time s,
+    acceleration; header lines skipped) or CSV. ``units`` (``"g"``,
+    ``"m/s2"``, ``"gal"``) is needed when the header does not state them.
+
+    Returns ``source``, ``header`` (the header lines), ``units`` (of the
+    file), ``dt`` (None if not uniform), ``times`` (s), ``acceleration``
+    (m/s², converted), ``pga`` (m/s²)."""
+    path = os.fspath(path)
+    if not isinstance(path, str):
+        raise TypeError("path: expected a file name")
+    if units is not None and not isinstance(units, str):
+        raise TypeError("units: expected 'g', 'm/s2' or 'gal'")
+    try:
+        size = os.stat(path).st_size
+    except OSError as e:
+        raise OSError(f"{path}: cannot read: {e.strerror}") from None
+    if size > 1 << 30:
+        raise ValueError(f"path: {path} has {size} bytes, more than the input limit of 1 GiB")
+    with open(path, encoding="utf-8", errors="replace") as f:
+        text = f.read()
+    return Result(_core.parse_record(text, path, units))
+
+
+def response_spectrum(
+    record: Any,
+    periods: Optional[ArrayLike] = None,
+    *,
+    damping: float = 0.05,
+    scale: float = 1.0,
+    acceleration: Optional[ArrayLike] = None,
+) -> Result:
+    """Elastic response spectra of a record, exact for its piecewise-linear
+    ground acceleration (Nigam–Jennings; ``vibroimpact spectrum``).
+    ``record``: a result of :func:`read_record`, a file name, or the sample
+    times (s) with ``acceleration`` (m/s²). ``periods`` (s): default 100
+    log-spaced from 0.05 to 5. Peaks over the record's time steps.
+
+    Returns ``period``, ``pseudo_acceleration`` (m/s²), ``pseudo_velocity``
+    (m/s), ``displacement`` (m)."""
+    if isinstance(record, (str, os.PathLike)):
+        record = read_record(record)
+    if acceleration is None:
+        try:
+            times, acc = record["times"], record["acceleration"]
+        except (KeyError, TypeError, IndexError):
+            raise TypeError(
+                "record: expected a read_record result, a file name, or times with acceleration="
+            ) from None
+    else:
+        times, acc = record, acceleration
+    if periods is None:
+        periods = np.geomspace(0.05, 5.0, 100)
+    for name, v in (("damping", damping), ("scale", scale)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    return Result(
+        _core.response_spectrum(
+            _floats(times, "times", allow_scalar=False),
+            _floats(acc, "acceleration", allow_scalar=False),
+            _floats(periods, "periods"),
+            float(damping),
+            float(scale),
+        )
+    )

@@ -1,0 +1,115 @@
+//! End-to-end tests of `spectrum` on recorded ground motions.
+
+mod common;
+use common::*;
+
+/// A short AT2 record in g (a decaying 2 Hz sine), and the same samples as
+/// two columns in gal.
+fn records(dir: &std::path::Path) -> (String, String) {
+    let n = 400;
+    let values: Vec<f64> = (0..n)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            0.2 * (2.0 * std::f64::consts::PI * 2.0 * t).sin() * (-t / 2.0).exp()
+        })
+        .collect();
+    let mut at2 = String::from(
+        "PEER NGA STRONG MOTION DATABASE RECORD\nTEST 1/1/00, STATION, 000\nACCELERATION TIME SERIES IN UNITS OF G\n",
+    );
+    at2.push_str(&format!("NPTS=  {n}, DT=   .0100 SEC\n"));
+    for chunk in values.chunks(5) {
+        let line: Vec<String> = chunk.iter().map(|v| format!("{v:15.7E}")).collect();
+        at2.push_str(&line.join(""));
+        at2.push('\n');
+    }
+    let mut cols = String::from("time (s)   acceleration (cm/s2)\n");
+    for (k, v) in values.iter().enumerate() {
+        let g: f64 = format!("{v:.7E}").parse().unwrap();
+        cols.push_str(&format!("{} {:e}\n", k as f64 * 0.01, g * 980.665));
+    }
+    let a = dir.join("r.AT2");
+    let c = dir.join("r.txt");
+    std::fs::write(&a, at2).unwrap();
+    std::fs::write(&c, cols).unwrap();
+    (a.display().to_string(), c.display().to_string())
+}
+
+/// JSON rows with the documented fields, the record's metadata, and the
+/// same spectrum from the record in g (AT2) and in gal (two columns).
+#[test]
+fn spectrum_of_a_record_in_two_units() {
+    let dir = temp_dir("records");
+    let (at2, cols) = records(&dir);
+    let args = |f: &str| {
+        json(&[
+            "spectrum",
+            f,
+            "--periods",
+            "0.1:2:8log",
+            "--damping",
+            "0.05",
+            "--format",
+            "json",
+        ])
+    };
+    let (a, c) = (args(&at2), args(&cols));
+    assert_eq!(a["record"]["units"], "g");
+    assert_eq!(c["record"]["units"], "gal");
+    assert_eq!(a["record"]["samples"], 400);
+    assert_eq!(a["record"]["dt"], 0.01);
+    let rows = a["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 8);
+    for (x, y) in rows.iter().zip(c["rows"].as_array().unwrap()) {
+        let (p, q) = (
+            x["pseudo_acceleration"].as_f64().unwrap(),
+            y["pseudo_acceleration"].as_f64().unwrap(),
+        );
+        assert!((p - q).abs() < 1e-12 * p, "{p} vs {q}");
+        let w = 2.0 * std::f64::consts::PI / x["period"].as_f64().unwrap();
+        let sd = x["displacement"].as_f64().unwrap();
+        assert!((x["pseudo_velocity"].as_f64().unwrap() - w * sd).abs() < 1e-12 * w * sd);
+    }
+    let out = dir.join("spec");
+    let ok = run(&["spectrum", &at2, "--out", out.to_str().unwrap()]);
+    assert!(ok.status.success());
+    for f in [
+        "spectrum.json",
+        "spectrum.csv",
+        "spectrum.svg",
+        "spectrum.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
+
+#[test]
+fn bad_records_and_options_are_refused() {
+    let dir = temp_dir("records-bad");
+    let (at2, _) = records(&dir);
+    let gap = dir.join("gap.txt");
+    std::fs::write(&gap, "t a (g)\n0 1\n0.01 2\n0.02 1\n0.9 0\n0.91 1\n").unwrap();
+    let nounits = dir.join("nounits.txt");
+    std::fs::write(&nounits, "t a\n0 1\n0.01 2\n").unwrap();
+    let gap_s = gap.display().to_string();
+    let nounits_s = nounits.display().to_string();
+    for (args, needle) in [
+        (
+            vec!["spectrum", &at2, "--units", "furlong"],
+            "--units: units `furlong`",
+        ),
+        (
+            vec!["spectrum", &at2, "--periods", "2:1:10"],
+            "--periods 2:1:10",
+        ),
+        (vec!["spectrum", &at2, "--damping", "1.5"], "--damping 1.5"),
+        (vec!["spectrum", &gap_s], "gap.txt:5: a gap"),
+        (vec!["spectrum", &nounits_s], "states no units"),
+        (vec!["spectrum", "/nonexistent/x.AT2"], "x.AT2"),
+    ] {
+        let out = run(&args);
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}

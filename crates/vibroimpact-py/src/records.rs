@@ -1,0 +1,72 @@
+//! The binding of [`vibroimpact::record`] and [`vibroimpact::spectrum`]:
+//! ground-motion records parsed from text (the Python side reads the
+//! file) and their response spectra.
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact::record::{parse_record as parse, Record, Units};
+use vibroimpact::spectrum::response_spectrum as spectrum;
+
+use crate::convert::{array1, floats, value_error};
+
+/// A record from the text of a file (`source` names it): `source`,
+/// `header`, `units` (of the file), `dt` (None if not uniform), `times`
+/// (s), `acceleration` (m/s²), `pga` (m/s²).
+#[pyfunction]
+#[pyo3(signature = (text, source, units = None))]
+pub fn parse_record<'py>(
+    py: Python<'py>,
+    text: &str,
+    source: &str,
+    units: Option<&str>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let units = units
+        .map(Units::parse)
+        .transpose()
+        .map_err(|e| value_error(format!("units: {e}")))?;
+    let r = parse(text, source, units).map_err(value_error)?;
+    let d = PyDict::new(py);
+    d.set_item("source", &r.source)?;
+    d.set_item("header", &r.header)?;
+    d.set_item("units", r.units.name())?;
+    d.set_item("dt", r.dt)?;
+    d.set_item("pga", r.pga())?;
+    d.set_item("times", array1(py, r.times))?;
+    d.set_item("acceleration", array1(py, r.acceleration))?;
+    Ok(d)
+}
+
+/// The response spectrum of the piecewise-linear record (`times` s,
+/// `acceleration` m/s²) × `scale` at `damping` for `periods` (s): arrays
+/// `period`, `pseudo_acceleration` (m/s²), `pseudo_velocity` (m/s),
+/// `displacement` (m); peaks over the record's time steps.
+#[pyfunction]
+pub fn response_spectrum<'py>(
+    py: Python<'py>,
+    times: PyReadonlyArray1<'py, f64>,
+    acceleration: PyReadonlyArray1<'py, f64>,
+    periods: PyReadonlyArray1<'py, f64>,
+    damping: f64,
+    scale: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let t = floats(&times, "times")?;
+    let a = floats(&acceleration, "acceleration")?;
+    let p = floats(&periods, "periods")?;
+    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let rows = py
+        .detach(|| spectrum(&record, scale, damping, &p))
+        .map_err(value_error)?;
+    let d = PyDict::new(py);
+    let col = |f: fn(&vibroimpact::spectrum::SpectralPoint) -> f64| {
+        rows.iter().map(f).collect::<Vec<f64>>()
+    };
+    d.set_item("period", array1(py, col(|r| r.period)))?;
+    d.set_item(
+        "pseudo_acceleration",
+        array1(py, col(|r| r.pseudo_acceleration)),
+    )?;
+    d.set_item("pseudo_velocity", array1(py, col(|r| r.pseudo_velocity)))?;
+    d.set_item("displacement", array1(py, col(|r| r.displacement)))?;
+    Ok(d)
+}

@@ -1,0 +1,73 @@
+"""Records and response spectra against SciPy."""
+
+import math
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+
+scipy_signal = pytest.importorskip("scipy.signal")
+
+
+def _at2(path, values, dt=0.01):
+    with open(path, "w") as f:
+        f.write("PEER NGA STRONG MOTION DATABASE RECORD\n")
+        f.write("SYNTHETIC 1/1/00, TEST STATION, 000\n")
+        f.write("ACCELERATION TIME SERIES IN UNITS OF G\n")
+        f.write(f"NPTS=  {len(values)}, DT=   {dt:.4f} SEC\n")
+        for i in range(0, len(values), 5):
+            f.write("".join(f"{v:15.7E}" for v in values[i : i + 5]) + "\n")
+
+
+def _synthetic(n=2000, dt=0.01):
+    t = np.arange(n) * dt
+    return 0.3 * np.sin(2 * np.pi * 1.3 * t) * np.exp(-(((t - 8) / 4) ** 2)) + 0.05 * np.sin(
+        2 * np.pi * 4.7 * t
+    )
+
+
+def test_spectrum_matches_scipy_lsim_with_first_order_hold(tmp_path):
+    values = _synthetic()
+    path = tmp_path / "syn.AT2"
+    _at2(path, values)
+    rec = vi.read_record(path)
+    assert rec["units"] == "g" and rec["dt"] == pytest.approx(0.01)
+    assert rec["pga"] == pytest.approx(np.max(np.abs(values)) * 9.80665, rel=1e-6)
+    periods = np.geomspace(0.06, 5.0, 25)  # >= 6 dt
+    spec = vi.response_spectrum(rec, periods, damping=0.05)
+    t, a = rec["times"], rec["acceleration"]
+    for k, T in enumerate(periods):
+        w = 2 * math.pi / T
+        sys = scipy_signal.lti([[0, 1], [-w * w, -2 * 0.05 * w]], [[0], [-1]], [[1, 0]], [[0]])
+        _, y, _ = scipy_signal.lsim(sys, a, t, interp=True)
+        sd = np.max(np.abs(y))
+        assert spec["displacement"][k] == pytest.approx(sd, rel=1e-6), T
+        assert spec["pseudo_acceleration"][k] == pytest.approx(w * w * sd, rel=1e-6)
+
+
+def test_units_give_the_same_spectrum(tmp_path):
+    values = _synthetic(600)
+    t = np.arange(600) * 0.01
+    for units, factor in (("g", 1.0), ("m/s2", 9.80665), ("gal", 980.665)):
+        p = tmp_path / f"rec_{units.replace('/', '')}.txt"
+        np.savetxt(p, np.column_stack([t, values * factor]), header="time acceleration")
+        s = vi.response_spectrum(vi.read_record(p, units=units), [0.2, 1.0])
+        if units == "g":
+            ref = s
+        np.testing.assert_allclose(s["pseudo_acceleration"], ref["pseudo_acceleration"], rtol=1e-12)
+
+
+def test_bad_records_raise_naming_the_argument(tmp_path):
+    p = tmp_path / "bad.txt"
+    p.write_text("time acc\n0 1\n0.01 2\n")
+    with pytest.raises(ValueError, match="states no units"):
+        vi.read_record(p)
+    with pytest.raises(ValueError, match="units"):
+        vi.read_record(p, units="furlong")
+    with pytest.raises(OSError, match="cannot read"):
+        vi.read_record(tmp_path / "missing.AT2")
+    with pytest.raises(ValueError, match="damping"):
+        vi.response_spectrum([0.0, 0.01, 0.02], [1.0], acceleration=[0.0, 1.0, 0.0], damping=2.0)
+    with pytest.raises(ValueError, match="times"):
+        vi.response_spectrum([0.0, 0.01, 0.01], [1.0], acceleration=[0.0, 1.0, 0.0])
