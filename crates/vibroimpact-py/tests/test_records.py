@@ -71,3 +71,41 @@ def test_bad_records_raise_naming_the_argument(tmp_path):
         vi.response_spectrum([0.0, 0.01, 0.02], [1.0], acceleration=[0.0, 1.0, 0.0], damping=2.0)
     with pytest.raises(ValueError, match="times"):
         vi.response_spectrum([0.0, 0.01, 0.01], [1.0], acceleration=[0.0, 1.0, 0.0])
+
+
+def test_far_gap_linear_response_to_an_at2_record_matches_lsim(tmp_path):
+    """A body whose contact is never reached, driven by an AT2 record named
+    in its model file, moves as the exact piecewise-linear solution (SciPy
+    lsim, first-order hold) to 1e-8 of its peak."""
+    values = _synthetic(800)
+    _at2(tmp_path / "quake.AT2", values)
+    w, zeta, mass = 2 * math.pi / 0.7, 0.05, 1000.0
+    (tmp_path / "frame.toml").write_text(
+        f"""
+[[body]]
+name = "frame"
+mass = {mass}
+natural_frequency = {w!r}
+damping_ratio = {zeta}
+
+[[contact]]
+between = ["frame", "wall"]
+clearance = 1.0
+law = {{ law = "hertz", stiffness = 1e9 }}
+
+[excitation]
+type = "accelerogram"
+file = "quake.AT2"
+"""
+    )
+    model = vi.Model.load(tmp_path / "frame.toml")
+    sim = vi.simulate(model, duration=7.99, rtol=1e-12, atol=1e-16, output_step=0.01)
+    rec = vi.read_record(tmp_path / "quake.AT2")
+    sys = scipy_signal.lti([[0, 1], [-w * w, -2 * zeta * w]], [[0], [-1]], [[1, 0]], [[0]])
+    _, y, _ = scipy_signal.lsim(sys, rec["acceleration"], rec["times"], interp=True)
+    t = np.asarray(sim["t"])
+    u = np.asarray(sim["displacement"])[:, 0]
+    k = np.rint(t / 0.01).astype(int)
+    assert np.allclose(t, k * 0.01, atol=1e-9)
+    peak = np.max(np.abs(y))
+    assert np.max(np.abs(u - y[k])) < 1e-8 * peak

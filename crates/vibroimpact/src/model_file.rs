@@ -261,6 +261,9 @@ pub(crate) enum ExcitationSpec {
     },
     Accelerogram {
         file: Option<String>,
+        /// Units of the file's accelerations (g, m/s2, gal); its header's
+        /// for an AT2 file; m/s² for a CSV file without.
+        units: Option<String>,
         time: Option<Vec<f64>>,
         acceleration: Option<Vec<f64>>,
         scale: Option<f64>,
@@ -336,6 +339,11 @@ pub struct RecordSamples {
     pub values: Vec<f64>,
 }
 
+/// The caller's loader of accelerogram files: `(file, units)` to samples
+/// in m/s².
+pub type RecordLoader<'a> =
+    dyn FnMut(&str, Option<&str>) -> Result<RecordSamples, ModelFileError> + 'a;
+
 /// A parsed model file.
 #[derive(Clone, Debug)]
 pub struct ModelDocument {
@@ -365,12 +373,13 @@ impl Ctx<'_> {
 
 impl ModelDocument {
     /// Parses model text. `source` names it in messages; `load_record` is
-    /// called with the `file` of an `accelerogram` excitation and returns its
-    /// samples (e.g. [`parse_accelerogram_csv`] of the file's text).
+    /// called with the `file` and `units` of an `accelerogram` excitation and
+    /// returns its samples in m/s² (e.g. [`load_accelerogram`] of the
+    /// file's text).
     pub fn parse(
         text: &str,
         source: &str,
-        load_record: &mut dyn FnMut(&str) -> Result<RecordSamples, ModelFileError>,
+        load_record: &mut RecordLoader<'_>,
     ) -> Result<Self, ModelFileError> {
         let line_starts: Vec<usize> = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
@@ -405,12 +414,19 @@ impl ModelDocument {
                 span,
                 ExcitationSpec::Accelerogram {
                     file: f,
+                    units,
                     time,
                     acceleration,
                     ..
                 },
             )) => Some(match (f, time, acceleration) {
-                (Some(f), None, None) => load_record(f)?,
+                (Some(f), None, None) => load_record(f, units.as_deref())?,
+                (None, Some(_), Some(_)) if units.is_some() => {
+                    return Err(cx.err_at(
+                        span,
+                        "[excitation] accelerogram: `units` is for a `file`; inline `acceleration` is in m/s²",
+                    ))
+                }
                 (None, Some(t), Some(a)) if t.len() != a.len() => {
                     return Err(cx.err_at(
                         span,
@@ -453,20 +469,20 @@ impl ModelDocument {
         let text = read(path)
             .map_err(|e| ModelFileError(format!("{}: cannot read: {e}", path.display())))?;
         let dir = path.parent().unwrap_or_else(|| std::path::Path::new("."));
-        let mut load = |file: &str| -> Result<RecordSamples, ModelFileError> {
+        let mut load = |file: &str, units: Option<&str>| -> Result<RecordSamples, ModelFileError> {
             let record = dir.join(file);
             let source = record.display().to_string();
             let text = read(&record).map_err(|e| {
                 ModelFileError(format!("{source}: cannot read the accelerogram: {e}"))
             })?;
-            parse_accelerogram_csv(&text, &source)
+            load_accelerogram(&text, &source, units)
         };
         Self::parse(&text, &path.display().to_string(), &mut load)
     }
 
     /// Parses model text that refers to no accelerogram file.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelFileError> {
-        Self::parse(text, source, &mut |f| {
+        Self::parse(text, source, &mut |f, _| {
             Err(ModelFileError(format!(
                 "{source}: accelerogram file `{f}`: no files can be read here; give the samples inline (`time` and `acceleration` arrays)"
             )))
@@ -491,12 +507,14 @@ impl ModelDocument {
         if let (Some(e), Some(r)) = (file.excitation.as_mut(), &self.record) {
             if let ExcitationSpec::Accelerogram {
                 file: f,
+                units,
                 time,
                 acceleration,
                 ..
             } = e.get_mut()
             {
                 *f = None;
+                *units = None;
                 *time = Some(r.times.clone());
                 *acceleration = Some(r.values.clone());
             }
@@ -826,6 +844,28 @@ impl ModelDocument {
 /// Python package read (1 GiB): larger ones are refused before reading
 /// rather than exhausting memory. (The library itself reads no files.)
 pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+
+/// The samples (m/s²) of an accelerogram file's text: a record in any form
+/// of [`crate::record`] (AT2, two columns) when it is an AT2 file or
+/// `units` are given, else a two-column CSV in m/s²
+/// ([`parse_accelerogram_csv`]).
+pub fn load_accelerogram(
+    text: &str,
+    source: &str,
+    units: Option<&str>,
+) -> Result<RecordSamples, ModelFileError> {
+    let units = units
+        .map(crate::record::Units::parse)
+        .transpose()
+        .map_err(|e| ModelFileError(format!("{source}: [excitation] {e}")))?;
+    if units.is_some() || crate::record::is_at2(text, source) {
+        crate::record::parse_record(text, source, units)
+            .map(|r| r.samples())
+            .map_err(ModelFileError)
+    } else {
+        parse_accelerogram_csv(text, source)
+    }
+}
 
 /// Parses a two-column accelerogram CSV (time s, acceleration m/s²); a
 /// header row and `#` comment lines are allowed. `source` names the text in

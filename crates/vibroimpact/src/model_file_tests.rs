@@ -120,7 +120,7 @@ fn accelerograms_from_text_and_inline() {
         .to_string();
     assert!(e.contains("bad.csv:3:") && e.contains("increase"), "{e}");
     let text = "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"ok.csv\"\nscale = 0.5\n";
-    let doc = ModelDocument::parse(text, "m.toml", &mut |f| {
+    let doc = ModelDocument::parse(text, "m.toml", &mut |f, _| {
         assert_eq!(f, "ok.csv");
         Ok(a.clone())
     })

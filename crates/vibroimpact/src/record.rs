@@ -335,16 +335,20 @@ fn check_gaps(times: &[f64], lines: &[usize], source: &str) -> Result<(), String
     Ok(())
 }
 
-/// A record from text: `.AT2` if its fourth line has `NPTS` and `DT`, its
-/// first line names PEER or `source` ends in `.AT2`; else two columns.
-pub fn parse_record(text: &str, source: &str, units: Option<Units>) -> Result<Record, String> {
-    let is_at2 = text.lines().nth(3).is_some_and(|l| npts_dt(l).is_some())
+/// Whether the text is an AT2 file: its fourth line has `NPTS` and `DT`,
+/// its first line names PEER or `source` ends in `.AT2`.
+pub fn is_at2(text: &str, source: &str) -> bool {
+    text.lines().nth(3).is_some_and(|l| npts_dt(l).is_some())
         || text
             .lines()
             .next()
             .is_some_and(|l| l.to_ascii_uppercase().contains("PEER"))
-        || source.to_ascii_uppercase().ends_with(".AT2");
-    if is_at2 {
+        || source.to_ascii_uppercase().ends_with(".AT2")
+}
+
+/// A record from text: AT2 ([`is_at2`]), else two columns.
+pub fn parse_record(text: &str, source: &str, units: Option<Units>) -> Result<Record, String> {
+    if is_at2(text, source) {
         parse_at2(text, source, units)
     } else {
         parse_columns(text, source, units)

@@ -104,7 +104,7 @@ fn model_file_mutants_parse_build_and_simulate_without_panics() {
     no_panics(
         "model file",
         inputs.into_iter(),
-        |text| match ModelDocument::parse(text, "fuzz.toml", &mut |name| loader(name)) {
+        |text| match ModelDocument::parse(text, "fuzz.toml", &mut |name, _| loader(name)) {
             Err(e) => assert!(
                 e.0.starts_with("fuzz.toml") || e.0.starts_with("record:"),
                 "unnamed error: {e}"
@@ -168,7 +168,7 @@ fn parameters_set_or_refuse_without_panics() {
     let mut rng = Rng(seed() ^ 2);
     let docs: Vec<ModelDocument> = [ROW, ROW2, POUNDING, EXPLICIT]
         .iter()
-        .map(|t| ModelDocument::parse(t, "m.toml", &mut |name| loader(name)).unwrap())
+        .map(|t| ModelDocument::parse(t, "m.toml", &mut |name, _| loader(name)).unwrap())
         .collect();
     let n = cases(400);
     let inputs: Vec<String> = (0..n)
