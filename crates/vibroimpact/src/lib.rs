@@ -57,6 +57,7 @@ pub mod newton;
 pub mod numeric;
 pub mod parameter;
 pub mod periodic;
+pub mod pounding;
 pub mod record;
 pub mod reference;
 pub mod results;

@@ -1,0 +1,376 @@
+//! Pounding of adjacent structures (docs/earthquakes.md): two shear frames
+//! side by side on the same ground, separated by a gap at one or more
+//! floors where they may collide under a recorded ground motion. The pair
+//! becomes a model of the library's kind (floors are bodies on a line,
+//! storeys are springs and dampers, the gap is a contact with any of the
+//! contact laws), so a pounding run is a simulation like any other.
+//!
+//! Each frame has floor masses m_i, storey stiffnesses k_i (storey i joins
+//! floor i − 1, or the ground for i = 1, to floor i) and Rayleigh damping
+//! C = αM + βK with the ratio ζ in its first two modes (one storey: ζ
+//! exactly). In the floors' displacements relative to the ground, C is a
+//! damper α m_i from each floor to the ground and a damper β k_i beside
+//! each storey spring: exactly the model's body dampers and couplings.
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::contact::ContactLaw;
+use crate::dynamics::ChainDynamics;
+use crate::integrate::OdeSystem;
+use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
+use crate::record::Record;
+use crate::simulate::{simulate, SimulationOptions};
+
+/// A shear frame: floors from the ground up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShearFrame {
+    /// Floor masses (kg), from the first floor up.
+    pub masses: Vec<f64>,
+    /// Storey stiffnesses (N/m): storey i joins floor i − 1 (the ground for
+    /// i = 1) to floor i.
+    pub stiffnesses: Vec<f64>,
+    /// Rayleigh damping ratio in the first two modes.
+    pub damping_ratio: f64,
+}
+
+impl ShearFrame {
+    /// Checks the frame: as many storeys as floors, masses and stiffnesses
+    /// positive and finite, a damping ratio in [0, 1).
+    pub fn check(&self, name: &str) -> Result<(), String> {
+        if self.masses.is_empty() || self.masses.len() != self.stiffnesses.len() {
+            return Err(format!(
+                "{name}: {} masses and {} storey stiffnesses; give one of each per floor",
+                self.masses.len(),
+                self.stiffnesses.len()
+            ));
+        }
+        for (i, (m, k)) in self.masses.iter().zip(&self.stiffnesses).enumerate() {
+            if !(m.is_finite() && *m > 0.0 && k.is_finite() && *k > 0.0) {
+                return Err(format!(
+                    "{name}: floor {}: mass {m} and stiffness {k} must be positive and finite",
+                    i + 1
+                ));
+            }
+        }
+        if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
+            return Err(format!(
+                "{name}: damping ratio {}: give a value in [0, 1)",
+                self.damping_ratio
+            ));
+        }
+        Ok(())
+    }
+
+    /// The stiffness matrix K (tridiagonal).
+    fn stiffness_matrix(&self) -> DMatrix<f64> {
+        let n = self.masses.len();
+        let k = &self.stiffnesses;
+        DMatrix::from_fn(n, n, |r, c| {
+            if r == c {
+                k[r] + k.get(r + 1).copied().unwrap_or(0.0)
+            } else if r + 1 == c {
+                -k[c]
+            } else if c + 1 == r {
+                -k[r]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The natural circular frequencies (rad/s), lowest first: the
+    /// eigenvalues of M^{-1/2} K M^{-1/2}.
+    pub fn natural_frequencies(&self) -> Vec<f64> {
+        let k = self.stiffness_matrix();
+        let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
+        let n = s.len();
+        let a = DMatrix::from_fn(n, n, |r, c| s[r] * k[(r, c)] * s[c]);
+        let mut w: Vec<f64> = SymmetricEigen::new(a)
+            .eigenvalues
+            .iter()
+            .map(|l| l.max(0.0).sqrt())
+            .collect();
+        w.sort_by(f64::total_cmp);
+        w
+    }
+
+    /// The fundamental period T1 (s).
+    pub fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.natural_frequencies()[0]
+    }
+
+    /// Rayleigh's (α, β) with ζ in modes 1 and 2 (one storey: β = 0, α = 2ζω).
+    pub fn rayleigh(&self) -> (f64, f64) {
+        let w = self.natural_frequencies();
+        let z = self.damping_ratio;
+        match w.as_slice() {
+            [w1] => (2.0 * z * w1, 0.0),
+            [w1, w2, ..] => {
+                let alpha = 2.0 * z * w1 * w2 / (w1 + w2);
+                (alpha, 2.0 * z / (w1 + w2))
+            }
+            [] => (0.0, 0.0),
+        }
+    }
+}
+
+/// Two frames side by side, `left` of `right`, with a gap at some floors.
+#[derive(Clone, Debug)]
+pub struct PoundingPair {
+    /// The frame on the left.
+    pub left: ShearFrame,
+    /// The frame on the right.
+    pub right: ShearFrame,
+    /// The gap at rest (m).
+    pub gap: f64,
+    /// The floors (1-based) at which they may collide, each at most the
+    /// lower frame's height.
+    pub floors: Vec<usize>,
+    /// The contact law of every pounding floor.
+    pub law: ContactLaw,
+}
+
+/// The peak response of the two frames to one record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Response {
+    /// Peak storey drifts max |u_i − u_{i−1}| (m), left then right frame.
+    pub drift: [Vec<f64>; 2],
+    /// Peak absolute floor accelerations max |ü_i + a_g| over the samples
+    /// (m/s²), left then right.
+    pub acceleration: [Vec<f64>; 2],
+    /// Peak floor displacements relative to the ground (m).
+    pub displacement: [Vec<f64>; 2],
+    /// Largest impact force (N), 0 without impacts.
+    pub peak_impact_force: f64,
+    /// Impacts.
+    pub impacts: usize,
+    /// Per pounding floor, the largest closing max (u_left − u_right) (m).
+    pub closing: Vec<f64>,
+}
+
+/// One record's pounding study: the pair with and without its contacts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoundingResult {
+    /// With the contacts.
+    pub pounding: Response,
+    /// The frames apart (no contacts).
+    pub free: Response,
+    /// The smallest gap that avoids contact: the largest closing of the
+    /// free frames over the pounding floors (m; 0 if they never close).
+    pub required_gap: f64,
+    /// The code rules from the free frames' peak displacements u_L, u_R at
+    /// the pounding floors (largest over them, m): absolute sum, SRSS, and
+    /// the double difference `√(u_L² + u_R² − 2ρ u_L u_R)` with ρ the
+    /// correlation of two oscillators of the frames' fundamental periods
+    /// and damping (Der Kiureghian's CQC coefficient).
+    pub code_gaps: CodeGaps,
+}
+
+/// Separation gaps of the code rules (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CodeGaps {
+    /// u_L + u_R.
+    pub absolute_sum: f64,
+    /// √(u_L² + u_R²).
+    pub srss: f64,
+    /// √(u_L² + u_R² − 2ρ u_L u_R).
+    pub double_difference: f64,
+    /// ρ.
+    pub correlation: f64,
+}
+
+/// Der Kiureghian's correlation of two oscillators with frequency ratio r
+/// = ω_j/ω_i and damping ζ_i, ζ_j.
+pub fn correlation(r: f64, zi: f64, zj: f64) -> f64 {
+    let num = 8.0 * (zi * zj).sqrt() * (zi + r * zj) * r.powf(1.5);
+    let den = (1.0 - r * r).powi(2)
+        + 4.0 * zi * zj * r * (1.0 + r * r)
+        + 4.0 * (zi * zi + zj * zj) * r * r;
+    num / den
+}
+
+impl PoundingPair {
+    /// Checks the pair.
+    pub fn check(&self) -> Result<(), String> {
+        self.left.check("left frame")?;
+        self.right.check("right frame")?;
+        if !(self.gap.is_finite() && self.gap >= 0.0) {
+            return Err(format!("gap {}: give a finite gap >= 0", self.gap));
+        }
+        let top = self.left.masses.len().min(self.right.masses.len());
+        if self.floors.is_empty() {
+            return Err("floors: give at least one pounding floor".into());
+        }
+        if let Some(f) = self.floors.iter().find(|f| **f == 0 || **f > top) {
+            return Err(format!(
+                "floors: floor {f} is not a floor of both frames (1 to {top})"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The pair as a model under `record` × `scale`: the left frame's
+    /// floors, then the right frame's, on one line; a contact per pounding
+    /// floor if `contacts`.
+    pub fn model(&self, record: &Record, scale: f64, contacts: bool) -> Result<Model, String> {
+        self.check()?;
+        let mut bodies = Vec::new();
+        let mut couplings = Vec::new();
+        for (name, frame) in [("L", &self.left), ("R", &self.right)] {
+            let first = bodies.len();
+            let (alpha, beta) = frame.rayleigh();
+            for (i, (&m, &k)) in frame.masses.iter().zip(&frame.stiffnesses).enumerate() {
+                let ground = i == 0;
+                bodies.push(Body {
+                    name: format!("{name}{}", i + 1),
+                    mass: m,
+                    stiffness: if ground { k } else { 0.0 },
+                    damping: alpha * m + if ground { beta * k } else { 0.0 },
+                });
+                if !ground {
+                    couplings.push(Coupling {
+                        a: first + i - 1,
+                        b: first + i,
+                        stiffness: k,
+                        damping: beta * k,
+                    });
+                }
+            }
+        }
+        let n_left = self.left.masses.len();
+        let contact_list = if contacts {
+            self.floors
+                .iter()
+                .map(|&f| Contact {
+                    pair: ContactPair::Bodies {
+                        left: f - 1,
+                        right: n_left + f - 1,
+                    },
+                    clearance: self.gap,
+                    law: self.law.clone(),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let base = BaseExcitation::Record(
+            Accelerogram::new(record.times.clone(), record.acceleration.clone(), scale)
+                .map_err(|e| format!("{}: {e}", record.source))?,
+        );
+        Model::new(
+            bodies,
+            couplings,
+            contact_list,
+            base,
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    /// The peak response to `record` × `scale` over its duration, sampled
+    /// every `sample` seconds (accelerations and drifts; impact forces are
+    /// the impact log's exact peaks), at tolerance `rtol`.
+    fn response(
+        &self,
+        record: &Record,
+        scale: f64,
+        contacts: bool,
+        (sample, rtol): (f64, f64),
+    ) -> Result<Response, String> {
+        let model = self.model(record, scale, contacts)?;
+        let opts = SimulationOptions {
+            t_end: record.times.last().copied().unwrap_or(0.0),
+            rtol,
+            atol: rtol * 1e-4 * self.gap.max(1e-3),
+            output_step: Some(sample),
+            ..SimulationOptions::default()
+        };
+        let sim = simulate(&model, &opts).map_err(|e| e.0)?;
+        if let Some(e) = &sim.error {
+            return Err(format!("{}: {}", record.source, e));
+        }
+        let nl = self.left.masses.len();
+        let n = model.bodies().len();
+        let mut dynamics = ChainDynamics::new(&model, false);
+        let mut dy = vec![0.0; 2 * n];
+        let mut drift = [vec![0.0f64; nl], vec![0.0f64; n - nl]];
+        let mut acceleration = drift.clone();
+        let mut displacement = drift.clone();
+        let mut closing = vec![f64::NEG_INFINITY; self.floors.len()];
+        for (j, &t) in sim.times.iter().enumerate() {
+            let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
+            let u = &row[..n];
+            let y = crate::dynamics::to_interleaved(row);
+            dynamics.rhs(t, &y, &mut dy);
+            let ag = model.base().at(t);
+            for (side, (start, len)) in [(0, nl), (nl, n - nl)].into_iter().enumerate() {
+                for i in 0..len {
+                    let below = if i == 0 { 0.0 } else { u[start + i - 1] };
+                    drift[side][i] = drift[side][i].max((u[start + i] - below).abs());
+                    displacement[side][i] = displacement[side][i].max(u[start + i].abs());
+                    let a = dy[2 * (start + i) + 1] + ag;
+                    acceleration[side][i] = acceleration[side][i].max(a.abs());
+                }
+            }
+            for (c, &f) in self.floors.iter().enumerate() {
+                closing[c] = closing[c].max(u[f - 1] - u[nl + f - 1]);
+            }
+        }
+        Ok(Response {
+            drift,
+            acceleration,
+            displacement,
+            peak_impact_force: sim.impacts.iter().fold(0.0, |m, i| m.max(i.peak_force)),
+            impacts: sim.impacts.len(),
+            closing,
+        })
+    }
+
+    /// The pounding study of one record: the pair with and without its
+    /// contacts, the gap that avoids contact and the code rules' gaps.
+    pub fn analyse(
+        &self,
+        record: &Record,
+        scale: f64,
+        sample: f64,
+        rtol: f64,
+    ) -> Result<PoundingResult, String> {
+        if !(sample.is_finite() && sample > 0.0) {
+            return Err(format!("sample step {sample}: give a positive step"));
+        }
+        let pounding = self.response(record, scale, true, (sample, rtol))?;
+        let free = self.response(record, scale, false, (sample, rtol))?;
+        let required_gap = free.closing.iter().fold(0.0f64, |m, c| m.max(*c));
+        let ul = self
+            .floors
+            .iter()
+            .fold(0.0f64, |m, &f| m.max(free.displacement[0][f - 1]));
+        let ur = self
+            .floors
+            .iter()
+            .fold(0.0f64, |m, &f| m.max(free.displacement[1][f - 1]));
+        let (wl, wr) = (
+            self.left.natural_frequencies()[0],
+            self.right.natural_frequencies()[0],
+        );
+        let rho = correlation(wr / wl, self.left.damping_ratio, self.right.damping_ratio);
+        Ok(PoundingResult {
+            pounding,
+            free,
+            required_gap,
+            code_gaps: CodeGaps {
+                absolute_sum: ul + ur,
+                srss: (ul * ul + ur * ur).sqrt(),
+                // ≥ (u_L − u_R)² ≥ 0 for ρ ≤ 1; the max only guards rounding.
+                double_difference: (ul * ul + ur * ur - 2.0 * rho * ul * ur).max(0.0).sqrt(),
+                correlation: rho,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+#[path = "pounding_tests.rs"]
+mod tests;

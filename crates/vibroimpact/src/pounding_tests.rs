@@ -1,0 +1,163 @@
+//! Pounding studies: frame dynamics, the gap that avoids contact, the code
+//! rules.
+
+use super::*;
+
+fn frame(n: usize, m: f64, k: f64) -> ShearFrame {
+    ShearFrame {
+        masses: vec![m; n],
+        stiffnesses: vec![k; n],
+        damping_ratio: 0.05,
+    }
+}
+
+/// A 12-s record: a 1.5 Hz and a 3.2 Hz burst (m/s², dt 0.01).
+fn record() -> Record {
+    let times: Vec<f64> = (0..=1200).map(|k| k as f64 * 0.01).collect();
+    let a: Vec<f64> = times
+        .iter()
+        .map(|t| {
+            let env = (-((t - 4.0) / 2.0).powi(2)).exp();
+            env * (2.0 * (2.0 * std::f64::consts::PI * 1.5 * t).sin()
+                + 1.2 * (2.0 * std::f64::consts::PI * 3.2 * t).sin())
+        })
+        .collect();
+    Record::from_samples("burst", times, &a).unwrap()
+}
+
+/// Two equal storeys: ω² = (k/m)(3 ∓ √5)/2; Rayleigh damping gives ζ in
+/// both modes (modal ratios φᵀCφ / 2ωφᵀMφ to 1e-12).
+#[test]
+fn frame_frequencies_and_rayleigh_damping() {
+    let f = frame(2, 2.0e5, 8.0e7);
+    let w = f.natural_frequencies();
+    let k_over_m: f64 = 8.0e7 / 2.0e5;
+    let exact = [
+        (k_over_m * (3.0 - 5f64.sqrt()) / 2.0).sqrt(),
+        (k_over_m * (3.0 + 5f64.sqrt()) / 2.0).sqrt(),
+    ];
+    for (a, b) in w.iter().zip(exact) {
+        assert!((a - b).abs() < 1e-12 * b, "{a} vs {b}");
+    }
+    let f3 = ShearFrame {
+        masses: vec![3.0e5, 2.5e5, 2.0e5],
+        stiffnesses: vec![1.2e8, 1.0e8, 0.7e8],
+        damping_ratio: 0.04,
+    };
+    let (alpha, beta) = f3.rayleigh();
+    let k = f3.stiffness_matrix();
+    let m = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(f3.masses.clone()));
+    let c = &m * alpha + &k * beta;
+    // Modes from the generalised problem K φ = ω² M φ.
+    let s = DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(
+        3,
+        f3.masses.iter().map(|m| 1.0 / m.sqrt()),
+    ));
+    let eig = SymmetricEigen::new(&s * &k * &s);
+    let mut modes: Vec<(f64, nalgebra::DVector<f64>)> = (0..3)
+        .map(|j| (eig.eigenvalues[j].sqrt(), &s * eig.eigenvectors.column(j)))
+        .collect();
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (w, phi) in modes.iter().take(2) {
+        let zeta =
+            (phi.transpose() * &c * phi)[(0, 0)] / (2.0 * w * (phi.transpose() * &m * phi)[(0, 0)]);
+        assert!((zeta - 0.04).abs() < 1e-12, "{zeta}");
+    }
+    // The model's body dampers and couplings are C.
+    let pair = PoundingPair {
+        left: f3.clone(),
+        right: frame(1, 1e5, 1e7),
+        gap: 1.0,
+        floors: vec![1],
+        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+    };
+    let model = pair.model(&record(), 1.0, false).unwrap();
+    let dynamics = ChainDynamics::new(&model, false);
+    assert_eq!(dynamics.bodies(), 4);
+}
+
+/// The gap that avoids contact: 2 % below the free frames' largest closing
+/// they pound, 2 % above they do not, and then the response equals the
+/// free one exactly (Hertz's law has no force apart). The code rules are
+/// ordered DDC ≤ SRSS ≤ ABS, and ABS bounds the true gap.
+#[test]
+fn required_gap_and_code_rules() {
+    let pair = |gap: f64| PoundingPair {
+        left: frame(3, 2.0e5, 6.0e7),
+        right: frame(2, 3.0e5, 1.5e8),
+        gap,
+        floors: vec![1, 2],
+        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    };
+    let rec = record();
+    let far = pair(1.0).analyse(&rec, 1.0, 0.0025, 1e-9).unwrap();
+    assert_eq!(far.pounding.impacts, 0);
+    assert_eq!(far.pounding, far.free);
+    let need = far.required_gap;
+    assert!(need > 1e-3, "{need}");
+    let below = pair(0.98 * need).analyse(&rec, 1.0, 0.0025, 1e-9).unwrap();
+    assert!(below.pounding.impacts > 0 && below.pounding.peak_impact_force > 0.0);
+    let above = pair(1.02 * need).analyse(&rec, 1.0, 0.0025, 1e-9).unwrap();
+    assert_eq!(above.pounding.impacts, 0);
+    let g = far.code_gaps;
+    assert!(g.double_difference <= g.srss && g.srss <= g.absolute_sum);
+    assert!(need <= g.absolute_sum);
+    assert!(g.correlation > 0.0 && g.correlation < 1.0);
+    // Identical frames move together: no gap needed, and ρ = 1.
+    let same = PoundingPair {
+        right: frame(3, 2.0e5, 6.0e7),
+        ..pair(0.01)
+    };
+    let r = same.analyse(&rec, 1.0, 0.0025, 1e-9).unwrap();
+    assert!(r.required_gap.abs() < 1e-12, "{}", r.required_gap);
+    assert!((r.code_gaps.correlation - 1.0).abs() < 1e-12);
+    assert!(r.code_gaps.double_difference < 1e-9);
+}
+
+#[test]
+fn bad_pairs_are_refused() {
+    let ok = PoundingPair {
+        left: frame(2, 1e5, 1e7),
+        right: frame(1, 1e5, 1e7),
+        gap: 0.01,
+        floors: vec![1],
+        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+    };
+    let cases = [
+        (
+            PoundingPair {
+                floors: vec![2],
+                ..ok.clone()
+            },
+            "floor 2 is not a floor of both",
+        ),
+        (
+            PoundingPair {
+                gap: -1.0,
+                ..ok.clone()
+            },
+            "gap -1",
+        ),
+        (
+            PoundingPair {
+                floors: vec![],
+                ..ok.clone()
+            },
+            "at least one",
+        ),
+        (
+            PoundingPair {
+                left: ShearFrame {
+                    stiffnesses: vec![1e7],
+                    ..frame(2, 1e5, 1e7)
+                },
+                ..ok.clone()
+            },
+            "left frame: 2 masses and 1 storey",
+        ),
+    ];
+    for (p, needle) in cases {
+        let e = p.check().unwrap_err();
+        assert!(e.contains(needle), "{e}");
+    }
+}
