@@ -247,7 +247,7 @@ impl PoundingPair {
                         right: n_left + f - 1,
                     },
                     clearance: self.gap,
-                    law: self.law.clone(),
+                    law: self.law,
                 })
                 .collect()
         } else {
