@@ -371,6 +371,165 @@ impl PoundingPair {
     }
 }
 
+/// One cell of a pounding spectrum: a gap and a period ratio, over the
+/// records.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectrumCell {
+    /// The gap (m).
+    pub gap: f64,
+    /// T_left / T_right (the right frame's stiffnesses scaled to it).
+    pub period_ratio: f64,
+    /// Per record: the largest impact force (N).
+    pub impact_force: Vec<f64>,
+    /// Per record: the impacts.
+    pub impacts: Vec<usize>,
+    /// Per record: the largest ratio of a storey drift with pounding to the
+    /// same drift of the free frames, over both frames.
+    pub drift_amplification: Vec<f64>,
+    /// Per record: the gap that avoids contact (m).
+    pub required_gap: Vec<f64>,
+}
+
+/// The pair with the right frame's stiffnesses scaled so that T_left /
+/// T_right = `ratio`.
+pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, String> {
+    if !(ratio.is_finite() && ratio > 0.0) {
+        return Err(format!("period ratio {ratio}: give a positive ratio"));
+    }
+    pair.check()?;
+    let factor = (pair.right.period() * ratio / pair.left.period()).powi(2);
+    let mut out = pair.clone();
+    out.right.stiffnesses.iter_mut().for_each(|k| *k *= factor);
+    Ok(out)
+}
+
+/// The pounding spectrum: every (gap, period ratio) cell over `records`
+/// (each with its scale), in parallel, cells gap-major; each record's run
+/// sampled every `sample` s at tolerance `rtol`. The same numbers at any
+/// thread count.
+pub fn pounding_spectrum(
+    pair: &PoundingPair,
+    records: &[(Record, f64)],
+    gaps: &[f64],
+    ratios: &[f64],
+    (sample, rtol): (f64, f64),
+) -> Result<Vec<SpectrumCell>, String> {
+    use rayon::prelude::*;
+    if records.is_empty() || gaps.is_empty() || ratios.is_empty() {
+        return Err("a pounding spectrum needs records, gaps and period ratios".into());
+    }
+    if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
+        return Err(format!("gap {g}: give finite gaps >= 0"));
+    }
+    let pairs: Vec<PoundingPair> = ratios
+        .iter()
+        .map(|&r| with_period_ratio(pair, r))
+        .collect::<Result<_, _>>()?;
+    let cells: Vec<(usize, usize)> = (0..gaps.len())
+        .flat_map(|g| (0..ratios.len()).map(move |r| (g, r)))
+        .collect();
+    cells
+        .par_iter()
+        .map(|&(g, r)| {
+            let p = PoundingPair {
+                gap: gaps[g],
+                ..pairs[r].clone()
+            };
+            let mut cell = SpectrumCell {
+                gap: gaps[g],
+                period_ratio: ratios[r],
+                impact_force: Vec::new(),
+                impacts: Vec::new(),
+                drift_amplification: Vec::new(),
+                required_gap: Vec::new(),
+            };
+            for (record, scale) in records {
+                let res = p.analyse(record, *scale, sample, rtol)?;
+                let amp = (0..2)
+                    .flat_map(|side| {
+                        let (a, b) = (&res.pounding.drift[side], &res.free.drift[side]);
+                        a.iter()
+                            .zip(b)
+                            .map(|(x, y)| if *y > 0.0 { x / y } else { 1.0 })
+                    })
+                    .fold(0.0f64, f64::max);
+                cell.impact_force.push(res.pounding.peak_impact_force);
+                cell.impacts.push(res.pounding.impacts);
+                cell.drift_amplification.push(amp);
+                cell.required_gap.push(res.required_gap);
+            }
+            Ok(cell)
+        })
+        .collect()
+}
+
+/// The empirical q-quantile (0 ≤ q ≤ 1) of `values` with linear
+/// interpolation between order statistics (NaN for none).
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let x = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (i, f) = (x.floor() as usize, x - x.floor());
+    if i + 1 < v.len() {
+        v[i] * (1.0 - f) + v[i + 1] * f
+    } else {
+        v[i]
+    }
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameSpec {
+    masses: Vec<f64>,
+    stiffnesses: Vec<f64>,
+    damping_ratio: f64,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PairSpec {
+    left: FrameSpec,
+    right: FrameSpec,
+    gap: f64,
+    floors: Vec<usize>,
+    law: crate::model_file::LawSpec,
+}
+
+/// A pair from TOML text: `[left]` and `[right]` (`masses`, `stiffnesses`,
+/// `damping_ratio`), `gap`, `floors` and `law` (a contact law as in model
+/// files); messages name `source` and the line.
+pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, String> {
+    let spec: PairSpec = toml::from_str(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        match line {
+            Some(l) => format!("{source}:{l}: {}", e.message().trim()),
+            None => format!("{source}: {}", e.message().trim()),
+        }
+    })?;
+    let frame = |f: FrameSpec| ShearFrame {
+        masses: f.masses,
+        stiffnesses: f.stiffnesses,
+        damping_ratio: f.damping_ratio,
+    };
+    let pair = PoundingPair {
+        left: frame(spec.left),
+        right: frame(spec.right),
+        gap: spec.gap,
+        floors: spec.floors,
+        law: spec
+            .law
+            .build()
+            .map_err(|e| format!("{source}: law: {e}"))?,
+    };
+    pair.check().map_err(|e| format!("{source}: {e}"))?;
+    Ok(pair)
+}
+
 #[cfg(test)]
 #[path = "pounding_tests.rs"]
 mod tests;

@@ -161,3 +161,69 @@ fn bad_pairs_are_refused() {
         assert!(e.contains(needle), "{e}");
     }
 }
+
+/// The spectrum over gaps × period ratios: the period ratio is set, a cell
+/// whose gap exceeds the required one has no impact and an amplification
+/// of exactly 1, the smallest gap pounds, and the numbers are the same on
+/// one thread and on two.
+#[test]
+fn pounding_spectrum_cells() {
+    let pair = PoundingPair {
+        left: frame(3, 2.0e5, 6.0e7),
+        right: frame(2, 3.0e5, 1.5e8),
+        gap: 0.0,
+        floors: vec![1, 2],
+        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    };
+    let scaled = with_period_ratio(&pair, 1.7).unwrap();
+    assert!((scaled.left.period() / scaled.right.period() - 1.7).abs() < 1e-12);
+    let records = vec![(record(), 1.0), (record(), 0.5)];
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                pounding_spectrum(&pair, &records, &[0.001, 0.5], &[0.8, 1.7], (0.005, 1e-8))
+            })
+            .unwrap()
+    };
+    let cells = run(1);
+    assert_eq!(cells, run(2));
+    assert_eq!(cells.len(), 4);
+    for c in &cells {
+        for (k, need) in c.required_gap.iter().enumerate() {
+            if c.gap > *need {
+                assert_eq!(c.impacts[k], 0);
+                assert_eq!(c.drift_amplification[k], 1.0);
+            }
+        }
+    }
+    assert!(cells[0].impacts[0] > 0, "{:?}", cells[0]);
+    assert_eq!(quantile(&[3.0, 1.0, 2.0], 0.5), 2.0);
+    assert_eq!(quantile(&[1.0, 2.0], 0.25), 1.25);
+}
+
+#[test]
+fn pair_files_are_parsed_and_checked() {
+    let text =
+        "gap = 0.02\nfloors = [1]\nlaw = { law = \"hertz\", stiffness = 1e9, exponent = 1.5 }\n\
+                [left]\nmasses = [1e5]\nstiffnesses = [1e7]\ndamping_ratio = 0.05\n\
+                [right]\nmasses = [1e5, 1e5]\nstiffnesses = [2e7, 2e7]\ndamping_ratio = 0.02\n";
+    let p = parse_pair(text, "pair.toml").unwrap();
+    assert_eq!(
+        (p.left.masses.len(), p.right.masses.len(), p.gap),
+        (1, 2, 0.02)
+    );
+    let e = parse_pair(
+        &text.replace("damping_ratio = 0.02", "dampingratio = 0.02"),
+        "pair.toml",
+    )
+    .unwrap_err();
+    assert!(
+        e.starts_with("pair.toml:11:") && e.contains("dampingratio"),
+        "{e}"
+    );
+    let e = parse_pair(&text.replace("floors = [1]", "floors = [2]"), "pair.toml").unwrap_err();
+    assert!(e.contains("floor 2 is not a floor of both"), "{e}");
+}
