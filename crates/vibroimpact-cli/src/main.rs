@@ -26,7 +26,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{basins, branch, chart, identify, impact, simulate, spectrum, sweep};
+use commands::{basins, branch, chart, identify, impact, pounding, simulate, spectrum, sweep};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -65,6 +65,11 @@ enum Command {
     /// columns, CSV): pseudo-acceleration, pseudo-velocity, displacement.
     #[command(allow_negative_numbers = true)]
     Spectrum(spectrum::SpectrumArgs),
+    /// Pounding of two shear frames under recorded ground motions: response
+    /// with and without pounding, the gap that avoids contact, code rules,
+    /// and pounding spectra over gap × period ratio.
+    #[command(allow_negative_numbers = true)]
+    Pounding(pounding::PoundingArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
     Periodic(branch::PeriodicArgs),
@@ -100,6 +105,7 @@ fn main() -> ExitCode {
         Some(Command::Chart(args)) => chart::run(args),
         Some(Command::Basins(args)) => basins::run(args),
         Some(Command::Spectrum(args)) => spectrum::run(args),
+        Some(Command::Pounding(args)) => pounding::run(args),
         Some(Command::Report { out }) => report::run(out),
         None => report::run(&cli.out),
     };

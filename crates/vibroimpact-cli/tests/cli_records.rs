@@ -113,3 +113,100 @@ fn bad_records_and_options_are_refused() {
         assert!(out.stdout.is_empty(), "{args:?}");
     }
 }
+
+/// `pounding` on the example pair and the synthetic record: the JSON
+/// fields, pounding below the required gap, amplification, the code rules'
+/// order; the spectrum's cells and CSV; bad input refused.
+#[test]
+fn pounding_of_two_frames() {
+    let pair = repo_file("examples/pounding-frames.toml");
+    let quake = repo_file("examples/synthetic-quake.csv");
+    let doc = json(&[
+        "pounding", &pair, &quake, "--units", "m/s2", "--format", "json",
+    ]);
+    let run = &doc["runs"][0];
+    assert_eq!(run["record"]["units"], "m/s2");
+    let need = run["required_gap"].as_f64().unwrap();
+    assert!(need > 0.02, "{need}");
+    assert!(run["pounding"]["impacts"].as_u64().unwrap() > 0);
+    assert!(run["pounding"]["peak_impact_force"].as_f64().unwrap() > 0.0);
+    assert_eq!(run["free"]["impacts"], 0);
+    let g = &run["code_gaps"];
+    let (abs, srss, ddc) = (
+        g["absolute_sum"].as_f64().unwrap(),
+        g["srss"].as_f64().unwrap(),
+        g["double_difference"].as_f64().unwrap(),
+    );
+    assert!(ddc <= srss && srss <= abs && need <= abs);
+    assert_eq!(
+        run["amplification"]["drift"]["left"]
+            .as_array()
+            .unwrap()
+            .len(),
+        3
+    );
+    let dir = temp_dir("pounding");
+    let spec = json(&[
+        "pounding",
+        &pair,
+        &quake,
+        "--units",
+        "m/s2",
+        "--gaps",
+        "0.01:0.06:3",
+        "--ratios",
+        "0.5:2:2",
+        "--format",
+        "json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let cells = spec["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 6);
+    for c in cells {
+        let need = c["required_gap"]["median"].as_f64().unwrap();
+        if c["gap"].as_f64().unwrap() > need {
+            assert_eq!(c["impacts"]["median"].as_f64().unwrap(), 0.0);
+        }
+    }
+    assert!(dir.join("pounding.json").is_file() && dir.join("spectrum.csv").is_file());
+    let bad_pair = dir.join("bad.toml");
+    std::fs::write(
+        &bad_pair,
+        std::fs::read_to_string(&pair)
+            .unwrap()
+            .replace("floors = [1, 2]", "floors = [3]"),
+    )
+    .unwrap();
+    let bad = bad_pair.display().to_string();
+    for (args, needle) in [
+        (
+            vec!["pounding", &bad, &quake, "--units", "m/s2"],
+            "floor 3 is not a floor of both",
+        ),
+        (vec!["pounding", &pair, &quake], "states no units"),
+        (
+            vec![
+                "pounding",
+                &pair,
+                &quake,
+                "--units",
+                "m/s2",
+                "--gaps",
+                "0.01:0.02:2",
+            ],
+            "--ratios",
+        ),
+        (
+            vec![
+                "pounding", &pair, &quake, "--units", "m/s2", "--format", "csv",
+            ],
+            "--format csv",
+        ),
+    ] {
+        let out = common::run(&args);
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}

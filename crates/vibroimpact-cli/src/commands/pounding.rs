@@ -1,0 +1,292 @@
+//! `vibroimpact pounding`: two shear frames side by side under recorded
+//! ground motions ([`vibroimpact::pounding`]): per record the response
+//! with and without pounding, the gap that avoids contact and the code
+//! rules; with `--gaps` and `--ratios` the pounding spectrum over an
+//! ensemble (median and 16/84 % quantiles).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use serde_json::{json, Value};
+use vibroimpact::pounding::{
+    parse_pair, pounding_spectrum, quantile, PoundingPair, Response, SpectrumCell,
+};
+use vibroimpact::record::{parse_record, Record, Units};
+
+use crate::error::CliError;
+use crate::format::{CsvText, Format};
+use crate::output::{ensure_dir, write_atomic};
+
+/// Options of `vibroimpact pounding`.
+#[derive(Args, Debug)]
+pub struct PoundingArgs {
+    /// The pair (TOML: `[left]` and `[right]` frames with `masses`,
+    /// `stiffnesses`, `damping_ratio`; `gap`, `floors`, `law`; see
+    /// docs/earthquakes.md).
+    pair: PathBuf,
+    /// Records (AT2, two columns or CSV), one run each.
+    #[arg(required = true)]
+    records: Vec<PathBuf>,
+    /// Units of the records when their headers do not state them.
+    #[arg(long)]
+    units: Option<String>,
+    /// Scale factor applied to every record.
+    #[arg(long, default_value_t = 1.0)]
+    scale: f64,
+    /// Output sampling of drifts and accelerations (s).
+    #[arg(long, default_value_t = 0.0025)]
+    sample: f64,
+    /// Integration tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    rtol: f64,
+    /// Pounding spectrum: gaps FROM:TO:N (m), with --ratios.
+    #[arg(long, requires = "ratios")]
+    gaps: Option<String>,
+    /// Pounding spectrum: period ratios T_left/T_right FROM:TO:N, with
+    /// --gaps.
+    #[arg(long, requires = "gaps")]
+    ratios: Option<String>,
+    /// Output folder for pounding.json (and spectrum.csv).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// `FROM:TO:N` as N evenly spaced values (N = 1: FROM).
+fn range(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
+    let bad = || CliError::new(format!("--{flag} {text}: give FROM:TO:N, e.g. 0.01:0.1:10"));
+    let parts: Vec<&str> = text.split(':').collect();
+    let [a, b, n] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let a: f64 = a.parse().map_err(|_| bad())?;
+    let b: f64 = b.parse().map_err(|_| bad())?;
+    let n: usize = n.parse().map_err(|_| bad())?;
+    if n == 0 || !a.is_finite() || !b.is_finite() || (n > 1 && a == b) {
+        return Err(bad());
+    }
+    Ok((0..n)
+        .map(|i| {
+            if n == 1 {
+                a
+            } else {
+                a + (b - a) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect())
+}
+
+fn response_json(r: &Response) -> Value {
+    json!({
+        "peak_drift": { "left": r.drift[0], "right": r.drift[1] },
+        "peak_floor_acceleration": { "left": r.acceleration[0], "right": r.acceleration[1] },
+        "peak_displacement": { "left": r.displacement[0], "right": r.displacement[1] },
+        "peak_impact_force": r.peak_impact_force,
+        "impacts": r.impacts,
+        "closing": r.closing,
+    })
+}
+
+fn ratio(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| if *y > 0.0 { x / y } else { 1.0 })
+        .collect()
+}
+
+fn record_json(r: &Record, scale: f64) -> Value {
+    json!({
+        "source": r.source, "header": r.header, "units": r.units.name(), "dt": r.dt,
+        "samples": r.times.len(), "duration": r.duration(), "pga": r.pga(), "scale": scale,
+    })
+}
+
+/// Median and 16/84 % quantiles of a list.
+fn stats(v: &[f64]) -> Value {
+    json!({ "median": quantile(v, 0.5), "p16": quantile(v, 0.16), "p84": quantile(v, 0.84), "values": v })
+}
+
+fn cell_json(c: &SpectrumCell) -> Value {
+    let impacts: Vec<f64> = c.impacts.iter().map(|&i| i as f64).collect();
+    json!({
+        "gap": c.gap,
+        "period_ratio": c.period_ratio,
+        "peak_impact_force": stats(&c.impact_force),
+        "impacts": stats(&impacts),
+        "drift_amplification": stats(&c.drift_amplification),
+        "required_gap": stats(&c.required_gap),
+    })
+}
+
+fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    w.row([
+        "gap",
+        "period_ratio",
+        "impact_force_median",
+        "impact_force_p16",
+        "impact_force_p84",
+        "drift_amplification_median",
+        "drift_amplification_p84",
+        "required_gap_median",
+    ])?;
+    for c in cells {
+        w.row([
+            format!("{:e}", c.gap),
+            format!("{:e}", c.period_ratio),
+            format!("{:e}", quantile(&c.impact_force, 0.5)),
+            format!("{:e}", quantile(&c.impact_force, 0.16)),
+            format!("{:e}", quantile(&c.impact_force, 0.84)),
+            format!("{:e}", quantile(&c.drift_amplification, 0.5)),
+            format!("{:e}", quantile(&c.drift_amplification, 0.84)),
+            format!("{:e}", quantile(&c.required_gap, 0.5)),
+        ])?;
+    }
+    w.finish()
+}
+
+/// Runs `vibroimpact pounding`.
+pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
+    let units = args
+        .units
+        .as_deref()
+        .map(Units::parse)
+        .transpose()
+        .map_err(|e| CliError::new(format!("--units: {e}")))?;
+    if !(args.scale.is_finite() && args.sample.is_finite() && args.sample > 0.0) {
+        return Err(CliError::new(format!(
+            "--scale {} --sample {}: give a finite scale and a positive sample step",
+            args.scale, args.sample
+        )));
+    }
+    let source = args.pair.display().to_string();
+    let text =
+        crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
+    let pair: PoundingPair = parse_pair(&text, &source).map_err(CliError::new)?;
+    let mut records = Vec::new();
+    for path in &args.records {
+        let name = path.display().to_string();
+        let text =
+            crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
+        records.push((
+            parse_record(&text, &name, units).map_err(CliError::new)?,
+            args.scale,
+        ));
+    }
+    let frames = json!({
+        "left_period": pair.left.period(),
+        "right_period": pair.right.period(),
+        "gap": pair.gap,
+        "floors": pair.floors,
+    });
+    let (doc, csv) = match (&args.gaps, &args.ratios) {
+        (Some(g), Some(r)) => {
+            let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
+            let cells =
+                pounding_spectrum(&pair, &records, &gaps, &ratios, (args.sample, args.rtol))
+                    .map_err(CliError::new)?;
+            let doc = json!({
+                "pair": frames,
+                "records": records.iter().map(|(r, s)| record_json(r, *s)).collect::<Vec<_>>(),
+                "cells": cells.iter().map(cell_json).collect::<Vec<_>>(),
+            });
+            (doc, Some(spectrum_csv(&cells)?))
+        }
+        _ => {
+            let mut list = Vec::new();
+            for (r, s) in &records {
+                let res = pair
+                    .analyse(r, *s, args.sample, args.rtol)
+                    .map_err(CliError::new)?;
+                list.push(json!({
+                    "record": record_json(r, *s),
+                    "pounding": response_json(&res.pounding),
+                    "free": response_json(&res.free),
+                    "amplification": {
+                        "drift": { "left": ratio(&res.pounding.drift[0], &res.free.drift[0]),
+                                   "right": ratio(&res.pounding.drift[1], &res.free.drift[1]) },
+                        "floor_acceleration": { "left": ratio(&res.pounding.acceleration[0], &res.free.acceleration[0]),
+                                                "right": ratio(&res.pounding.acceleration[1], &res.free.acceleration[1]) },
+                    },
+                    "required_gap": res.required_gap,
+                    "code_gaps": {
+                        "absolute_sum": res.code_gaps.absolute_sum,
+                        "srss": res.code_gaps.srss,
+                        "double_difference": res.code_gaps.double_difference,
+                        "correlation": res.code_gaps.correlation,
+                    },
+                }));
+            }
+            (json!({ "pair": frames, "runs": list }), None)
+        }
+    };
+    if let Some(dir) = &args.out {
+        ensure_dir(dir)?;
+        write_atomic(
+            &dir.join("pounding.json"),
+            serde_json::to_string_pretty(&doc)?.as_bytes(),
+        )?;
+        if let Some(c) = &csv {
+            write_atomic(&dir.join("spectrum.csv"), c.as_bytes())?;
+        }
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        Format::Csv => {
+            match &csv {
+                Some(c) => print!("{c}"),
+                None => return Err(CliError::new(
+                    "--format csv: the CSV is the pounding spectrum's (give --gaps and --ratios)",
+                )),
+            }
+        }
+        Format::Table => print_table(&doc),
+    }
+    Ok(())
+}
+
+fn print_table(doc: &Value) {
+    let p = &doc["pair"];
+    println!(
+        "T_left {:.4} s, T_right {:.4} s, gap {} m at floors {}",
+        p["left_period"].as_f64().unwrap_or(f64::NAN),
+        p["right_period"].as_f64().unwrap_or(f64::NAN),
+        p["gap"],
+        p["floors"]
+    );
+    if let Some(runs) = doc["runs"].as_array() {
+        for r in runs {
+            println!(
+                "{}: {} impacts, peak force {:.4e} N, required gap {:.4e} m (ABS {:.4e}, SRSS {:.4e}, DDC {:.4e})",
+                r["record"]["source"].as_str().unwrap_or("?"),
+                r["pounding"]["impacts"],
+                r["pounding"]["peak_impact_force"].as_f64().unwrap_or(f64::NAN),
+                r["required_gap"].as_f64().unwrap_or(f64::NAN),
+                r["code_gaps"]["absolute_sum"].as_f64().unwrap_or(f64::NAN),
+                r["code_gaps"]["srss"].as_f64().unwrap_or(f64::NAN),
+                r["code_gaps"]["double_difference"].as_f64().unwrap_or(f64::NAN),
+            );
+        }
+    }
+    if let Some(cells) = doc["cells"].as_array() {
+        println!(
+            "{:>10} {:>8} {:>14} {:>12}",
+            "gap [m]", "T_L/T_R", "median F [N]", "median amp"
+        );
+        for c in cells {
+            println!(
+                "{:>10.4} {:>8.3} {:>14.4e} {:>12.4}",
+                c["gap"].as_f64().unwrap_or(f64::NAN),
+                c["period_ratio"].as_f64().unwrap_or(f64::NAN),
+                c["peak_impact_force"]["median"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                c["drift_amplification"]["median"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+            );
+        }
+    }
+}
