@@ -70,3 +70,59 @@ pub fn response_spectrum<'py>(
     d.set_item("displacement", array1(py, col(|r| r.displacement)))?;
     Ok(d)
 }
+
+/// One record's pounding study of the pair in `pair_text` (TOML, named by
+/// `source`): `left_period`, `right_period`, `pounding` and `free` (each
+/// with `peak_drift`, `peak_floor_acceleration`, `peak_displacement` as
+/// [left, right] lists, `peak_impact_force`, `impacts`, `closing`),
+/// `required_gap` and `code_gaps`.
+#[pyfunction]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol))]
+#[allow(clippy::too_many_arguments)]
+pub fn pounding<'py>(
+    py: Python<'py>,
+    pair_text: &str,
+    source: &str,
+    times: PyReadonlyArray1<'py, f64>,
+    acceleration: PyReadonlyArray1<'py, f64>,
+    scale: f64,
+    sample: f64,
+    rtol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let t = floats(&times, "times")?;
+    let a = floats(&acceleration, "acceleration")?;
+    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let res = py
+        .detach(|| pair.analyse(&record, scale, sample, rtol))
+        .map_err(value_error)?;
+    let response = |r: &vibroimpact::pounding::Response| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("peak_drift", [r.drift[0].clone(), r.drift[1].clone()])?;
+        d.set_item(
+            "peak_floor_acceleration",
+            [r.acceleration[0].clone(), r.acceleration[1].clone()],
+        )?;
+        d.set_item(
+            "peak_displacement",
+            [r.displacement[0].clone(), r.displacement[1].clone()],
+        )?;
+        d.set_item("peak_impact_force", r.peak_impact_force)?;
+        d.set_item("impacts", r.impacts)?;
+        d.set_item("closing", r.closing.clone())?;
+        Ok(d)
+    };
+    let d = PyDict::new(py);
+    d.set_item("left_period", pair.left.period())?;
+    d.set_item("right_period", pair.right.period())?;
+    d.set_item("pounding", response(&res.pounding)?)?;
+    d.set_item("free", response(&res.free)?)?;
+    d.set_item("required_gap", res.required_gap)?;
+    let g = PyDict::new(py);
+    g.set_item("absolute_sum", res.code_gaps.absolute_sum)?;
+    g.set_item("srss", res.code_gaps.srss)?;
+    g.set_item("double_difference", res.code_gaps.double_difference)?;
+    g.set_item("correlation", res.code_gaps.correlation)?;
+    d.set_item("code_gaps", g)?;
+    Ok(d)
+}

@@ -43,6 +43,7 @@ __all__ = [
     "impact",
     "parameter_values",
     "periodic",
+    "pounding",
     "read_record",
     "response_spectrum",
     "simulate",
@@ -933,5 +934,58 @@ def response_spectrum(
             _floats(periods, "periods"),
             float(damping),
             float(scale),
+        )
+    )
+
+
+def _record_arrays(record: Any):
+    if isinstance(record, (str, os.PathLike)):
+        record = read_record(record)
+    try:
+        return record["times"], record["acceleration"]
+    except (KeyError, TypeError, IndexError):
+        raise TypeError("record: expected a read_record result or a file name") from None
+
+
+def pounding(
+    pair: Union[str, "os.PathLike[str]"],
+    record: Any,
+    *,
+    scale: float = 1.0,
+    sample: float = 0.0025,
+    rtol: float = 1e-8,
+) -> Result:
+    """Pounding of two shear frames under one record (``vibroimpact
+    pounding``): ``pair`` is a pair file (TOML, docs/earthquakes.md) or its
+    text, ``record`` a :func:`read_record` result or a file name, scaled by
+    ``scale``. ``sample`` (s): the sampling of drifts and floor
+    accelerations.
+
+    Returns ``left_period``, ``right_period``, ``pounding`` and ``free``
+    (``peak_drift``, ``peak_floor_acceleration``, ``peak_displacement`` as
+    [left, right] lists per floor, ``peak_impact_force``, ``impacts``,
+    ``closing``), ``required_gap`` and ``code_gaps`` (``absolute_sum``,
+    ``srss``, ``double_difference``, ``correlation``)."""
+    if isinstance(pair, os.PathLike) or (isinstance(pair, str) and "\n" not in pair and os.path.exists(pair)):
+        source = os.fspath(pair)
+        with open(source, encoding="utf-8") as f:
+            text = f.read()
+    elif isinstance(pair, str):
+        source, text = "<pair>", pair
+    else:
+        raise TypeError("pair: expected a pair file name or its TOML text")
+    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    times, acc = _record_arrays(record)
+    return Result(
+        _core.pounding(
+            text,
+            source,
+            _floats(times, "times", allow_scalar=False),
+            _floats(acc, "acceleration", allow_scalar=False),
+            float(scale),
+            float(sample),
+            float(rtol),
         )
     )
