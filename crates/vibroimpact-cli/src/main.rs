@@ -19,6 +19,7 @@ mod model_io;
 mod output;
 mod plot;
 mod progress;
+mod records;
 mod report;
 
 use std::path::PathBuf;

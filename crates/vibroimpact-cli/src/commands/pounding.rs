@@ -11,11 +11,11 @@ use serde_json::{json, Value};
 use vibroimpact::pounding::{
     parse_pair, pounding_spectrum, quantile, PoundingPair, Response, SpectrumCell,
 };
-use vibroimpact::record::{parse_record, Record, Units};
 
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
+use crate::records;
 
 /// Options of `vibroimpact pounding`.
 #[derive(Args, Debug)]
@@ -96,13 +96,6 @@ fn ratio(a: &[f64], b: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn record_json(r: &Record, scale: f64) -> Value {
-    json!({
-        "source": r.source, "header": r.header, "units": r.units.name(), "dt": r.dt,
-        "samples": r.times.len(), "duration": r.duration(), "pga": r.pga(), "scale": scale,
-    })
-}
-
 /// Median and 16/84 % quantiles of a list.
 fn stats(v: &[f64]) -> Value {
     json!({ "median": quantile(v, 0.5), "p16": quantile(v, 0.16), "p84": quantile(v, 0.84), "values": v })
@@ -149,12 +142,7 @@ fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
 
 /// Runs `vibroimpact pounding`.
 pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
-    let units = args
-        .units
-        .as_deref()
-        .map(Units::parse)
-        .transpose()
-        .map_err(|e| CliError::new(format!("--units: {e}")))?;
+    let units = records::units(args.units.as_deref())?;
     if !(args.scale.is_finite() && args.sample.is_finite() && args.sample > 0.0) {
         return Err(CliError::new(format!(
             "--scale {} --sample {}: give a finite scale and a positive sample step",
@@ -165,16 +153,11 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let text =
         crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
     let pair: PoundingPair = parse_pair(&text, &source).map_err(CliError::new)?;
-    let mut records = Vec::new();
-    for path in &args.records {
-        let name = path.display().to_string();
-        let text =
-            crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
-        records.push((
-            parse_record(&text, &name, units).map_err(CliError::new)?,
-            args.scale,
-        ));
-    }
+    let runs = args
+        .records
+        .iter()
+        .map(|path| Ok((records::read(path, units)?, args.scale)))
+        .collect::<Result<Vec<_>, CliError>>()?;
     let frames = json!({
         "left_period": pair.left.period(),
         "right_period": pair.right.period(),
@@ -184,24 +167,23 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let (doc, csv) = match (&args.gaps, &args.ratios) {
         (Some(g), Some(r)) => {
             let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
-            let cells =
-                pounding_spectrum(&pair, &records, &gaps, &ratios, (args.sample, args.rtol))
-                    .map_err(CliError::new)?;
+            let cells = pounding_spectrum(&pair, &runs, &gaps, &ratios, (args.sample, args.rtol))
+                .map_err(CliError::new)?;
             let doc = json!({
                 "pair": frames,
-                "records": records.iter().map(|(r, s)| record_json(r, *s)).collect::<Vec<_>>(),
+                "records": runs.iter().map(|(r, s)| records::metadata(r, *s)).collect::<Vec<_>>(),
                 "cells": cells.iter().map(cell_json).collect::<Vec<_>>(),
             });
             (doc, Some(spectrum_csv(&cells)?))
         }
         _ => {
             let mut list = Vec::new();
-            for (r, s) in &records {
+            for (r, s) in &runs {
                 let res = pair
                     .analyse(r, *s, args.sample, args.rtol)
                     .map_err(CliError::new)?;
                 list.push(json!({
-                    "record": record_json(r, *s),
+                    "record": records::metadata(r, *s),
                     "pounding": response_json(&res.pounding),
                     "free": response_json(&res.free),
                     "amplification": {

@@ -6,13 +6,13 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde_json::json;
-use vibroimpact::record::{parse_record, Record, Units};
 use vibroimpact::spectrum::{periods, response_spectrum, SpectralPoint};
 
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
+use crate::records;
 
 /// Options of `vibroimpact spectrum`.
 #[derive(Args, Debug)]
@@ -64,20 +64,6 @@ fn parse_periods(text: &str) -> Result<Vec<f64>, CliError> {
     periods(a, b, n, log).map_err(|e| CliError::new(format!("--periods {text}: {e}")))
 }
 
-/// The record's metadata carried into every output.
-fn record_json(r: &Record, scale: f64) -> serde_json::Value {
-    json!({
-        "source": r.source,
-        "header": r.header,
-        "units": r.units.name(),
-        "dt": r.dt,
-        "samples": r.times.len(),
-        "duration": r.duration(),
-        "pga": r.pga(),
-        "scale": scale,
-    })
-}
-
 fn csv(rows: &[SpectralPoint]) -> Result<String, CliError> {
     let mut w = CsvText::new();
     w.row([
@@ -99,17 +85,9 @@ fn csv(rows: &[SpectralPoint]) -> Result<String, CliError> {
 
 /// Runs `vibroimpact spectrum`.
 pub fn run(args: &SpectrumArgs) -> Result<(), CliError> {
-    let units = args
-        .units
-        .as_deref()
-        .map(Units::parse)
-        .transpose()
-        .map_err(|e| CliError::new(format!("--units: {e}")))?;
+    let units = records::units(args.units.as_deref())?;
     let periods = parse_periods(&args.periods)?;
-    let source = args.record.display().to_string();
-    let text = crate::input::read_text(&args.record)
-        .map_err(|e| CliError::new(format!("{source}: {e}")))?;
-    let record = parse_record(&text, &source, units).map_err(CliError::new)?;
+    let record = records::read(&args.record, units)?;
     let rows = response_spectrum(&record, args.scale, args.damping, &periods).map_err(|e| {
         CliError::new(
             e.replace("damping ", "--damping ")
@@ -117,7 +95,7 @@ pub fn run(args: &SpectrumArgs) -> Result<(), CliError> {
         )
     })?;
     let doc = json!({
-        "record": record_json(&record, args.scale),
+        "record": records::metadata(&record, args.scale),
         "damping": args.damping,
         "peaks": "over the record's time steps",
         "units": { "period": "s", "pseudo_acceleration": "m/s2", "pseudo_velocity": "m/s", "displacement": "m" },

@@ -938,6 +938,17 @@ def response_spectrum(
     )
 
 
+def _pair_text(pair: Any):
+    """(source, TOML text) of a pounding pair given as a file name or text."""
+    if isinstance(pair, os.PathLike) or (isinstance(pair, str) and "\n" not in pair and os.path.exists(pair)):
+        source = os.fspath(pair)
+        with open(source, encoding="utf-8") as f:
+            return source, f.read()
+    if isinstance(pair, str):
+        return "<pair>", pair
+    raise TypeError("pair: expected a pair file name or its TOML text")
+
+
 def _record_arrays(record: Any):
     if isinstance(record, (str, os.PathLike)):
         record = read_record(record)
@@ -966,14 +977,7 @@ def pounding(
     [left, right] lists per floor, ``peak_impact_force``, ``impacts``,
     ``closing``), ``required_gap`` and ``code_gaps`` (``absolute_sum``,
     ``srss``, ``double_difference``, ``correlation``)."""
-    if isinstance(pair, os.PathLike) or (isinstance(pair, str) and "\n" not in pair and os.path.exists(pair)):
-        source = os.fspath(pair)
-        with open(source, encoding="utf-8") as f:
-            text = f.read()
-    elif isinstance(pair, str):
-        source, text = "<pair>", pair
-    else:
-        raise TypeError("pair: expected a pair file name or its TOML text")
+    source, text = _pair_text(pair)
     for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")

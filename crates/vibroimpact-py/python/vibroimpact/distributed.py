@@ -209,14 +209,7 @@ def ida(
 
     import vibroimpact as vi
 
-    if isinstance(pair, os.PathLike) or (isinstance(pair, str) and os.path.exists(pair)):
-        source = os.fspath(pair)
-        with open(source, encoding="utf-8") as f:
-            text = f.read()
-    elif isinstance(pair, str):
-        source, text = "<pair>", pair
-    else:
-        raise TypeError("pair: expected a pair file name or its TOML text")
+    source, text = vi._pair_text(pair)
     recs = [vi.read_record(r) if isinstance(r, (str, os.PathLike)) else r for r in records]
     scales = np.asarray(scales, dtype=np.float64)
     if scales.ndim != 1 or scales.size == 0 or not np.all(np.isfinite(scales)):

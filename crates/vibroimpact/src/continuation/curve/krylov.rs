@@ -13,12 +13,12 @@
 //! the Ritz values of an Arnoldi iteration: nothing of size d² is formed.
 
 use super::system::{Constraint, Observation};
-use super::{bound_crossed, CurveKind, CurveOptions, CurvePoint, CurveSystem};
+use super::{bound_crossed, CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonSystem};
 use crate::periodic::{
     arnoldi_matrix, floquet_multipliers, forcing_period, gmres, map_and_product,
-    multipliers_of_map, orbit_summary, ShootingOptions, MULTIPLIER_RTOL,
+    multipliers_of_map, orbit_summary, ShootingOptions,
 };
 
 /// Residual tolerance of the corrector (scaled max-norm).
@@ -57,23 +57,14 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
             ));
         }
         let n = model.bodies().len();
-        let w = model.forcing_frequency().unwrap_or(1.0);
-        let ds = opts.shooting.displacement_scale;
+        let scales = Scales::new(opts, model, (p, q));
         Ok(Self {
             family,
             kind,
-            // As the dense form: the tangent column in the step control, at
-            // the tolerance of reported multipliers.
-            opts: ShootingOptions {
-                rtol: (opts.shooting.rtol / 100.0).max(MULTIPLIER_RTOL),
-                control_monodromy: true,
-                ..opts.shooting.clone()
-            },
-            scale: (0..2 * n)
-                .map(|i| if i < n { ds } else { ds * w })
-                .collect(),
-            p_scale: p.abs().max(1e-12),
-            q_scale: q.abs().max(1e-12),
+            opts: scales.shooting,
+            scale: scales.orbit,
+            p_scale: scales.parameters[0],
+            q_scale: scales.parameters[1],
             c: vec![0.0; 2 * n],
             arnoldi: arnoldi.max(1),
         })

@@ -16,8 +16,11 @@
 //! is a regular solution curve: pseudo-arclength continuation with Newton
 //! on `[G; g; tᵀ(z − z_pred)] = 0`. The Jacobian is taken by forward
 //! differences (d + 2 or d + 3 period maps with their monodromy: the dense
-//! form, for rows of a few bodies). Codimension-two points on the way are
-//! detected and located ([`Codim2Kind`], `codim2.rs`).
+//! form, `system.rs`, for rows of a few bodies); long rows use the
+//! matrix-free extended form of `krylov.rs` (folds, flips, branch points).
+//! One continuation loop serves both ([`CurveSystem`]). Codimension-two
+//! points on the way are detected and located ([`Codim2Kind`],
+//! `codim2.rs`).
 
 mod codim2;
 mod krylov;
@@ -365,6 +368,37 @@ fn advance<S: CurveSystem>(
     let tn = sys.tangent(&next, Some(t))?;
     let seen = sys.observe(&next)?;
     Ok(Advance::Next(next, tn, seen))
+}
+
+/// What both forms of a curve scale and integrate with: the shooting
+/// options for the test functions — the tolerance of reported multipliers
+/// (shooting's, 100× tighter) with the monodromy's columns in the step
+/// control, else g = 0 leaves a multiplier up to 1e-6 from the critical
+/// value — the orbit's scales (displacement scale for u, × Ω for v) and
+/// the parameters' scales (their start values).
+struct Scales {
+    shooting: ShootingOptions,
+    orbit: Vec<f64>,
+    parameters: [f64; 2],
+}
+
+impl Scales {
+    fn new(opts: &CurveOptions, model: &Model, (p, q): (f64, f64)) -> Self {
+        let n = model.bodies().len();
+        let w = model.forcing_frequency().unwrap_or(1.0);
+        let ds = opts.shooting.displacement_scale;
+        Self {
+            shooting: ShootingOptions {
+                rtol: (opts.shooting.rtol / 100.0).max(crate::periodic::MULTIPLIER_RTOL),
+                control_monodromy: true,
+                ..opts.shooting.clone()
+            },
+            orbit: (0..2 * n)
+                .map(|i| if i < n { ds } else { ds * w })
+                .collect(),
+            parameters: [p.abs().max(1e-12), q.abs().max(1e-12)],
+        }
+    }
 }
 
 /// The parameter bound (index in z and scaled value) that z crossed, if

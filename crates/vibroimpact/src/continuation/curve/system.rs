@@ -4,12 +4,12 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem};
+use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonSystem};
 use crate::periodic::{
     floquet_multipliers, forcing_period, map_multipliers, orbit_summary, period_map,
-    period_map_with, ShootingOptions, MAX_STEPS, MULTIPLIER_RTOL,
+    period_map_with, ShootingOptions, MAX_STEPS,
 };
 use crate::simulate::{simulate, SimulationOptions};
 
@@ -83,26 +83,15 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
         (p, q): (f64, f64),
     ) -> Self {
         let n = model.bodies().len();
-        let w = model.forcing_frequency().unwrap_or(1.0);
-        let ds = opts.shooting.displacement_scale;
         let k = kind.borders();
+        let scales = Scales::new(opts, model, (p, q));
         Self {
             family,
             kind,
-            // The test function reads the monodromy: at the tolerance of
-            // reported multipliers (as shooting's, 100× tighter) and with
-            // its columns in the step control, else g = 0 leaves a
-            // multiplier up to 1e-6 from the critical value.
-            opts: ShootingOptions {
-                rtol: (opts.shooting.rtol / 100.0).max(MULTIPLIER_RTOL),
-                control_monodromy: true,
-                ..opts.shooting.clone()
-            },
-            scale: (0..2 * n)
-                .map(|i| if i < n { ds } else { ds * w })
-                .collect(),
-            p_scale: p.abs().max(1e-12),
-            q_scale: q.abs().max(1e-12),
+            opts: scales.shooting,
+            scale: scales.orbit,
+            p_scale: scales.parameters[0],
+            q_scale: scales.parameters[1],
             b: DMatrix::zeros(2 * n, k),
             c: DMatrix::zeros(2 * n, k),
             rows: if k == 2 { vec![0, 3] } else { vec![0] },

@@ -1,0 +1,38 @@
+//! Recorded ground motions as the commands read and report them
+//! (`spectrum`, `pounding`; docs/earthquakes.md).
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+use vibroimpact::record::{parse_record, Record, Units};
+
+use crate::error::CliError;
+
+/// `--units` parsed (None: the records' headers say).
+pub fn units(flag: Option<&str>) -> Result<Option<Units>, CliError> {
+    flag.map(Units::parse)
+        .transpose()
+        .map_err(|e| CliError::new(format!("--units: {e}")))
+}
+
+/// Reads a record file: AT2, two columns or CSV; errors name the file and
+/// line.
+pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
+    let name = path.display().to_string();
+    let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
+    parse_record(&text, &name, units).map_err(CliError::new)
+}
+
+/// The record's metadata carried into every output.
+pub fn metadata(r: &Record, scale: f64) -> Value {
+    json!({
+        "source": r.source,
+        "header": r.header,
+        "units": r.units.name(),
+        "dt": r.dt,
+        "samples": r.times.len(),
+        "duration": r.duration(),
+        "pga": r.pga(),
+        "scale": scale,
+    })
+}
