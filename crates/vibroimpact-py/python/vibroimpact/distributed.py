@@ -177,9 +177,13 @@ def ensemble(
 
 
 def _pounding_task(text: str, source: str, times, acc, scale: float, sample: float, rtol: float):
-    from . import _core
+    from . import _core, _floats
 
-    return dict(_core.pounding(text, source, times, acc, scale, sample, rtol))
+    # Arrays unpickled on a worker need not be aligned: copied as the
+    # binding reads them.
+    t = _floats(times, "times", allow_scalar=False)
+    a = _floats(acc, "acceleration", allow_scalar=False)
+    return dict(_core.pounding(text, source, t, a, scale, sample, rtol))
 
 
 def ida(
