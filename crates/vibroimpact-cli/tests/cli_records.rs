@@ -169,7 +169,14 @@ fn pounding_of_two_frames() {
             assert_eq!(c["impacts"]["median"].as_f64().unwrap(), 0.0);
         }
     }
-    assert!(dir.join("pounding.json").is_file() && dir.join("spectrum.csv").is_file());
+    for f in [
+        "pounding.json",
+        "spectrum.csv",
+        "spectrum.svg",
+        "spectrum.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
     let bad_pair = dir.join("bad.toml");
     std::fs::write(
         &bad_pair,

@@ -15,6 +15,7 @@ use vibroimpact::pounding::{
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition, Series};
 use crate::records;
 
 /// Options of `vibroimpact pounding`.
@@ -46,7 +47,8 @@ pub struct PoundingArgs {
     /// --gaps.
     #[arg(long, requires = "gaps")]
     ratios: Option<String>,
-    /// Output folder for pounding.json (and spectrum.csv).
+    /// Output folder for pounding.json (and, for a spectrum, spectrum.csv
+    /// and the figure spectrum.svg/.png).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Format on standard output.
@@ -113,6 +115,29 @@ fn cell_json(c: &SpectrumCell) -> Value {
     })
 }
 
+/// The pounding spectrum's figure: the median peak impact force against
+/// the gap, one line per period ratio.
+fn spectrum_figure(cells: &[SpectrumCell]) -> Figure {
+    let mut fig = Figure::new(
+        "Pounding spectrum: median peak impact force",
+        "gap  [m]",
+        "peak impact force  [MN]",
+    )
+    .legend_at(LegendPosition::Best);
+    let mut ratios: Vec<f64> = cells.iter().map(|c| c.period_ratio).collect();
+    ratios.sort_by(f64::total_cmp);
+    ratios.dedup();
+    for (k, r) in ratios.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = cells
+            .iter()
+            .filter(|c| c.period_ratio == *r)
+            .map(|c| (c.gap, 1e-6 * quantile(&c.impact_force, 0.5)))
+            .collect();
+        fig.push(Series::line(format!("T_L/T_R = {r:.3}"), pts).with_color(k % 7));
+    }
+    fig
+}
+
 fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
     let mut w = CsvText::new();
     w.row([
@@ -174,6 +199,10 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
                 "records": runs.iter().map(|(r, s)| records::metadata(r, *s)).collect::<Vec<_>>(),
                 "cells": cells.iter().map(cell_json).collect::<Vec<_>>(),
             });
+            if let Some(dir) = &args.out {
+                ensure_dir(dir)?;
+                render(&spectrum_figure(&cells), &dir.join("spectrum"))?;
+            }
             (doc, Some(spectrum_csv(&cells)?))
         }
         _ => {
