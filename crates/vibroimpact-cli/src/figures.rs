@@ -285,3 +285,44 @@ pub fn parameter_label(name: &str) -> String {
         other => other.to_string(),
     }
 }
+
+/// The directions of a sweep's points: up and down, or the one.
+pub fn sweep_directions(summary: &SweepSummary) -> Vec<Direction> {
+    if summary.up_down {
+        vec![Direction::Up, Direction::Down]
+    } else {
+        vec![Direction::None]
+    }
+}
+
+/// The brute-force bifurcation diagram: the Poincaré samples of the first
+/// body against the parameter (up and down apart).
+pub fn diagram_figure(summary: &SweepSummary) -> Figure {
+    let first = summary.bodies.first().cloned().unwrap_or_default();
+    let mut fig = Figure::new(
+        format!("Poincaré samples of {first}"),
+        parameter_label(&summary.parameter_name),
+        format!("u_{first} at t = kT  [mm]"),
+    )
+    .legend_at(if summary.up_down {
+        LegendPosition::Best
+    } else {
+        LegendPosition::None
+    });
+    for (c, d) in sweep_directions(summary).iter().enumerate() {
+        let pts: Vec<(f64, f64)> = summary
+            .points
+            .iter()
+            .filter(|p| p.direction == *d)
+            .flat_map(|p| p.sections.iter().map(move |s| (p.parameter, 1e3 * s[0])))
+            .collect();
+        let label = if summary.up_down { d.name() } else { "" };
+        let marker = if *d == Direction::Down {
+            Marker::Triangle
+        } else {
+            Marker::Circle
+        };
+        fig.push(Series::markers(label, pts, marker).with_color(c));
+    }
+    fig
+}

@@ -9,11 +9,11 @@ use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, Sweep
 use crate::args::MethodName;
 use crate::args::ParameterRange;
 use crate::error::CliError;
-use crate::figures::{lyapunov_figure, parameter_label};
+use crate::figures::{diagram_figure, lyapunov_figure, parameter_label, sweep_directions};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_family;
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use crate::plot::{render, Figure, LegendPosition, Series};
 
 /// Options of `vibroimpact sweep`.
 #[derive(Args, Debug)]
@@ -93,38 +93,9 @@ fn write_outputs(dir: &Path, summary: &SweepSummary) -> Result<(), CliError> {
         &dir.join("summary.json"),
         serde_json::to_string_pretty(summary)?.as_bytes(),
     )?;
-    let directions: Vec<Direction> = if summary.up_down {
-        vec![Direction::Up, Direction::Down]
-    } else {
-        vec![Direction::None]
-    };
-    let first = summary.bodies.first().cloned().unwrap_or_default();
+    let directions = sweep_directions(summary);
     let x_label = parameter_label(&summary.parameter_name);
-    let mut fig = Figure::new(
-        format!("Poincaré samples of {first}"),
-        x_label.clone(),
-        format!("u_{first} at t = kT  [mm]"),
-    )
-    .legend_at(if summary.up_down {
-        LegendPosition::Best
-    } else {
-        LegendPosition::None
-    });
-    for (c, d) in directions.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = summary
-            .points
-            .iter()
-            .filter(|p| p.direction == *d)
-            .flat_map(|p| p.sections.iter().map(move |s| (p.parameter, 1e3 * s[0])))
-            .collect();
-        let label = if summary.up_down { d.name() } else { "" };
-        let marker = if *d == Direction::Down {
-            Marker::Triangle
-        } else {
-            Marker::Circle
-        };
-        fig.push(Series::markers(label, pts, marker).with_color(c));
-    }
+    let fig = diagram_figure(summary);
     render(&fig, &dir.join("sweep"))?;
     let n = summary.bodies.len();
     let shown: Vec<usize> = if n <= 8 {

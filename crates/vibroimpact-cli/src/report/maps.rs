@@ -15,13 +15,16 @@ use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{guess_by_simulation_with, ShootingOptions};
 use vibroimpact::reference::NATURAL_FREQUENCY as W0;
-use vibroimpact::sweep::{sweep, Direction, SweepOptions, SweepSummary};
+use vibroimpact::sweep::{sweep, SweepOptions, SweepSummary};
 
 use super::{html_table, DataFile, Report};
 use crate::curves::{curves, Curves, SecondParameter};
 use crate::error::CliError;
-use crate::figures::{basins_figure, chart_figure, class, curve_series, lyapunov_figure, CLASSES};
-use crate::plot::{Figure, LegendPosition, Marker, Series};
+use crate::figures::{
+    basins_figure, chart_figure, class, curve_series, diagram_figure, lyapunov_figure,
+    sweep_directions, CLASSES,
+};
+use crate::plot::{Figure, Marker, Series};
 
 /// The R2 model file with N = 2 (the other sizes by its `count`).
 const ROW_N2: &str = include_str!("../../../../examples/fujita-row-n2.toml");
@@ -224,23 +227,6 @@ fn points(c: &Curve) -> Vec<(f64, f64)> {
     c.points.iter().map(|p| (p.p, p.q)).collect()
 }
 
-/// The brute-force diagram: Poincaré samples of u1 against the frequency.
-fn diagram(sweep: &SweepSummary) -> Figure {
-    let pts: Vec<(f64, f64)> = sweep
-        .points
-        .iter()
-        .flat_map(|p| p.sections.iter().map(move |s| (p.parameter, 1e3 * s[0])))
-        .collect();
-    let mut fig = Figure::new(
-        "Brute force: Poincaré samples of u1 (R2, N = 2)",
-        "forcing frequency Ω  [rad/s]",
-        "u1 at t = kT  [mm]",
-    )
-    .legend_at(LegendPosition::None);
-    fig.push(Series::markers("", pts, Marker::Circle).with_color(0));
-    fig
-}
-
 /// Cells per class of a chart, as table cells.
 fn class_counts(chart: &Chart) -> Vec<usize> {
     let mut counts = vec![0usize; CLASSES.len()];
@@ -404,7 +390,7 @@ pub(super) fn render(report: &mut Report, maps: &Maps) -> Result<(), CliError> {
         })
         .collect();
     report.figure(
-        &diagram(sweep),
+        &diagram_figure(sweep),
         "fig_map_diagram_n2",
         &format!(
             "R2 with N = 2, brute force from the model's initial state at {} frequencies: \
@@ -420,7 +406,7 @@ pub(super) fn render(report: &mut Report, maps: &Maps) -> Result<(), CliError> {
         )],
     )?;
     report.figure(
-        &lyapunov_figure(sweep, &[Direction::None]),
+        &lyapunov_figure(sweep, &sweep_directions(sweep)),
         "fig_map_lyapunov_n2",
         &format!(
             "Under the diagram: the largest Lyapunov exponent of the same runs (QR of the \

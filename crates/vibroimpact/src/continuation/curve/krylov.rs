@@ -13,12 +13,11 @@
 //! the Ritz values of an Arnoldi iteration: nothing of size d² is formed.
 
 use super::system::{Constraint, Observation};
-use super::{bound_crossed, CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
+use super::{bound_crossed, CurveKind, CurveOptions, CurveSystem, Scales};
 use crate::model::Model;
-use crate::newton::{damped_newton, NewtonOptions, NewtonSystem};
+use crate::newton::NewtonSystem;
 use crate::periodic::{
-    arnoldi_matrix, floquet_multipliers, forcing_period, gmres, map_and_product,
-    multipliers_of_map, orbit_summary, ShootingOptions,
+    arnoldi_matrix, floquet_multipliers, gmres, map_and_product, ShootingOptions,
 };
 
 /// Residual tolerance of the corrector (scaled max-norm).
@@ -197,24 +196,12 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
     }
 
     fn correct(&mut self, pred: &[f64], constraint: Constraint<'_>) -> Result<Vec<f64>, String> {
-        let opts = NewtonOptions {
-            tol: TOL,
-            max_iterations: 10,
-            max_step: 0.5,
-            line_search: false,
-            stall: Some((1.0, 10.0)),
-        };
         let mut corr = Corrector {
             sys: self,
             pred,
             constraint,
         };
-        let out = damped_newton(&mut corr, pred, &opts)?;
-        if out.converged() {
-            Ok(out.x)
-        } else {
-            Err(format!("the corrector stopped ({:?})", out.stop))
-        }
+        super::run_corrector(&mut corr, pred, TOL, 10)
     }
 
     /// `[J; t_prevᵀ] t = e` by GMRES (without a previous tangent: the
@@ -254,22 +241,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
         };
         let ritz = arnoldi_matrix(&mut apply, d, m, noise)?;
         let eigenvalues = floquet_multipliers(&ritz).map_err(|e| e.to_string())?;
-        let multipliers = multipliers_of_map(eigenvalues.clone(), self.opts.symmetric);
-        let period = forcing_period(&model).map_err(|e| e.to_string())?
-            * f64::from(self.opts.subharmonic.max(1));
-        let orbit =
-            orbit_summary(&model, &x, period, 0, self.opts.rtol).map_err(|e| e.to_string())?;
-        Ok(Observation {
-            point: CurvePoint {
-                p,
-                q,
-                state: x,
-                max_displacement: orbit.max_displacement,
-                multipliers,
-            },
-            eigenvalues,
-            kappa: f64::NAN,
-        })
+        Observation::new(&model, x, (p, q), eigenvalues, f64::NAN, &self.opts)
     }
 
     fn bound_crossed(&self, z: &[f64], bounds: &[(f64, f64); 2]) -> Option<(usize, f64)> {

@@ -401,6 +401,30 @@ impl Scales {
     }
 }
 
+/// Newton on a curve's corrector (either form) from `pred`, to the
+/// residual `tol` in at most `max_iterations` (full steps of at most 0.5
+/// scaled units, a stall at the noise floor accepted): the corrected z.
+fn run_corrector<S: crate::newton::NewtonSystem<Error = String>>(
+    corr: &mut S,
+    pred: &[f64],
+    tol: f64,
+    max_iterations: usize,
+) -> Result<Vec<f64>, String> {
+    let opts = crate::newton::NewtonOptions {
+        tol,
+        max_iterations,
+        max_step: 0.5,
+        line_search: false,
+        stall: Some((1.0, 10.0)),
+    };
+    let out = crate::newton::damped_newton(corr, pred, &opts)?;
+    if out.converged() {
+        Ok(out.x)
+    } else {
+        Err(format!("the corrector stopped ({:?})", out.stop))
+    }
+}
+
 /// The parameter bound (index in z and scaled value) that z crossed, if
 /// any: p at `p_index`, q after it, scaled by `scales`.
 fn bound_crossed(

@@ -6,9 +6,9 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
 use crate::model::Model;
-use crate::newton::{damped_newton, NewtonOptions, NewtonSystem};
+use crate::newton::NewtonSystem;
 use crate::periodic::{
-    floquet_multipliers, forcing_period, map_multipliers, orbit_summary, period_map,
+    floquet_multipliers, forcing_period, multipliers_of_map, orbit_summary, period_map,
     period_map_with, ShootingOptions, MAX_STEPS,
 };
 use crate::simulate::{simulate, SimulationOptions};
@@ -72,6 +72,36 @@ pub(super) struct Observation {
     pub eigenvalues: Vec<Complex<f64>>,
     /// κ on a Neimark–Sacker curve (NaN on the others).
     pub kappa: f64,
+}
+
+impl Observation {
+    /// The point (p, q) of the orbit from `x` with the eigenvalues of its
+    /// shooting map: the multipliers from them (squared on the half map)
+    /// and the orbit's amplitudes from one integrated period.
+    pub(super) fn new(
+        model: &Model,
+        x: Vec<f64>,
+        (p, q): (f64, f64),
+        eigenvalues: Vec<Complex<f64>>,
+        kappa: f64,
+        opts: &ShootingOptions,
+    ) -> Result<Observation, String> {
+        let multipliers = multipliers_of_map(eigenvalues.clone(), opts.symmetric);
+        let period =
+            forcing_period(model).map_err(|e| e.to_string())? * f64::from(opts.subharmonic.max(1));
+        let orbit = orbit_summary(model, &x, period, 0, opts.rtol).map_err(|e| e.to_string())?;
+        Ok(Observation {
+            point: CurvePoint {
+                p,
+                q,
+                state: x,
+                max_displacement: orbit.max_displacement,
+                multipliers,
+            },
+            eigenvalues,
+            kappa,
+        })
+    }
 }
 
 impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
@@ -355,25 +385,13 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     /// Newton on `[G; g; constraint] = 0` from `pred`, to a residual of
     /// [`CURVE_TOL`].
     fn correct(&mut self, pred: &[f64], constraint: Constraint<'_>) -> Result<Vec<f64>, String> {
-        let opts = NewtonOptions {
-            tol: CURVE_TOL,
-            max_iterations: 12,
-            max_step: 0.5,
-            line_search: false,
-            stall: Some((1.0, 10.0)),
-        };
         let mut corr = Corrector {
             sys: self,
             pred,
             constraint,
             chord: None,
         };
-        let out = damped_newton(&mut corr, pred, &opts)?;
-        if out.converged() {
-            Ok(out.x)
-        } else {
-            Err(format!("the corrector stopped ({:?})", out.stop))
-        }
+        super::run_corrector(&mut corr, pred, CURVE_TOL, 12)
     }
 
     /// Follows the accepted point z: new borders (the null vectors of A
@@ -396,22 +414,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
         let model = (self.family)(p, q)?;
         let map = period_map(&model, &x, &self.opts).map_err(|e| e.to_string())?;
         let eigenvalues = floquet_multipliers(&map.monodromy).map_err(|e| e.to_string())?;
-        let multipliers =
-            map_multipliers(&map.monodromy, self.opts.symmetric).map_err(|e| e.to_string())?;
-        let period = self.period(&model)?;
-        let orbit =
-            orbit_summary(&model, &x, period, 0, self.opts.rtol).map_err(|e| e.to_string())?;
-        Ok(Observation {
-            point: CurvePoint {
-                p,
-                q,
-                state: x,
-                max_displacement: orbit.max_displacement,
-                multipliers,
-            },
-            eigenvalues,
-            kappa,
-        })
+        Observation::new(&model, x, (p, q), eigenvalues, kappa, &self.opts)
     }
 }
 

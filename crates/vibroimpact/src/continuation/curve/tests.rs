@@ -118,49 +118,24 @@ fn fold_curve_joins_the_two_folds_through_a_cusp() {
         end.p,
         lp2.parameter
     );
-    for point in curve.points.iter().step_by(5) {
-        let m = r2(1, point.p, point.q).unwrap();
-        // The orbit and its monodromy integrated again (at the tolerance
-        // of reported multipliers, 1e-13 against the curve's 1e-12):
-        // periodic to 1e-8 of its size, with a multiplier +1 to 2e-7. The
-        // curve's own multiplier is 1 to 1e-10; the two monodromies differ
-        // by up to 5e-8 (measured), since the variational columns ride on
-        // the state's steps outside the error control. (Shooting's Newton
-        // is singular at a fold.)
-        let fine = ShootingOptions {
-            rtol: 1e-13,
-            control_monodromy: true,
-            ..opts.shooting.clone()
-        };
-        let map = period_map(&m, &point.state, &fine).unwrap();
-        let size = point.max_displacement[0];
-        let off = map
-            .image
-            .iter()
-            .zip(&point.state)
-            .enumerate()
-            .fold(0.0f64, |e, (i, (a, b))| {
-                e.max((a - b).abs() / if i == 0 { size } else { size * point.p })
-            });
-        assert!(
-            off < 1e-8,
-            "at ({}, {}): off the orbit by {off:e}",
-            point.p,
-            point.q
-        );
-        let multipliers = map_multipliers(&map.monodromy, fine.symmetric).unwrap();
-        let near_one = multipliers
-            .iter()
-            .map(|m| (m - 1.0).norm())
-            .fold(f64::INFINITY, f64::min);
-        assert!(
-            near_one < 1e-8,
-            "at ({}, {}): {multipliers:?}, own {:?}",
-            point.p,
-            point.q,
-            point.multipliers
-        );
-    }
+    // The orbit and its monodromy integrated again (at the tolerance of
+    // reported multipliers, 1e-13 against the curve's 1e-12): periodic to
+    // 1e-8 of its size, with a multiplier +1 to 1e-8. The curve's own
+    // multiplier is 1 to 1e-10; the two monodromies differ by up to 5e-8
+    // (measured), since the variational columns ride on the state's steps
+    // outside the error control. (Shooting's Newton is singular at a fold.)
+    check_points(
+        &curve,
+        (true, true),
+        opts.shooting.symmetric,
+        5,
+        1e-8,
+        |m| {
+            m.iter()
+                .map(|m| (m - 1.0).norm())
+                .fold(f64::INFINITY, f64::min)
+        },
+    );
 }
 
 fn r2_family(p: f64, q: f64) -> Result<Model, String> {
