@@ -75,9 +75,10 @@ pub fn response_spectrum<'py>(
 /// `source`): `left_period`, `right_period`, `pounding` and `free` (each
 /// with `peak_drift`, `peak_floor_acceleration`, `peak_displacement` as
 /// [left, right] lists, `peak_impact_force`, `impacts`, `closing`),
-/// `required_gap` and `code_gaps`.
+/// `required_gap` and `code_gaps`; with `free` false, the pounding run
+/// alone (`pounding` and the periods).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol))]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, free))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding<'py>(
     py: Python<'py>,
@@ -88,14 +89,12 @@ pub fn pounding<'py>(
     scale: f64,
     sample: f64,
     rtol: f64,
+    free: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
     let t = floats(&times, "times")?;
     let a = floats(&acceleration, "acceleration")?;
     let record = Record::from_samples("record", t, &a).map_err(value_error)?;
-    let res = py
-        .detach(|| pair.analyse(&record, scale, sample, rtol))
-        .map_err(value_error)?;
     let response = |r: &vibroimpact::pounding::Response| -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("peak_drift", [r.drift[0].clone(), r.drift[1].clone()])?;
@@ -115,6 +114,16 @@ pub fn pounding<'py>(
     let d = PyDict::new(py);
     d.set_item("left_period", pair.left.period())?;
     d.set_item("right_period", pair.right.period())?;
+    if !free {
+        let r = py
+            .detach(|| pair.respond(&record, scale, true, sample, rtol))
+            .map_err(value_error)?;
+        d.set_item("pounding", response(&r)?)?;
+        return Ok(d);
+    }
+    let res = py
+        .detach(|| pair.analyse(&record, scale, sample, rtol))
+        .map_err(value_error)?;
     d.set_item("pounding", response(&res.pounding)?)?;
     d.set_item("free", response(&res.free)?)?;
     d.set_item("required_gap", res.required_gap)?;

@@ -118,7 +118,14 @@ pub struct Accelerogram {
     times: Vec<f64>,
     values: Vec<f64>,
     scale: f64,
+    /// Samples per second on average, `(n - 1) / (t_last - t_first)`: the
+    /// first guess of a sample's segment (exact for a uniform record).
+    rate: f64,
 }
+
+/// How far [`Accelerogram::at`] walks from its first guess before it falls
+/// back to bisection (a record whose spacing varies a lot).
+const SEGMENT_WALK: usize = 4;
 
 impl Accelerogram {
     /// From strictly increasing times and accelerations (m/s²). Errors name
@@ -157,11 +164,34 @@ impl Accelerogram {
                 "accelerogram: scale must be finite",
             ));
         }
+        let rate = (times.len() - 1) as f64 / (times[times.len() - 1] - times[0]);
         Ok(Self {
             times,
             values,
             scale,
+            rate,
         })
+    }
+
+    /// The segment `k` (samples `k - 1`, `k`) holding `t` inside the
+    /// record: the first `k` with `t < t_k`, or the last segment at the
+    /// record's end. Guessed from the average spacing and corrected by a
+    /// short walk (a uniform record: no walk), so that the integrator's
+    /// dozen evaluations per step do not each bisect the record; the
+    /// segment is exactly the bisection's.
+    fn segment(&self, t: f64) -> usize {
+        let n = self.times.len();
+        let mut k = (((t - self.times[0]) * self.rate) as usize + 1).clamp(1, n - 1);
+        for _ in 0..SEGMENT_WALK {
+            if self.times[k - 1] > t {
+                k -= 1;
+            } else if t >= self.times[k] && k < n - 1 {
+                k += 1;
+            } else {
+                return k;
+            }
+        }
+        self.times.partition_point(|&x| x <= t).clamp(1, n - 1)
     }
 
     /// Scaled acceleration at time t (m/s²).
@@ -170,7 +200,7 @@ impl Accelerogram {
         if t < self.times[0] || t > self.times[n - 1] {
             return 0.0;
         }
-        let k = self.times.partition_point(|&x| x <= t).clamp(1, n - 1);
+        let k = self.segment(t);
         let (t0, t1) = (self.times[k - 1], self.times[k]);
         let w = (t - t0) / (t1 - t0);
         self.scale * (self.values[k - 1] + w * (self.values[k] - self.values[k - 1]))
@@ -833,6 +863,27 @@ mod tests {
         assert_eq!(r.at(-1.0), 0.0);
         assert!(Accelerogram::new(vec![0.0, 1.0, 1.0], vec![0.0; 3], 1.0).is_err());
         assert_eq!(r.peak(), 1.0);
+    }
+
+    #[test]
+    fn accelerogram_segment_is_the_bisections() {
+        // A uniform record with rounding in its times, a record with a
+        // slow stretch (long walks fall back to bisection) and one with
+        // only two samples; every sample time, the midpoints and the ends.
+        let uniform: Vec<f64> = (0..2001).map(|k| k as f64 * 0.005).collect();
+        let mut uneven: Vec<f64> = (0..200).map(|k| k as f64 * 0.01).collect();
+        uneven.extend((1..50).map(|k| 1.99 + k as f64 * 0.2));
+        for times in [uniform, uneven, vec![-1.0, 2.0]] {
+            let n = times.len();
+            let r = Accelerogram::new(times.clone(), vec![0.0; n], 1.0).unwrap();
+            let mut probes = times.clone();
+            probes.extend(times.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            probes.extend(times.iter().map(|t| t - 1e-12));
+            for t in probes.into_iter().filter(|t| *t >= times[0]) {
+                let bisection = times.partition_point(|&x| x <= t).clamp(1, n - 1);
+                assert_eq!(r.segment(t), bisection, "t = {t}");
+            }
+        }
     }
 
     #[test]

@@ -19,7 +19,7 @@ use crate::dynamics::ChainDynamics;
 use crate::integrate::OdeSystem;
 use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
 use crate::record::Record;
-use crate::simulate::{simulate, SimulationOptions};
+use crate::simulate::{simulate_streaming, SimulationOptions};
 
 /// A shear frame: floors from the ground up.
 #[derive(Clone, Debug, PartialEq)]
@@ -269,16 +269,21 @@ impl PoundingPair {
         .map_err(|e| e.to_string())
     }
 
-    /// The peak response to `record` × `scale` over its duration, sampled
-    /// every `sample` seconds (accelerations and drifts; impact forces are
-    /// the impact log's exact peaks), at tolerance `rtol`.
-    fn response(
+    /// The peak response to `record` × `scale` over its duration, with the
+    /// contacts or without (`contacts`): drifts, floor accelerations and
+    /// displacements sampled every `sample` seconds, impact forces the
+    /// impact log's exact peaks, at tolerance `rtol`.
+    pub fn respond(
         &self,
         record: &Record,
         scale: f64,
         contacts: bool,
-        (sample, rtol): (f64, f64),
+        sample: f64,
+        rtol: f64,
     ) -> Result<Response, String> {
+        if !(sample.is_finite() && sample > 0.0) {
+            return Err(format!("sample step {sample}: give a positive step"));
+        }
         let model = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
             t_end: record.times.last().copied().unwrap_or(0.0),
@@ -287,22 +292,20 @@ impl PoundingPair {
             output_step: Some(sample),
             ..SimulationOptions::default()
         };
-        let sim = simulate(&model, &opts).map_err(|e| e.0)?;
-        if let Some(e) = &sim.error {
-            return Err(format!("{}: {}", record.source, e));
-        }
         let nl = self.left.masses.len();
         let n = model.bodies().len();
         let mut dynamics = ChainDynamics::new(&model, false);
-        let mut dy = vec![0.0; 2 * n];
+        let (mut y, mut dy) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
         let mut drift = [vec![0.0f64; nl], vec![0.0f64; n - nl]];
         let mut acceleration = drift.clone();
         let mut displacement = drift.clone();
         let mut closing = vec![f64::NEG_INFINITY; self.floors.len()];
-        for (j, &t) in sim.times.iter().enumerate() {
-            let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
+        // Peaks taken as the samples stream by (nothing stored).
+        let sim = simulate_streaming(&model, &opts, |t, row| {
             let u = &row[..n];
-            let y = crate::dynamics::to_interleaved(row);
+            for (i, (&x, &v)) in row[..n].iter().zip(&row[n..]).enumerate() {
+                (y[2 * i], y[2 * i + 1]) = (x, v);
+            }
             dynamics.rhs(t, &y, &mut dy);
             let ag = model.base().at(t);
             for (side, (start, len)) in [(0, nl), (nl, n - nl)].into_iter().enumerate() {
@@ -317,6 +320,11 @@ impl PoundingPair {
             for (c, &f) in self.floors.iter().enumerate() {
                 closing[c] = closing[c].max(u[f - 1] - u[nl + f - 1]);
             }
+            true
+        })
+        .map_err(|e| e.0)?;
+        if let Some(e) = &sim.error {
+            return Err(format!("{}: {}", record.source, e));
         }
         Ok(Response {
             drift,
@@ -337,11 +345,8 @@ impl PoundingPair {
         sample: f64,
         rtol: f64,
     ) -> Result<PoundingResult, String> {
-        if !(sample.is_finite() && sample > 0.0) {
-            return Err(format!("sample step {sample}: give a positive step"));
-        }
-        let pounding = self.response(record, scale, true, (sample, rtol))?;
-        let free = self.response(record, scale, false, (sample, rtol))?;
+        let pounding = self.respond(record, scale, true, sample, rtol)?;
+        let free = self.respond(record, scale, false, sample, rtol)?;
         let required_gap = free.closing.iter().fold(0.0f64, |m, c| m.max(*c));
         let ul = self
             .floors

@@ -965,12 +965,14 @@ def pounding(
     scale: float = 1.0,
     sample: float = 0.0025,
     rtol: float = 1e-8,
+    free: bool = True,
 ) -> Result:
     """Pounding of two shear frames under one record (``vibroimpact
     pounding``): ``pair`` is a pair file (TOML, docs/earthquakes.md) or its
     text, ``record`` a :func:`read_record` result or a file name, scaled by
     ``scale``. ``sample`` (s): the sampling of drifts and floor
-    accelerations.
+    accelerations. ``free=False`` runs the pair with its contacts only
+    (half the work; no ``free``, ``required_gap`` or ``code_gaps``).
 
     Returns ``left_period``, ``right_period``, ``pounding`` and ``free``
     (``peak_drift``, ``peak_floor_acceleration``, ``peak_displacement`` as
@@ -981,6 +983,8 @@ def pounding(
     for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    if not isinstance(free, bool):
+        raise TypeError(f"free: expected True or False, got {free!r}")
     times, acc = _record_arrays(record)
     return Result(
         _core.pounding(
@@ -991,5 +995,6 @@ def pounding(
             float(scale),
             float(sample),
             float(rtol),
+            free,
         )
     )

@@ -183,7 +183,7 @@ def _pounding_task(text: str, source: str, times, acc, scale: float, sample: flo
     # binding reads them.
     t = _floats(times, "times", allow_scalar=False)
     a = _floats(acc, "acceleration", allow_scalar=False)
-    return dict(_core.pounding(text, source, t, a, scale, sample, rtol))
+    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, True))
 
 
 def ida(
