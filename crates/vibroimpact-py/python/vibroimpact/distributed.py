@@ -176,9 +176,10 @@ def ensemble(
     return [Result(d) for d in _gather(futures, progress, len(futures))]
 
 
-def _pounding_task(text: str, source: str, times, acc, scale: float, sample: float, rtol: float):
+def _pounding_task(text: str, source: str, record, scale: float, sample: float, rtol: float):
     from . import _core, _floats
 
+    times, acc = record
     # Arrays unpickled on a worker need not be aligned: copied as the
     # binding reads them.
     t = _floats(times, "times", allow_scalar=False)
@@ -221,18 +222,20 @@ def ida(
     if not recs:
         raise ValueError("records: give at least one record")
     jobs = [(i, float(s)) for i in range(len(recs)) for s in scales]
-    args = [
-        (text, source, np.asarray(recs[i]["times"]), np.asarray(recs[i]["acceleration"]), s, sample, rtol)
-        for i, s in jobs
-    ]
+    arrays = [(np.asarray(r["times"]), np.asarray(r["acceleration"])) for r in recs]
     if client is None:
         results = []
-        for k, a in enumerate(args):
-            results.append(_pounding_task(*a))
+        for k, (i, s) in enumerate(jobs):
+            results.append(_pounding_task(text, source, arrays[i], s, sample, rtol))
             if progress is not None:
-                progress(k + 1, len(args))
+                progress(k + 1, len(jobs))
     else:
-        futures = [client.submit(_pounding_task, *a, retries=retries, pure=False) for a in args]
+        # Each record goes to the cluster once, not once per scale.
+        shipped = client.scatter(arrays)
+        futures = [
+            client.submit(_pounding_task, text, source, shipped[i], s, sample, rtol, retries=retries, pure=False)
+            for i, s in jobs
+        ]
         results = _gather(futures, progress, len(futures))
     period = float(results[0]["left_period"])
     sa_unit = [
