@@ -25,14 +25,5 @@ pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
 
 /// The record's metadata carried into every output.
 pub fn metadata(r: &Record, scale: f64) -> Value {
-    json!({
-        "source": r.source,
-        "header": r.header,
-        "units": r.units.name(),
-        "dt": r.dt,
-        "samples": r.times.len(),
-        "duration": r.duration(),
-        "pga": r.pga(),
-        "scale": scale,
-    })
+    json!(r.metadata(scale))
 }

@@ -205,7 +205,12 @@ fn simulate_bad_models() {
         &["simulate", &path, "--periods", "1"],
         "--periods needs a periodic excitation",
     );
-    let ok = run(&["simulate", &path, "--duration", "3"]);
+    // A record is not extended with zeros.
+    assert_clean_error(
+        &["simulate", &path, "--duration", "3"],
+        "the accelerogram ends at 2 s",
+    );
+    let ok = run(&["simulate", &path, "--duration", "2"]);
     assert!(
         ok.status.success(),
         "{}",

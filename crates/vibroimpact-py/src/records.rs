@@ -135,3 +135,55 @@ pub fn pounding<'py>(
     d.set_item("code_gaps", g)?;
     Ok(d)
 }
+
+/// The time history of the pair (TOML `pair_text`) with its contacts under
+/// the record × `scale`: `t`, `left` and `right` (floor displacements,
+/// floors × samples, m), and the impact log `impact_time`,
+/// `impact_floor` (1-based), `impact_peak_force` (N).
+#[pyfunction]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol))]
+#[allow(clippy::too_many_arguments)]
+pub fn pounding_history<'py>(
+    py: Python<'py>,
+    pair_text: &str,
+    source: &str,
+    times: PyReadonlyArray1<'py, f64>,
+    acceleration: PyReadonlyArray1<'py, f64>,
+    scale: f64,
+    sample: f64,
+    rtol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let t = floats(&times, "times")?;
+    let a = floats(&acceleration, "acceleration")?;
+    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let sim = py
+        .detach(|| pair.history(&record, scale, sample, rtol))
+        .map_err(value_error)?;
+    let (nl, n) = (pair.left.masses.len(), sim.final_displacement.len());
+    let floors = |range: std::ops::Range<usize>| -> Vec<Vec<f64>> {
+        range
+            .map(|i| sim.states.chunks(2 * n).map(|row| row[i]).collect())
+            .collect()
+    };
+    let d = PyDict::new(py);
+    d.set_item("left", floors(0..nl))?;
+    d.set_item("right", floors(nl..n))?;
+    d.set_item(
+        "impact_time",
+        array1(py, sim.impacts.iter().map(|i| i.start_time).collect()),
+    )?;
+    d.set_item(
+        "impact_floor",
+        sim.impacts
+            .iter()
+            .map(|i| pair.floors[i.contact])
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "impact_peak_force",
+        array1(py, sim.impacts.iter().map(|i| i.peak_force).collect()),
+    )?;
+    d.set_item("t", array1(py, sim.times))?;
+    Ok(d)
+}

@@ -287,7 +287,9 @@ pub fn simulate<'py>(
     })?;
     let sim = result.map_err(value_error)?;
     let n = m.bodies().len();
-    let d = document(py, &simulation_summary(m, &sim))?;
+    let mut summary = simulation_summary(m, &sim);
+    summary.record = model.loaded.record.clone();
+    let d = document(py, &summary)?;
     let (u, v) = split_states(py, &sim.states, sim.times.len(), n)?;
     d.set_item("t", array1(py, sim.times))?;
     d.set_item("displacement", u)?;

@@ -36,10 +36,11 @@ def test_plots_draw_the_results():
     plt.close("all")
 
 
-def test_example_notebook_runs():
+@pytest.mark.parametrize("name", ["seed-study.ipynb", "pounding-records.ipynb"])
+def test_example_notebook_runs(name):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
-    nb = nbformat.read(EXAMPLES / "seed-study.ipynb", as_version=4)
+    nb = nbformat.read(EXAMPLES / name, as_version=4)
     client = nbclient.NotebookClient(
         nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(EXAMPLES)}}
     )

@@ -162,3 +162,21 @@ def test_gmspy_records_are_read_from_the_installed_package():
     assert "KAKOGAWA" in " ".join(kobe["header"])
     with pytest.raises(ValueError, match="name"):
         records.gmspy_record("Atlantis")
+
+
+def test_a_simulation_carries_its_record_and_refuses_to_outrun_it(tmp_path):
+    values = _synthetic(500)
+    _at2(tmp_path / "quake.AT2", values)
+    model = tmp_path / "frame.toml"
+    model.write_text(
+        "[[body]]\nname = \"floor\"\nmass = 1.0e5\nstiffness = 4.0e7\ndamping = 2.0e5\n\n"
+        "[excitation]\ntype = \"accelerogram\"\nfile = \"quake.AT2\"\nscale = 0.5\n"
+    )
+    h = vi.simulate(model, duration=4.99)
+    r = h["record"]
+    assert r["source"].endswith("quake.AT2") and r["units"] == "g" and r["samples"] == 500
+    assert r["dt"] == pytest.approx(0.01) and r["duration"] == pytest.approx(4.99)
+    assert r["pga"] == pytest.approx(np.max(np.abs(values)) * 9.80665, rel=1e-6)
+    assert r["scale"] == 0.5 and r["header"][1].startswith("SYNTHETIC")
+    with pytest.raises(ValueError, match="accelerogram ends at 4.99"):
+        vi.simulate(model, duration=6.0)

@@ -211,6 +211,11 @@ impl Accelerogram {
         &self.times
     }
 
+    /// The scale factor.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
     /// Largest |scaled acceleration|.
     pub fn peak(&self) -> f64 {
         self.values.iter().fold(0.0f64, |m, a| m.max(a.abs())) * self.scale.abs()

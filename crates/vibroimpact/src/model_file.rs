@@ -16,6 +16,7 @@ use crate::contact::{ContactLaw, ForceForm};
 use crate::model::{
     Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, HarmonicForce, Model,
 };
+use crate::record::{Record, RecordMetadata};
 
 /// A model-file error: one line naming the source, the line and the key.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -326,23 +327,13 @@ pub struct LoadedModel {
     pub model: Model,
     /// `[simulation]` settings.
     pub simulation: SimulationSpec,
-}
-
-/// A recorded base acceleration as read, before scaling.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RecordSamples {
-    /// Where it came from (a file name), for messages.
-    pub source: String,
-    /// Sample times (s), strictly increasing.
-    pub times: Vec<f64>,
-    /// Accelerations (m/s²).
-    pub values: Vec<f64>,
+    /// The accelerogram's record and scale, if the excitation is one.
+    pub record: Option<RecordMetadata>,
 }
 
 /// The caller's loader of accelerogram files: `(file, units)` to samples
 /// in m/s².
-pub type RecordLoader<'a> =
-    dyn FnMut(&str, Option<&str>) -> Result<RecordSamples, ModelFileError> + 'a;
+pub type RecordLoader<'a> = dyn FnMut(&str, Option<&str>) -> Result<Record, ModelFileError> + 'a;
 
 /// A parsed model file.
 #[derive(Clone, Debug)]
@@ -351,7 +342,7 @@ pub struct ModelDocument {
     /// Byte offset of the start of every line of the text (for line numbers).
     line_starts: Vec<usize>,
     source: String,
-    record: Option<RecordSamples>,
+    record: Option<Record>,
 }
 
 /// Errors located in the document: `label:line: message`.
@@ -437,11 +428,10 @@ impl ModelDocument {
                         ),
                     ))
                 }
-                (None, Some(t), Some(a)) => RecordSamples {
-                    source: format!("{source} [excitation]"),
-                    times: t.clone(),
-                    values: a.clone(),
-                },
+                (None, Some(t), Some(a)) => {
+                    Record::from_samples(&format!("{source} [excitation]"), t.clone(), a)
+                        .map_err(|m| cx.err_at(span, format!("[excitation] accelerogram: {m}")))?
+                }
                 _ => return Err(cx.err_at(
                     span,
                     "[excitation] accelerogram: give `file`, or `time` and `acceleration` arrays",
@@ -469,7 +459,7 @@ impl ModelDocument {
         let text = read(path)
             .map_err(|e| ModelFileError(format!("{}: cannot read: {e}", path.display())))?;
         let dir = path.parent().unwrap_or_else(|| std::path::Path::new("."));
-        let mut load = |file: &str, units: Option<&str>| -> Result<RecordSamples, ModelFileError> {
+        let mut load = |file: &str, units: Option<&str>| -> Result<Record, ModelFileError> {
             let record = dir.join(file);
             let source = record.display().to_string();
             let text = read(&record).map_err(|e| {
@@ -516,7 +506,7 @@ impl ModelDocument {
                 *f = None;
                 *units = None;
                 *time = Some(r.times.clone());
-                *acceleration = Some(r.values.clone());
+                *acceleration = Some(r.acceleration.clone());
             }
         }
         // Serialising plain data (numbers, strings, arrays, tables) cannot fail.
@@ -777,8 +767,12 @@ impl ModelDocument {
                         // The samples' errors belong to the record, the
                         // scale's to the model file's [excitation].
                         BaseExcitation::Record(
-                            Accelerogram::new(record.times.clone(), record.values.clone(), scale)
-                                .map_err(|e| match e.key.as_str() {
+                            Accelerogram::new(
+                                record.times.clone(),
+                                record.acceleration.clone(),
+                                scale,
+                            )
+                            .map_err(|e| match e.key.as_str() {
                                 "excitation.scale" => cx.err_at(
                                     span.clone(),
                                     format!("[excitation] scale = {scale}: must be finite"),
@@ -836,7 +830,15 @@ impl ModelDocument {
                 return Err(cx.plain(format!("[simulation] {key} = {v}: must be finite and > 0")));
             }
         }
-        Ok(LoadedModel { model, simulation })
+        let record = match (&self.record, model.base()) {
+            (Some(r), BaseExcitation::Record(a)) => Some(r.metadata(a.scale())),
+            _ => None,
+        };
+        Ok(LoadedModel {
+            model,
+            simulation,
+            record,
+        })
     }
 }
 
@@ -845,7 +847,7 @@ impl ModelDocument {
 /// rather than exhausting memory. (The library itself reads no files.)
 pub const MAX_INPUT_BYTES: u64 = 1 << 30;
 
-/// The samples (m/s²) of an accelerogram file's text: a record in any form
+/// The record (m/s²) of an accelerogram file's text: a record in any form
 /// of [`crate::record`] (AT2, two columns) when it is an AT2 file or
 /// `units` are given, else a two-column CSV in m/s²
 /// ([`parse_accelerogram_csv`]).
@@ -853,15 +855,13 @@ pub fn load_accelerogram(
     text: &str,
     source: &str,
     units: Option<&str>,
-) -> Result<RecordSamples, ModelFileError> {
+) -> Result<Record, ModelFileError> {
     let units = units
         .map(crate::record::Units::parse)
         .transpose()
         .map_err(|e| ModelFileError(format!("{source}: [excitation] {e}")))?;
     if units.is_some() || crate::record::is_at2(text, source) {
-        crate::record::parse_record(text, source, units)
-            .map(|r| r.samples())
-            .map_err(ModelFileError)
+        crate::record::parse_record(text, source, units).map_err(ModelFileError)
     } else {
         parse_accelerogram_csv(text, source)
     }
@@ -870,7 +870,7 @@ pub fn load_accelerogram(
 /// Parses a two-column accelerogram CSV (time s, acceleration m/s²); a
 /// header row and `#` comment lines are allowed. `source` names the text in
 /// messages, which give its line.
-pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<RecordSamples, ModelFileError> {
+pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<Record, ModelFileError> {
     let err = |msg: String| Err(ModelFileError(msg));
     let mut times = Vec::new();
     let mut values = Vec::new();
@@ -906,11 +906,7 @@ pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<RecordSamples,
             None => return err(format!("{source}:{line_no}: `{l}` is not two numbers")),
         }
     }
-    Ok(RecordSamples {
-        source: source.to_string(),
-        times,
-        values,
-    })
+    Record::from_samples(source, times, &values).map_err(ModelFileError)
 }
 
 #[cfg(test)]

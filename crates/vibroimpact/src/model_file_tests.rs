@@ -114,7 +114,7 @@ fn errors_name_line_and_key() {
 #[test]
 fn accelerograms_from_text_and_inline() {
     let a = parse_accelerogram_csv("time,acceleration\n0,0\n0.5,1\n1.0,0\n", "ok.csv").unwrap();
-    assert_eq!((a.times.len(), a.values[1]), (3, 1.0));
+    assert_eq!((a.times.len(), a.acceleration[1]), (3, 1.0));
     let e = parse_accelerogram_csv("0,0\n0.5,1\n0.4,0\n", "bad.csv")
         .unwrap_err()
         .to_string();

@@ -285,13 +285,7 @@ impl PoundingPair {
             return Err(format!("sample step {sample}: give a positive step"));
         }
         let model = self.model(record, scale, contacts)?;
-        let opts = SimulationOptions {
-            t_end: record.times.last().copied().unwrap_or(0.0),
-            rtol,
-            atol: rtol * 1e-4 * self.gap.max(1e-3),
-            output_step: Some(sample),
-            ..SimulationOptions::default()
-        };
+        let opts = self.options(record, sample, rtol);
         let nl = self.left.masses.len();
         let n = model.bodies().len();
         let mut dynamics = ChainDynamics::new(&model, false);
@@ -334,6 +328,36 @@ impl PoundingPair {
             impacts: sim.impacts.len(),
             closing,
         })
+    }
+
+    /// The time history of the pair with its contacts under `record` ×
+    /// `scale`: every floor's displacement sampled every `sample` seconds
+    /// (body order: the left frame's floors, then the right frame's) and
+    /// the impact log, at tolerance `rtol`.
+    pub fn history(
+        &self,
+        record: &Record,
+        scale: f64,
+        sample: f64,
+        rtol: f64,
+    ) -> Result<crate::simulate::Simulation, String> {
+        let model = self.model(record, scale, true)?;
+        let sim = crate::simulate::simulate(&model, &self.options(record, sample, rtol))
+            .map_err(|e| e.0)?;
+        match &sim.error {
+            Some(e) => Err(format!("{}: {}", record.source, e)),
+            None => Ok(sim),
+        }
+    }
+
+    fn options(&self, record: &Record, sample: f64, rtol: f64) -> SimulationOptions {
+        SimulationOptions {
+            t_end: record.times.last().copied().unwrap_or(0.0),
+            rtol,
+            atol: rtol * 1e-4 * self.gap.max(1e-3),
+            output_step: Some(sample),
+            ..SimulationOptions::default()
+        }
     }
 
     /// The pounding study of one record: the pair with and without its

@@ -99,6 +99,19 @@ fn required_gap_and_code_rules() {
     assert!(below.pounding.impacts > 0 && below.pounding.peak_impact_force > 0.0);
     let above = pair(1.02 * need).analyse(&rec, 1.0, 0.0025, 1e-9).unwrap();
     assert_eq!(above.pounding.impacts, 0);
+    // The history of the pounding run: the same impacts and peak force,
+    // its largest sampled drift the response's (same samples), a sample
+    // every 2.5 ms over the record.
+    let h = pair(0.98 * need).history(&rec, 1.0, 0.0025, 1e-9).unwrap();
+    assert_eq!(h.impacts.len(), below.pounding.impacts);
+    let peak = h.impacts.iter().fold(0.0f64, |m, i| m.max(i.peak_force));
+    assert_eq!(peak, below.pounding.peak_impact_force);
+    let duration = *rec.times.last().unwrap();
+    assert_eq!(h.times.len(), (duration / 0.0025).round() as usize + 1);
+    let top_drift = (0..h.times.len())
+        .map(|j| (h.states[j * 10 + 2] - h.states[j * 10 + 1]).abs())
+        .fold(0.0, f64::max);
+    assert_eq!(top_drift, below.pounding.drift[0][2]);
     let g = far.code_gaps;
     assert!(g.double_difference <= g.srss && g.srss <= g.absolute_sum);
     assert!(need <= g.absolute_sum);

@@ -5,7 +5,7 @@
 //! samples (no resampling). The library parses text; the callers read the
 //! files.
 
-use crate::model_file::RecordSamples;
+use serde::Serialize;
 
 /// Standard gravity (m/s²) for records in g.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
@@ -51,6 +51,27 @@ impl Units {
     }
 }
 
+/// A record's metadata as results carry it (docs/earthquakes.md).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RecordMetadata {
+    /// Where it came from (a file name).
+    pub source: String,
+    /// The header lines as in the file.
+    pub header: Vec<String>,
+    /// The units of the file's values (`g`, `m/s2`, `gal`).
+    pub units: &'static str,
+    /// The time step if uniform (s).
+    pub dt: Option<f64>,
+    /// The sample count.
+    pub samples: usize,
+    /// The duration (s).
+    pub duration: f64,
+    /// The peak ground acceleration of the record as read (m/s²).
+    pub pga: f64,
+    /// The scale factor applied.
+    pub scale: f64,
+}
+
 /// A ground-motion record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
@@ -82,12 +103,18 @@ impl Record {
         }
     }
 
-    /// The samples (m/s²) for a model's accelerogram excitation.
-    pub fn samples(&self) -> RecordSamples {
-        RecordSamples {
+    /// What every result computed from the record carries about it, with
+    /// the scale factor applied.
+    pub fn metadata(&self, scale: f64) -> RecordMetadata {
+        RecordMetadata {
             source: self.source.clone(),
-            times: self.times.clone(),
-            values: self.acceleration.clone(),
+            header: self.header.clone(),
+            units: self.units.name(),
+            dt: self.dt,
+            samples: self.times.len(),
+            duration: self.duration(),
+            pga: self.pga(),
+            scale,
         }
     }
 

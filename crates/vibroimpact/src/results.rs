@@ -335,6 +335,10 @@ pub struct SimulationSummary {
     pub contact_laws: Vec<String>,
     /// Energy audit (J), with --energy.
     pub energy: Option<EnergySummary>,
+    /// The recorded ground motion, when the excitation is one (set by the
+    /// caller from [`crate::model_file::LoadedModel::record`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub record: Option<crate::record::RecordMetadata>,
 }
 
 /// Impacts of one contact.
@@ -403,5 +407,6 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
             contact_dissipation: e.contact_dissipation,
             residual: e.residual(),
         }),
+        record: None,
     }
 }

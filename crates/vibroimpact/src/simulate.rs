@@ -677,6 +677,16 @@ pub fn simulate_streaming(
             )));
         }
     }
+    if let BaseExcitation::Record(r) = model.base() {
+        let end = r.times().last().copied().unwrap_or(0.0);
+        // A hair of slack for a duration typed from the record's own times.
+        if opts.t_end > end * (1.0 + 1e-12) {
+            return Err(OptionsError(format!(
+                "duration = {} s: the accelerogram ends at {end} s; give a duration up to the record's end (a record is not extended with zeros)",
+                opts.t_end
+            )));
+        }
+    }
     let mut sys = ChainDynamics::new(model, opts.energy);
     let mut y0 = sys.initial_state(model);
     if let Some(start) = &opts.start {

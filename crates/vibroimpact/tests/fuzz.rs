@@ -15,9 +15,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use vibroimpact::contact::{ContactLaw, ForceForm};
 use vibroimpact::integrate::Method;
 use vibroimpact::model::{BaseExcitation, Model};
-use vibroimpact::model_file::{
-    parse_accelerogram_csv, ModelDocument, ModelFileError, RecordSamples,
-};
+use vibroimpact::model_file::{parse_accelerogram_csv, ModelDocument, ModelFileError};
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
@@ -64,7 +62,7 @@ acceleration = [0.0, 1.0, -1.0, 0.0]
 
 /// The record loader of the fuzzed model files: the example record, or an
 /// error for any other name.
-fn loader(name: &str) -> Result<RecordSamples, ModelFileError> {
+fn loader(name: &str) -> Result<vibroimpact::record::Record, ModelFileError> {
     if name == "synthetic-quake.csv" {
         parse_accelerogram_csv(QUAKE, name)
     } else {

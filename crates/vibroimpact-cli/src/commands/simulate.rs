@@ -241,6 +241,17 @@ pub fn summary_text(s: &SimulationSummary) -> String {
     for c in &s.impacts_per_contact {
         t.push_str(&format!("  {:<16} {} impacts\n", c.contact, c.impacts));
     }
+    if let Some(r) = &s.record {
+        t.push_str(&format!(
+            "record: {} ({} samples, {}, {:.3} s, PGA {:.4} m/s2 as read) x {}\n",
+            r.source,
+            r.samples,
+            r.dt.map_or("non-uniform step".to_string(), |dt| format!("dt {dt} s")),
+            r.duration,
+            r.pga,
+            r.scale
+        ));
+    }
     if let Some(e) = &s.energy {
         t.push_str(&format!(
             "energy: input {:.6e} J, dampers {:.6e} J, contacts {:.6e} J, mechanical {:.6e} J, balance residual {:.2e} J\n",
@@ -281,7 +292,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let mut sim = simulate_streaming(model, &opts, |t, state| {
         history.as_mut().is_none_or(|h| h.sample(t, state))
     })?;
-    let s = simulation_summary(model, &sim);
+    let mut s = simulation_summary(model, &sim);
+    s.record = loaded.record.clone();
     if let (Some(dir), Some(history)) = (&args.out, history) {
         (sim.times, sim.states) = history.finish()?;
         write_outputs(dir, model, &sim, &s, phase_body)?;

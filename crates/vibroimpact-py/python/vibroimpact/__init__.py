@@ -44,6 +44,7 @@ __all__ = [
     "parameter_values",
     "periodic",
     "pounding",
+    "pounding_history",
     "read_record",
     "response_spectrum",
     "simulate",
@@ -998,3 +999,37 @@ def pounding(
             free,
         )
     )
+
+
+def pounding_history(
+    pair: Union[str, "os.PathLike[str]"],
+    record: Any,
+    *,
+    scale: float = 1.0,
+    sample: float = 0.01,
+    rtol: float = 1e-8,
+) -> Result:
+    """The time history of a pounding pair with its contacts under one
+    record (as :func:`pounding` takes them), sampled every ``sample``
+    seconds: ``t`` (s), ``left`` and ``right`` (floor displacements relative
+    to the ground, floors × samples, m) and the impact log
+    ``impact_time`` (s), ``impact_floor`` (1-based), ``impact_peak_force``
+    (N)."""
+    source, text = _pair_text(pair)
+    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    times, acc = _record_arrays(record)
+    d = _core.pounding_history(
+        text,
+        source,
+        _floats(times, "times", allow_scalar=False),
+        _floats(acc, "acceleration", allow_scalar=False),
+        float(scale),
+        float(sample),
+        float(rtol),
+    )
+    d["left"] = np.asarray(d["left"])
+    d["right"] = np.asarray(d["right"])
+    d["impact_floor"] = np.asarray(d["impact_floor"], dtype=np.int64)
+    return Result(d)

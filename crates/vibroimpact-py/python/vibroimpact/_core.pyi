@@ -91,3 +91,7 @@ def pounding(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
     rtol: float, free: bool,
 ) -> dict[str, Any]: ...
+def pounding_history(
+    pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
+    rtol: float,
+) -> dict[str, Any]: ...
