@@ -12,6 +12,9 @@ use crate::error::CliError;
 pub enum MethodName {
     /// Explicit 8th-order Dormand–Prince (DOP853): impacts, free flight.
     Dop853,
+    /// Explicit 5th-order Dormand–Prince (DOPRI5): loose tolerances with
+    /// steps limited by a record's samples.
+    Dopri5,
     /// Implicit Rosenbrock (RODAS): bodies pressed together for long times.
     Rodas,
     /// DOP853, switching to RODAS when its stiffness test fires.
@@ -23,6 +26,7 @@ impl MethodName {
     pub fn method(self) -> Method {
         match self {
             MethodName::Dop853 => Method::Dop853,
+            MethodName::Dopri5 => Method::Dopri5,
             MethodName::Rodas => Method::Rodas,
             MethodName::Auto => Method::Auto,
         }

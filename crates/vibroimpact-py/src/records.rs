@@ -5,6 +5,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use vibroimpact::pounding::{PoundingPair, RunSettings};
 use vibroimpact::record::{parse_record as parse, Record, Units};
 use vibroimpact::spectrum::response_spectrum as spectrum;
 
@@ -71,6 +72,26 @@ pub fn response_spectrum<'py>(
     Ok(d)
 }
 
+/// A pounding run's pair (TOML `pair_text` named by `source`), record and
+/// settings.
+fn inputs(
+    pair_text: &str,
+    source: &str,
+    (times, acceleration): (&PyReadonlyArray1<'_, f64>, &PyReadonlyArray1<'_, f64>),
+    (sample, rtol, method): (f64, f64, &str),
+) -> PyResult<(PoundingPair, Record, RunSettings)> {
+    let run = RunSettings {
+        sample,
+        rtol,
+        method: crate::solve::method(method)?,
+    };
+    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let t = floats(times, "times")?;
+    let a = floats(acceleration, "acceleration")?;
+    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    Ok((pair, record, run))
+}
+
 /// One record's pounding study of the pair in `pair_text` (TOML, named by
 /// `source`): `left_period`, `right_period`, `pounding` and `free` (each
 /// with `peak_drift`, `peak_floor_acceleration`, `peak_displacement` as
@@ -78,7 +99,7 @@ pub fn response_spectrum<'py>(
 /// `required_gap` and `code_gaps`; with `free` false, the pounding run
 /// alone (`pounding` and the periods).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, free))]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, free))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding<'py>(
     py: Python<'py>,
@@ -89,12 +110,15 @@ pub fn pounding<'py>(
     scale: f64,
     sample: f64,
     rtol: f64,
+    method: &str,
     free: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
-    let t = floats(&times, "times")?;
-    let a = floats(&acceleration, "acceleration")?;
-    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let (pair, record, run) = inputs(
+        pair_text,
+        source,
+        (&times, &acceleration),
+        (sample, rtol, method),
+    )?;
     let response = |r: &vibroimpact::pounding::Response| -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("peak_drift", [r.drift[0].clone(), r.drift[1].clone()])?;
@@ -116,13 +140,13 @@ pub fn pounding<'py>(
     d.set_item("right_period", pair.right.period())?;
     if !free {
         let r = py
-            .detach(|| pair.respond(&record, scale, true, sample, rtol))
+            .detach(|| pair.respond(&record, scale, true, &run))
             .map_err(value_error)?;
         d.set_item("pounding", response(&r)?)?;
         return Ok(d);
     }
     let res = py
-        .detach(|| pair.analyse(&record, scale, sample, rtol))
+        .detach(|| pair.analyse(&record, scale, &run))
         .map_err(value_error)?;
     d.set_item("pounding", response(&res.pounding)?)?;
     d.set_item("free", response(&res.free)?)?;
@@ -141,7 +165,7 @@ pub fn pounding<'py>(
 /// floors × samples, m), and the impact log `impact_time`,
 /// `impact_floor` (1-based), `impact_peak_force` (N).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol))]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding_history<'py>(
     py: Python<'py>,
@@ -152,13 +176,16 @@ pub fn pounding_history<'py>(
     scale: f64,
     sample: f64,
     rtol: f64,
+    method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
-    let t = floats(&times, "times")?;
-    let a = floats(&acceleration, "acceleration")?;
-    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let (pair, record, run) = inputs(
+        pair_text,
+        source,
+        (&times, &acceleration),
+        (sample, rtol, method),
+    )?;
     let sim = py
-        .detach(|| pair.history(&record, scale, sample, rtol))
+        .detach(|| pair.history(&record, scale, &run))
         .map_err(value_error)?;
     let (nl, n) = (pair.left.masses.len(), sim.final_displacement.len());
     let floors = |range: std::ops::Range<usize>| -> Vec<Vec<f64>> {

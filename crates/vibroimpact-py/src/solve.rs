@@ -53,10 +53,11 @@ fn impact_error(e: ImpactError) -> PyErr {
 pub(crate) fn method(name: &str) -> PyResult<Method> {
     match name {
         "dop853" => Ok(Method::Dop853),
+        "dopri5" => Ok(Method::Dopri5),
         "rodas" => Ok(Method::Rodas),
         "auto" => Ok(Method::Auto),
         other => Err(value_error(format!(
-            "method = {other:?}: give \"dop853\", \"rodas\" or \"auto\""
+            "method = {other:?}: give \"dop853\", \"dopri5\", \"rodas\" or \"auto\""
         ))),
     }
 }

@@ -16,7 +16,7 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::contact::ContactLaw;
 use crate::dynamics::ChainDynamics;
-use crate::integrate::OdeSystem;
+use crate::integrate::{Method, OdeSystem};
 use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
 use crate::record::Record;
 use crate::simulate::{simulate_streaming, SimulationOptions};
@@ -128,6 +128,31 @@ pub struct PoundingPair {
     pub floors: Vec<usize>,
     /// The contact law of every pounding floor.
     pub law: ContactLaw,
+}
+
+/// How a pounding run is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunSettings {
+    /// Sampling step of drifts, floor accelerations and displacements (s);
+    /// impact forces are the impact log's exact peaks whatever the step.
+    pub sample: f64,
+    /// Relative tolerance of the integration (the absolute one is
+    /// `rtol · 1e-4 · max(gap, 1 mm)`).
+    pub rtol: f64,
+    /// Integration method: DOP853, or DOPRI5 for loose tolerances (a
+    /// record's samples limit the step; docs/earthquakes.md).
+    pub method: Method,
+}
+
+impl RunSettings {
+    /// Sampling every `sample` s at tolerance `rtol` with DOP853.
+    pub fn new(sample: f64, rtol: f64) -> Self {
+        Self {
+            sample,
+            rtol,
+            method: Method::Dop853,
+        }
+    }
 }
 
 /// The peak response of the two frames to one record.
@@ -271,21 +296,17 @@ impl PoundingPair {
 
     /// The peak response to `record` × `scale` over its duration, with the
     /// contacts or without (`contacts`): drifts, floor accelerations and
-    /// displacements sampled every `sample` seconds, impact forces the
-    /// impact log's exact peaks, at tolerance `rtol`.
+    /// displacements sampled as `run` says, impact forces the impact log's
+    /// exact peaks.
     pub fn respond(
         &self,
         record: &Record,
         scale: f64,
         contacts: bool,
-        sample: f64,
-        rtol: f64,
+        run: &RunSettings,
     ) -> Result<Response, String> {
-        if !(sample.is_finite() && sample > 0.0) {
-            return Err(format!("sample step {sample}: give a positive step"));
-        }
         let model = self.model(record, scale, contacts)?;
-        let opts = self.options(record, sample, rtol);
+        let opts = self.options(record, run)?;
         let nl = self.left.masses.len();
         let n = model.bodies().len();
         let mut dynamics = ChainDynamics::new(&model, false);
@@ -331,33 +352,36 @@ impl PoundingPair {
     }
 
     /// The time history of the pair with its contacts under `record` ×
-    /// `scale`: every floor's displacement sampled every `sample` seconds
-    /// (body order: the left frame's floors, then the right frame's) and
-    /// the impact log, at tolerance `rtol`.
+    /// `scale`: every floor's displacement sampled every `run.sample`
+    /// seconds (body order: the left frame's floors, then the right
+    /// frame's) and the impact log.
     pub fn history(
         &self,
         record: &Record,
         scale: f64,
-        sample: f64,
-        rtol: f64,
+        run: &RunSettings,
     ) -> Result<crate::simulate::Simulation, String> {
         let model = self.model(record, scale, true)?;
-        let sim = crate::simulate::simulate(&model, &self.options(record, sample, rtol))
-            .map_err(|e| e.0)?;
+        let sim =
+            crate::simulate::simulate(&model, &self.options(record, run)?).map_err(|e| e.0)?;
         match &sim.error {
             Some(e) => Err(format!("{}: {}", record.source, e)),
             None => Ok(sim),
         }
     }
 
-    fn options(&self, record: &Record, sample: f64, rtol: f64) -> SimulationOptions {
-        SimulationOptions {
-            t_end: record.times.last().copied().unwrap_or(0.0),
-            rtol,
-            atol: rtol * 1e-4 * self.gap.max(1e-3),
-            output_step: Some(sample),
-            ..SimulationOptions::default()
+    fn options(&self, record: &Record, run: &RunSettings) -> Result<SimulationOptions, String> {
+        if !(run.sample.is_finite() && run.sample > 0.0) {
+            return Err(format!("sample step {}: give a positive step", run.sample));
         }
+        Ok(SimulationOptions {
+            t_end: record.times.last().copied().unwrap_or(0.0),
+            rtol: run.rtol,
+            atol: run.rtol * 1e-4 * self.gap.max(1e-3),
+            output_step: Some(run.sample),
+            method: run.method,
+            ..SimulationOptions::default()
+        })
     }
 
     /// The pounding study of one record: the pair with and without its
@@ -366,11 +390,10 @@ impl PoundingPair {
         &self,
         record: &Record,
         scale: f64,
-        sample: f64,
-        rtol: f64,
+        run: &RunSettings,
     ) -> Result<PoundingResult, String> {
-        let pounding = self.respond(record, scale, true, sample, rtol)?;
-        let free = self.respond(record, scale, false, sample, rtol)?;
+        let pounding = self.respond(record, scale, true, run)?;
+        let free = self.respond(record, scale, false, run)?;
         let required_gap = free.closing.iter().fold(0.0f64, |m, c| m.max(*c));
         let ul = self
             .floors
@@ -434,14 +457,13 @@ pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair
 
 /// The pounding spectrum: every (gap, period ratio) cell over `records`
 /// (each with its scale), in parallel, cells gap-major; each record's run
-/// sampled every `sample` s at tolerance `rtol`. The same numbers at any
-/// thread count.
+/// as `run` says. The same numbers at any thread count.
 pub fn pounding_spectrum(
     pair: &PoundingPair,
     records: &[(Record, f64)],
     gaps: &[f64],
     ratios: &[f64],
-    (sample, rtol): (f64, f64),
+    run: &RunSettings,
 ) -> Result<Vec<SpectrumCell>, String> {
     use rayon::prelude::*;
     if records.is_empty() || gaps.is_empty() || ratios.is_empty() {
@@ -473,7 +495,7 @@ pub fn pounding_spectrum(
                 required_gap: Vec::new(),
             };
             for (record, scale) in records {
-                let res = p.analyse(record, *scale, sample, rtol)?;
+                let res = p.analyse(record, *scale, run)?;
                 let amp = (0..2)
                     .flat_map(|side| {
                         let (a, b) = (&res.pounding.drift[side], &res.free.drift[side]);

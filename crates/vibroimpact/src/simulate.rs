@@ -58,7 +58,8 @@ pub struct SimulationOptions {
     /// contacts may be engaged; the overlap check of model files does not
     /// apply).
     pub start: Option<Vec<f64>>,
-    /// Integration method: DOP853 (default), RODAS (implicit, for bodies
+    /// Integration method: DOP853 (default), DOPRI5 (loose tolerances with
+    /// steps limited by a record's samples), RODAS (implicit, for bodies
     /// pressed together for long times), or automatic switching on a
     /// stiffness test.
     pub method: Method,
@@ -577,9 +578,13 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
 /// is refused up front rather than exhausting memory.
 pub const MAX_HISTORY_VALUES: f64 = 2.5e8;
 
-/// The stability limit `h·|λ|` of the explicit method on the negative real
-/// axis (DOP853's stiffness threshold).
+/// The stability limit `h·|λ|` of DOP853 on the negative real axis (its
+/// stiffness threshold).
 const EXPLICIT_STABILITY: f64 = 6.1;
+
+/// DOPRI5's stability limit on the negative real axis (its stiffness
+/// threshold).
+const DOPRI5_STABILITY: f64 = 3.25;
 
 /// Every this many steps a run checks its progress.
 const PROGRESS_CHECK: u64 = 100_000;
@@ -599,13 +604,18 @@ const STIFF_FREE_FLIGHT_STEPS: f64 = 1e4;
 /// that make it stiff; `Auto` on such a model runs RODAS throughout.
 fn effective_method(model: &Model, opts: &SimulationOptions) -> Result<Method, OptionsError> {
     let fast = model.free_flight_rate();
-    let steps_per = |t: f64| t * fast.rate / EXPLICIT_STABILITY;
+    let limit = if opts.method == Method::Dopri5 {
+        DOPRI5_STABILITY
+    } else {
+        EXPLICIT_STABILITY
+    };
+    let steps_per = |t: f64| t * fast.rate / limit;
     let reference = model
         .forcing_frequency()
         .map_or(opts.t_end, |w| 2.0 * std::f64::consts::PI / w)
         .min(opts.t_end);
     match opts.method {
-        Method::Dop853 if steps_per(opts.t_end) > opts.max_steps as f64 => {
+        Method::Dop853 | Method::Dopri5 if steps_per(opts.t_end) > opts.max_steps as f64 => {
             let b = &model.bodies()[fast.body];
             let cause = if fast.damping {
                 format!("its damping/mass = {:.3e} 1/s", fast.rate)
@@ -616,7 +626,7 @@ fn effective_method(model: &Model, opts: &SimulationOptions) -> Result<Method, O
                 "the model is stiff: body {} has {cause}, which limits an explicit step to {:.1e} s, \
                  {:.1e} steps for the {} s simulated (limit {}); use the implicit method rodas (or auto)",
                 b.name,
-                EXPLICIT_STABILITY / fast.rate,
+                limit / fast.rate,
                 steps_per(opts.t_end),
                 opts.t_end,
                 opts.max_steps
@@ -795,10 +805,11 @@ pub fn simulate_streaming(
         if let Some(h) = scan.entry_limit(st.h_next()) {
             st.limit_next_step(h);
         }
-        // DOP853 alone: stop early, with the reason, when stability limits
-        // its step so far that the rest of the run would exceed the step
-        // limit (a contact or body far stiffer than the motion).
-        if method == Method::Dop853 && st.stiffness_detected() {
+        // An explicit method alone: stop early, with the reason, when
+        // stability limits its step so far that the rest of the run would
+        // exceed the step limit (a contact or body far stiffer than the
+        // motion).
+        if matches!(method, Method::Dop853 | Method::Dopri5) && st.stiffness_detected() {
             let h = st.t() - st.t_prev();
             let projected = (opts.t_end - st.t()) / h;
             let limit = opts.max_steps;

@@ -9,8 +9,10 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::{json, Value};
 use vibroimpact::pounding::{
-    parse_pair, pounding_spectrum, quantile, PoundingPair, Response, SpectrumCell,
+    parse_pair, pounding_spectrum, quantile, PoundingPair, Response, RunSettings, SpectrumCell,
 };
+
+use crate::args::MethodName;
 
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
@@ -40,6 +42,10 @@ pub struct PoundingArgs {
     /// Integration tolerance.
     #[arg(long, default_value_t = 1e-8)]
     rtol: f64,
+    /// Integration method (dopri5: the faster choice at tolerances of 1e-3
+    /// to 1e-5, where the record's samples limit the step).
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    method: MethodName,
     /// Pounding spectrum: gaps FROM:TO:N (m), with --ratios.
     #[arg(long, requires = "ratios")]
     gaps: Option<String>,
@@ -174,6 +180,11 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             args.scale, args.sample
         )));
     }
+    let run = RunSettings {
+        sample: args.sample,
+        rtol: args.rtol,
+        method: args.method.method(),
+    };
     let source = args.pair.display().to_string();
     let text =
         crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
@@ -192,8 +203,8 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let (doc, csv) = match (&args.gaps, &args.ratios) {
         (Some(g), Some(r)) => {
             let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
-            let cells = pounding_spectrum(&pair, &runs, &gaps, &ratios, (args.sample, args.rtol))
-                .map_err(CliError::new)?;
+            let cells =
+                pounding_spectrum(&pair, &runs, &gaps, &ratios, &run).map_err(CliError::new)?;
             let doc = json!({
                 "pair": frames,
                 "records": runs.iter().map(|(r, s)| records::metadata(r, *s)).collect::<Vec<_>>(),
@@ -208,9 +219,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         _ => {
             let mut list = Vec::new();
             for (r, s) in &runs {
-                let res = pair
-                    .analyse(r, *s, args.sample, args.rtol)
-                    .map_err(CliError::new)?;
+                let res = pair.analyse(r, *s, &run).map_err(CliError::new)?;
                 list.push(json!({
                     "record": records::metadata(r, *s),
                     "pounding": response_json(&res.pounding),

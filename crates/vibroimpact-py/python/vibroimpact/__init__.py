@@ -405,7 +405,7 @@ def simulate(
     Give ``duration`` (s) or ``periods`` (forcing periods). ``rtol``,
     ``atol``, ``impact_force_threshold``: default the model's
     ``[simulation]`` settings, else 1e-8, rtol*1e-4, 1e-3 N. ``method``:
-    "dop853", "rodas" or "auto". ``output_step`` (s): sampling of the
+    "dop853", "dopri5", "rodas" or "auto". ``output_step`` (s): sampling of the
     history, default 1/100 forcing period (or duration/2000); 0: none.
 
     Returns the CLI's summary fields (``completed``, ``error``,
@@ -443,7 +443,7 @@ def simulate(
             t_end,
             _real(rtol, "rtol", positive=True, optional=True),
             _real(atol, "atol", positive=True, optional=True),
-            _method(method, ("dop853", "rodas", "auto")),
+            _method(method, ("dop853", "dopri5", "rodas", "auto")),
             output_step,
             _flag(energy, "energy"),
             _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
@@ -659,7 +659,7 @@ def sweep(
         up_down=_flag(up_down, "up_down"),
         rtol=_real(rtol, "rtol", positive=True, optional=True),
         atol=_real(atol, "atol", positive=True, optional=True),
-        method=_method(method, ("dop853", "rodas", "auto")),
+        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         lyapunov=None if lyapunov is None else _count(lyapunov, "lyapunov", minimum=1, maximum=10**6),
     )
@@ -769,7 +769,7 @@ def chart(
         lyapunov=_flag(lyapunov, "lyapunov"),
         rtol=_real(rtol, "rtol", positive=True, optional=True),
         atol=_real(atol, "atol", positive=True, optional=True),
-        method=_method(method, ("dop853", "rodas", "auto")),
+        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
     )
     if threads is not None:
@@ -864,7 +864,7 @@ def basins(
         _count(record, "record", minimum=1, maximum=10**7),
         _real(rtol, "rtol", positive=True, optional=True),
         _real(atol, "atol", positive=True, optional=True),
-        _method(method, ("dop853", "rodas", "auto")),
+        _method(method, ("dop853", "dopri5", "rodas", "auto")),
         _real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         threads,
         _progress(progress),
@@ -959,6 +959,32 @@ def _record_arrays(record: Any):
         raise TypeError("record: expected a read_record result or a file name") from None
 
 
+def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any) -> None:
+    """Checks the settings of a pounding run (the binding checks their
+    ranges)."""
+    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    _method(method, ("dop853", "dopri5", "rodas", "auto"))
+
+
+def _pounding_args(pair: Any, record: Any, scale: Any, sample: Any, rtol: Any, method: Any) -> tuple:
+    """The binding's leading arguments of a pounding run, checked."""
+    source, text = _pair_text(pair)
+    _pounding_settings(scale, sample, rtol, method)
+    times, acc = _record_arrays(record)
+    return (
+        text,
+        source,
+        _floats(times, "times", allow_scalar=False),
+        _floats(acc, "acceleration", allow_scalar=False),
+        float(scale),
+        float(sample),
+        float(rtol),
+        method,
+    )
+
+
 def pounding(
     pair: Union[str, "os.PathLike[str]"],
     record: Any,
@@ -966,39 +992,28 @@ def pounding(
     scale: float = 1.0,
     sample: float = 0.0025,
     rtol: float = 1e-8,
+    method: str = "dop853",
     free: bool = True,
 ) -> Result:
     """Pounding of two shear frames under one record (``vibroimpact
     pounding``): ``pair`` is a pair file (TOML, docs/earthquakes.md) or its
     text, ``record`` a :func:`read_record` result or a file name, scaled by
     ``scale``. ``sample`` (s): the sampling of drifts and floor
-    accelerations. ``free=False`` runs the pair with its contacts only
-    (half the work; no ``free``, ``required_gap`` or ``code_gaps``).
+    accelerations. ``method``: "dop853", or "dopri5", the faster at
+    ``rtol`` 1e-3 to 1e-5 (the record's samples limit the step; peaks
+    within 1 % there, docs/earthquakes.md). ``free=False`` runs the pair
+    with its contacts only (half the work; no ``free``, ``required_gap``
+    or ``code_gaps``).
 
     Returns ``left_period``, ``right_period``, ``pounding`` and ``free``
     (``peak_drift``, ``peak_floor_acceleration``, ``peak_displacement`` as
     [left, right] lists per floor, ``peak_impact_force``, ``impacts``,
     ``closing``), ``required_gap`` and ``code_gaps`` (``absolute_sum``,
     ``srss``, ``double_difference``, ``correlation``)."""
-    source, text = _pair_text(pair)
-    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    args = _pounding_args(pair, record, scale, sample, rtol, method)
     if not isinstance(free, bool):
         raise TypeError(f"free: expected True or False, got {free!r}")
-    times, acc = _record_arrays(record)
-    return Result(
-        _core.pounding(
-            text,
-            source,
-            _floats(times, "times", allow_scalar=False),
-            _floats(acc, "acceleration", allow_scalar=False),
-            float(scale),
-            float(sample),
-            float(rtol),
-            free,
-        )
-    )
+    return Result(_core.pounding(*args, free))
 
 
 def pounding_history(
@@ -1008,6 +1023,7 @@ def pounding_history(
     scale: float = 1.0,
     sample: float = 0.01,
     rtol: float = 1e-8,
+    method: str = "dop853",
 ) -> Result:
     """The time history of a pounding pair with its contacts under one
     record (as :func:`pounding` takes them), sampled every ``sample``
@@ -1015,20 +1031,7 @@ def pounding_history(
     to the ground, floors × samples, m) and the impact log
     ``impact_time`` (s), ``impact_floor`` (1-based), ``impact_peak_force``
     (N)."""
-    source, text = _pair_text(pair)
-    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"{name}: expected a finite number, got {v!r}")
-    times, acc = _record_arrays(record)
-    d = _core.pounding_history(
-        text,
-        source,
-        _floats(times, "times", allow_scalar=False),
-        _floats(acc, "acceleration", allow_scalar=False),
-        float(scale),
-        float(sample),
-        float(rtol),
-    )
+    d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method))
     d["left"] = np.asarray(d["left"])
     d["right"] = np.asarray(d["right"])
     d["impact_floor"] = np.asarray(d["impact_floor"], dtype=np.int64)

@@ -30,7 +30,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--up-down", action="store_true")
     s.add_argument("--rtol", type=float)
     s.add_argument("--atol", type=float)
-    s.add_argument("--method", default="dop853", choices=["dop853", "rodas", "auto"])
+    s.add_argument("--method", default="dop853", choices=["dop853", "dopri5", "rodas", "auto"])
     s.add_argument("--cluster-tolerance", type=float)
     s.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://HOST:8786")
     s.add_argument("--tasks", type=int, help="Dask tasks (default: 4 per worker thread)")

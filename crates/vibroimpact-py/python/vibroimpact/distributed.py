@@ -176,7 +176,7 @@ def ensemble(
     return [Result(d) for d in _gather(futures, progress, len(futures))]
 
 
-def _pounding_task(text: str, source: str, record, scale: float, sample: float, rtol: float):
+def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
     from . import _core, _floats
 
     times, acc = record
@@ -184,7 +184,8 @@ def _pounding_task(text: str, source: str, record, scale: float, sample: float, 
     # binding reads them.
     t = _floats(times, "times", allow_scalar=False)
     a = _floats(acc, "acceleration", allow_scalar=False)
-    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, True))
+    sample, rtol, method = run
+    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, method, True))
 
 
 def ida(
@@ -196,6 +197,7 @@ def ida(
     damping: float = 0.05,
     sample: float = 0.0025,
     rtol: float = 1e-8,
+    method: str = "dop853",
     retries: int = 2,
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Result:
@@ -203,7 +205,8 @@ def ida(
     every record × every scale factor, one Dask task each with ``client``
     (else here, one after the other; the same numbers either way). The
     intensity is the scaled record's pseudo-spectral acceleration Sa(T1) at
-    the left frame's fundamental period and ``damping``.
+    the left frame's fundamental period and ``damping``. ``sample``,
+    ``rtol`` and ``method`` as :func:`vibroimpact.pounding` takes them.
 
     Returns arrays over the runs, record-major: ``record`` (index),
     ``scale``, ``sa`` (m/s²), ``peak_impact_force`` (N), ``impacts``,
@@ -215,6 +218,8 @@ def ida(
     import vibroimpact as vi
 
     source, text = vi._pair_text(pair)
+    vi._pounding_settings(1.0, sample, rtol, method)
+    run = (float(sample), float(rtol), method)
     recs = [vi.read_record(r) if isinstance(r, (str, os.PathLike)) else r for r in records]
     scales = np.asarray(scales, dtype=np.float64)
     if scales.ndim != 1 or scales.size == 0 or not np.all(np.isfinite(scales)):
@@ -226,14 +231,14 @@ def ida(
     if client is None:
         results = []
         for k, (i, s) in enumerate(jobs):
-            results.append(_pounding_task(text, source, arrays[i], s, sample, rtol))
+            results.append(_pounding_task(text, source, arrays[i], s, run))
             if progress is not None:
                 progress(k + 1, len(jobs))
     else:
         # Each record goes to the cluster once, not once per scale.
         shipped = client.scatter(arrays)
         futures = [
-            client.submit(_pounding_task, text, source, shipped[i], s, sample, rtol, retries=retries, pure=False)
+            client.submit(_pounding_task, text, source, shipped[i], s, run, retries=retries, pure=False)
             for i, s in jobs
         ]
         results = _gather(futures, progress, len(futures))

@@ -5,8 +5,8 @@
 
 use super::test_systems::{fixed, tol, Decay, Harmonic};
 use super::{
-    Dop853Method, Driver, IntegrationError, IntegratorOptions, Interrupt, OdeSystem, RejectReason,
-    RodasMethod, StepMethod,
+    Dop853Method, Dopri5Method, Driver, IntegrationError, IntegratorOptions, Interrupt, OdeSystem,
+    RejectReason, RodasMethod, StepMethod,
 };
 
 /// Forced, damped oscillator `x'' + 0.2 x' + x = cos(1.3 t)`, from (1, 0):
@@ -375,6 +375,19 @@ fn dop853_conforms() {
     check_admissibility::<Dop853Method>();
     check_limits::<Dop853Method>();
     check_misuse::<Dop853Method>();
+}
+
+#[test]
+fn dopri5_conforms() {
+    // Measured at h = 0.1, 0.05: orders 5.03 and 4.96 (dense output of
+    // order 4: local error h^5).
+    check_orders::<Dopri5Method>(0.1, 5.0, 4.0);
+    check_adaptive_accuracy_and_end_time::<Dopri5Method>(100.0);
+    check_nan_in_stages::<Dopri5Method>(|d| d.nan_above = 1.5);
+    check_nan_beyond_time::<Dopri5Method>();
+    check_admissibility::<Dopri5Method>();
+    check_limits::<Dopri5Method>();
+    check_misuse::<Dopri5Method>();
 }
 
 #[test]

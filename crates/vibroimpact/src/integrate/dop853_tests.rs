@@ -2,7 +2,9 @@
 //! output, robustness and the stiffness test.
 use super::*;
 use crate::integrate::integrate_to;
-use crate::integrate::test_systems::{fixed, observed_order, tol, Decay, Harmonic};
+use crate::integrate::test_systems::{
+    dot, fixed, observed_order, rooted_trees, tol, tree_data, Decay, Harmonic,
+};
 use crate::integrate::{IntegrationError, IntegratorOptions};
 
 // ---------------------------------------------------------------------
@@ -47,68 +49,6 @@ fn damped_exact(t: f64) -> [f64; 2] {
 // ---------------------------------------------------------------------
 // 1. Tableau.
 // ---------------------------------------------------------------------
-
-/// All rooted trees up to `max_order`, as (order, children): children are
-/// indices of earlier trees, non-increasing, so each tree appears once.
-fn rooted_trees(max_order: usize) -> Vec<(usize, Vec<usize>)> {
-    fn multisets(
-        trees: &[(usize, Vec<usize>)],
-        remaining: usize,
-        max_idx: usize,
-        current: &mut Vec<usize>,
-        out: &mut Vec<Vec<usize>>,
-    ) {
-        if remaining == 0 {
-            out.push(current.clone());
-            return;
-        }
-        for idx in (0..=max_idx).rev() {
-            if trees[idx].0 <= remaining {
-                current.push(idx);
-                multisets(trees, remaining - trees[idx].0, idx, current, out);
-                current.pop();
-            }
-        }
-    }
-    let mut trees: Vec<(usize, Vec<usize>)> = vec![(1, vec![])];
-    for order in 2..=max_order {
-        let existing = trees.len();
-        let mut children = Vec::new();
-        multisets(
-            &trees[..existing],
-            order - 1,
-            existing - 1,
-            &mut Vec::new(),
-            &mut children,
-        );
-        trees.extend(children.into_iter().map(|c| (order, c)));
-    }
-    trees
-}
-
-/// Per tree: density γ(t) and the stage vector Φ_i(t) of the extended
-/// 16-stage tableau (`Φ_i(•) = 1`, `Φ_i([t1..tm]) = Π_k Σ_j a_ij Φ_j(t_k)`).
-fn tree_data(trees: &[(usize, Vec<usize>)]) -> Vec<(f64, [f64; N_STAGES_EXTENDED])> {
-    let mut data: Vec<(f64, [f64; N_STAGES_EXTENDED])> = Vec::new();
-    for (order, children) in trees {
-        let mut gamma = *order as f64;
-        let mut phi = [1.0; N_STAGES_EXTENDED];
-        for &c in children {
-            let (g, pc) = data[c];
-            gamma *= g;
-            for (i, p) in phi.iter_mut().enumerate() {
-                let a_phi: f64 = A[i].iter().zip(&pc).map(|(a, x)| a * x).sum();
-                *p *= a_phi;
-            }
-        }
-        data.push((gamma, phi));
-    }
-    data
-}
-
-fn dot(w: &[f64], phi: &[f64]) -> f64 {
-    w.iter().zip(phi).map(|(a, b)| a * b).sum()
-}
 
 /// Weights b_i(θ) of the continuous extension (per unit h), built from
 /// the same Horner form as the code ([`eval_cont`]).
@@ -157,7 +97,7 @@ fn tableau_order_conditions() {
     }
     // Number of rooted trees (OEIS A000081): checks the enumeration.
     assert_eq!(counts, [0, 1, 1, 2, 4, 9, 20, 48, 115]);
-    let data = tree_data(&trees);
+    let data = tree_data(&trees, &A);
     for ((order, _), (gamma, phi)) in trees.iter().zip(&data) {
         // 8th-order solution: all 200 conditions of orders 1..=8
         // (measured residual <= 2.2e-15).
@@ -190,7 +130,7 @@ fn tableau_order_conditions() {
 #[test]
 fn dense_output_order_conditions() {
     let trees = rooted_trees(8);
-    let data = tree_data(&trees);
+    let data = tree_data(&trees, &A);
     for theta in [0.1, 0.3, 0.5, 0.77, 0.9, 1.0] {
         let w = dense_weights(theta);
         let mut worst8 = 0.0f64;

@@ -1,11 +1,14 @@
 //! Numerical integration of ordinary differential equations `y' = f(t, y)`.
 //!
-//! Two integrators with the same step-by-step interface:
+//! Three integrators with the same step-by-step interface:
 //!
 //! * [`Dop853`]: an adaptive explicit Runge–Kutta method of order 8, the
 //!   Dormand–Prince 8(5,3) pair "DOP853" of Hairer, Nørsett & Wanner
 //!   (*Solving Ordinary Differential Equations I*, Sec. II.5), with its
 //!   7th-order dense output and Hairer's stiffness test;
+//! * [`Dopri5`]: the Dormand–Prince 5(4) pair of Hairer's `dopri5.f` with
+//!   its 4th-order dense output, for loose tolerances where something else
+//!   than accuracy limits the step (a record's samples);
 //! * [`Rodas`]: the L-stable, stiffly accurate Rosenbrock method RODAS of
 //!   order 4(3) (Hairer & Wanner, *Solving Ordinary Differential Equations
 //!   II*, Sec. IV.7 and VI.3, code `rodas.f`), for stiff phases such as bodies pressed together by a
@@ -20,8 +23,9 @@
 //! * [`Driver`] is the one step driver (reset, step loop, step-size control,
 //!   limits, accept/reject, dense-output end points, statistics), generic
 //!   over a [`StepMethod`] that holds only what differs between methods;
-//!   [`Dop853`] and [`Rodas`] are the driver around [`Dop853Method`] and
-//!   [`RodasMethod`]. [`Stepper`] holds either behind one interface and can
+//!   [`Dop853`], [`Dopri5`] and [`Rodas`] are the driver around
+//!   [`Dop853Method`], [`Dopri5Method`] and [`RodasMethod`]. [`Stepper`]
+//!   holds any of them behind one interface and can
 //!   switch from DOP853 to RODAS when stiffness is detected
 //!   ([`Method::Auto`]).
 //! * [`events`] detects and locates sign changes of event functions on the
@@ -33,8 +37,10 @@
 
 mod dop853;
 mod dop853_tableau;
+mod dopri5;
 mod driver;
 pub mod events;
+mod explicit;
 pub mod linalg;
 pub mod rosenbrock;
 mod stepper;
@@ -45,6 +51,7 @@ mod conformance_tests;
 mod test_systems;
 
 pub use dop853::{Dop853, Dop853Method};
+pub use dopri5::{Dopri5, Dopri5Method};
 pub use driver::{Attempt, Driver, Point, StepMethod, Trial};
 pub use linalg::{BandMatrix, Singular};
 pub use rosenbrock::{Rodas, RodasMethod};
@@ -194,7 +201,7 @@ pub struct IntegratorOptions {
     /// state do not control the step size (they are still checked for
     /// finiteness). Default `None`: all components.
     pub error_components: Option<usize>,
-    /// Whether [`Dop853`] runs Hairer's stiffness test after every accepted
+    /// Whether [`Dop853`] and [`Dopri5`] run Hairer's stiffness test after every accepted
     /// step (see [`Driver::stiffness_detected`]); it only reports and never
     /// changes the computed solution. Ignored by [`Rodas`]. Default `true`.
     pub stiffness_check: bool,

@@ -1,13 +1,16 @@
-//! [`Stepper`]: DOP853 or RODAS behind one interface, with the automatic
-//! switch from DOP853 to RODAS when DOP853's stiffness test fires.
+//! [`Stepper`]: DOP853, DOPRI5 or RODAS behind one interface, with the
+//! automatic switch from DOP853 to RODAS when DOP853's stiffness test fires.
 
-use super::{Dop853, IntegrationError, IntegratorOptions, OdeSystem, Rodas, Stats};
+use super::{Dop853, Dopri5, IntegrationError, IntegratorOptions, OdeSystem, Rodas, Stats};
 
 /// Integration method of a [`Stepper`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     /// The explicit [`Dop853`] (non-stiff problems).
     Dop853,
+    /// The explicit [`Dopri5`] (non-stiff problems at loose tolerances,
+    /// steps limited by breakpoints such as a record's samples).
+    Dopri5,
     /// The linearly implicit [`Rodas`] (stiff problems).
     Rodas,
     /// Start every integration (every [`Stepper::reset`]) with DOP853 and
@@ -23,6 +26,7 @@ pub enum Method {
 #[allow(clippy::large_enum_variant)]
 enum Engines {
     Dop853(Dop853),
+    Dopri5(Dopri5),
     Rodas(Rodas),
     /// DOP853 from every reset, RODAS (`on_rodas`) from the moment DOP853's
     /// stiffness test fired until the next reset.
@@ -46,12 +50,13 @@ macro_rules! active {
         match $engines {
             Engines::Dop853($d) | Engines::Auto { dop853: $d, on_rodas: false, .. } => $e,
             Engines::Rodas($d) | Engines::Auto { rodas: $d, on_rodas: true, .. } => $e,
+            Engines::Dopri5($d) => $e,
         }
     };
 }
 
-/// Either integrator behind one interface, with optional automatic switching
-/// from DOP853 to RODAS ([`Method::Auto`]).
+/// Any of the integrators behind one interface, with optional automatic
+/// switching from DOP853 to RODAS ([`Method::Auto`]).
 ///
 /// The methods have the semantics of the same-named methods of the
 /// [`Driver`](super::Driver) and act on the *active* integrator
@@ -83,6 +88,7 @@ impl Stepper {
     ) -> Result<Self, IntegrationError> {
         let engines = match method {
             Method::Dop853 => Engines::Dop853(Dop853::new(dim, opts.clone())?),
+            Method::Dopri5 => Engines::Dopri5(Dopri5::new(dim, opts.clone())?),
             Method::Rodas => Engines::Rodas(Rodas::new(dim, opts.clone())?),
             Method::Auto => Engines::Auto {
                 dop853: Dop853::new(dim, opts.clone())?,
@@ -102,9 +108,11 @@ impl Stepper {
         self.method
     }
 
-    /// The integrator in use: [`Method::Dop853`] or [`Method::Rodas`].
+    /// The integrator in use: [`Method::Dop853`], [`Method::Dopri5`] or
+    /// [`Method::Rodas`].
     pub fn active(&self) -> Method {
         match self.engines {
+            Engines::Dopri5(_) => Method::Dopri5,
             Engines::Dop853(_)
             | Engines::Auto {
                 on_rodas: false, ..
@@ -179,7 +187,7 @@ impl Stepper {
     }
 
     /// Dense output of the last accepted step, valid in `[t_prev, t]`: 7th
-    /// order for DOP853, 3rd order for RODAS.
+    /// order for DOP853, 4th for DOPRI5, 3rd for RODAS.
     ///
     /// # Panics
     /// If `out.len()` differs from the dimension.
@@ -199,6 +207,7 @@ impl Stepper {
     pub fn stats(&self) -> Stats {
         match &self.engines {
             Engines::Dop853(d) => d.stats(),
+            Engines::Dopri5(d) => d.stats(),
             Engines::Rodas(r) => r.stats(),
             Engines::Auto { dop853, rodas, .. } => dop853.stats() + rodas.stats(),
         }
@@ -208,6 +217,7 @@ impl Stepper {
     pub fn reset_stats(&mut self) {
         match &mut self.engines {
             Engines::Dop853(d) => d.reset_stats(),
+            Engines::Dopri5(d) => d.reset_stats(),
             Engines::Rodas(r) => r.reset_stats(),
             Engines::Auto { dop853, rodas, .. } => {
                 dop853.reset_stats();
@@ -236,11 +246,12 @@ impl Stepper {
         }
     }
 
-    /// Whether DOP853 is active and its stiffness test currently reports
-    /// stiffness ([`Dop853::stiffness_detected`](super::Driver::stiffness_detected)); `false` while RODAS is
-    /// active.
+    /// Whether an explicit method is active and its stiffness test currently
+    /// reports stiffness ([`Dop853::stiffness_detected`](super::Driver::stiffness_detected));
+    /// `false` while RODAS is active.
     pub fn stiffness_detected(&self) -> bool {
         match &self.engines {
+            Engines::Dopri5(d) => d.stiffness_detected(),
             Engines::Dop853(d)
             | Engines::Auto {
                 dop853: d,
@@ -370,6 +381,21 @@ mod tests {
             out[0],
             r.dense_component(&mut sys, 0, 0.5 * (r.t() + r.t_prev()))
         );
+
+        // Method::Dopri5 behaves exactly like a standalone Dopri5, and
+        // reports stiffness through its own test.
+        let mut st = Stepper::new(Method::Dopri5, 1, tol(1e-6)).unwrap();
+        let mut d = Dopri5::new(1, tol(1e-6)).unwrap();
+        st.reset(&mut sys, 0.0, &[0.0]).unwrap();
+        d.reset(&mut sys, 0.0, &[0.0]).unwrap();
+        for _ in 0..200 {
+            st.step(&mut sys, 1.0).unwrap();
+            d.step(&mut sys, 1.0).unwrap();
+        }
+        assert_eq!(st.active(), Method::Dopri5);
+        assert_eq!((st.y(), st.stats()), (d.y(), d.stats()));
+        assert!(st.stiffness_detected() && d.stiffness_detected());
+        assert_eq!(st.rodas_jacobian_bound(), None);
 
         // Method::Dop853 never switches, even when its test fires.
         let mut st = Stepper::new(Method::Dop853, 1, tol(1e-6)).unwrap();

@@ -111,3 +111,68 @@ pub fn tol(tol: f64) -> IntegratorOptions {
 pub fn observed_order(e_coarse: f64, e_fine: f64) -> f64 {
     (e_coarse / e_fine).log2()
 }
+
+/// All rooted trees up to `max_order`, as (order, children): children are
+/// indices of earlier trees, non-increasing, so each tree appears once.
+pub fn rooted_trees(max_order: usize) -> Vec<(usize, Vec<usize>)> {
+    fn multisets(
+        trees: &[(usize, Vec<usize>)],
+        remaining: usize,
+        max_idx: usize,
+        current: &mut Vec<usize>,
+        out: &mut Vec<Vec<usize>>,
+    ) {
+        if remaining == 0 {
+            out.push(current.clone());
+            return;
+        }
+        for idx in (0..=max_idx).rev() {
+            if trees[idx].0 <= remaining {
+                current.push(idx);
+                multisets(trees, remaining - trees[idx].0, idx, current, out);
+                current.pop();
+            }
+        }
+    }
+    let mut trees: Vec<(usize, Vec<usize>)> = vec![(1, vec![])];
+    for order in 2..=max_order {
+        let existing = trees.len();
+        let mut children = Vec::new();
+        multisets(
+            &trees[..existing],
+            order - 1,
+            existing - 1,
+            &mut Vec::new(),
+            &mut children,
+        );
+        trees.extend(children.into_iter().map(|c| (order, c)));
+    }
+    trees
+}
+
+/// Per tree: density γ(t) and the stage vector Φ_i(t) of the tableau `a`
+/// (row i: the coefficients of stage i; `Φ_i(•) = 1`,
+/// `Φ_i([t1..tm]) = Π_k Σ_j a_ij Φ_j(t_k)`). A method's weights `w` meet
+/// the order condition of tree t when `w·Φ(t) = 1/γ(t)`.
+pub fn tree_data(trees: &[(usize, Vec<usize>)], a: &[&[f64]]) -> Vec<(f64, Vec<f64>)> {
+    let mut data: Vec<(f64, Vec<f64>)> = Vec::new();
+    for (order, children) in trees {
+        let mut gamma = *order as f64;
+        let mut phi = vec![1.0; a.len()];
+        for &c in children {
+            let (g, pc) = &data[c];
+            gamma *= g;
+            for (i, p) in phi.iter_mut().enumerate() {
+                let a_phi: f64 = a[i].iter().zip(pc).map(|(a, x)| a * x).sum();
+                *p *= a_phi;
+            }
+        }
+        data.push((gamma, phi));
+    }
+    data
+}
+
+/// `w · φ`.
+pub fn dot(w: &[f64], phi: &[f64]) -> f64 {
+    w.iter().zip(phi).map(|(a, b)| a * b).sum()
+}
