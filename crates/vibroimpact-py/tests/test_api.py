@@ -164,18 +164,29 @@ def _long_simulation(**kw):
 
 
 def test_gil_is_released():
-    start = time.perf_counter()
-    _long_simulation()
-    _long_simulation()
-    serial = time.perf_counter() - start
-    threads = [threading.Thread(target=_long_simulation) for _ in range(2)]
-    start = time.perf_counter()
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    parallel = time.perf_counter() - start
-    assert parallel < 0.8 * serial, (serial, parallel)
+    # While a worker thread is inside a long call, the main thread keeps
+    # running Python: the longest pause it sees is far shorter than the
+    # call. Holding the GIL would make that pause the whole call. (A
+    # serial-versus-parallel wall-clock ratio measures the machine's load
+    # as much as the binding, and failed on a busy CI machine.)
+    span = {}
+
+    def worker():
+        start = time.perf_counter()
+        _long_simulation()
+        span["call"] = time.perf_counter() - start
+
+    thread = threading.Thread(target=worker)
+    last = time.perf_counter()
+    longest_pause = 0.0
+    thread.start()
+    while thread.is_alive():
+        now = time.perf_counter()
+        longest_pause = max(longest_pause, now - last)
+        last = now
+    thread.join()
+    assert span["call"] > 0.2, span
+    assert longest_pause < 0.25 * span["call"], (longest_pause, span)
 
 
 def test_ctrl_c_interrupts_a_long_call():
