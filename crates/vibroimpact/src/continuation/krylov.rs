@@ -15,13 +15,19 @@ const MAX_GMRES: usize = 400;
 
 impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     /// `Ĵ_x v` in scaled variables at the point of `linear`: `(DG v - v)`
-    /// with DG acting on unscaled vectors.
+    /// with DG acting on unscaled vectors (the unknowns' scale on `v`, the
+    /// residual's on the product).
     fn jacobian_product(&self, model: &Model, x: &[f64], v: &[f64]) -> Option<Vec<f64>> {
-        let unscaled: Vec<f64> = v.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
+        let unit = self.state_unit;
+        let unscaled: Vec<f64> = v
+            .iter()
+            .zip(&self.scale)
+            .map(|(a, s)| a * s * unit)
+            .collect();
         let product = map_product(model, x, &unscaled, &self.opts.shooting).ok()?;
         Some(
             (0..v.len())
-                .map(|i| product[i] / self.scale[i] - v[i])
+                .map(|i| product[i] / self.scale[i] - unit * v[i])
                 .collect(),
         )
     }

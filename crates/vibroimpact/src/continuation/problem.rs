@@ -47,10 +47,23 @@ pub(super) struct Solved {
 
 /// The continuation problem in scaled variables: the family of models, the
 /// options and the scales.
+///
+/// The residual's rows are scaled by `scale` (the corrector's tolerance
+/// is on them); the unknowns' state part by `scale · state_unit`, with
+/// `state_unit = √(max(N, 2)/2)` for a row of N bodies. The arclength is
+/// the Euclidean norm of the unknowns, so the state counts in it as its
+/// root-mean-square over the bodies, as much for a row of 100 as for a row
+/// of two: without it, a parameter step of the same size moved the
+/// arclength √(N/2) times further and the steps `ds_max` allows shrank
+/// with N (docs/decisions.md D20).
 pub(super) struct Problem<F> {
     family: F,
     pub(super) opts: ContinuationOptions,
+    /// Scales of the residual's rows (the state's displacement and
+    /// velocity scales).
     pub(super) scale: Vec<f64>,
+    /// Factor from `scale` to the unknowns' state scale.
+    pub(super) state_unit: f64,
     p_scale: f64,
     pub(super) d: usize,
     /// Integration steps of the last evaluation of the map (0: none yet).
@@ -69,6 +82,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             family,
             opts,
             scale: (0..d).map(|i| if i < d / 2 { u } else { u * w }).collect(),
+            state_unit: ((d / 2).max(2) as f64 / 2.0).sqrt(),
             p_scale,
             d,
             steps: 0,
@@ -83,13 +97,17 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         let x = z[..self.d]
             .iter()
             .zip(&self.scale)
-            .map(|(a, s)| a * s)
+            .map(|(a, s)| a * s * self.state_unit)
             .collect();
         (x, z[self.d] * self.p_scale)
     }
 
     pub(super) fn scale_state(&self, x: &[f64], p: f64) -> Vec<f64> {
-        let mut z: Vec<f64> = x.iter().zip(&self.scale).map(|(a, s)| a / s).collect();
+        let mut z: Vec<f64> = x
+            .iter()
+            .zip(&self.scale)
+            .map(|(a, s)| a / (s * self.state_unit))
+            .collect();
         z.push(p / self.p_scale);
         z
     }
@@ -144,7 +162,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         for r in 0..d {
             for c in 0..d {
                 let id = if r == c { 1.0 } else { 0.0 };
-                jac[(r, c)] = (map.monodromy[(r, c)] - id) * self.scale[c] / self.scale[r];
+                jac[(r, c)] =
+                    (map.monodromy[(r, c)] - id) * self.scale[c] * self.state_unit / self.scale[r];
             }
             jac[(r, d)] = dp_column[r] * self.p_scale / self.scale[r];
         }
@@ -558,7 +577,13 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
         })
     }
 
+    /// Max-norm in the residual's scales (the state part of the unknowns
+    /// × `state_unit`): the damping `corrector_max_step` limits a state
+    /// step to the same physical size at any N.
     fn step_norm(&self, delta: &[f64]) -> f64 {
-        delta.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        let (d, unit) = (self.problem.d, self.problem.state_unit);
+        delta[..d]
+            .iter()
+            .fold(delta[d].abs(), |m, v| m.max(unit * v.abs()))
     }
 }

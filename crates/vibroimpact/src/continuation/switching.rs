@@ -185,7 +185,12 @@ fn switch_directions<F: FnMut(f64) -> Result<Model, String>>(
         };
         let map = period_map(model, &point.state, &half)?;
         let v = null_vector(&map.monodromy + DMatrix::<f64>::identity(d, d))?;
-        let mut dir: Vec<f64> = v.iter().zip(&problem.scale).map(|(a, s)| a / s).collect();
+        let unit = problem.state_unit;
+        let mut dir: Vec<f64> = v
+            .iter()
+            .zip(&problem.scale)
+            .map(|(a, s)| a / (s * unit))
+            .collect();
         dir.push(0.0);
         directions.push(dir);
     } else {
