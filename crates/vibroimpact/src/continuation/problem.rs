@@ -220,6 +220,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             chord_norms: Vec::new(),
             last: None,
             full_seen: false,
+            krylov_norm: None,
         };
         let out = damped_newton(&mut corrector, pred, &opts).ok()?;
         let chord = corrector.chord_norms.len();
@@ -516,6 +517,8 @@ struct Corrector<'p, 'a, F> {
     last: Option<(Vec<f64>, Vec<f64>)>,
     /// Whether an iterate was evaluated in full (Newton from then on).
     full_seen: bool,
+    /// Residual norm of the last matrix-free iterate (divergence test).
+    krylov_norm: Option<f64>,
 }
 
 impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
@@ -555,7 +558,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
         r.g.iter().fold(c.abs(), |m, v| m.max(v.abs()))
     }
 
-    fn direction(&mut self, _z: &[f64], (r, c): &Self::Point) -> Result<Option<Vec<f64>>, ()> {
+    fn direction(&mut self, _z: &[f64], point: &Self::Point) -> Result<Option<Vec<f64>>, ()> {
+        let (r, c) = point;
         let d = self.problem.d;
         let mut rhs = DVector::zeros(d + 1);
         for (row, gr) in r.g.iter().enumerate() {
@@ -568,6 +572,16 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
                 .solve(&rhs)
                 .map(|d| d.as_slice().to_vec()),
             (Some(krylov @ Linear::Krylov { .. }), _) => {
+                // An iterate whose residual grew is off the branch, often
+                // deep in a contact where every product is an expensive
+                // integration and GMRES needs a hundred of them (R2 N = 100
+                // near 0.68 ω0: 40 s for one direction): the correction
+                // fails and the step is halved (docs/decisions.md D20).
+                let norm = self.residual_norm(point);
+                if self.krylov_norm.is_some_and(|previous| norm > previous) {
+                    return Err(());
+                }
+                self.krylov_norm = Some(norm);
                 // Inexact Newton: the direction to 1e-4 relative.
                 self.problem
                     .bordered_solve(krylov, self.t, rhs.as_slice(), 1e-4)

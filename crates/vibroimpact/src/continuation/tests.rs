@@ -45,6 +45,44 @@ fn linear_branch_is_exact() {
     }
 }
 
+/// The arclength counts the state as its root-mean-square over the bodies:
+/// in the linear limit a row of 8 identical bodies moves as one body, and
+/// its branch takes the same steps in the frequency as a row of two (with
+/// the plain Euclidean norm of the scaled state, steps twice as short in
+/// the parameter).
+#[test]
+fn steps_do_not_shrink_with_the_row_length() {
+    let opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            rtol: 1e-12,
+            tol: 1e-10,
+            displacement_scale: 1e-2,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let branch = |n: usize| {
+        let family = move |w: f64| r2(n, 1e3, w);
+        continue_branch(family, 0.8 * W0, &vec![0.0; 2 * n], 1.2 * W0, &opts, |_| {
+            true
+        })
+        .unwrap()
+    };
+    let (two, eight) = (branch(2), branch(8));
+    assert_eq!(two.stop, StopReason::ReachedEnd);
+    assert_eq!(eight.stop, StopReason::ReachedEnd);
+    assert!(two.points.len() > 10);
+    assert_eq!(two.points.len(), eight.points.len());
+    for (a, b) in two.points.iter().zip(&eight.points) {
+        assert!(
+            (a.parameter - b.parameter).abs() < 1e-8 * W0,
+            "{} vs {}",
+            a.parameter,
+            b.parameter
+        );
+    }
+}
+
 /// The iterator on R3 with a user event: the amplitude of body 1 reaching
 /// the steady amplitude at 0.9 ω0 is found twice (below and above
 /// resonance) and located to the exact amplitude; the first step is the
