@@ -24,7 +24,7 @@
 //! the number of contacts actually closing, and linearly with N.
 
 use crate::contact::{ContactLaw, LawKind};
-use crate::integrate::{BandMatrix, OdeSystem};
+use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian};
 use crate::model::{BaseExcitation, Model};
 
 /// Index in the interleaved state `[u_1, v_1, …]` of component k of a
@@ -564,6 +564,52 @@ impl OdeSystem for ChainDynamics {
             let (s, _) = self.approach(k, y);
             s <= c.absurd
         })
+    }
+}
+
+/// The Jacobian recorded for tangent replay: springs, dampers and
+/// couplings are the model's (constant); each contact not screened out
+/// contributes its index and its force's partial derivatives
+/// `(∂F/∂s, ∂F/∂ṡ)`, as in [`OdeSystem::jacobian`].
+impl RecordedJacobian for ChainDynamics {
+    type Entry = (u32, f64, f64);
+
+    fn record_jacobian(&self, y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
+        let sc = &self.screen;
+        for k in 0..sc.l.len() {
+            let (s, sdot) = self.approach(k, y);
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                continue;
+            }
+            let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
+            out.push((k as u32, c.d_ds, c.d_dsdot));
+        }
+    }
+
+    fn apply_recorded(&self, entries: &[(u32, f64, f64)], v: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        for i in 0..n {
+            out[2 * i] = v[2 * i + 1];
+            out[2 * i + 1] = -self.stiffness[i] * v[2 * i] - self.damping[i] * v[2 * i + 1];
+        }
+        for &(a, b, k, c) in &self.couplings {
+            let f = k * (v[2 * b] - v[2 * a]) + c * (v[2 * b + 1] - v[2 * a + 1]);
+            out[2 * a + 1] += f;
+            out[2 * b + 1] -= f;
+        }
+        let sc = &self.screen;
+        for &(k, d_ds, d_dsdot) in entries {
+            let k = k as usize;
+            let (l, r, ml, mr) = (sc.l[k], sc.r[k], sc.ml[k], sc.mr[k]);
+            let ds = ml * v[2 * l] - mr * v[2 * r];
+            let dsdot = ml * v[2 * l + 1] - mr * v[2 * r + 1];
+            let f = d_ds * ds + d_dsdot * dsdot;
+            out[2 * l + 1] -= ml * f;
+            out[2 * r + 1] += mr * f;
+        }
+        for i in 0..n {
+            out[2 * i + 1] *= self.inv_mass[i];
+        }
     }
 }
 

@@ -23,10 +23,15 @@
 //! same order (the integration itself uses the interleaved layout of
 //! [`ChainDynamics`]).
 
+use std::convert::Infallible;
+
 use nalgebra::{Complex, DMatrix, DVector};
 
 use crate::dynamics::{from_interleaved, interleaved_index, to_interleaved, ChainDynamics};
-use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, Interrupt, OdeSystem};
+use crate::integrate::{
+    integrate_recorded, integrate_to, IntegrationError, IntegratorOptions, Interrupt, OdeSystem,
+    Recorder, TangentTape,
+};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::simulate::{simulate, OptionsError, SimulationOptions};
@@ -232,7 +237,43 @@ pub fn period_map(
     x: &[f64],
     opts: &ShootingOptions,
 ) -> Result<PeriodMap, IntegrationError> {
-    period_map_with(model, x, opts, None, true, MAX_STEPS).map(|(map, _, _)| map)
+    period_map_with(model, x, opts, None, true, MAX_STEPS).map(|m| m.map)
+}
+
+/// What [`period_map_with`] computes besides the map.
+pub(crate) struct MapDerivatives {
+    /// The map and, dense, its Jacobian (0 × 0 otherwise).
+    pub(crate) map: PeriodMap,
+    /// `∂P/∂p`, with a shifted model.
+    pub(crate) dp_column: Option<Vec<f64>>,
+    /// Integration steps taken.
+    pub(crate) steps: u64,
+    /// Without the dense Jacobian: products with it, replayed on the
+    /// integration's own steps.
+    pub(crate) tangent: Option<MapTangent>,
+}
+
+/// Products with the shooting map's Jacobian (Φ, or DG = S Φ_{1/2} for the
+/// half map) replayed on the steps of the integration that computed the
+/// map (`integrate::tangent`): the same numbers, to rounding, as one
+/// integration of the state with the column, without integrating.
+#[derive(Clone, Debug)]
+pub(crate) struct MapTangent {
+    tape: TangentTape<ChainDynamics>,
+    n: usize,
+    symmetric: bool,
+}
+
+impl MapTangent {
+    /// `Φ v` (or `DG v`), body order.
+    pub(crate) fn product(&self, v: &[f64]) -> Vec<f64> {
+        let w = from_interleaved(&self.tape.apply(&to_interleaved(v)), self.n);
+        if self.symmetric {
+            mirror(&w)
+        } else {
+            w
+        }
+    }
 }
 
 /// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
@@ -240,9 +281,10 @@ pub fn period_map(
 /// family: the sensitivity column of the variational equations at the
 /// end time plus the flow times the change of the end time,
 /// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map); at
-/// most `max_steps` integration steps, and the steps taken. Without
-/// `dense` no column of Φ is carried (the monodromy is 0 × 0): the map and
-/// its parameter derivative for matrix-free continuation.
+/// most `max_steps` integration steps. Without `dense` no column of Φ is
+/// carried (the monodromy is 0 × 0) and the integration records its tape
+/// for products with Φ: the map, its parameter derivative and the
+/// products for matrix-free continuation.
 pub(crate) fn period_map_with(
     model: &Model,
     x: &[f64],
@@ -250,7 +292,7 @@ pub(crate) fn period_map_with(
     shifted: Option<(&Model, f64)>,
     dense: bool,
     max_steps: u64,
-) -> Result<(PeriodMap, Option<Vec<f64>>, u64), IntegrationError> {
+) -> Result<MapDerivatives, IntegrationError> {
     let n = model.bodies().len();
     let d = 2 * n;
     if dense && d > MAX_DENSE_DIM {
@@ -264,12 +306,12 @@ pub(crate) fn period_map_with(
     }
     let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
     let t = map_time(model, opts).map_err(invalid)?;
-    let sys = ChainDynamics::new(model, false);
+    let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
     let columns = if dense { d } else { 0 };
     let (mut var, dt_dp) = match shifted {
         Some((model_p, dp)) => {
             let t_p = map_time(model_p, opts).map_err(invalid)?;
-            let shifted_sys = ChainDynamics::new(model_p, false);
+            let shifted_sys = Recorder::new(ChainDynamics::new(model_p, false), false);
             let var = Variational::with_parameter(sys, columns, shifted_sys, dp);
             (var, (t_p - t) / dp)
         }
@@ -286,7 +328,15 @@ pub(crate) fn period_map_with(
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
-    let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+    let (z, stats, tangent) = if dense {
+        let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+        (z, stats, None)
+    } else {
+        let (z, stats, tape) =
+            integrate_recorded(&mut var, Variational::system_mut, 0.0, &z0, t, &int_opts)?;
+        let symmetric = opts.symmetric;
+        (z, stats, Some(MapTangent { tape, n, symmetric }))
+    };
     let inter = |k: usize| interleaved_index(k, n);
     let image = from_interleaved(&z, n);
     let phi = var.sensitivity(&z);
@@ -297,7 +347,7 @@ pub(crate) fn period_map_with(
         from_interleaved(&column, n)
     });
     let k = columns;
-    if opts.symmetric {
+    let (map, dp_column) = if opts.symmetric {
         // G = S P_{nT/2}: DG = S Φ_{1/2}, rows mirrored and negated.
         let monodromy =
             DMatrix::from_fn(k, k, |r, c| -phi[inter(c) * d + inter(mirror_index(r, n))]);
@@ -305,10 +355,17 @@ pub(crate) fn period_map_with(
             image: mirror(&image),
             monodromy,
         };
-        return Ok((map, dp_column.map(|c| mirror(&c)), stats.steps));
-    }
-    let monodromy = DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]);
-    Ok((PeriodMap { image, monodromy }, dp_column, stats.steps))
+        (map, dp_column.map(|c| mirror(&c)))
+    } else {
+        let monodromy = DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]);
+        (PeriodMap { image, monodromy }, dp_column)
+    };
+    Ok(MapDerivatives {
+        map,
+        dp_column,
+        steps: stats.steps,
+        tangent,
+    })
 }
 
 /// Floquet multipliers from the Jacobian of the shooting map: its
@@ -454,6 +511,42 @@ struct KrylovShooting<'a> {
     scale: &'a [f64],
     /// Newton iterations so far (for error reports).
     iteration: usize,
+    /// The last evaluated state and the products at it.
+    tangent: Option<(Vec<f64>, MapTangent)>,
+}
+
+impl KrylovShooting<'_> {
+    /// The scaled residual at `x` and the products there.
+    fn record(&self, x: &[f64]) -> Result<(Vec<f64>, MapTangent), PeriodicError> {
+        let iteration = self.iteration;
+        let out = period_map_with(self.model, x, self.opts, None, false, MAX_STEPS)
+            .map_err(|source| PeriodicError::Integration { iteration, source })?;
+        let tangent = out.tangent.ok_or_else(|| {
+            PeriodicError::Options("the period map recorded no tangent (internal error)".into())
+        })?;
+        let image = out.map.image;
+        let residual = (0..x.len())
+            .map(|i| (image[i] - x[i]) / self.scale[i])
+            .collect();
+        Ok((residual, tangent))
+    }
+
+    /// The products at `x`, from its evaluation (again if `x` was not the
+    /// last state evaluated).
+    fn tangent_at(&mut self, x: &[f64]) -> Result<&MapTangent, PeriodicError> {
+        let fresh = match self.tangent.take() {
+            Some((at, tangent)) if at == x => (at, tangent),
+            _ => (x.to_vec(), self.record(x)?.1),
+        };
+        Ok(&self.tangent.insert(fresh).1)
+    }
+
+    /// `(Φ − I) v` in scaled variables.
+    fn shifted_product(tangent: &MapTangent, scale: &[f64], v: &[f64]) -> Vec<f64> {
+        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s).collect();
+        let phi_v = tangent.product(&unscaled);
+        (0..v.len()).map(|i| phi_v[i] / scale[i] - v[i]).collect()
+    }
 }
 
 impl NewtonSystem for KrylovShooting<'_> {
@@ -462,21 +555,9 @@ impl NewtonSystem for KrylovShooting<'_> {
     type Error = PeriodicError;
 
     fn evaluate(&mut self, x: &[f64]) -> Result<Vec<f64>, PeriodicError> {
-        let mut op = MonodromyOperator {
-            model: self.model,
-            x: x.to_vec(),
-            opts: self.opts,
-            products: 0,
-        };
-        let (image, _) =
-            op.apply(&vec![0.0; x.len()])
-                .map_err(|source| PeriodicError::Integration {
-                    iteration: self.iteration,
-                    source,
-                })?;
-        Ok((0..x.len())
-            .map(|i| (image[i] - x[i]) / self.scale[i])
-            .collect())
+        let (residual, tangent) = self.record(x)?;
+        self.tangent = Some((x.to_vec(), tangent));
+        Ok(residual)
     }
 
     fn residual_norm(&self, r: &Vec<f64>) -> f64 {
@@ -485,21 +566,13 @@ impl NewtonSystem for KrylovShooting<'_> {
 
     fn direction(&mut self, x: &[f64], r: &Vec<f64>) -> Result<Option<Vec<f64>>, PeriodicError> {
         self.iteration += 1;
-        let mut op = MonodromyOperator {
-            model: self.model,
-            x: x.to_vec(),
-            opts: self.opts,
-            products: 0,
-        };
         let b: Vec<f64> = r.iter().map(|v| -v).collect();
         let noise = 1e3 * self.opts.rtol;
-        let mut apply = shifted_monodromy(&mut op, self.scale);
-        let (delta, _, _) = gmres(&mut apply, &b, 60, 1e-3, noise).map_err(|source| {
-            PeriodicError::Integration {
-                iteration: self.iteration,
-                source,
-            }
-        })?;
+        let scale = self.scale;
+        let tangent = self.tangent_at(x)?;
+        let mut apply =
+            |v: &[f64]| -> Result<_, Infallible> { Ok(Self::shifted_product(tangent, scale, v)) };
+        let Ok((delta, _, _)) = gmres(&mut apply, &b, 60, 1e-3, noise);
         Ok(Some(
             delta.iter().zip(self.scale).map(|(d, s)| d * s).collect(),
         ))
@@ -568,44 +641,6 @@ pub fn shoot(
         monodromy,
         multipliers,
     })
-}
-
-/// Matrix-free products with the monodromy matrix at a fixed state: each
-/// `Φ v` integrates the orbit with one variational column started at v
-/// (about twice the cost of the orbit alone), so shooting needs no
-/// dim × dim matrix (large rows, N >= 200).
-struct MonodromyOperator<'a> {
-    model: &'a Model,
-    x: Vec<f64>,
-    opts: &'a ShootingOptions,
-    products: usize,
-}
-
-impl MonodromyOperator<'_> {
-    /// `(P(x), Φ v)` in body order (`(G(x), DG v)` for the half map).
-    fn apply(&mut self, v: &[f64]) -> Result<(Vec<f64>, Vec<f64>), IntegrationError> {
-        self.products += 1;
-        let n = self.model.bodies().len();
-        let d = 2 * n;
-        let t = map_time(self.model, self.opts)
-            .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let mut var = Variational::new(ChainDynamics::new(self.model, false), 1);
-        let z0 = var.initial_state_with(&to_interleaved(&self.x), &[&to_interleaved(v)]);
-        let int_opts = IntegratorOptions {
-            rtol: self.opts.rtol,
-            atol: self.opts.rtol * self.opts.displacement_scale,
-            max_steps: MAX_STEPS,
-            error_components: (!self.opts.control_monodromy).then_some(d),
-            interrupt: self.opts.interrupt.clone(),
-            ..IntegratorOptions::default()
-        };
-        let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
-        let (image, product) = (from_interleaved(&z, n), from_interleaved(&z[d..], n));
-        if self.opts.symmetric {
-            return Ok((mirror(&image), mirror(&product)));
-        }
-        Ok((image, product))
-    }
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -707,30 +742,6 @@ fn least_squares(h: &DMatrix<f64>, k: usize, beta: f64) -> (DVector<f64>, f64) {
     (y, res)
 }
 
-/// `(Φ - I) v` in scaled variables (Φ acts on unscaled vectors), as a
-/// closure for [`gmres`].
-fn shifted_monodromy<'o, 'm: 'o>(
-    op: &'o mut MonodromyOperator<'m>,
-    scale: &'o [f64],
-) -> impl FnMut(&[f64]) -> Result<Vec<f64>, IntegrationError> + use<'o, 'm> {
-    move |v: &[f64]| {
-        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s).collect();
-        let (_, phi_v) = op.apply(&unscaled)?;
-        Ok((0..v.len()).map(|i| phi_v[i] / scale[i] - v[i]).collect())
-    }
-}
-
-/// `DG v` (Φ v for the full map) at the state `x` by one integration of the
-/// state with one tangent column, body order.
-pub(crate) fn map_product(
-    model: &Model,
-    x: &[f64],
-    v: &[f64],
-    opts: &ShootingOptions,
-) -> Result<Vec<f64>, IntegrationError> {
-    map_and_product(model, x, v, opts).map(|(_, product)| product)
-}
-
 /// `(G(x), DG v)` (the map and a product with its Jacobian) by one
 /// integration of the state with one tangent column, body order.
 pub(crate) fn map_and_product(
@@ -739,17 +750,30 @@ pub(crate) fn map_and_product(
     v: &[f64],
     opts: &ShootingOptions,
 ) -> Result<(Vec<f64>, Vec<f64>), IntegrationError> {
-    let mut op = MonodromyOperator {
-        model,
-        x: x.to_vec(),
-        opts,
-        products: 0,
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+    let mut var = Variational::new(ChainDynamics::new(model, false), 1);
+    let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
+    let int_opts = IntegratorOptions {
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps: MAX_STEPS,
+        error_components: (!opts.control_monodromy).then_some(d),
+        interrupt: opts.interrupt.clone(),
+        ..IntegratorOptions::default()
     };
-    op.apply(v)
+    let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+    let (image, product) = (from_interleaved(&z, n), from_interleaved(&z[d..], n));
+    if opts.symmetric {
+        return Ok((mirror(&image), mirror(&product)));
+    }
+    Ok((image, product))
 }
 
-/// Newton–Krylov shooting for large systems (matrix-free; see
-/// `MonodromyOperator`): each Newton step solves `(Φ - I) δ = -(P(x) - x)`
+/// Newton–Krylov shooting for large systems (matrix-free: products with
+/// Φ replayed on each iterate's integration, `MapTangent`): each Newton
+/// step solves `(Φ - I) δ = -(P(x) - x)`
 /// by GMRES to a relative residual of 1e-3 (inexact Newton). The dominant
 /// Floquet multipliers come from an Arnoldi iteration of Φ at the solution
 /// (`arnoldi` Krylov vectors; Ritz values, largest modulus first). The
@@ -784,21 +808,18 @@ pub fn shoot_krylov(
         opts,
         scale: &scale,
         iteration: 0,
+        tangent: None,
     };
     let out = damped_newton(&mut sys, guess, &newton_options(opts))?;
-    let (x, iteration) = (out.x, sys.iteration);
+    let x = out.x;
     // Dominant multipliers: Arnoldi on Φ (Ritz values of the Hessenberg
     // matrix of Φ - I, shifted back by 1), from a generic start vector.
-    let mut op = MonodromyOperator {
-        model,
-        x: x.clone(),
-        opts,
-        products: 0,
-    };
     let noise = 1e3 * opts.rtol;
-    let mut apply = shifted_monodromy(&mut op, &scale);
-    let ritz = arnoldi_matrix(&mut apply, d, arnoldi, noise)
-        .map_err(|source| PeriodicError::Integration { iteration, source })?;
+    let tangent = sys.tangent_at(&x)?;
+    let mut apply = |v: &[f64]| -> Result<_, Infallible> {
+        Ok(KrylovShooting::shifted_product(tangent, &scale, v))
+    };
+    let Ok(ritz) = arnoldi_matrix(&mut apply, d, arnoldi, noise);
     let multipliers = map_multipliers(&ritz, opts.symmetric)?;
     Ok(PeriodicSolution {
         converged: out.stop == NewtonStop::Converged,

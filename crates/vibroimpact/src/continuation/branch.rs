@@ -132,10 +132,14 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
                 };
                 (half, Vec::new())
             });
-        let events: Vec<Box<dyn BranchEvent>> = BUILT_IN
-            .iter()
-            .map(|k| Box::new(*k) as Box<dyn BranchEvent>)
-            .collect();
+        let events: Vec<Box<dyn BranchEvent>> = if opts.special_points {
+            BUILT_IN
+                .iter()
+                .map(|k| Box::new(*k) as Box<dyn BranchEvent>)
+                .collect()
+        } else {
+            Vec::new()
+        };
         let mut this = Self {
             counts: vec![0; events.len()],
             events,
@@ -229,7 +233,12 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         if change > allowed && 0.5 * ds >= self.problem.opts.ds_min {
             return Err(factor.min(fail));
         }
-        let next = self.problem.add_orbit(next).ok_or(fail)?;
+        let orbit = self.problem.opts.special_points || self.events.iter().any(|e| e.needs_orbit());
+        let next = if orbit {
+            self.problem.add_orbit(next).ok_or(fail)?
+        } else {
+            next
+        };
         Ok((next, iterations, factor))
     }
 

@@ -159,6 +159,14 @@ pub struct ContinuationOptions {
     /// multiplier outside the Arnoldi space is not seen). Memory
     /// O(N · dimension) instead of O(N²); for rows of hundreds of bodies.
     pub krylov: Option<usize>,
+    /// Detect and locate the built-in special points and summarise each
+    /// point's orbit (default true). Off, the branch is only a path to its
+    /// end: no built-in special points, and the points between the first
+    /// and the last come without amplitudes (empty) and with 0 impacts per period
+    /// unless an added event reads them (the amplitude homotopy of
+    /// [`amplitude_homotopy`](start::amplitude_homotopy), whose points
+    /// serve only to reach the model's own amplitude).
+    pub special_points: bool,
 }
 
 impl Default for ContinuationOptions {
@@ -187,6 +195,7 @@ impl Default for ContinuationOptions {
             use_symmetry: true,
             parameter_scale: None,
             krylov: None,
+            special_points: true,
         }
     }
 }

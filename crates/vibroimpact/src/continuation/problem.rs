@@ -3,6 +3,8 @@
 //! tangent, and a converged point evaluated in full (orbit summary,
 //! multipliers, test values).
 
+use std::sync::Arc;
+
 use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
@@ -12,7 +14,7 @@ use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
     forcing_period, map_multipliers, map_time, mirror, multipliers_of_map, orbit_summary,
-    period_map_with, ShootingOptions, MAX_STEPS,
+    period_map_with, MapTangent, ShootingOptions, MAX_STEPS,
 };
 
 /// The linearisation of the extended system at a point.
@@ -26,13 +28,11 @@ pub(super) enum Linear {
         /// Φ, or DG of the half map (body order, unscaled).
         monodromy: DMatrix<f64>,
     },
-    /// Matrix-free: products Ĵ_x v from one tangent integration each at
-    /// the state `x` and parameter `p`, and the column Ĝ_p.
+    /// Matrix-free: products Ĵ_x v replayed on the steps of the point's
+    /// integration, and the column Ĝ_p.
     Krylov {
-        /// The state (body order, unscaled).
-        x: Vec<f64>,
-        /// The parameter.
-        p: f64,
+        /// Products with Φ (or DG), unscaled.
+        tangent: Arc<MapTangent>,
         /// Ĝ_p, scaled.
         g_p: Vec<f64>,
     },
@@ -145,17 +145,20 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         let model_p = self.model(p + dp).ok()?;
         let shifted = Some((&model_p, dp));
         let dense = self.opts.krylov.is_none();
-        let (map, dp_column, steps) =
+        let derivatives =
             period_map_with(&model, &x, &self.opts.shooting, shifted, dense, budget).ok()?;
-        self.steps = steps;
-        let dp_column = dp_column?;
-        if !dense {
+        self.steps = derivatives.steps;
+        let (map, dp_column) = (derivatives.map, derivatives.dp_column?);
+        if let Some(tangent) = derivatives.tangent {
             let g_p = (0..d)
                 .map(|r| dp_column[r] * self.p_scale / self.scale[r])
                 .collect();
             return Some(Residual {
                 g: scaled(&map.image, &self.scale),
-                linear: Some(Linear::Krylov { x, p, g_p }),
+                linear: Some(Linear::Krylov {
+                    tangent: Arc::new(tangent),
+                    g_p,
+                }),
             });
         }
         let mut jac = DMatrix::zeros(d, d + 1);

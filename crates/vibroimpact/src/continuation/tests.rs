@@ -158,6 +158,40 @@ fn r2_branch(from: f64, to: f64) -> Branch {
     continue_branch(family, from * W0, &guess, to * W0, &opts, |_| true).unwrap()
 }
 
+/// Without special points the branch takes the same steps (locating a
+/// special point does not move the branch) and its points between the
+/// first and the last carry no orbit summary; with them the same window
+/// has its special points.
+#[test]
+fn a_branch_without_special_points_takes_the_same_steps() {
+    let (from, to) = (0.56, 0.5);
+    let family = |w: f64| r2(2, 1e-3, w);
+    let start = r2(2, 1e-3, from * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let run = |special_points: bool| {
+        let opts = ContinuationOptions {
+            special_points,
+            ..Default::default()
+        };
+        continue_branch(family, from * W0, &guess, to * W0, &opts, |_| true).unwrap()
+    };
+    let (with, without) = (run(true), run(false));
+    assert!(with.special.len() >= 2, "{}", with.special.len());
+    assert!(without.special.is_empty());
+    assert_eq!(with.stop, StopReason::ReachedEnd);
+    assert_eq!(without.stop, StopReason::ReachedEnd);
+    assert_eq!(with.points.len(), without.points.len());
+    for (a, b) in with.points.iter().zip(&without.points) {
+        assert!((a.parameter - b.parameter).abs() < 1e-12 * W0);
+    }
+    assert!(!without.points[0].max_displacement.is_empty());
+    let last = without.points.len() - 1;
+    assert!(!without.points[last].max_displacement.is_empty());
+    assert!(without.points[1..last]
+        .iter()
+        .all(|p| p.max_displacement.is_empty()));
+}
+
 /// R2, N = 2 (a mirror-symmetric row): the branch from 1.5 ω0 down is
 /// followed on the half map and has exactly AUTO-07p's special points
 /// (plus grazing, which AUTO does not detect), located from either

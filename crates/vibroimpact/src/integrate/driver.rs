@@ -563,6 +563,12 @@ impl<M: StepMethod> Driver<M> {
         self.at.t_prev
     }
 
+    /// Size of the last accepted step (`t − t_prev` before rounding; 0
+    /// right after [`reset`](Self::reset)).
+    pub fn h_last(&self) -> f64 {
+        self.at.h_last
+    }
+
     /// State at [`t`](Self::t).
     pub fn y(&self) -> &[f64] {
         &self.at.y

@@ -44,6 +44,7 @@ mod explicit;
 pub mod linalg;
 pub mod rosenbrock;
 mod stepper;
+pub mod tangent;
 
 #[cfg(test)]
 mod conformance_tests;
@@ -56,6 +57,7 @@ pub use driver::{Attempt, Driver, Point, StepMethod, Trial};
 pub use linalg::{BandMatrix, Singular};
 pub use rosenbrock::{Rodas, RodasMethod};
 pub use stepper::{Method, Stepper};
+pub use tangent::{integrate_recorded, RecordedJacobian, Recorder, TangentTape};
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};

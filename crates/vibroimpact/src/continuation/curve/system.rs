@@ -5,11 +5,12 @@
 use nalgebra::{Complex, DMatrix, DVector};
 
 use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
+use crate::continuation::problem::period_image;
 use crate::model::Model;
 use crate::newton::NewtonSystem;
 use crate::periodic::{
     floquet_multipliers, forcing_period, multipliers_of_map, orbit_summary, period_map,
-    period_map_with, ShootingOptions, MAX_STEPS,
+    ShootingOptions,
 };
 use crate::simulate::{simulate, SimulationOptions};
 
@@ -312,9 +313,9 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
         if self.kind == CurveKind::Grazing {
             let (x, p, q, _) = self.unscale(z);
             let model = (self.family)(p, q)?;
-            let (map, _, _) = period_map_with(&model, &x, &self.opts, None, false, MAX_STEPS)
-                .map_err(|e| e.to_string())?;
-            let g = self.orbit_residual(&map.image, &x);
+            let image = period_image(&model, &x, &self.opts)
+                .ok_or("the period map failed at a grazing-curve iterate")?;
+            let g = self.orbit_residual(&image, &x);
             let margin = self.grazing_margin(&model, &x)? * CURVE_TOL / TEST_TOL;
             return Ok(DVector::from_iterator(
                 g.len() + 1,
