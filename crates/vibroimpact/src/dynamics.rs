@@ -23,7 +23,7 @@
 //! its gap exceeds about 0.36 mm, so the cost of a right-hand side grows with
 //! the number of contacts actually closing, and linearly with N.
 
-use crate::contact::{ContactLaw, LawKind};
+use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian};
 use crate::model::{BaseExcitation, Model};
 
@@ -355,6 +355,26 @@ impl ChainDynamics {
         self.contacts.len()
     }
 
+    /// The contacts not screened out at `y`, with their laws' force and
+    /// partial derivatives there (for the Jacobian).
+    fn evaluated_contacts<'a>(
+        &'a self,
+        y: &'a [f64],
+    ) -> impl Iterator<Item = (usize, ContactForce)> + 'a {
+        let sc = &self.screen;
+        (0..sc.l.len()).filter_map(move |k| {
+            let (s, sdot) = self.approach(k, y);
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                None
+            } else {
+                Some((
+                    k,
+                    self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]),
+                ))
+            }
+        })
+    }
+
     /// Mechanical energy E (J) of state y (see the module notes).
     pub fn mechanical_energy(&self, y: &[f64]) -> f64 {
         let mut e = 0.0;
@@ -533,13 +553,7 @@ impl OdeSystem for ChainDynamics {
         for &(a, b, k, c) in &self.couplings {
             pair(jac, a, b, k, c);
         }
-        let sc = &self.screen;
-        for k in 0..sc.l.len() {
-            let (s, sdot) = self.approach(k, y);
-            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
-                continue;
-            }
-            let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
+        for (k, c) in self.evaluated_contacts(y) {
             match (self.contacts[k].left, self.contacts[k].right) {
                 // -F on l, +F on r, F = F(u_l - u_r - g, v_l - v_r): the same
                 // shape as a coupling of stiffness ∂F/∂s between r and l.
@@ -575,15 +589,10 @@ impl RecordedJacobian for ChainDynamics {
     type Entry = (u32, f64, f64);
 
     fn record_jacobian(&self, y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
-        let sc = &self.screen;
-        for k in 0..sc.l.len() {
-            let (s, sdot) = self.approach(k, y);
-            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
-                continue;
-            }
-            let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
-            out.push((k as u32, c.d_ds, c.d_dsdot));
-        }
+        out.extend(
+            self.evaluated_contacts(y)
+                .map(|(k, c)| (k as u32, c.d_ds, c.d_dsdot)),
+        );
     }
 
     fn apply_recorded(&self, entries: &[(u32, f64, f64)], v: &[f64], out: &mut [f64]) {

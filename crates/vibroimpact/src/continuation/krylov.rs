@@ -6,71 +6,95 @@
 
 use nalgebra::Complex;
 
-use super::problem::{Linear, Problem};
+use super::problem::{unit_along, Linear, Problem};
 use crate::model::Model;
 use crate::periodic::{arnoldi_matrix, floquet_multipliers, gmres, MapTangent};
 
 /// Largest GMRES basis of a bordered solve.
 const MAX_GMRES: usize = 400;
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
-    /// `Ĵ_x v` in scaled variables at the point of `linear`: `(DG v - v)`
-    /// with DG acting on unscaled vectors (the unknowns' scale on `v`, the
-    /// residual's on the product).
-    fn jacobian_product(&self, tangent: &MapTangent, v: &[f64]) -> Vec<f64> {
-        let unit = self.state_unit;
+/// The extended system's matrix-free operators at one point: what the
+/// products need and nothing of the model family, so that the tangent and
+/// the multipliers of a point can be computed at the same time on two
+/// threads.
+pub(super) struct Operators<'a> {
+    tangent: &'a MapTangent,
+    /// Ĝ_p, scaled.
+    g_p: &'a [f64],
+    /// The residual's scale (and, times `unit`, the unknowns').
+    scale: &'a [f64],
+    unit: f64,
+    /// Relative accuracy of a product (GMRES and Arnoldi breakdowns).
+    noise: f64,
+}
+
+impl Operators<'_> {
+    /// `Ĵ_x v` in scaled variables: `(DG v - v)` with DG acting on
+    /// unscaled vectors (the unknowns' scale on `v`, the residual's on the
+    /// product).
+    fn jacobian_product(&self, v: &[f64]) -> Vec<f64> {
         let unscaled: Vec<f64> = v
             .iter()
-            .zip(&self.scale)
-            .map(|(a, s)| a * s * unit)
+            .zip(self.scale)
+            .map(|(a, s)| a * s * self.unit)
             .collect();
-        let product = tangent.product(&unscaled);
+        let product = self.tangent.product(&unscaled);
         (0..v.len())
-            .map(|i| product[i] / self.scale[i] - unit * v[i])
+            .map(|i| product[i] / self.scale[i] - self.unit * v[i])
             .collect()
     }
 
     /// Solves the bordered system `[Ĵ_x Ĝ_p; tᵀ] u = rhs` ((d+1)-vectors,
-    /// scaled) by GMRES to the relative residual `rel_tol`, matrix-free.
-    pub(super) fn bordered_solve(
-        &mut self,
-        linear: &Linear,
-        t: &[f64],
-        rhs: &[f64],
-        rel_tol: f64,
-    ) -> Option<Vec<f64>> {
-        let Linear::Krylov { tangent, g_p } = linear else {
-            return None;
-        };
-        let d = self.d;
+    /// scaled) by GMRES to the relative residual `rel_tol`.
+    pub(super) fn bordered_solve(&self, t: &[f64], rhs: &[f64], rel_tol: f64) -> Option<Vec<f64>> {
+        let d = self.g_p.len();
         let mut apply = |u: &[f64]| -> Result<Vec<f64>, ()> {
-            let mut out = self.jacobian_product(tangent, &u[..d]);
-            out.iter_mut().zip(g_p).for_each(|(o, g)| *o += g * u[d]);
+            let mut out = self.jacobian_product(&u[..d]);
+            out.iter_mut()
+                .zip(self.g_p)
+                .for_each(|(o, g)| *o += g * u[d]);
             out.push(t.iter().zip(u).map(|(a, b)| a * b).sum());
             Ok(out)
         };
-        let noise = 1e3 * self.opts.shooting.rtol;
-        let (u, _, _) = gmres(&mut apply, rhs, (d + 1).min(MAX_GMRES), rel_tol, noise).ok()?;
+        let (u, _, _) = gmres(&mut apply, rhs, (d + 1).min(MAX_GMRES), rel_tol, self.noise).ok()?;
         u.iter().all(|v| v.is_finite()).then_some(u)
     }
 
+    /// The unit tangent, oriented along `previous`: `[Ĵ_x Ĝ_p; previousᵀ]
+    /// t = e_{d+1}` to 1e-8.
+    pub(super) fn tangent(&self, previous: &[f64]) -> Option<Vec<f64>> {
+        let mut e = vec![0.0; self.g_p.len() + 1];
+        e[self.g_p.len()] = 1.0;
+        Some(unit_along(
+            self.bordered_solve(previous, &e, 1e-8)?,
+            previous,
+        ))
+    }
+
     /// The dominant eigenvalues of the shooting map's Jacobian (Φ, or DG of
-    /// the half map) at the point of `linear`: Ritz values of an Arnoldi
-    /// iteration of `opts.krylov` vectors from a generic start, largest
-    /// modulus first.
-    pub(super) fn dominant_map_eigenvalues(
-        &mut self,
-        linear: &Linear,
-    ) -> Option<Vec<Complex<f64>>> {
-        let Linear::Krylov { tangent, .. } = linear else {
+    /// the half map): Ritz values of an Arnoldi iteration of `m` vectors
+    /// from a generic start, largest modulus first.
+    pub(super) fn dominant_map_eigenvalues(&self, m: usize) -> Option<Vec<Complex<f64>>> {
+        let d = self.g_p.len();
+        let mut apply = |v: &[f64]| -> Result<Vec<f64>, ()> { Ok(self.jacobian_product(v)) };
+        let ritz = arnoldi_matrix(&mut apply, d, m, self.noise).ok()?;
+        floquet_multipliers(&ritz).ok()
+    }
+}
+
+impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+    /// The matrix-free operators at the point of `linear` (None for a dense
+    /// linearisation).
+    pub(super) fn operators<'a>(&'a self, linear: &'a Linear) -> Option<Operators<'a>> {
+        let Linear::Krylov { tangent, g_p } = linear else {
             return None;
         };
-        let d = self.d;
-        let m = self.opts.krylov?;
-        let mut apply =
-            |v: &[f64]| -> Result<Vec<f64>, ()> { Ok(self.jacobian_product(tangent, v)) };
-        let noise = 1e3 * self.opts.shooting.rtol;
-        let ritz = arnoldi_matrix(&mut apply, d, m, noise).ok()?;
-        floquet_multipliers(&ritz).ok()
+        Some(Operators {
+            tangent,
+            g_p,
+            scale: &self.scale,
+            unit: self.state_unit,
+            noise: 1e3 * self.opts.shooting.rtol,
+        })
     }
 }

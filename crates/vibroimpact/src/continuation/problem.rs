@@ -260,26 +260,29 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
             },
         ))
     }
+}
 
-    /// Unit tangent at a solution, oriented along `previous`: the solution
-    /// of `[Ĵ; previousᵀ] t = e_{d+1}`, normalised.
-    pub(super) fn tangent(&mut self, linear: &Linear, previous: &[f64]) -> Option<Vec<f64>> {
-        let d = self.d;
-        let mut e = DVector::zeros(d + 1);
-        e[d] = 1.0;
-        let t = match linear {
-            Linear::Dense { jac, .. } => bordered(jac, previous).lu().solve(&e)?,
-            Linear::Krylov { .. } => {
-                DVector::from_vec(self.bordered_solve(linear, previous, e.as_slice(), 1e-8)?)
-            }
-        };
-        let norm = t.norm();
-        let mut t: Vec<f64> = t.iter().map(|v| v / norm).collect();
-        if t.iter().zip(previous).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
-            t.iter_mut().for_each(|v| *v = -*v);
-        }
-        Some(t)
-    }
+/// Unit tangent at a solution with the dense Jacobian `jac` = [Ĵ_x Ĝ_p],
+/// oriented along `previous`: the solution of `[jac; previousᵀ] t =
+/// e_{d+1}`, normalised.
+fn dense_tangent(jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
+    let d = jac.nrows();
+    let mut e = DVector::zeros(d + 1);
+    e[d] = 1.0;
+    let t = bordered(jac, previous).lu().solve(&e)?;
+    Some(unit_along(t.as_slice().to_vec(), previous))
+}
+
+/// `t` normalised and oriented along `previous`.
+pub(super) fn unit_along(mut t: Vec<f64>, previous: &[f64]) -> Vec<f64> {
+    let norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let sign = if t.iter().zip(previous).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    t.iter_mut().for_each(|v| *v *= sign / norm);
+    t
 }
 
 /// `P(x)` without the variational equations.
@@ -358,17 +361,25 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         previous_tangent: &[f64],
         with_orbit: bool,
     ) -> Option<Evaluated> {
-        let tangent = self.tangent(&solved.linear, previous_tangent)?;
         let (x, p) = self.unscale(&solved.z);
         let symmetric = self.opts.shooting.symmetric;
-        let (multipliers, tests) = match &solved.linear {
+        let (tangent, multipliers, tests) = match &solved.linear {
             Linear::Dense { jac, monodromy } => {
+                let tangent = dense_tangent(jac, previous_tangent)?;
                 let multipliers = map_multipliers(monodromy, symmetric).ok()?;
                 let tests = TestValues::at(jac, &tangent, monodromy, &multipliers, 0, symmetric);
-                (multipliers, tests)
+                (tangent, multipliers, tests)
             }
             Linear::Krylov { .. } => {
-                let map_eigenvalues = self.dominant_map_eigenvalues(&solved.linear)?;
+                // The tangent and the multipliers are independent: one
+                // thread each (the same numbers on any thread count).
+                let operators = self.operators(&solved.linear)?;
+                let m = self.opts.krylov?;
+                let (tangent, map_eigenvalues) = rayon::join(
+                    || operators.tangent(previous_tangent),
+                    || operators.dominant_map_eigenvalues(m),
+                );
+                let (tangent, map_eigenvalues) = (tangent?, map_eigenvalues?);
                 let multipliers = multipliers_of_map(map_eigenvalues.clone(), symmetric);
                 let tests = TestValues::from_spectrum(
                     tangent[self.d],
@@ -376,7 +387,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
                     &multipliers,
                     symmetric,
                 );
-                (multipliers, tests)
+                (tangent, multipliers, tests)
             }
         };
         let point = BranchPoint {
@@ -587,7 +598,8 @@ impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, 
                 self.krylov_norm = Some(norm);
                 // Inexact Newton: the direction to 1e-4 relative.
                 self.problem
-                    .bordered_solve(krylov, self.t, rhs.as_slice(), 1e-4)
+                    .operators(krylov)
+                    .and_then(|o| o.bordered_solve(self.t, rhs.as_slice(), 1e-4))
             }
             (None, Some(b)) => b.clone().lu().solve(&rhs).map(|d| d.as_slice().to_vec()),
             (None, None) => None,

@@ -48,11 +48,23 @@ where
         ..opts.clone()
     };
     let x0 = vec![0.0; 2 * rest.bodies().len()];
-    let branch = continue_branch(&mut family, a0, &x0, amplitude, &local, |_| true)?;
+    // A stop request fails every integration, which the step control would
+    // take for a corrector that does not converge: say it was the request.
+    let interrupted = || {
+        opts.shooting
+            .interrupt
+            .as_ref()
+            .is_some_and(|i| i.requested())
+    };
+    let branch = continue_branch(&mut family, a0, &x0, amplitude, &local, |_| !interrupted())?;
     match (branch.stop, branch.points.last()) {
         (StopReason::ReachedEnd, Some(last)) if last.parameter == amplitude => {
             Ok(last.state.clone())
         }
+        (_, last) if interrupted() => Err(ContinuationError::Invalid(format!(
+            "interrupted during the homotopy in the forcing amplitude, at {} of {amplitude}",
+            last.map_or(a0, |p| p.parameter)
+        ))),
         (stop, last) => Err(ContinuationError::Invalid(format!(
             "the homotopy in the forcing amplitude did not reach {amplitude}: it stopped at {} ({stop})",
             last.map_or(a0, |p| p.parameter)
@@ -97,5 +109,36 @@ mod tests {
             amplitude_homotopy(family, f64::NAN, &opts),
             Err(ContinuationError::Invalid(_))
         ));
+    }
+
+    /// A stop requested during the homotopy is reported as such, not as a
+    /// corrector that does not converge.
+    #[test]
+    fn an_interrupted_homotopy_says_so() {
+        let interrupt = crate::integrate::Interrupt::default();
+        let mut opts = ContinuationOptions::default();
+        opts.shooting.interrupt = Some(interrupt.clone());
+        let mut calls = 0;
+        let family = |a: f64| {
+            calls += 1;
+            if calls == 30 {
+                interrupt.request();
+            }
+            reference::r2(4, reference::CLEARANCE, 0.9 * W0)
+                .map(|m| {
+                    m.with_base(BaseExcitation::Harmonic {
+                        amplitude: a,
+                        frequency: 0.9 * W0,
+                        phase: 0.0,
+                    })
+                })
+                .map_err(|e| e.to_string())
+        };
+        let err = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("interrupted during the homotopy"),
+            "{err}"
+        );
     }
 }

@@ -553,6 +553,37 @@ fn krylov_branch_matches_dense() {
     }
 }
 
+/// The matrix-free branch computes a point's tangent and multipliers on
+/// two threads: the same bytes on one thread and on two.
+#[test]
+fn krylov_branch_is_the_same_on_any_thread_count() {
+    let family = |w: f64| r2(8, 1e-3, w);
+    let start = r2(8, 1e-3, 0.5 * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let opts = ContinuationOptions {
+        krylov: Some(12),
+        max_points: 40,
+        ..Default::default()
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            continue_branch(family, 0.5 * W0, &guess, 0.6 * W0, &opts, |_| true).unwrap()
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.points.len(), two.points.len());
+    assert!(one.points.len() > 10, "{}", one.points.len());
+    for (a, b) in one.points.iter().zip(&two.points) {
+        assert_eq!(a.parameter.to_bits(), b.parameter.to_bits());
+        assert_eq!(a.state, b.state);
+        assert_eq!(a.multipliers, b.multipliers);
+    }
+}
+
 /// Matrix-free options that cannot work are refused before anything runs.
 #[test]
 fn krylov_dimension_is_checked() {
