@@ -1,6 +1,6 @@
 //! Tangent replay: products `Φ v` of a DOP853 integration's sensitivity
 //! from the integration's own record, without integrating again
-//! (docs/theory.md §5, "products replayed on the state's steps").
+//! (docs/theory.md §5, docs/decisions.md D21).
 //!
 //! An explicit Runge–Kutta method applied to the state and its variational
 //! equations `w' = J(y(t)) w`, with the steps chosen by the state alone,
