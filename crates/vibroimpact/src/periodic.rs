@@ -274,6 +274,16 @@ impl MapTangent {
             w
         }
     }
+
+    /// `(Φ − I) v` in scaled variables: `v` in units of `scale · unit`,
+    /// the product in units of `scale`, i.e. `Φ (s u v) / s − u v`.
+    pub(crate) fn shifted_scaled(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
+        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s * unit).collect();
+        let phi_v = self.product(&unscaled);
+        (0..v.len())
+            .map(|i| phi_v[i] / scale[i] - unit * v[i])
+            .collect()
+    }
 }
 
 /// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
@@ -540,13 +550,6 @@ impl KrylovShooting<'_> {
         };
         Ok(&self.tangent.insert(fresh).1)
     }
-
-    /// `(Φ − I) v` in scaled variables.
-    fn shifted_product(tangent: &MapTangent, scale: &[f64], v: &[f64]) -> Vec<f64> {
-        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s).collect();
-        let phi_v = tangent.product(&unscaled);
-        (0..v.len()).map(|i| phi_v[i] / scale[i] - v[i]).collect()
-    }
 }
 
 impl NewtonSystem for KrylovShooting<'_> {
@@ -571,7 +574,7 @@ impl NewtonSystem for KrylovShooting<'_> {
         let scale = self.scale;
         let tangent = self.tangent_at(x)?;
         let mut apply =
-            |v: &[f64]| -> Result<_, Infallible> { Ok(Self::shifted_product(tangent, scale, v)) };
+            |v: &[f64]| -> Result<_, Infallible> { Ok(tangent.shifted_scaled(v, scale, 1.0)) };
         let Ok((delta, _, _)) = gmres(&mut apply, &b, 60, 1e-3, noise);
         Ok(Some(
             delta.iter().zip(self.scale).map(|(d, s)| d * s).collect(),
@@ -816,9 +819,8 @@ pub fn shoot_krylov(
     // matrix of Φ - I, shifted back by 1), from a generic start vector.
     let noise = 1e3 * opts.rtol;
     let tangent = sys.tangent_at(&x)?;
-    let mut apply = |v: &[f64]| -> Result<_, Infallible> {
-        Ok(KrylovShooting::shifted_product(tangent, &scale, v))
-    };
+    let mut apply =
+        |v: &[f64]| -> Result<_, Infallible> { Ok(tangent.shifted_scaled(v, &scale, 1.0)) };
     let Ok(ritz) = arnoldi_matrix(&mut apply, d, arnoldi, noise);
     let multipliers = map_multipliers(&ritz, opts.symmetric)?;
     Ok(PeriodicSolution {

@@ -33,15 +33,7 @@ impl Operators<'_> {
     /// unscaled vectors (the unknowns' scale on `v`, the residual's on the
     /// product).
     fn jacobian_product(&self, v: &[f64]) -> Vec<f64> {
-        let unscaled: Vec<f64> = v
-            .iter()
-            .zip(self.scale)
-            .map(|(a, s)| a * s * self.unit)
-            .collect();
-        let product = self.tangent.product(&unscaled);
-        (0..v.len())
-            .map(|i| product[i] / self.scale[i] - self.unit * v[i])
-            .collect()
+        self.tangent.shifted_scaled(v, self.scale, self.unit)
     }
 
     /// Solves the bordered system `[Ĵ_x Ĝ_p; tᵀ] u = rhs` ((d+1)-vectors,

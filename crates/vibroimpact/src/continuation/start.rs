@@ -79,21 +79,27 @@ mod tests {
     use crate::model::BaseExcitation;
     use crate::reference::{self, NATURAL_FREQUENCY as W0};
 
+    /// R2 with N = 4 under the base acceleration `amplitude` sin(ω t).
+    fn r2_n4_forced(
+        omega: f64,
+        amplitude: f64,
+    ) -> Result<crate::model::Model, crate::model::ModelError> {
+        reference::r2(4, reference::CLEARANCE, omega).map(|m| {
+            m.with_base(BaseExcitation::Harmonic {
+                amplitude,
+                frequency: omega,
+                phase: 0.0,
+            })
+        })
+    }
+
     /// R2 with N = 4 at 1.5 ω0: a guess by simulation does not lead
     /// Newton to a periodic orbit there, the homotopy from rest does, and
     /// the orbit it gives is periodic (a continuation can start from it).
     #[test]
     fn homotopy_starts_r2_n4_where_a_simulated_guess_does_not() {
         let w = 1.5 * W0;
-        let model = |a: f64| {
-            reference::r2(4, reference::CLEARANCE, w).map(|m| {
-                m.with_base(BaseExcitation::Harmonic {
-                    amplitude: a,
-                    frequency: w,
-                    phase: 0.0,
-                })
-            })
-        };
+        let model = |a: f64| r2_n4_forced(w, a);
         let family = |a: f64| model(a).map_err(|e| e.to_string());
         let opts = ContinuationOptions::default();
         let x = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap();
@@ -124,15 +130,7 @@ mod tests {
             if calls == 30 {
                 interrupt.request();
             }
-            reference::r2(4, reference::CLEARANCE, 0.9 * W0)
-                .map(|m| {
-                    m.with_base(BaseExcitation::Harmonic {
-                        amplitude: a,
-                        frequency: 0.9 * W0,
-                        phase: 0.0,
-                    })
-                })
-                .map_err(|e| e.to_string())
+            r2_n4_forced(0.9 * W0, a).map_err(|e| e.to_string())
         };
         let err = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap_err();
         assert!(

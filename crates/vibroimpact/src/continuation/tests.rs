@@ -10,11 +10,9 @@ fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
     crate::reference::r2(n, clearance, omega).map_err(|e| e.to_string())
 }
 
-/// R3 along a branch: amplitude equals the exact steady state, no
-/// special points, all stable.
-#[test]
-fn linear_branch_is_exact() {
-    let family = |w: f64| r2(2, 1e3, w);
+/// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,
+/// tight tolerances.
+fn linear_branch(n: usize) -> Branch {
     let opts = ContinuationOptions {
         shooting: ShootingOptions {
             rtol: 1e-12,
@@ -24,7 +22,18 @@ fn linear_branch_is_exact() {
         },
         ..Default::default()
     };
-    let b = continue_branch(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts, |_| true).unwrap();
+    let family = |w: f64| r2(n, 1e3, w);
+    continue_branch(family, 0.8 * W0, &vec![0.0; 2 * n], 1.2 * W0, &opts, |_| {
+        true
+    })
+    .unwrap()
+}
+
+/// R3 along a branch: amplitude equals the exact steady state, no
+/// special points, all stable.
+#[test]
+fn linear_branch_is_exact() {
+    let b = linear_branch(2);
     assert_eq!(b.stop, StopReason::ReachedEnd);
     assert!(
         b.special.is_empty(),
@@ -52,23 +61,7 @@ fn linear_branch_is_exact() {
 /// the parameter).
 #[test]
 fn steps_do_not_shrink_with_the_row_length() {
-    let opts = ContinuationOptions {
-        shooting: ShootingOptions {
-            rtol: 1e-12,
-            tol: 1e-10,
-            displacement_scale: 1e-2,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let branch = |n: usize| {
-        let family = move |w: f64| r2(n, 1e3, w);
-        continue_branch(family, 0.8 * W0, &vec![0.0; 2 * n], 1.2 * W0, &opts, |_| {
-            true
-        })
-        .unwrap()
-    };
-    let (two, eight) = (branch(2), branch(8));
+    let (two, eight) = (linear_branch(2), linear_branch(8));
     assert_eq!(two.stop, StopReason::ReachedEnd);
     assert_eq!(eight.stop, StopReason::ReachedEnd);
     assert!(two.points.len() > 10);
