@@ -350,6 +350,21 @@ impl ChainDynamics {
         &self.contacts[k].law
     }
 
+    /// The part of the right-hand side that depends on time alone (the
+    /// base acceleration and the harmonic forces, per unit mass) at `t`,
+    /// in the interleaved state layout: `f(t, y) = f(0-forcing; y) +
+    /// source(t)`.
+    pub fn source(&self, t: f64, out: &mut [f64]) {
+        let zdd = self.base.at(t);
+        for i in 0..self.n {
+            out[2 * i] = 0.0;
+            out[2 * i + 1] = -zdd;
+        }
+        for &(body, p, w, phi) in &self.forces {
+            out[2 * body + 1] += p * (w * t + phi).sin() * self.inv_mass[body];
+        }
+    }
+
     /// Number of contacts.
     pub fn contacts(&self) -> usize {
         self.contacts.len()
@@ -681,6 +696,77 @@ mod tests {
         assert!((dy[1] - fa / 0.2).abs() < 1e-12 * (fa / 0.2).abs().max(1.0));
         assert!((dy[3] - fb / 0.3).abs() < 1e-12 * (fb / 0.3).abs().max(1.0));
         assert_eq!(sys.bandwidth(), (3, 2));
+    }
+
+    /// The time-only part of the right-hand side is the difference between
+    /// the forced and the unforced equations at any state (contacts
+    /// engaged), for a harmonic base and a harmonic force on one body.
+    #[test]
+    fn source_is_the_forced_minus_the_unforced_rhs() {
+        let bodies = vec![
+            Body::from_frequency("a", 0.2, 7.0, 0.01),
+            Body::from_frequency("b", 0.3, 5.0, 0.02),
+        ];
+        let contacts = vec![Contact {
+            pair: ContactPair::Bodies { left: 0, right: 1 },
+            clearance: 1e-4,
+            law: law(),
+        }];
+        let build = |base, forces| {
+            Model::new(
+                bodies.clone(),
+                vec![],
+                contacts.clone(),
+                base,
+                forces,
+                vec![],
+                vec![],
+            )
+            .unwrap()
+        };
+        let base = BaseExcitation::Harmonic {
+            amplitude: 0.5,
+            frequency: 6.0,
+            phase: 0.3,
+        };
+        let force = crate::model::HarmonicForce {
+            body: 1,
+            amplitude: 0.2,
+            frequency: 6.0,
+            phase: -0.4,
+        };
+        let forced = build(base.clone(), vec![force]);
+        let unforced = build(BaseExcitation::None, vec![]);
+        assert!(forced.differs_only_in_forcing(&unforced));
+        let (mut a, mut b) = (
+            ChainDynamics::new(&forced, false),
+            ChainDynamics::new(&unforced, false),
+        );
+        let y = [5e-5, 0.1, -2e-5, -0.05];
+        let (mut fa, mut fb, mut q) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+        let t = 0.7;
+        a.rhs(t, &y, &mut fa);
+        b.rhs(t, &y, &mut fb);
+        a.source(t, &mut q);
+        let zdd = 0.5 * (6.0 * t + 0.3f64).sin();
+        let by_hand = [0.0, -zdd, 0.0, -zdd + 0.2 * (6.0 * t - 0.4f64).sin() / 0.3];
+        for i in 0..4 {
+            assert!((fa[i] - fb[i] - q[i]).abs() < 1e-12, "component {i}");
+            assert!((q[i] - by_hand[i]).abs() < 1e-15, "component {i}");
+        }
+        let mut stiffer = bodies.clone();
+        stiffer[0].stiffness *= 1.01;
+        let other = Model::new(
+            stiffer,
+            vec![],
+            contacts.clone(),
+            base,
+            vec![],
+            vec![],
+            vec![],
+        )
+        .unwrap();
+        assert!(!forced.differs_only_in_forcing(&other));
     }
 
     /// The analytic banded Jacobian equals central differences of the

@@ -705,6 +705,15 @@ impl Model {
         freq
     }
 
+    /// Whether `other` is this model with another excitation only (the same
+    /// bodies, couplings and contacts): then the equations of motion of the
+    /// two differ by a function of time alone.
+    pub fn differs_only_in_forcing(&self, other: &Model) -> bool {
+        self.bodies == other.bodies
+            && self.couplings == other.couplings
+            && self.contacts == other.contacts
+    }
+
     /// Whether the model is equivariant under the spatio-temporal mirror
     /// symmetry of a symmetric row: `u_i → -u_{N-1-i}` together with the
     /// time shift of half a forcing period (which flips the sign of every

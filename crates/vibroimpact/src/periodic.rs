@@ -316,6 +316,14 @@ pub(crate) fn period_map_with(
     }
     let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
     let t = map_time(model, opts).map_err(invalid)?;
+    if let Some((model_p, dp)) = shifted {
+        // The state's steps alone choose the steps, with or without the
+        // column: the column can then be replayed on the tape.
+        if !dense && !opts.control_monodromy && model.differs_only_in_forcing(model_p) {
+            let t_p = map_time(model_p, opts).map_err(invalid)?;
+            return forced_map(model, x, opts, (model_p, dp, t_p), t, max_steps);
+        }
+    }
     let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
     let columns = if dense { d } else { 0 };
     let (mut var, dt_dp) = match shifted {
@@ -375,6 +383,72 @@ pub(crate) fn period_map_with(
         dp_column,
         steps: stats.steps,
         tangent,
+    })
+}
+
+/// [`period_map_with`] without the dense Jacobian for a parameter that
+/// only changes the forcing (`shifted = (model at p + dp, dp, its map
+/// time)`): the state alone is integrated, recording its tape, and the
+/// parameter's sensitivity column is replayed on the tape with the source
+/// `∂f/∂p = (q_{p+dp}(t) − q_p(t)) / dp`, `q` the time-only part of the
+/// equations (docs/theory.md §5): the recurrence of the integrated column,
+/// stage by stage, at the cost of one product instead of a state-sized
+/// column carried through every stage, error estimate and rejected step.
+fn forced_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    (model_p, dp, t_p): (&Model, f64, f64),
+    t: f64,
+    max_steps: u64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let mut sys = Recorder::new(ChainDynamics::new(model, false), true);
+    let int_opts = IntegratorOptions {
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps,
+        interrupt: opts.interrupt.clone(),
+        ..IntegratorOptions::default()
+    };
+    fn identity(r: &mut Recorder<ChainDynamics>) -> &mut Recorder<ChainDynamics> {
+        r
+    }
+    let (y, stats, tape) =
+        integrate_recorded(&mut sys, identity, 0.0, &to_interleaved(x), t, &int_opts)?;
+    let (here, shifted) = (
+        ChainDynamics::new(model, false),
+        ChainDynamics::new(model_p, false),
+    );
+    let mut q_p = vec![0.0; d];
+    let mut source = |time: f64, out: &mut [f64]| {
+        here.source(time, out);
+        shifted.source(time, &mut q_p);
+        out.iter_mut()
+            .zip(&q_p)
+            .for_each(|(o, s)| *o = (s - *o) / dp);
+    };
+    let s = tape.apply_with_source(&vec![0.0; d], &mut source);
+    let mut flow = vec![0.0; d];
+    sys.rhs(t, &y, &mut flow);
+    let dt_dp = (t_p - t) / dp;
+    let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
+    let (image, column) = (from_interleaved(&y, n), from_interleaved(&column, n));
+    let symmetric = opts.symmetric;
+    let (image, column) = if symmetric {
+        (mirror(&image), mirror(&column))
+    } else {
+        (image, column)
+    };
+    Ok(MapDerivatives {
+        map: PeriodMap {
+            image,
+            monodromy: DMatrix::zeros(0, 0),
+        },
+        dp_column: Some(column),
+        steps: stats.steps,
+        tangent: Some(MapTangent { tape, n, symmetric }),
     })
 }
 

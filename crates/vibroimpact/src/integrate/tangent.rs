@@ -111,6 +111,10 @@ impl<S: RecordedJacobian> OdeSystem for Recorder<S> {
     }
 }
 
+/// A source term `q(t, out)` of a replayed linear recurrence: writes
+/// `q(t)` into `out`.
+pub type Source<'a> = dyn FnMut(f64, &mut [f64]) + 'a;
+
 /// The record of one DOP853 integration: its accepted steps and the
 /// Jacobian at every stage, replayed by [`apply`](Self::apply).
 #[derive(Clone, Debug)]
@@ -119,6 +123,8 @@ pub struct TangentTape<S: RecordedJacobian> {
     dim: usize,
     /// Accepted step sizes.
     steps: Vec<f64>,
+    /// Start time of each accepted step.
+    starts: Vec<f64>,
     /// Stage `s` of step `k` is record `N_STAGES k + s`; record
     /// `N_STAGES (k + 1)` is `J` at the step's end, the next step's stage 0.
     offsets: Vec<usize>,
@@ -144,21 +150,41 @@ impl<S: RecordedJacobian> TangentTape<S> {
     /// `Φ v`: the sensitivity of the end state to the initial state, in
     /// the direction `v` (state order of the system).
     pub fn apply(&self, v: &[f64]) -> Vec<f64> {
+        self.replay(v, None)
+    }
+
+    /// The solution at the end of `w' = J(y(t)) w + q(t)`, `w(t0) = v`,
+    /// replayed on the recorded steps: `q(t, out)` writes the source at
+    /// `t`. With `v = 0` and `q = ∂f/∂p` of a parameter that enters the
+    /// equations through a function of time alone (a forcing amplitude or
+    /// frequency), the sensitivity of the end state to the parameter: the
+    /// same recurrence, stage by stage, as the integration of the
+    /// parameter's variational column on the state's steps.
+    pub fn apply_with_source(&self, v: &[f64], q: &mut Source) -> Vec<f64> {
+        self.replay(v, Some(q))
+    }
+
+    fn replay(&self, v: &[f64], mut q: Option<&mut Source>) -> Vec<f64> {
         let d = self.dim;
         let mut w = v.to_vec();
         let mut w_new = vec![0.0; d];
         let mut w_stage = vec![0.0; d];
         let mut k = vec![0.0; N_STAGES * d];
-        for (step, &h) in self.steps.iter().enumerate() {
+        let mut source = vec![0.0; if q.is_some() { d } else { 0 }];
+        let mut stage = |s: usize, t: f64, w: &[f64], k: &mut [f64]| {
+            self.sys.apply_recorded(self.record(s), w, k);
+            if let Some(q) = q.as_mut() {
+                q(t, &mut source);
+                k.iter_mut().zip(&source).for_each(|(k, q)| *k += q);
+            }
+        };
+        for (step, (&h, &t)) in self.steps.iter().zip(&self.starts).enumerate() {
             let first = N_STAGES * step;
-            self.sys.apply_recorded(self.record(first), &w, &mut k[..d]);
+            stage(first, t, &w, &mut k[..d]);
             for s in 1..N_STAGES {
                 combine(&w, &k[..s * d], A[s], h, &mut w_stage);
-                self.sys.apply_recorded(
-                    self.record(first + s),
-                    &w_stage,
-                    &mut k[s * d..(s + 1) * d],
-                );
+                let (_, k_s) = k.split_at_mut(s * d);
+                stage(first + s, t + C[s] * h, &w_stage, &mut k_s[..d]);
             }
             combine(&w, &k, &B, h, &mut w_new);
             std::mem::swap(&mut w, &mut w_new);
@@ -204,6 +230,7 @@ where
         sys: rec.sys.clone(),
         dim: rec.sys.dim(),
         steps: Vec::new(),
+        starts: Vec::new(),
         offsets: vec![0],
         entries: rec.evaluation(0).to_vec(),
     };
@@ -231,6 +258,7 @@ where
             tape.offsets.push(tape.entries.len());
         }
         tape.steps.push(h);
+        tape.starts.push(t);
     }
     recorder(sys).clear();
     Ok((solver.y().to_vec(), solver.stats(), tape))
