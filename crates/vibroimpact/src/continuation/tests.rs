@@ -546,6 +546,52 @@ fn krylov_branch_matches_dense() {
     }
 }
 
+/// Matrix-free against dense on a row longer than two (the unknowns'
+/// state scale then differs from the residual's by √(N/2), D20): R2 N = 8
+/// from its stable impacting orbit at 0.5 ω0 to 0.53 ω0, the same special
+/// points to 1e-6 ω0 and the same largest multiplier at both ends to 1e-6.
+#[test]
+fn krylov_branch_matches_dense_on_a_longer_row() {
+    let family = |w: f64| r2(8, 1e-3, w);
+    let start = r2(8, 1e-3, 0.5 * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let run = |krylov| {
+        let opts = ContinuationOptions {
+            krylov,
+            ..Default::default()
+        };
+        continue_branch(family, 0.5 * W0, &guess, 0.53 * W0, &opts, |_| true).unwrap()
+    };
+    let (dense, krylov) = (run(None), run(Some(16)));
+    assert_eq!(krylov.stop, StopReason::ReachedEnd);
+    assert!(
+        dense.points[0].stable,
+        "{}",
+        dense.points[0].spectral_radius()
+    );
+    assert!(!dense.special.is_empty());
+    assert_eq!(krylov.special.len(), dense.special.len());
+    for (k, d) in krylov.special.iter().zip(&dense.special) {
+        assert_eq!(k.kind, d.kind);
+        assert!(
+            (k.parameter - d.parameter).abs() < 1e-6 * W0,
+            "{} {} vs {} {}",
+            k.label,
+            k.parameter / W0,
+            d.label,
+            d.parameter / W0
+        );
+    }
+    for (k, d) in [
+        (&krylov.points[0], &dense.points[0]),
+        (krylov.points.last().unwrap(), dense.points.last().unwrap()),
+    ] {
+        assert_eq!(k.parameter, d.parameter);
+        let (rk, rd) = (k.spectral_radius(), d.spectral_radius());
+        assert!((rk / rd - 1.0).abs() < 1e-6, "{rk} vs {rd}");
+    }
+}
+
 /// The matrix-free branch computes a point's tangent and multipliers on
 /// two threads: the same bytes on one thread and on two.
 #[test]

@@ -150,7 +150,7 @@ impl<S: RecordedJacobian> TangentTape<S> {
     /// `Φ v`: the sensitivity of the end state to the initial state, in
     /// the direction `v` (state order of the system).
     pub fn apply(&self, v: &[f64]) -> Vec<f64> {
-        self.replay(v, None)
+        self.replay(v, |_, _| {})
     }
 
     /// The solution at the end of `w' = J(y(t)) w + q(t)`, `w(t0) = v`,
@@ -161,30 +161,31 @@ impl<S: RecordedJacobian> TangentTape<S> {
     /// same recurrence, stage by stage, as the integration of the
     /// parameter's variational column on the state's steps.
     pub fn apply_with_source(&self, v: &[f64], q: &mut Source) -> Vec<f64> {
-        self.replay(v, Some(q))
+        let mut source = vec![0.0; self.dim];
+        self.replay(v, |t, k| {
+            q(t, &mut source);
+            k.iter_mut().zip(&source).for_each(|(k, q)| *k += q);
+        })
     }
 
-    fn replay(&self, v: &[f64], mut q: Option<&mut Source>) -> Vec<f64> {
+    /// The recurrence with `add(t, k)` adding the source at stage time `t`
+    /// to the stage derivative `k` (a no-op for `Φ v`, inlined away).
+    fn replay(&self, v: &[f64], mut add: impl FnMut(f64, &mut [f64])) -> Vec<f64> {
         let d = self.dim;
         let mut w = v.to_vec();
         let mut w_new = vec![0.0; d];
         let mut w_stage = vec![0.0; d];
         let mut k = vec![0.0; N_STAGES * d];
-        let mut source = vec![0.0; if q.is_some() { d } else { 0 }];
-        let mut stage = |s: usize, t: f64, w: &[f64], k: &mut [f64]| {
-            self.sys.apply_recorded(self.record(s), w, k);
-            if let Some(q) = q.as_mut() {
-                q(t, &mut source);
-                k.iter_mut().zip(&source).for_each(|(k, q)| *k += q);
-            }
-        };
         for (step, (&h, &t)) in self.steps.iter().zip(&self.starts).enumerate() {
             let first = N_STAGES * step;
-            stage(first, t, &w, &mut k[..d]);
+            self.sys.apply_recorded(self.record(first), &w, &mut k[..d]);
+            add(t, &mut k[..d]);
             for s in 1..N_STAGES {
                 combine(&w, &k[..s * d], A[s], h, &mut w_stage);
-                let (_, k_s) = k.split_at_mut(s * d);
-                stage(first + s, t + C[s] * h, &w_stage, &mut k_s[..d]);
+                let k_s = &mut k[s * d..(s + 1) * d];
+                self.sys
+                    .apply_recorded(self.record(first + s), &w_stage, k_s);
+                add(t + C[s] * h, k_s);
             }
             combine(&w, &k, &B, h, &mut w_new);
             std::mem::swap(&mut w, &mut w_new);
