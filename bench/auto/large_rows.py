@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""Matrix-free continuation on long rows (issue 11, item 3): R2 with N bodies.
+
+    python3 bench/auto/large_rows.py [--n 64,100,1000] [--budget 180]
+        [--out bench/auto/results/large-rows-DATE]
+
+Three tasks, all with `vibroimpact continue ROW --parameter frequency
+--start homotopy` (ROW = examples/fujita-row-n2.toml with `count = N`):
+
+1. The window 0.5 -> 0.537 omega0 (the piece of the symmetric branch every
+   N follows before its fold at 0.538, bench/auto/README.md "Any N") for
+   every N of --n, matrix-free (`--krylov`), and at the smallest N also
+   dense (`--dense`): wall time, points, special points, the largest
+   multiplier at both ends, peak memory. Matrix-free and dense must give
+   the same special points to 1e-6 omega0 and the same largest multiplier
+   to 1e-6 (checked, printed).
+2. N = 100 from 0.5 omega0 towards 1.5 (`--to 11.115`), stopped by SIGINT
+   after --budget seconds (Ctrl-C keeps the points): how far the branch
+   gets in that time, its folds and special points.
+
+AUTO-07p is not run here: at N = 16 one of its branch steps takes ~1.8 s
+(bench/auto/README.md), so these rows are out of its reach.
+
+Writes OUT.json (everything, with load averages and the commit) and OUT.txt
+(the table). Standard library only; needs a release build of the CLI.
+"""
+import argparse
+import datetime
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+OMEGA0 = 7.41
+EXE = os.path.join(ROOT, "target", "release", "vibroimpact")
+
+
+def loadavg():
+    with open("/proc/loadavg") as f:
+        return [float(x) for x in f.read().split()[:3]]
+
+
+def row_file(n, workdir):
+    src = open(os.path.join(ROOT, "examples", "fujita-row-n2.toml")).read()
+    path = os.path.join(workdir, f"row-n{n}.toml")
+    with open(path, "w") as f:
+        f.write(src.replace("count = 2", f"count = {n}", 1))
+    return path
+
+
+def run(cmd, budget=None):
+    """Runs `cmd`; with `budget`, sends SIGINT after that many seconds.
+    Returns (seconds, returncode, stdout, stderr, peak RSS of the child in MB)."""
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    streams = {}
+    readers = [threading.Thread(target=lambda k=k, f=f: streams.__setitem__(k, f.read()))
+               for k, f in (("out", p.stdout), ("err", p.stderr))]
+    for r in readers:
+        r.start()
+    timer = threading.Timer(budget, p.send_signal, [signal.SIGINT]) if budget else None
+    if timer:
+        timer.start()
+    _, status, usage = os.wait4(p.pid, 0)
+    seconds = time.perf_counter() - t0
+    if timer:
+        timer.cancel()
+    for r in readers:
+        r.join()
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return seconds, p.returncode, streams["out"], streams["err"], usage.ru_maxrss / 1024
+
+
+def largest(point):
+    return max(abs(complex(re, im)) for re, im in point["floquet_multipliers"])
+
+
+def summary(doc):
+    points = doc["points"]
+    return {
+        "points": len(points),
+        "stop": doc["stop"],
+        "omega_range": [min(p["parameter"] for p in points) / OMEGA0,
+                        max(p["parameter"] for p in points) / OMEGA0],
+        "last_omega": points[-1]["parameter"] / OMEGA0,
+        "largest_multiplier_ends": [largest(points[0]), largest(points[-1])],
+        "special_points": [{"label": s["label"], "kind": s["kind"],
+                            "omega_over_omega0": s["parameter"] / OMEGA0}
+                           for s in doc["special_points"]],
+    }
+
+
+def window(n, linear, workdir):
+    cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
+           "--from", str(0.5 * OMEGA0), "--to", str(0.537 * OMEGA0), "--start", "homotopy",
+           f"--{linear}", "--format", "json"]
+    seconds, rc, out, err, mb = run(cmd)
+    if rc != 0:
+        return {"n": n, "linear": linear, "error": err.strip()[-500:], "command": " ".join(cmd)}
+    return {"n": n, "linear": linear, "seconds": seconds, "peak_mb": mb,
+            "command": " ".join(cmd[:2] + ["ROW"] + cmd[3:]), **summary(json.loads(out))}
+
+
+def budgeted(n, budget, workdir):
+    cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
+           "--from", str(0.5 * OMEGA0), "--to", str(1.5 * OMEGA0), "--start", "homotopy",
+           "--krylov", "--format", "json"]
+    seconds, rc, out, err, mb = run(cmd, budget)
+    if not out.strip():
+        return {"n": n, "error": err.strip()[-500:], "returncode": rc}
+    doc = json.loads(out)
+    return {"n": n, "budget_seconds": budget, "seconds": seconds, "returncode": rc,
+            "peak_mb": mb, "command": " ".join(cmd[:2] + ["ROW"] + cmd[3:]),
+            "folds": [s["omega_over_omega0"] for s in summary(doc)["special_points"]
+                      if s["kind"] == "fold"],
+            **summary(doc)}
+
+
+def compare(dense, krylov):
+    """Largest differences between the dense and matrix-free windows."""
+    a, b = dense["special_points"], krylov["special_points"]
+    same_kinds = [s["kind"] for s in a] == [s["kind"] for s in b]
+    gap = max((abs(x["omega_over_omega0"] - y["omega_over_omega0"]) for x, y in zip(a, b)),
+              default=0.0)
+    rel = max(abs(x / y - 1) for x, y in zip(krylov["largest_multiplier_ends"],
+                                              dense["largest_multiplier_ends"]))
+    return {"same_kinds": same_kinds, "special_point_gap_omega0": gap,
+            "largest_multiplier_rel_diff": rel,
+            "passed": same_kinds and gap < 1e-6 and rel < 1e-6}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--n", default="64,100,1000")
+    ap.add_argument("--budget", type=float, default=180.0)
+    ap.add_argument("--out", default=os.path.join(
+        HERE, "results", f"large-rows-{datetime.date.today().isoformat()}"))
+    args = ap.parse_args()
+    if not os.path.exists(EXE):
+        sys.exit(f"{EXE} missing: run `cargo build --release` first")
+    ns = [int(x) for x in args.n.split(",")]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip()
+    result = {"commit": commit, "load_before": loadavg(), "windows": [], "check": None}
+    with tempfile.TemporaryDirectory() as workdir:
+        dense = window(ns[0], "dense", workdir)
+        result["windows"].append(dense)
+        for n in ns:
+            result["windows"].append(window(n, "krylov", workdir))
+            print(json.dumps(result["windows"][-1])[:300], file=sys.stderr)
+        krylov0 = result["windows"][1]
+        if "error" not in dense and "error" not in krylov0:
+            result["check"] = compare(dense, krylov0)
+        result["budgeted"] = budgeted(100, args.budget, workdir)
+    result["load_after"] = loadavg()
+    lines = ["| N | linear algebra | window 0.5 -> 0.537 (s) | points | special points (omega/omega0) "
+             "| largest multiplier at 0.537 | peak MB |", "|---|---|---|---|---|---|---|"]
+    for w in result["windows"]:
+        if "error" in w:
+            lines.append(f"| {w['n']} | {w['linear']} | error: {w['error'][:80]} | | | | |")
+            continue
+        sp = ", ".join(f"{s['label']} {s['omega_over_omega0']:.7f}" for s in w["special_points"])
+        mb = f"{w['peak_mb']:.0f}"
+        lines.append(f"| {w['n']} | {w['linear']} | {w['seconds']:.2f} | {w['points']} | {sp} "
+                     f"| {w['largest_multiplier_ends'][1]:.6f} | {mb} |")
+    if result["check"]:
+        c = result["check"]
+        lines.append(f"\nN = {ns[0]} dense vs matrix-free: special points {c['special_point_gap_omega0']:.1e} "
+                     f"omega0 apart, largest multiplier {c['largest_multiplier_rel_diff']:.1e} relative: "
+                     f"{'PASS' if c['passed'] else 'FAIL'}")
+    b = result["budgeted"]
+    if "error" not in b:
+        lines.append(f"\nN = 100 from 0.5 omega0 towards 1.5, stopped after {b['seconds']:.0f} s: "
+                     f"{b['points']} points, omega {b['omega_range'][0]:.4f}-{b['omega_range'][1]:.4f} "
+                     f"(last {b['last_omega']:.4f}), {len(b['special_points'])} special points, folds "
+                     + ", ".join(f"{f:.7f}" for f in b["folds"]))
+    else:
+        lines.append(f"\nN = 100 budgeted run: error {b['error']}")
+    text = "\n".join(lines)
+    print(text)
+    os.makedirs(os.path.dirname(args.out), exist_ok=True)
+    with open(args.out + ".json.tmp", "w") as f:
+        json.dump(result, f, indent=1)
+    os.replace(args.out + ".json.tmp", args.out + ".json")
+    with open(args.out + ".txt.tmp", "w") as f:
+        f.write(text + "\n")
+    os.replace(args.out + ".txt.tmp", args.out + ".txt")
+
+
+if __name__ == "__main__":
+    main()
