@@ -87,6 +87,23 @@ pub struct ShootingOptions {
     pub interrupt: Option<Interrupt>,
 }
 
+impl ShootingOptions {
+    /// The integrator's options for a period map: these tolerances, at most
+    /// `max_steps` steps, the stop request; with `state` = Some(d) carried
+    /// columns (variational, tangent) ride along on the steps of the first
+    /// d components (the state) unless `control_monodromy`.
+    pub(crate) fn integrator(&self, max_steps: u64, state: Option<usize>) -> IntegratorOptions {
+        IntegratorOptions {
+            rtol: self.rtol,
+            atol: self.rtol * self.displacement_scale,
+            max_steps,
+            error_components: state.filter(|_| !self.control_monodromy),
+            interrupt: self.interrupt.clone(),
+            ..IntegratorOptions::default()
+        }
+    }
+}
+
 impl Default for ShootingOptions {
     fn default() -> Self {
         Self {
@@ -338,14 +355,7 @@ pub(crate) fn period_map_with(
     let z0 = var.initial_state(&to_interleaved(x));
     // The state controls the steps: Φ rides along on the same steps, so a
     // period map costs O(N) steps × O(N² · bandwidth) per step.
-    let int_opts = IntegratorOptions {
-        rtol: opts.rtol,
-        atol: opts.rtol * opts.displacement_scale,
-        max_steps,
-        error_components: (!opts.control_monodromy).then_some(d),
-        interrupt: opts.interrupt.clone(),
-        ..IntegratorOptions::default()
-    };
+    let int_opts = opts.integrator(max_steps, Some(d));
     let (z, stats, tangent) = if dense {
         let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
         (z, stats, None)
@@ -405,13 +415,7 @@ fn forced_map(
     let n = model.bodies().len();
     let d = 2 * n;
     let mut sys = Recorder::new(ChainDynamics::new(model, false), true);
-    let int_opts = IntegratorOptions {
-        rtol: opts.rtol,
-        atol: opts.rtol * opts.displacement_scale,
-        max_steps,
-        interrupt: opts.interrupt.clone(),
-        ..IntegratorOptions::default()
-    };
+    let int_opts = opts.integrator(max_steps, None);
     fn identity(r: &mut Recorder<ChainDynamics>) -> &mut Recorder<ChainDynamics> {
         r
     }
@@ -832,14 +836,7 @@ pub(crate) fn map_and_product(
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
     let mut var = Variational::new(ChainDynamics::new(model, false), 1);
     let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
-    let int_opts = IntegratorOptions {
-        rtol: opts.rtol,
-        atol: opts.rtol * opts.displacement_scale,
-        max_steps: MAX_STEPS,
-        error_components: (!opts.control_monodromy).then_some(d),
-        interrupt: opts.interrupt.clone(),
-        ..IntegratorOptions::default()
-    };
+    let int_opts = opts.integrator(MAX_STEPS, Some(d));
     let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
     let (image, product) = (from_interleaved(&z, n), from_interleaved(&z[d..], n));
     if opts.symmetric {

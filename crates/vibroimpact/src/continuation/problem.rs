@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
 use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
-use crate::integrate::{integrate_to, IntegratorOptions};
+use crate::integrate::integrate_to;
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
@@ -301,13 +301,7 @@ fn period_image_within(
     let t = map_time(model, opts).ok()?;
     let mut sys = crate::dynamics::ChainDynamics::new(model, false);
     let y0 = crate::dynamics::to_interleaved(x);
-    let int_opts = IntegratorOptions {
-        rtol: opts.rtol,
-        atol: opts.rtol * opts.displacement_scale,
-        max_steps,
-        interrupt: opts.interrupt.clone(),
-        ..IntegratorOptions::default()
-    };
+    let int_opts = opts.integrator(max_steps, None);
     let (y, stats) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
     let image = crate::dynamics::from_interleaved(&y, n);
     let image = if opts.symmetric {
