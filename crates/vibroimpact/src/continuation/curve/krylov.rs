@@ -10,14 +10,17 @@
 //! integration of the orbit with the tangent column v (two for DG²); the
 //! Newton directions and the tangent are solved by GMRES on
 //! forward-difference products of the residual, and the multipliers are
-//! the Ritz values of an Arnoldi iteration: nothing of size d² is formed.
+//! the Ritz values of an Arnoldi iteration (its products, and those of the
+//! start's inverse iteration, replayed on the tape of one integration of
+//! the map: `integrate::tangent`): nothing of size d² is formed.
 
 use super::system::{Constraint, Observation};
 use super::{bound_crossed, CurveKind, CurveOptions, CurveSystem, Scales};
 use crate::model::Model;
 use crate::newton::NewtonSystem;
 use crate::periodic::{
-    arnoldi_matrix, floquet_multipliers, gmres, map_and_product, ShootingOptions,
+    arnoldi_matrix, floquet_multipliers, gmres, map_and_product, period_map_with, MapTangent,
+    ShootingOptions, MAX_STEPS,
 };
 
 /// Residual tolerance of the corrector (scaled max-norm).
@@ -95,6 +98,27 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
         Ok((scaled(image), scaled(product)))
     }
 
+    /// Products `DG u` at the orbit `x` (unscaled) of `model`, replayed on
+    /// the steps of one integration of the map (`MapTangent`): for the
+    /// many products at one point (inverse iteration, Arnoldi).
+    fn tangent_at(&self, model: &Model, x: &[f64]) -> Result<MapTangent, String> {
+        period_map_with(model, x, &self.opts, None, false, MAX_STEPS)
+            .map_err(|e| e.to_string())?
+            .tangent
+            .ok_or_else(|| "the period map recorded no tape".to_string())
+    }
+
+    /// `DG u` for a scaled u, scaled, from a point's tape.
+    fn replayed(&self, tangent: &MapTangent, u: &[f64]) -> Vec<f64> {
+        let unscaled: Vec<f64> = u.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
+        let product = tangent.product(&unscaled);
+        product
+            .iter()
+            .zip(&self.scale)
+            .map(|(a, s)| a / s)
+            .collect()
+    }
+
     /// The residual `[G − x; A v; cᵀv − 1]` (2d + 1), scaled.
     fn residual(&mut self, z: &[f64]) -> Result<Vec<f64>, String> {
         let d = self.d();
@@ -166,6 +190,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
         let mut v: Vec<f64> = (0..d)
             .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
             .collect();
+        let tangent = self.tangent_at(&model, state)?;
         for _ in 0..2 {
             let norm = v.iter().map(|a| a * a).sum::<f64>().sqrt();
             let b: Vec<f64> = v.iter().map(|a| a / norm).collect();
@@ -173,11 +198,11 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
             let kind = self.kind;
             let symmetric = self.opts.symmetric;
             let mut apply = |u: &[f64]| -> Result<Vec<f64>, String> {
-                let (_, dgu) = self.map(&model, state, u)?;
+                let dgu = self.replayed(&tangent, u);
                 Ok(match (kind, symmetric) {
                     (CurveKind::Fold, _) => (0..d).map(|i| dgu[i] - u[i]).collect(),
                     (CurveKind::PeriodDoubling, true) => {
-                        let (_, dg2u) = self.map(&model, state, &dgu)?;
+                        let dg2u = self.replayed(&tangent, &dgu);
                         (0..d).map(|i| dg2u[i] + u[i]).collect()
                     }
                     _ => (0..d).map(|i| dgu[i] + u[i]).collect(),
@@ -235,8 +260,9 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
         let model = (self.family)(p, q)?;
         let noise = 1e3 * self.opts.rtol;
         let m = self.arnoldi.min(d);
+        let tangent = self.tangent_at(&model, &x)?;
         let mut apply = |u: &[f64]| -> Result<Vec<f64>, String> {
-            let (_, dgu) = self.map(&model, &x, u)?;
+            let dgu = self.replayed(&tangent, u);
             Ok((0..d).map(|i| dgu[i] - u[i]).collect())
         };
         let ritz = arnoldi_matrix(&mut apply, d, m, noise)?;
