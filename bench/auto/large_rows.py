@@ -56,7 +56,8 @@ def row_file(n, workdir):
 
 def run(cmd, budget=None):
     """Runs `cmd`; with `budget`, sends SIGINT after that many seconds.
-    Returns (seconds, returncode, stdout, stderr, peak RSS of the child in MB)."""
+    Returns (seconds, returncode, stdout, stderr, peak RSS of the child in
+    MB, whether the budget ran out and SIGINT was sent)."""
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     streams = {}
@@ -64,7 +65,15 @@ def run(cmd, budget=None):
                for k, f in (("out", p.stdout), ("err", p.stderr))]
     for r in readers:
         r.start()
-    timer = threading.Timer(budget, p.send_signal, [signal.SIGINT]) if budget else None
+    interrupted = threading.Event()
+
+    def interrupt():
+        # os.kill, not Popen.send_signal (whose poll() could reap the
+        # child before wait4 below); the pid stays ours until wait4.
+        interrupted.set()
+        os.kill(p.pid, signal.SIGINT)
+
+    timer = threading.Timer(budget, interrupt) if budget else None
     if timer:
         timer.start()
     _, status, usage = os.wait4(p.pid, 0)
@@ -74,7 +83,8 @@ def run(cmd, budget=None):
     for r in readers:
         r.join()
     p.returncode = os.waitstatus_to_exitcode(status)
-    return seconds, p.returncode, streams["out"], streams["err"], usage.ru_maxrss / 1024
+    return (seconds, p.returncode, streams["out"], streams["err"], usage.ru_maxrss / 1024,
+            interrupted.is_set())
 
 
 def largest(point):
@@ -100,7 +110,7 @@ def window(n, linear, workdir):
     cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
            "--from", str(0.5 * OMEGA0), "--to", str(0.537 * OMEGA0), "--start", "homotopy",
            f"--{linear}", "--format", "json"]
-    seconds, rc, out, err, mb = run(cmd)
+    seconds, rc, out, err, mb, _ = run(cmd)
     if rc != 0:
         return {"n": n, "linear": linear, "error": err.strip()[-500:], "command": " ".join(cmd)}
     return {"n": n, "linear": linear, "seconds": seconds, "peak_mb": mb,
@@ -111,11 +121,14 @@ def budgeted(n, budget, workdir):
     cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
            "--from", str(0.5 * OMEGA0), "--to", str(1.5 * OMEGA0), "--start", "homotopy",
            "--krylov", "--format", "json"]
-    seconds, rc, out, err, mb = run(cmd, budget)
+    seconds, rc, out, err, mb, interrupted = run(cmd, budget)
     if not out.strip():
         return {"n": n, "error": err.strip()[-500:], "returncode": rc}
     doc = json.loads(out)
+    # A stop request can end the run inside a correction, which then reads
+    # as a corrector that does not converge: `interrupted` says it was ours.
     return {"n": n, "budget_seconds": budget, "seconds": seconds, "returncode": rc,
+            "interrupted_by_budget": interrupted,
             "peak_mb": mb, "command": " ".join(cmd[:2] + ["ROW"] + cmd[3:]),
             "folds": [s["omega_over_omega0"] for s in summary(doc)["special_points"]
                       if s["kind"] == "fold"],
@@ -149,9 +162,10 @@ def main():
                             capture_output=True, text=True).stdout.strip()
     result = {"commit": commit, "load_before": loadavg(), "windows": [], "check": None}
     with tempfile.TemporaryDirectory() as workdir:
-        dense = window(ns[0], "dense", workdir)
+        smallest = min(ns)
+        dense = window(smallest, "dense", workdir)
         result["windows"].append(dense)
-        for n in ns:
+        for n in sorted(ns):
             result["windows"].append(window(n, "krylov", workdir))
             print(json.dumps(result["windows"][-1])[:300], file=sys.stderr)
         krylov0 = result["windows"][1]
@@ -171,12 +185,13 @@ def main():
                      f"| {w['largest_multiplier_ends'][1]:.6f} | {mb} |")
     if result["check"]:
         c = result["check"]
-        lines.append(f"\nN = {ns[0]} dense vs matrix-free: special points {c['special_point_gap_omega0']:.1e} "
+        lines.append(f"\nN = {min(ns)} dense vs matrix-free: special points {c['special_point_gap_omega0']:.1e} "
                      f"omega0 apart, largest multiplier {c['largest_multiplier_rel_diff']:.1e} relative: "
                      f"{'PASS' if c['passed'] else 'FAIL'}")
     b = result["budgeted"]
     if "error" not in b:
-        lines.append(f"\nN = 100 from 0.5 omega0 towards 1.5, stopped after {b['seconds']:.0f} s: "
+        how = "stopped by SIGINT" if b["interrupted_by_budget"] else "ended"
+        lines.append(f"\nN = 100 from 0.5 omega0 towards 1.5, {how} after {b['seconds']:.0f} s: "
                      f"{b['points']} points, omega {b['omega_range'][0]:.4f}-{b['omega_range'][1]:.4f} "
                      f"(last {b['last_omega']:.4f}), {len(b['special_points'])} special points, folds "
                      + ", ".join(f"{f:.7f}" for f in b["folds"]))

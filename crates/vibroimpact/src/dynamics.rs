@@ -352,8 +352,10 @@ impl ChainDynamics {
 
     /// The part of the right-hand side that depends on time alone (the
     /// base acceleration and the harmonic forces, per unit mass) at `t`,
-    /// in the interleaved state layout: `f(t, y) = f(0-forcing; y) +
-    /// source(t)`.
+    /// in the interleaved state layout of the 2N mechanical components:
+    /// `f(t, y) = f(0-forcing; y) + source(t)` there. The energy
+    /// quadratures (with `energy`) are not covered: the input work's rate
+    /// depends on the forcing and the state together.
     pub fn source(&self, t: f64, out: &mut [f64]) {
         let zdd = self.base.at(t);
         for i in 0..self.n {

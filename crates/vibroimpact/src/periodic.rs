@@ -421,10 +421,7 @@ fn forced_map(
     }
     let (y, stats, tape) =
         integrate_recorded(&mut sys, identity, 0.0, &to_interleaved(x), t, &int_opts)?;
-    let (here, shifted) = (
-        ChainDynamics::new(model, false),
-        ChainDynamics::new(model_p, false),
-    );
+    let (here, shifted) = (sys.system(), ChainDynamics::new(model_p, false));
     let mut q_p = vec![0.0; d];
     let mut source = |time: f64, out: &mut [f64]| {
         here.source(time, out);

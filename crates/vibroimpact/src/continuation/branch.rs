@@ -281,6 +281,12 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         q >= lo - tol && q <= hi + tol
     }
 
+    /// Whether a stop was requested (`ShootingOptions::interrupt`).
+    fn interrupted(&self) -> bool {
+        let interrupt = &self.problem.opts.shooting.interrupt;
+        interrupt.as_ref().is_some_and(|i| i.requested())
+    }
+
     /// One accepted point, or the reason the branch ends.
     fn advance(&mut self) -> BranchStep {
         if self.points >= self.problem.opts.max_points {
@@ -289,6 +295,11 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         let (next, iterations, factor) = loop {
             match self.try_step(self.ds) {
                 Ok(found) => break found,
+                // A stop request fails every integration, which would read
+                // as a corrector that does not converge at any step.
+                Err(_) if self.interrupted() => {
+                    return BranchStep::Stop(StopReason::Interrupted);
+                }
                 Err(shrink) => self.ds *= shrink,
             }
             if self.ds < self.problem.opts.ds_min {

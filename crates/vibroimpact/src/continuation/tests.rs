@@ -610,6 +610,29 @@ fn krylov_branch_is_the_same_on_any_thread_count() {
     }
 }
 
+/// A stop requested while a step is being corrected ends the branch as
+/// interrupted, with the points so far, not as a corrector that does not
+/// converge (the request fails every integration).
+#[test]
+fn a_stop_inside_a_correction_reads_as_interrupted() {
+    let interrupt = crate::integrate::Interrupt::default();
+    let mut opts = ContinuationOptions::default();
+    opts.shooting.interrupt = Some(interrupt.clone());
+    let mut calls = 0;
+    let family = |w: f64| {
+        calls += 1;
+        if calls == 40 {
+            interrupt.request();
+        }
+        r2(2, 1e-3, w)
+    };
+    let start = r2(2, 1e-3, 1.5 * W0).unwrap();
+    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let b = continue_branch(family, 1.5 * W0, &guess, 0.5 * W0, &opts, |_| true).unwrap();
+    assert_eq!(b.stop, StopReason::Interrupted);
+    assert!(b.points.len() > 3, "{}", b.points.len());
+}
+
 /// Matrix-free options that cannot work are refused before anything runs.
 #[test]
 fn krylov_dimension_is_checked() {
