@@ -87,6 +87,12 @@ def run(cmd, budget=None):
             interrupted.is_set())
 
 
+def shown(cmd):
+    """The command as recorded: the executable relative to the checkout, the
+    temporary model file as ROW."""
+    return " ".join([os.path.relpath(cmd[0], ROOT), cmd[1], "ROW"] + cmd[3:])
+
+
 def largest(point):
     return max(abs(complex(re, im)) for re, im in point["floquet_multipliers"])
 
@@ -112,9 +118,9 @@ def window(n, linear, workdir):
            f"--{linear}", "--format", "json"]
     seconds, rc, out, err, mb, _ = run(cmd)
     if rc != 0:
-        return {"n": n, "linear": linear, "error": err.strip()[-500:], "command": " ".join(cmd)}
+        return {"n": n, "linear": linear, "error": err.strip()[-500:], "command": shown(cmd)}
     return {"n": n, "linear": linear, "seconds": seconds, "peak_mb": mb,
-            "command": " ".join(cmd[:2] + ["ROW"] + cmd[3:]), **summary(json.loads(out))}
+            "command": shown(cmd), **summary(json.loads(out))}
 
 
 def budgeted(n, budget, workdir):
@@ -129,7 +135,7 @@ def budgeted(n, budget, workdir):
     # as a corrector that does not converge: `interrupted` says it was ours.
     return {"n": n, "budget_seconds": budget, "seconds": seconds, "returncode": rc,
             "interrupted_by_budget": interrupted,
-            "peak_mb": mb, "command": " ".join(cmd[:2] + ["ROW"] + cmd[3:]),
+            "peak_mb": mb, "command": shown(cmd),
             "folds": [s["omega_over_omega0"] for s in summary(doc)["special_points"]
                       if s["kind"] == "fold"],
             **summary(doc)}
