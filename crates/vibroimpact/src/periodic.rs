@@ -292,14 +292,20 @@ impl MapTangent {
         }
     }
 
-    /// `(Φ − I) v` in scaled variables: `v` in units of `scale · unit`,
-    /// the product in units of `scale`, i.e. `Φ (s u v) / s − u v`.
-    pub(crate) fn shifted_scaled(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
+    /// `Φ v` in scaled variables: `v` in units of `scale · unit`, the
+    /// product in units of `scale`, i.e. `Φ (s u v) / s`.
+    pub(crate) fn scaled_product(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
         let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s * unit).collect();
-        let phi_v = self.product(&unscaled);
-        (0..v.len())
-            .map(|i| phi_v[i] / scale[i] - unit * v[i])
-            .collect()
+        let mut phi_v = self.product(&unscaled);
+        phi_v.iter_mut().zip(scale).for_each(|(a, s)| *a /= s);
+        phi_v
+    }
+
+    /// `(Φ − I) v` in the same variables: `Φ (s u v) / s − u v`.
+    pub(crate) fn shifted_scaled(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
+        let mut w = self.scaled_product(v, scale, unit);
+        w.iter_mut().zip(v).for_each(|(a, b)| *a -= unit * b);
+        w
     }
 }
 

@@ -108,17 +108,6 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
             .ok_or_else(|| "the period map recorded no tape".to_string())
     }
 
-    /// `DG u` for a scaled u, scaled, from a point's tape.
-    fn replayed(&self, tangent: &MapTangent, u: &[f64]) -> Vec<f64> {
-        let unscaled: Vec<f64> = u.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
-        let product = tangent.product(&unscaled);
-        product
-            .iter()
-            .zip(&self.scale)
-            .map(|(a, s)| a / s)
-            .collect()
-    }
-
     /// The residual `[G − x; A v; cᵀv − 1]` (2d + 1), scaled.
     fn residual(&mut self, z: &[f64]) -> Result<Vec<f64>, String> {
         let d = self.d();
@@ -198,11 +187,11 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
             let kind = self.kind;
             let symmetric = self.opts.symmetric;
             let mut apply = |u: &[f64]| -> Result<Vec<f64>, String> {
-                let dgu = self.replayed(&tangent, u);
+                let dgu = tangent.scaled_product(u, &self.scale, 1.0);
                 Ok(match (kind, symmetric) {
                     (CurveKind::Fold, _) => (0..d).map(|i| dgu[i] - u[i]).collect(),
                     (CurveKind::PeriodDoubling, true) => {
-                        let dg2u = self.replayed(&tangent, &dgu);
+                        let dg2u = tangent.scaled_product(&dgu, &self.scale, 1.0);
                         (0..d).map(|i| dg2u[i] + u[i]).collect()
                     }
                     _ => (0..d).map(|i| dgu[i] + u[i]).collect(),
@@ -262,7 +251,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
         let m = self.arnoldi.min(d);
         let tangent = self.tangent_at(&model, &x)?;
         let mut apply = |u: &[f64]| -> Result<Vec<f64>, String> {
-            let dgu = self.replayed(&tangent, u);
+            let dgu = tangent.scaled_product(u, &self.scale, 1.0);
             Ok((0..d).map(|i| dgu[i] - u[i]).collect())
         };
         let ritz = arnoldi_matrix(&mut apply, d, m, noise)?;
