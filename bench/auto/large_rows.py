@@ -17,6 +17,12 @@ Three tasks, all with `vibroimpact continue ROW --parameter frequency
 2. N = 100 from 0.5 omega0 towards 1.5 (`--to 11.115`), stopped by SIGINT
    after --budget seconds (Ctrl-C keeps the points): how far the branch
    gets in that time, its folds and special points.
+3. N = 100 at 0.9 omega0: the branch in the forcing amplitude from 0 (the
+   rest state) towards the model's 0.05 m/s^2 (what `--start homotopy`
+   follows), stopped by SIGINT after --budget seconds: how far it gets,
+   its folds, how many of its points are unstable and its largest
+   multiplier (issue 11 asks for the branch over 0.9 -> 1.1 omega0 at
+   N = 1000, which starts there).
 
 AUTO-07p is not run here: at N = 16 one of its branch steps takes ~1.8 s
 (bench/auto/README.md), so these rows are out of its reach.
@@ -46,11 +52,18 @@ def loadavg():
         return [float(x) for x in f.read().split()[:3]]
 
 
-def row_file(n, workdir):
+def row_file(n, workdir, omega=None):
+    """The example row with `count = n` (and the forcing frequency
+    `omega` in rad/s if given)."""
     src = open(os.path.join(ROOT, "examples", "fujita-row-n2.toml")).read()
-    path = os.path.join(workdir, f"row-n{n}.toml")
+    src = src.replace("count = 2", f"count = {n}", 1)
+    if omega is not None:
+        old = "frequency = 7.0395"
+        assert old in src, "the example's forcing frequency changed"
+        src = src.replace(old, f"frequency = {omega!r}", 1)
+    path = os.path.join(workdir, f"row-n{n}-{omega}.toml")
     with open(path, "w") as f:
-        f.write(src.replace("count = 2", f"count = {n}", 1))
+        f.write(src)
     return path
 
 
@@ -141,6 +154,28 @@ def budgeted(n, budget, workdir):
             **summary(doc)}
 
 
+def amplitude_branch(n, budget, workdir):
+    """Task 3: the branch in the forcing amplitude at 0.9 omega0."""
+    cmd = [EXE, "continue", row_file(n, workdir, 0.9 * OMEGA0), "--parameter", "amplitude",
+           "--from", "0", "--to", "0.05", "--krylov", "--max-points", "100000",
+           "--format", "json"]
+    seconds, rc, out, err, mb, interrupted = run(cmd, budget)
+    if not out.strip():
+        return {"n": n, "error": err.strip()[-500:], "returncode": rc, "command": shown(cmd)}
+    doc = json.loads(out)
+    points = doc["points"]
+    amplitudes = [p["parameter"] for p in points]
+    return {"n": n, "omega_over_omega0": 0.9, "budget_seconds": budget, "seconds": seconds,
+            "returncode": rc, "interrupted_by_budget": interrupted, "peak_mb": mb,
+            "command": shown(cmd), "points": len(points), "stop": doc["stop"],
+            "amplitude_range": [min(amplitudes), max(amplitudes)],
+            "last_amplitude": amplitudes[-1],
+            "unstable_points": sum(not p["stable"] for p in points),
+            "largest_multiplier": max(largest(p) for p in points),
+            "folds": [s["parameter"] for s in doc["special_points"] if s["kind"] == "fold"],
+            "special_points": len(doc["special_points"])}
+
+
 def compare(dense, krylov):
     """Largest differences between the dense and matrix-free windows."""
     a, b = dense["special_points"], krylov["special_points"]
@@ -178,6 +213,7 @@ def main():
         if "error" not in dense and "error" not in krylov0:
             result["check"] = compare(dense, krylov0)
         result["budgeted"] = budgeted(100, args.budget, workdir)
+        result["amplitude_branch"] = amplitude_branch(100, args.budget, workdir)
     result["load_after"] = loadavg()
     lines = ["| N | linear algebra | window 0.5 -> 0.537 (s) | points | special points (omega/omega0) "
              "| largest multiplier at 0.537 | peak MB |", "|---|---|---|---|---|---|---|"]
@@ -203,6 +239,17 @@ def main():
                      + ", ".join(f"{f:.7f}" for f in b["folds"]))
     else:
         lines.append(f"\nN = 100 budgeted run: error {b['error']}")
+    a = result["amplitude_branch"]
+    if "error" not in a:
+        how = "stopped by SIGINT" if a["interrupted_by_budget"] else "ended"
+        lines.append(f"\nN = 100 at 0.9 omega0, forcing amplitude from 0 towards 0.05 m/s^2, {how} "
+                     f"after {a['seconds']:.0f} s: {a['points']} points, amplitude "
+                     f"{a['amplitude_range'][0]:.4f}-{a['amplitude_range'][1]:.4f} (last "
+                     f"{a['last_amplitude']:.4f}), {a['unstable_points']} unstable, largest "
+                     f"multiplier {a['largest_multiplier']:.1f}, {len(a['folds'])} folds "
+                     + ", ".join(f"{f:.5f}" for f in a["folds"]))
+    else:
+        lines.append(f"\nN = 100 amplitude branch: error {a['error']}")
     text = "\n".join(lines)
     print(text)
     os.makedirs(os.path.dirname(args.out), exist_ok=True)

@@ -147,9 +147,10 @@ pub struct ContinuationOptions {
     /// regular points of the half map, found by its eigenvalue -1 instead
     /// of a singular extended Jacobian.
     pub use_symmetry: bool,
-    /// Scale of the parameter in the arclength (default `|p0|`, the start
-    /// value): steps change the parameter by at most about
-    /// `ds_max · scale`.
+    /// Scale of the parameter in the arclength (default: the start value
+    /// `|p0|`, or half the range `|p_end − p0|` if larger, so that a start
+    /// at or near zero does not make every step tiny): steps change the
+    /// parameter by at most about `ds_max · scale`.
     pub parameter_scale: Option<f64>,
     /// Matrix-free continuation with this Arnoldi dimension (None: dense).
     /// The corrector and the tangent solve their bordered systems by GMRES

@@ -76,6 +76,57 @@ fn steps_do_not_shrink_with_the_row_length() {
     }
 }
 
+/// An amplitude branch from zero forcing (the rest state, an exact
+/// periodic orbit) in the linear limit: the response is the exact steady
+/// state times A / A_ref at every point, and the parameter's scale is the
+/// range's (with the start's |p0| = 0 there was no scale at all; with a
+/// start at 1e-3 A_ref, every step moved A by at most 5e-5 of its start).
+#[test]
+fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
+    let w = 0.9 * W0;
+    let family = |a: f64| {
+        crate::reference::r2(2, crate::reference::R3_CLEARANCE, w)
+            .map(|m| {
+                m.with_base(crate::model::BaseExcitation::Harmonic {
+                    amplitude: a,
+                    frequency: w,
+                    phase: 0.0,
+                })
+            })
+            .map_err(|e| e.to_string())
+    };
+    let opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            rtol: 1e-12,
+            tol: 1e-10,
+            displacement_scale: 1e-2,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let a_ref = crate::reference::BASE_AMPLITUDE;
+    let b = continue_branch(family, 0.0, &[0.0; 4], a_ref, &opts, |_| true).unwrap();
+    assert_eq!(b.stop, StopReason::ReachedEnd);
+    // At least 2 / ds_max = 40 steps, and not many more: the state moves
+    // with the parameter.
+    assert!(
+        (40..=60).contains(&b.points.len()),
+        "{} points",
+        b.points.len()
+    );
+    assert_eq!(b.points.last().unwrap().parameter, a_ref);
+    for p in &b.points {
+        let exact = crate::reference::r3_steady_amplitude(w) * p.parameter / a_ref;
+        assert!(
+            (p.max_displacement[0] - exact).abs() < 1e-8 * exact.max(1e-12),
+            "at A = {}: {} vs {exact}",
+            p.parameter,
+            p.max_displacement[0]
+        );
+        assert!(p.stable);
+    }
+}
+
 /// The iterator on R3 with a user event: the amplitude of body 1 reaching
 /// the steady amplitude at 0.9 ω0 is found twice (below and above
 /// resonance) and located to the exact amplitude; the first step is the
