@@ -94,10 +94,16 @@ def test_periodic(cli):
     assert r.orbit_displacement.shape == (r.orbit_t.size, 2)
 
 
-def test_continue(cli):
+@pytest.mark.parametrize("parameter,from_,to", [
+    ("frequency", 11.115, 3.705),
+    # From the rest state at zero forcing (the amplitude homotopy).
+    ("amplitude", 0.0, 0.05),
+])
+def test_continue(cli, parameter, from_, to):
     m = EXAMPLES / "fujita-row-n2.toml"
-    doc = cli("continue", m, "--parameter", "frequency", "--from", "11.115", "--to", "3.705")
-    r = vi.continue_(m, "frequency", 11.115, 3.705)
+    doc = cli("continue", m, "--parameter", parameter, "--from", repr(from_), "--to", repr(to))
+    r = vi.continue_(m, parameter, from_, to)
+    assert r.stop == doc["stop"] == "ReachedEnd"
     assert len(r.points) == len(doc["points"])
     close(r.column("parameter"), [p["parameter"] for p in doc["points"]])
     close(r.column("max_displacement"), [p["max_displacement"] for p in doc["points"]])

@@ -10,10 +10,10 @@ fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
     crate::reference::r2(n, clearance, omega).map_err(|e| e.to_string())
 }
 
-/// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,
-/// tight tolerances.
-fn linear_branch(n: usize) -> Branch {
-    let opts = ContinuationOptions {
+/// Tight tolerances for branches in the linear limit, compared with exact
+/// steady states.
+fn tight_options() -> ContinuationOptions {
+    ContinuationOptions {
         shooting: ShootingOptions {
             rtol: 1e-12,
             tol: 1e-10,
@@ -21,7 +21,13 @@ fn linear_branch(n: usize) -> Branch {
             ..Default::default()
         },
         ..Default::default()
-    };
+    }
+}
+
+/// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,
+/// tight tolerances.
+fn linear_branch(n: usize) -> Branch {
+    let opts = tight_options();
     let family = |w: f64| r2(n, 1e3, w);
     continue_branch(family, 0.8 * W0, &vec![0.0; 2 * n], 1.2 * W0, &opts, |_| {
         true
@@ -95,15 +101,7 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
             })
             .map_err(|e| e.to_string())
     };
-    let opts = ContinuationOptions {
-        shooting: ShootingOptions {
-            rtol: 1e-12,
-            tol: 1e-10,
-            displacement_scale: 1e-2,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let opts = tight_options();
     let a_ref = crate::reference::BASE_AMPLITUDE;
     let b = continue_branch(family, 0.0, &[0.0; 4], a_ref, &opts, |_| true).unwrap();
     assert_eq!(b.stop, StopReason::ReachedEnd);
@@ -135,15 +133,7 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
 #[test]
 fn iterator_steps_and_user_event() {
     let level = crate::reference::r3_steady_amplitude(0.9 * W0);
-    let opts = ContinuationOptions {
-        shooting: ShootingOptions {
-            rtol: 1e-12,
-            tol: 1e-10,
-            displacement_scale: 1e-2,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let opts = tight_options();
     let family = |w: f64| r2(2, 1e3, w);
     let steps = Continuation::new(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts)
         .unwrap()
