@@ -109,6 +109,17 @@ def test_continue(cli, parameter, from_, to):
     close(r.column("max_displacement"), [p["max_displacement"] for p in doc["points"]])
     assert [s.label for s in r.special_points] == [s["label"] for s in doc["special_points"]]
     close(r.column("parameter", "special_points"), [s["parameter"] for s in doc["special_points"]])
+    if parameter == "amplitude":
+        # From rest; well below the first contact the row is linear, its
+        # response in proportion to the forcing (the exponential law's
+        # force is exp(-65) of its scale at half the grazing amplitude).
+        a, u = r.column("parameter"), r.column("max_displacement")
+        assert a[0] == 0.0 and np.all(u[0] == 0.0)
+        graze = min(s.parameter for s in r.special_points if s.kind == "grazing")
+        free = (a > 0) & (a < 0.5 * graze)
+        assert free.sum() >= 5
+        ratio = u[free, 0] / a[free]
+        np.testing.assert_allclose(ratio, ratio[0], rtol=1e-8)
 
 
 def test_sweep(cli):

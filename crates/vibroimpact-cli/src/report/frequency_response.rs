@@ -181,16 +181,17 @@ fn asymmetric_branches(
             ..opts.clone()
         };
         let t0 = Instant::now();
-        let switched = branch_switch_start(|w| row(n, w), bp, 1.5 * w0, &switch_opts, 0.02)
-            .and_then(|(p, x)| {
-                let target = if p >= bp.parameter {
-                    1.5 * w0
-                } else {
-                    0.5 * w0
-                };
-                continue_branch(|w| row(n, w), p, &x, target, &switch_opts, |_| true)
-            })
-            .map_err(|e| CliError::new(format!("R2 N = 2, switching at {label}: {e}")))?;
+        let switched =
+            branch_switch_start(|w| row(n, w), bp, (1.5 * w0, 0.5 * w0), &switch_opts, 0.02)
+                .and_then(|(p, x)| {
+                    let target = if p >= bp.parameter {
+                        1.5 * w0
+                    } else {
+                        0.5 * w0
+                    };
+                    continue_branch(|w| row(n, w), p, &x, target, &switch_opts, |_| true)
+                })
+                .map_err(|e| CliError::new(format!("R2 N = 2, switching at {label}: {e}")))?;
         eprintln!(
             "R2 N = 2: asymmetric branch from {label}, {} points in {:.1} s ({})",
             switched.points.len(),

@@ -100,13 +100,10 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
                 symmetric,
                 ..opts.shooting.clone()
             },
-            parameter_scale: Some(
-                opts.parameter_scale
-                    .unwrap_or_else(|| default_parameter_scale(p0, p_end)),
-            ),
             ..opts.clone()
         };
-        let mut problem = Problem::new(family, local, &model, p0);
+        let p_scale = parameter_scale(opts, p0, p_end);
+        let mut problem = Problem::new(family, local, &model, p_scale);
         let bounds = opts
             .bounds
             .map_or((p0.min(p_end), p0.max(p_end)), |(a, b)| {
@@ -421,16 +418,17 @@ pub fn validate_size(model: &Model, opts: &ContinuationOptions) -> Result<(), Co
     }
 }
 
-/// The parameter's scale in the arclength when the options give none: the
-/// start value |p0|, or half the range |p_end − p0| if that is larger.
-/// Either way a branch may cross its range in 2 / `ds_max` steps (40 at
+/// The parameter's scale in the arclength of a branch from `p0` towards
+/// `p_end`: `opts.parameter_scale` if given, else the start value |p0| or
+/// half the range |p_end − p0| if that is larger. Either way a branch may cross its range in 2 / `ds_max` steps (40 at
 /// the default) where the state moves little. A frequency branch from 0.5
 /// to 1.5 ω0 keeps |p0| (both are equal there); an amplitude branch from
 /// zero or nearly zero, whose |p0| made every parameter step a fraction of
 /// that tiny start (a row of 100 from 5e-5 to 0.05 m/s² took 1500 points
 /// to reach 0.0037), steps on the range's scale instead.
-fn default_parameter_scale(p0: f64, p_end: f64) -> f64 {
-    p0.abs().max(0.5 * (p_end - p0).abs())
+pub(super) fn parameter_scale(opts: &ContinuationOptions, p0: f64, p_end: f64) -> f64 {
+    opts.parameter_scale
+        .unwrap_or_else(|| p0.abs().max(0.5 * (p_end - p0).abs()))
 }
 
 /// The checks of the range and the options before anything runs.

@@ -5,7 +5,8 @@
 //! ## Formulation
 //! Unknowns `z = (x, p)`: the state at t = 0 of an nT-periodic orbit and the
 //! parameter, in scaled variables (`x̂ = x / scale`, displacement scale and
-//! ×Ω for velocities, `p̂ = p / |p0|`). The branch solves `G(x, p) =
+//! ×Ω for velocities, `p̂ = p / σ` with σ = |p0| or half the range if
+//! larger, or the option `parameter_scale`). The branch solves `G(x, p) =
 //! P_p(x) - x = 0`; its Jacobian is `[Φ - I, ∂G/∂p]` (Φ from the variational
 //! equations, `∂G/∂p` by a forward difference of the period map).
 //!

@@ -71,13 +71,12 @@ pub(super) struct Problem<F> {
 }
 
 impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
-    /// Scales: the displacement scale for u, × Ω of `model` for v, the
-    /// option `parameter_scale` (default |p0|) for p.
-    pub(super) fn new(family: F, opts: ContinuationOptions, model: &Model, p0: f64) -> Self {
+    /// Scales: the displacement scale for u, × Ω of `model` for v,
+    /// `p_scale` for p (the branch's, `branch::parameter_scale`).
+    pub(super) fn new(family: F, opts: ContinuationOptions, model: &Model, p_scale: f64) -> Self {
         let d = 2 * model.bodies().len();
         let w = model.forcing_frequency().unwrap_or(1.0);
         let u = opts.shooting.displacement_scale;
-        let p_scale = opts.parameter_scale.unwrap_or(p0.abs());
         Self {
             family,
             opts,

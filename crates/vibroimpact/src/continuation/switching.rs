@@ -4,6 +4,7 @@
 
 use nalgebra::DMatrix;
 
+use super::branch::parameter_scale;
 use super::problem::{period_image, Linear, Problem};
 use super::{
     continue_branch, model_at, Branch, BranchPoint, ContinuationError, ContinuationOptions,
@@ -110,12 +111,14 @@ fn null_vector(m: DMatrix<f64>) -> Result<Vec<f64>, ContinuationError> {
 /// corrected point that is still symmetric is refused; otherwise it is the
 /// direction of the 2-D null space of `[Φ - I, G_p]` orthogonal to the
 /// branch tangent. Steps `step` (then a quarter and 2.5 times it) both ways
-/// and corrects in the full period map. Returns `(p, x)`; the side of the
-/// point it lands on is not guaranteed: continue both ways if needed.
+/// and corrects in the full period map. `range`: the start and end values
+/// of the branch `point` lies on, whose parameter scale its tangent is in.
+/// Returns `(p, x)`; the side of the point it lands on is not guaranteed:
+/// continue both ways if needed.
 pub fn branch_switch_start<F>(
     mut family: F,
     point: &SpecialPoint,
-    p0: f64,
+    range: (f64, f64),
     opts: &ContinuationOptions,
     step: f64,
 ) -> Result<(f64, Vec<f64>), ContinuationError>
@@ -134,7 +137,8 @@ where
         },
         ..opts.clone()
     };
-    let mut problem = Problem::new(&mut family, opts.clone(), &model, p0);
+    let p_scale = parameter_scale(opts, range.0, range.1);
+    let mut problem = Problem::new(&mut family, opts.clone(), &model, p_scale);
     let z = problem.scale_state(&point.state, point.parameter);
     let (v, constraint) = switch_directions(&mut problem, &model, point, &z)?;
     for h in [step, 0.25 * step, 2.5 * step] {
@@ -284,7 +288,7 @@ where
             (p, x, sub * 2)
         }
         SpecialKind::BranchPoint => {
-            let (p, x) = branch_switch_start(&mut family, sp, range.0, opts, 0.02).map_err(fail)?;
+            let (p, x) = branch_switch_start(&mut family, sp, range, opts, 0.02).map_err(fail)?;
             (p, x, sub)
         }
         other => {

@@ -86,7 +86,8 @@ fn steps_do_not_shrink_with_the_row_length() {
 /// periodic orbit) in the linear limit: the response is the exact steady
 /// state times A / A_ref at every point, and the parameter's scale is the
 /// range's (with the start's |p0| = 0 there was no scale at all; with a
-/// start at 1e-3 A_ref, every step moved A by at most 5e-5 of its start).
+/// start at 1e-3 A_ref, every step moved A by at most ds_max·|p0| =
+/// 5e-5 A_ref).
 #[test]
 fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
     let w = 0.9 * W0;
@@ -123,6 +124,52 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
         );
         assert!(p.stable);
     }
+}
+
+/// R2 N = 2 at 0.95 ω0 with the base amplitude `a` (the example row).
+fn r2_amplitude(a: f64) -> Result<Model, String> {
+    let w = 0.95 * W0;
+    crate::reference::r2(2, crate::reference::CLEARANCE, w)
+        .map(|m| {
+            m.with_base(crate::model::BaseExcitation::Harmonic {
+                amplitude: a,
+                frequency: w,
+                phase: 0.0,
+            })
+        })
+        .map_err(|e| e.to_string())
+}
+
+/// Branch switching on a branch that starts at zero: the switch works in
+/// the main branch's parameter scale (half its range here), in which the
+/// branch point's tangent was stored. With |p0| = 0 as its scale the start
+/// off the branch point was NaN; with any other scale the tangent would be
+/// projected in the wrong variables.
+#[test]
+fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
+    let opts = ContinuationOptions::default();
+    let main = continue_branch(r2_amplitude, 0.0, &[0.0; 4], 0.05, &opts, |_| true).unwrap();
+    assert_eq!(main.stop, StopReason::ReachedEnd);
+    let bp = main.special.iter().find(|s| s.label == "BP1").unwrap();
+    let switched = switch_branch(r2_amplitude, &main, "BP1", (0.0, 0.05), &opts, |_| true)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let first = &switched.points[0];
+    // A start next to the branch point (a step of 0.02 in the scale 0.025)
+    // on the crossing branch: the two bodies move differently.
+    assert!(
+        (first.parameter - bp.parameter).abs() < 0.05 * 0.025,
+        "{} vs BP1 at {}",
+        first.parameter,
+        bp.parameter
+    );
+    let far = switched.points.last().unwrap();
+    let asymmetry = (far.max_displacement[0] - far.max_displacement[1]).abs();
+    assert!(
+        asymmetry > 1e-3 * far.max_displacement[0],
+        "{:?} at A = {}",
+        far.max_displacement,
+        far.parameter
+    );
 }
 
 /// The iterator on R3 with a user event: the amplitude of body 1 reaching
@@ -375,7 +422,7 @@ fn r2_asymmetric_branches_fold_and_period_doubling() {
     };
     let switched = |label: &str| {
         let bp = main.special.iter().find(|s| s.label == label).unwrap();
-        let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+        let (p, x) = branch_switch_start(family, bp, (1.5 * W0, 0.9 * W0), &opts, 0.02).unwrap();
         let model = r2(2, 1e-3, p).unwrap();
         // Off the symmetric branch: the two bodies move differently.
         let orbit = orbit_summary(&model, &x, 2.0 * std::f64::consts::PI / p, 256, 1e-11).unwrap();
@@ -471,7 +518,7 @@ fn r2_asymmetric_branch_connects_bp2_to_bp3() {
         ..Default::default()
     };
     let bp = main.special.iter().find(|s| s.label == "BP2").unwrap();
-    let (p, x) = branch_switch_start(family, bp, 1.5 * W0, &opts, 0.02).unwrap();
+    let (p, x) = branch_switch_start(family, bp, (1.5 * W0, 0.9 * W0), &opts, 0.02).unwrap();
     let b = continue_branch(family, p, &x, 0.5 * W0, &opts, |_| true).unwrap();
     assert_eq!(b.stop, StopReason::ClosedLoop);
     let last = b.special.last().expect("special points");
