@@ -420,8 +420,9 @@ pub fn validate_size(model: &Model, opts: &ContinuationOptions) -> Result<(), Co
 
 /// The parameter's scale in the arclength of a branch from `p0` towards
 /// `p_end`: `opts.parameter_scale` if given, else the start value |p0| or
-/// half the range |p_end − p0| if that is larger. Either way a branch may cross its range in 2 / `ds_max` steps (40 at
-/// the default) where the state moves little. A frequency branch from 0.5
+/// half the range |p_end − p0| if that is larger. With the default a
+/// branch may cross its range in 2 / `ds_max` steps (40 at the default
+/// `ds_max`) where the state moves little. A frequency branch from 0.5
 /// to 1.5 ω0 keeps |p0| (both are equal there); an amplitude branch from
 /// zero or nearly zero, whose |p0| made every parameter step a fraction of
 /// that tiny start (a row of 100 from 5e-5 to 0.05 m/s² took 1500 points

@@ -112,7 +112,8 @@ fn null_vector(m: DMatrix<f64>) -> Result<Vec<f64>, ContinuationError> {
 /// direction of the 2-D null space of `[Φ - I, G_p]` orthogonal to the
 /// branch tangent. Steps `step` (then a quarter and 2.5 times it) both ways
 /// and corrects in the full period map. `range`: the start and end values
-/// of the branch `point` lies on, whose parameter scale its tangent is in.
+/// of the branch `point` lies on, in that order (they set the parameter's
+/// scale its tangent is in).
 /// Returns `(p, x)`; the side of the point it lands on is not guaranteed:
 /// continue both ways if needed.
 pub fn branch_switch_start<F>(
@@ -137,6 +138,9 @@ where
         },
         ..opts.clone()
     };
+    // The parameter's scale of the branch `point` lies on, in which its
+    // tangent is stored. (The velocities' scale is Ω at the point, not at
+    // the branch's start: docs/decisions.md D23.)
     let p_scale = parameter_scale(opts, range.0, range.1);
     let mut problem = Problem::new(&mut family, opts.clone(), &model, p_scale);
     let z = problem.scale_state(&point.state, point.parameter);
@@ -247,7 +251,8 @@ pub struct SwitchError(pub String);
 
 /// The branch through special point `label` of `branch` (a branch point's
 /// crossing branch or a period doubling's period-2n branch), continued
-/// within `range` (the main branch's start and end values), away from the
+/// within `range` (the main branch's start and end values, in that order:
+/// they set the parameter's scale of its stored tangents), away from the
 /// special point.
 pub fn switch_branch<F, C>(
     mut family: F,
