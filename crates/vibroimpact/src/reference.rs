@@ -99,9 +99,20 @@ pub fn seed_bodies() -> TwoBodies {
 /// base acceleration `0.05 sin(frequency·t)` m/s², at rest at t = 0.
 /// Errors for `n = 0` or a clearance or frequency the model refuses.
 pub fn r2(n: usize, clearance: f64, frequency: f64) -> Result<Model, ModelError> {
+    r2_forced(n, clearance, frequency, BASE_AMPLITUDE)
+}
+
+/// [`r2`] under the base acceleration `amplitude · sin(frequency·t)` m/s²
+/// (branches and curves in the forcing amplitude; 0 is the rest state).
+pub fn r2_forced(
+    n: usize,
+    clearance: f64,
+    frequency: f64,
+    amplitude: f64,
+) -> Result<Model, ModelError> {
     let (m, w0, zeta) = (MASS, NATURAL_FREQUENCY, DAMPING_RATIO);
     let base = BaseExcitation::Harmonic {
-        amplitude: BASE_AMPLITUDE,
+        amplitude,
         frequency,
         phase: 0.0,
     };

@@ -76,7 +76,6 @@ where
 mod tests {
     use super::*;
     use crate::continuation::Continuation;
-    use crate::model::BaseExcitation;
     use crate::reference::{self, NATURAL_FREQUENCY as W0};
 
     /// R2 with N = 4 under the base acceleration `amplitude` sin(ω t).
@@ -84,13 +83,7 @@ mod tests {
         omega: f64,
         amplitude: f64,
     ) -> Result<crate::model::Model, crate::model::ModelError> {
-        reference::r2(4, reference::CLEARANCE, omega).map(|m| {
-            m.with_base(BaseExcitation::Harmonic {
-                amplitude,
-                frequency: omega,
-                phase: 0.0,
-            })
-        })
+        reference::r2_forced(4, reference::CLEARANCE, omega, amplitude)
     }
 
     /// R2 with N = 4 at 1.5 ω0: a guess by simulation does not lead

@@ -26,15 +26,7 @@ fn tight_options() -> ContinuationOptions {
 
 /// R2 N = 2 with this clearance, forced at `w` with the base amplitude `a`.
 fn r2_forced(clearance: f64, w: f64, a: f64) -> Result<Model, String> {
-    crate::reference::r2(2, clearance, w)
-        .map(|m| {
-            m.with_base(crate::model::BaseExcitation::Harmonic {
-                amplitude: a,
-                frequency: w,
-                phase: 0.0,
-            })
-        })
-        .map_err(|e| e.to_string())
+    crate::reference::r2_forced(2, clearance, w, a).map_err(|e| e.to_string())
 }
 
 /// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,

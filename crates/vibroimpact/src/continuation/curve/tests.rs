@@ -8,13 +8,7 @@ use crate::periodic::{map_multipliers, period_map};
 use crate::reference::NATURAL_FREQUENCY as W0;
 
 fn r2(n: usize, frequency: f64, amplitude: f64) -> Result<Model, String> {
-    use crate::model::BaseExcitation;
-    let m = crate::reference::r2(n, 1e-3, frequency).map_err(|e| e.to_string())?;
-    Ok(m.with_base(BaseExcitation::Harmonic {
-        amplitude,
-        frequency,
-        phase: 0.0,
-    }))
+    crate::reference::r2_forced(n, 1e-3, frequency, amplitude).map_err(|e| e.to_string())
 }
 
 /// R2 N = 1: the fold curve in (frequency, amplitude) from the fold LP1 of
