@@ -19,6 +19,10 @@
 //! 4. Cost of one shooting period map with the full monodromy (dense
 //!    variational equations, banded Jacobian) for N = 10 … 160 at rtol
 //!    1e-8, with the fitted growth exponent (issue: no faster than N²).
+//! 5. The local integrator (docs/theory.md §10, `local.rs`): R2 N = 1000
+//!    over 3 periods against SUNDIALS at equal accuracy, the struck
+//!    Hertzian chain from 10³ to 10⁶ beads, R2 N = 2 and 3 at equal
+//!    accuracy against the global integrator.
 //!
 //! Run: `cargo run --release -p vibroimpact-bench [-- --quick] [--no-peers]`.
 //! It builds the peers itself (`bench/peers/build.sh`, which installs
@@ -32,7 +36,9 @@ use clap::Parser;
 use serde_json::{json, Value};
 use vibroimpact::model::Model;
 use vibroimpact::reference;
-use vibroimpact::simulate::{simulate, SimulationOptions};
+use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
+
+mod local;
 
 #[derive(Parser, Debug)]
 #[command(about = "Benchmarks of vibroimpact against SUNDIALS and SciPy on reference problem R2")]
@@ -46,7 +52,7 @@ struct Args {
     /// Write the results as JSON here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Run only one section: n3, n1000, scaling or shooting.
+    /// Run only one section: n3, n1000, scaling, shooting or local.
     #[arg(long)]
     only: Option<String>,
 }
@@ -81,18 +87,38 @@ struct Run {
 }
 
 fn ours(n: usize, periods: f64, rtol: f64, atol: f64, repeats: usize) -> Run {
-    let model = r2(n);
-    let opts = SimulationOptions {
-        t_end: t_end(periods),
+    ours_with(
+        &r2(n),
+        t_end(periods),
         rtol,
         atol,
+        repeats,
+        Integrator::Global,
+    )
+}
+
+/// Our run of `model` over `[0, t_end]` with this integrator: the best
+/// wall time of `repeats`.
+fn ours_with(
+    model: &Model,
+    t_end: f64,
+    rtol: f64,
+    atol: f64,
+    repeats: usize,
+    integrator: Integrator,
+) -> Run {
+    let opts = SimulationOptions {
+        t_end,
+        rtol,
+        atol,
+        integrator,
         ..SimulationOptions::default()
     };
     let mut best = f64::INFINITY;
     let mut last = None;
     for _ in 0..repeats.max(1) {
         let start = Instant::now();
-        let sim = simulate(&model, &opts).expect("valid options");
+        let sim = simulate(model, &opts).expect("valid options");
         best = best.min(start.elapsed().as_secs_f64());
         assert!(
             sim.error.is_none(),
@@ -467,6 +493,9 @@ fn main() {
                 "n1000_krylov": {"seconds": krylov_seconds, "guess_seconds": guess_seconds, "newton_steps": sol.residual_history.len() - 1,
                     "converged": sol.converged, "stable": sol.stable(), "spectral_radius": sol.spectral_radius(), "dense_step_extrapolated_seconds": dense_step}}),
         );
+    }
+    if run("local") {
+        results.insert("local".into(), local::run(peers.as_ref(), args.quick));
     }
     if let Some(out) = &args.out {
         let text = serde_json::to_string_pretty(&Value::Object(results)).expect("serialisable");

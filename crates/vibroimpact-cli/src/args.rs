@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use vibroimpact::integrate::Method;
+use vibroimpact::simulate::Integrator;
 
 use crate::error::CliError;
 
@@ -29,6 +30,25 @@ impl MethodName {
             MethodName::Dopri5 => Method::Dopri5,
             MethodName::Rodas => Method::Rodas,
             MethodName::Auto => Method::Auto,
+        }
+    }
+}
+
+/// `--integrator`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorName {
+    /// Every body integrated at every step.
+    Global,
+    /// Exact motion between contacts; bodies in touch integrated.
+    Local,
+}
+
+impl IntegratorName {
+    /// The library's integrator.
+    pub fn integrator(self) -> Integrator {
+        match self {
+            IntegratorName::Global => Integrator::Global,
+            IntegratorName::Local => Integrator::Local,
         }
     }
 }

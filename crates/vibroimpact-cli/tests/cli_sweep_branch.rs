@@ -448,14 +448,21 @@ fn periodic_and_continue_contracts() {
     let doc = json(&["periodic", &model, "--format", "json"]);
     assert_eq!(doc["converged"], true);
     assert_eq!(doc["newton_stop"], "converged");
-    // N = 3 at 0.95 ω0 has no period-1 orbit near the simulated guess: the
-    // failure says why Newton stopped and what to try, after the last
-    // iterate marked as such.
+    // N = 3 at 0.95 ω0 has no period-1 orbit near the simulated guess (its
+    // motion is irregular: where the guess lands, and so which way Newton
+    // fails, depends on the last bits): the failure says why Newton
+    // stopped and what to try, after the last iterate marked as such.
     let out = run(&["periodic", &repo_file("examples/fujita-row.toml")]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        err.contains("Newton did not converge: the iteration budget ran out"),
+        [
+            "Newton did not converge: the iteration budget ran out",
+            "Newton did not converge: no step along the Newton direction reduces"
+        ]
+        .iter()
+        .any(|why| err.contains(why))
+            && (err.contains("start from") || err.contains("try another guess")),
         "{err}"
     );
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("NOT CONVERGED"));

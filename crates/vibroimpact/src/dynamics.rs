@@ -291,6 +291,11 @@ impl ChainDynamics {
         self.contact_evaluations
     }
 
+    /// The onset approach velocity of contact k's current impact.
+    pub fn onset_velocity(&self, k: usize) -> f64 {
+        self.onset_velocity[k]
+    }
+
     /// Sets the onset approach velocity of contact k's current impact.
     pub fn set_onset_velocity(&mut self, k: usize, v: f64) {
         self.onset_velocity[k] = v;
@@ -534,6 +539,12 @@ impl OdeSystem for ChainDynamics {
             dydt[m + 1] = damper;
             dydt[m + 2] = contact;
         }
+    }
+
+    /// A body's displacement and velocity: the error of the bodies that
+    /// move is not averaged with that of bodies at rest.
+    fn error_block(&self) -> Option<usize> {
+        Some(2)
     }
 
     /// Banded for the mechanical state; dense with the energy quadratures

@@ -47,6 +47,7 @@ pub mod contact;
 pub mod continuation;
 pub mod dynamics;
 pub mod eigen;
+pub mod free_motion;
 pub mod identify;
 pub mod impact;
 pub mod integrate;

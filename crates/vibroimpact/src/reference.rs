@@ -102,6 +102,21 @@ pub fn r2(n: usize, clearance: f64, frequency: f64) -> Result<Model, ModelError>
     r2_forced(n, clearance, frequency, BASE_AMPLITUDE)
 }
 
+/// The periodic state (body order) of [`r2`] at `frequency` on the
+/// branch that grows from rest, by the homotopy in the forcing amplitude:
+/// a test's start that does not depend on where a long chaotic transient
+/// of a simulation ends (at 0.5 ω0 that is the last bits of the step
+/// sequence).
+#[cfg(test)]
+pub(crate) fn r2_primary_orbit(n: usize, clearance: f64, frequency: f64) -> Vec<f64> {
+    crate::continuation::amplitude_homotopy(
+        |a| r2_forced(n, clearance, frequency, a).map_err(|e| e.to_string()),
+        BASE_AMPLITUDE,
+        &Default::default(),
+    )
+    .unwrap()
+}
+
 /// [`r2`] under the base acceleration `amplitude · sin(frequency·t)` m/s²
 /// (branches and curves in the forcing amplitude; 0 is the rest state).
 pub fn r2_forced(

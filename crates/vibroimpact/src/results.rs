@@ -333,6 +333,13 @@ pub struct SimulationSummary {
     pub contact_evaluations: u64,
     /// The contact laws and their force forms.
     pub contact_laws: Vec<String>,
+    /// `global` or `local` (docs/theory.md §10).
+    pub integrator: &'static str,
+    /// The local integrator's work: bound checks of contacts between
+    /// exactly moving bodies, changes of the integrated set, its largest
+    /// size and the number of bodies ever integrated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub local: Option<LocalSummary>,
     /// Energy audit (J), with --energy.
     pub energy: Option<EnergySummary>,
     /// The recorded ground motion, when the excitation is one (set by the
@@ -348,6 +355,20 @@ pub struct ContactCount {
     pub contact: String,
     /// Number of impacts.
     pub impacts: usize,
+}
+
+/// The local integrator's work.
+#[derive(Serialize, Debug)]
+pub struct LocalSummary {
+    /// Bound checks of contacts between exactly moving bodies.
+    pub contact_checks: u64,
+    /// Changes of the integrated set.
+    pub set_changes: u64,
+    /// Most bodies integrated at once.
+    pub largest_set: usize,
+    /// Bodies integrated at some time (the others moved exactly
+    /// throughout and were never evaluated).
+    pub bodies_integrated: usize,
 }
 
 /// Energy audit (J).
@@ -399,6 +420,17 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
         rejected_steps: sim.stats.rejected_steps,
         contact_evaluations: sim.contact_evaluations,
         contact_laws: laws,
+        integrator: if sim.local.is_some() {
+            "local"
+        } else {
+            "global"
+        },
+        local: sim.local.as_ref().map(|l| LocalSummary {
+            contact_checks: l.contact_checks,
+            set_changes: l.set_changes,
+            largest_set: l.largest_set,
+            bodies_integrated: l.bodies_integrated(),
+        }),
         energy: sim.energy.map(|e| EnergySummary {
             initial: e.initial,
             mechanical: e.mechanical,

@@ -70,6 +70,44 @@ pub struct SimulationOptions {
     /// simulation then ends early with [`IntegrationError::Interrupted`] as
     /// its error, keeping what was computed.
     pub interrupt: Option<Interrupt>,
+    /// The whole state integrated at every step ([`Integrator::Global`]),
+    /// or exact motion between contacts and the bodies in touch integrated
+    /// ([`Integrator::Local`], docs/theory.md §10).
+    pub integrator: Integrator,
+}
+
+/// How a simulation advances the state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Integrator {
+    /// Every body integrated at every step by the step driver.
+    #[default]
+    Global,
+    /// Exact motion between contacts; only bodies whose contacts are
+    /// active are integrated ([`local::LocalStats`] counts the work).
+    Local,
+}
+
+impl Integrator {
+    /// `global` or `local`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Global => "global",
+            Integrator::Local => "local",
+        }
+    }
+}
+
+impl std::str::FromStr for Integrator {
+    type Err = OptionsError;
+    fn from_str(s: &str) -> Result<Self, OptionsError> {
+        match s {
+            "global" => Ok(Integrator::Global),
+            "local" => Ok(Integrator::Local),
+            _ => Err(OptionsError(format!(
+                "integrator = {s:?}: must be global or local"
+            ))),
+        }
+    }
 }
 
 impl Default for SimulationOptions {
@@ -86,6 +124,7 @@ impl Default for SimulationOptions {
             method: Method::Dop853,
             extrema_window: None,
             interrupt: None,
+            integrator: Integrator::Global,
         }
     }
 }
@@ -173,6 +212,8 @@ pub struct Simulation {
     pub error: Option<SimulationFailure>,
     /// Exact extrema over the requested window (up to `final_time`).
     pub extrema: Option<Extrema>,
+    /// The local integrator's work (None for the global one).
+    pub local: Option<local::LocalStats>,
 }
 
 impl Simulation {
@@ -361,9 +402,22 @@ struct Tracker {
     active: Option<usize>,
 }
 
+impl Tracker {
+    /// A contact of this law, no impact under way.
+    fn new(law: &crate::contact::ContactLaw, impact_force_threshold: f64) -> Self {
+        Self {
+            s_on: law.onset_approach(impact_force_threshold),
+            entry_margin: law.entry_margin(),
+            active: None,
+        }
+    }
+}
+
 /// Scans one step for events and samples.
-struct StepScan<'a> {
-    model: &'a Model,
+struct StepScan {
+    /// The model's index of each contact of the integrated system (the
+    /// identity for the whole model; a subset for the local integrator).
+    ids: Vec<usize>,
     trackers: Vec<Tracker>,
     impacts: Vec<ImpactRecord>,
     /// (s, ṡ, dF/dt) of every contact at the start of the step.
@@ -389,7 +443,7 @@ fn contact_at(st: &mut Stepper, sys: &mut ChainDynamics, k: usize, t: f64) -> (f
     (v[0] - v[2] - sys.clearance(k), v[1] - v[3])
 }
 
-impl StepScan<'_> {
+impl StepScan {
     fn locate(
         st: &mut Stepper,
         sys: &mut ChainDynamics,
@@ -443,7 +497,7 @@ impl StepScan<'_> {
         }
         self.trackers[k].active = Some(self.impacts.len());
         self.impacts.push(ImpactRecord {
-            contact: k,
+            contact: self.ids[k],
             start_time: t,
             end_time: f64::NAN,
             impact_velocity: sd,
@@ -507,7 +561,7 @@ impl StepScan<'_> {
     /// Processes the events of the accepted step [t0, t1].
     fn scan(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) {
         let (t0, t1) = (st.t_prev(), st.t());
-        for k in 0..self.model.contacts().len() {
+        for k in 0..self.trackers.len() {
             let (s0, sd0, r0) = self.previous[k];
             let (s1, sd1, r1) = contact_end(sys, k, st.y(), st.dydt());
             self.previous[k] = (s1, sd1, r1);
@@ -734,17 +788,16 @@ pub fn simulate_streaming(
             .collect(),
         _ => Vec::new(),
     };
+    if opts.integrator == Integrator::Local {
+        return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
+    }
     let mut next_break = 0;
     let mut scan = StepScan {
-        model,
-        trackers: (0..model.contacts().len())
-            .map(|k| Tracker {
-                s_on: model.contacts()[k]
-                    .law
-                    .onset_approach(opts.impact_force_threshold),
-                entry_margin: model.contacts()[k].law.entry_margin(),
-                active: None,
-            })
+        ids: (0..model.contacts().len()).collect(),
+        trackers: model
+            .contacts()
+            .iter()
+            .map(|c| Tracker::new(&c.law, opts.impact_force_threshold))
             .collect(),
         impacts: Vec::new(),
         previous: Vec::new(),
@@ -915,8 +968,62 @@ pub fn simulate_streaming(
         energy,
         error,
         extrema: extrema.map(|x| x.found),
+        local: None,
     })
 }
+
+/// [`simulate_streaming`] by the local integrator.
+fn simulate_local(
+    model: &Model,
+    opts: &SimulationOptions,
+    method: Method,
+    y0: &[f64],
+    breakpoints: Vec<f64>,
+    sink: &mut dyn FnMut(f64, &[f64]) -> bool,
+) -> Result<Simulation, OptionsError> {
+    let run = local::run(model, opts, method, y0, breakpoints, sink)?;
+    let n = model.bodies().len();
+    let mut impacts = run.impacts;
+    impacts.sort_by(|a, b| {
+        a.start_time
+            .total_cmp(&b.start_time)
+            .then(a.contact.cmp(&b.contact))
+    });
+    let error = run.error.or(run
+        .sink_stopped
+        .map(|t| IntegrationError::Interrupted { t }));
+    let error = error.map(|source| {
+        let y = &run.y;
+        let deepest = (0..model.contacts().len())
+            .map(|k| {
+                let u: Vec<f64> = (0..n).map(|i| y[2 * i]).collect();
+                (k, model.approach(k, &u))
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        SimulationFailure {
+            source,
+            contact: deepest.map(|(k, _)| model.contact_name(k)),
+            approach: deepest.map_or(f64::NAN, |d| d.1),
+        }
+    });
+    Ok(Simulation {
+        times: Vec::new(),
+        states: Vec::new(),
+        final_time: run.t,
+        final_displacement: (0..n).map(|i| run.y[2 * i]).collect(),
+        final_velocity: (0..n).map(|i| run.y[2 * i + 1]).collect(),
+        impacts,
+        stats: run.stats,
+        contact_evaluations: run.contact_evaluations,
+        energy: None,
+        error,
+        extrema: None,
+        local: Some(run.local),
+    })
+}
+
+#[path = "local.rs"]
+pub mod local;
 
 #[cfg(test)]
 #[path = "simulate_tests.rs"]

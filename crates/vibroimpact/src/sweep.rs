@@ -760,6 +760,7 @@ mod tests {
             energy: None,
             error: None,
             extrema: None,
+            local: None,
         };
         let s = handover(&model, &sim, 5, 16, 5 + 32).unwrap();
         assert_eq!(s.u, vec![-5e-4, 1e-4]);

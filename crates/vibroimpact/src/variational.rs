@@ -183,6 +183,10 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
     fn admissible(&self, t: f64, z: &[f64]) -> bool {
         self.sys.admissible(t, &z[..self.dim])
     }
+
+    fn error_block(&self) -> Option<usize> {
+        self.sys.error_block()
+    }
 }
 
 #[cfg(test)]

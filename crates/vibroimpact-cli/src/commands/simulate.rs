@@ -6,7 +6,7 @@ use clap::Args;
 use vibroimpact::model::Model;
 use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
 
-use crate::args::MethodName;
+use crate::args::{IntegratorName, MethodName};
 use crate::error::CliError;
 use crate::format::{history_header, number, CsvText, SummaryFormat};
 use crate::model_io::read_model;
@@ -52,6 +52,10 @@ pub struct SimulateArgs {
     /// Integration method.
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     method: MethodName,
+    /// `global`: every body integrated at every step; `local`: exact
+    /// motion between contacts, only bodies in touch integrated.
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    integrator: IntegratorName,
     /// Force level F_on (N) that delimits impacts of the exponential law
     /// (default: [simulation] impact_force_threshold, else 1e-3 N).
     #[arg(long)]
@@ -92,6 +96,7 @@ fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOption
             .unwrap_or(1e-3),
         energy: args.energy,
         method: args.method.method(),
+        integrator: args.integrator.integrator(),
         ..SimulationOptions::default()
     })
 }
@@ -240,6 +245,12 @@ pub fn summary_text(s: &SimulationSummary) -> String {
     );
     for c in &s.impacts_per_contact {
         t.push_str(&format!("  {:<16} {} impacts\n", c.contact, c.impacts));
+    }
+    if let Some(l) = &s.local {
+        t.push_str(&format!(
+            "local integrator: {} bodies integrated (at most {} at once), {} set changes, {} contact checks\n",
+            l.bodies_integrated, l.largest_set, l.set_changes, l.contact_checks
+        ));
     }
     if let Some(r) = &s.record {
         t.push_str(&format!(

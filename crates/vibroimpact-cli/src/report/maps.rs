@@ -9,11 +9,13 @@ use std::time::Instant;
 
 use vibroimpact::basins::{basins, Basins, Component};
 use vibroimpact::chart::{chart, Chart, ChartOptions};
-use vibroimpact::continuation::{continue_branch, Branch, ContinuationOptions, Curve};
+use vibroimpact::continuation::{
+    amplitude_homotopy, continue_branch, Branch, ContinuationOptions, Curve,
+};
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
-use vibroimpact::periodic::{guess_by_simulation_with, ShootingOptions};
+use vibroimpact::periodic::ShootingOptions;
 use vibroimpact::reference::NATURAL_FREQUENCY as W0;
 use vibroimpact::sweep::{sweep, SweepOptions, SweepSummary};
 
@@ -152,8 +154,8 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
     })
 }
 
-/// The branch in frequency at the model's amplitude from a simulated
-/// guess at 0.5 ω0, and the curves of its folds, branch points, period
+/// The branch in frequency at the model's amplitude from its orbit at
+/// 0.5 ω0 (the homotopy in the amplitude from rest), and the curves of its folds, branch points, period
 /// doublings and Neimark–Sacker points in (frequency, amplitude).
 fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, Curves), CliError> {
     let p = doc.parameter("frequency")?;
@@ -163,8 +165,6 @@ fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, C
             .map(|m| m.model)
             .map_err(|e| e.to_string())
     };
-    let start = family(FREQUENCY.0).map_err(CliError::new)?;
-    let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))?;
     let defaults = ContinuationOptions::default();
     let opts = ContinuationOptions {
         shooting: ShootingOptions {
@@ -173,6 +173,20 @@ fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, C
         },
         ..defaults
     };
+    // The orbit at 0.5 ω0 on the branch that grows from rest (a simulated
+    // guess there ends a chaotic transient wherever its last bits take it).
+    let mut at_start = doc.clone();
+    at_start.set(&p, FREQUENCY.0)?;
+    let guess = amplitude_homotopy(
+        |a| {
+            at_start
+                .with_parameter(&q, a)
+                .map(|m| m.model)
+                .map_err(|e| e.to_string())
+        },
+        q.initial,
+        &opts,
+    )?;
     let branch = continue_branch(family, FREQUENCY.0, &guess, FREQUENCY.1, &opts, |_| true)?;
     let second = SecondParameter {
         parameter2: Some("amplitude".into()),

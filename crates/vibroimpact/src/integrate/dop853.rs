@@ -118,7 +118,8 @@ impl StepMethod for Dop853Method {
 
     /// The 11 new stages (stage 0 is the previous step's last evaluation,
     /// "first same as last") and the 8(5,3) error estimate
-    /// `|h|·e5² / sqrt(m·(e5² + 0.01·e3²))`.
+    /// `|h|·e5² / sqrt(m·(e5² + 0.01·e3²))`, the largest over the error
+    /// norm's blocks.
     fn attempt<S: OdeSystem>(&mut self, sys: &mut S, at: &Point, trial: &mut Trial) -> Attempt {
         let (n, h, y_new) = (at.dim(), trial.h, &mut *trial.y_new);
         for s in 1..N_STAGES {
@@ -137,24 +138,35 @@ impl StepMethod for Dop853Method {
         if !sys.admissible(trial.t_new, y_new) {
             return Err((RejectReason::NotAdmissible, SHRINK_HARD));
         }
-        let m = at.error_components();
-        let (mut err5, mut err3) = (0.0, 0.0);
-        for (i, (&y, &yn)) in at.y[..m].iter().zip(&y_new[..m]).enumerate() {
-            let sk = at.weight(y, yn);
-            let (mut e5, mut e3) = (0.0, 0.0);
-            for j in 0..N_STAGES {
-                let kj = self.k[j * n + i];
-                e5 += E5[j] * kj;
-                e3 += E3[j] * kj;
+        let (m, block) = (at.error_components(), at.error_block());
+        let mut worst = 0.0f64;
+        for start in (0..m).step_by(block) {
+            let end = (start + block).min(m);
+            let (mut err5, mut err3) = (0.0, 0.0);
+            for (i, (&y, &yn)) in
+                at.y.iter()
+                    .zip(y_new.iter())
+                    .enumerate()
+                    .take(end)
+                    .skip(start)
+            {
+                let sk = at.weight(y, yn);
+                let (mut e5, mut e3) = (0.0, 0.0);
+                for j in 0..N_STAGES {
+                    let kj = self.k[j * n + i];
+                    e5 += E5[j] * kj;
+                    e3 += E3[j] * kj;
+                }
+                err5 += (e5 / sk).powi(2);
+                err3 += (e3 / sk).powi(2);
             }
-            err5 += (e5 / sk).powi(2);
-            err3 += (e3 / sk).powi(2);
+            let mut deno = err5 + 0.01 * err3;
+            if deno <= 0.0 {
+                deno = 1.0;
+            }
+            worst = worst.max(h.abs() * err5 / ((end - start) as f64 * deno).sqrt());
         }
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        Ok(h.abs() * err5 / (m as f64 * deno).sqrt())
+        Ok(worst)
     }
 
     fn evaluate_end<S: OdeSystem>(&mut self, sys: &mut S, trial: &mut Trial) -> bool {

@@ -112,6 +112,8 @@ pub struct Dopri5Method {
     k: Vec<f64>,
     /// Stages of the last accepted step.
     k_acc: Vec<f64>,
+    /// The attempt's error estimate per component.
+    err: Vec<f64>,
 }
 
 impl StepMethod for Dopri5Method {
@@ -124,6 +126,7 @@ impl StepMethod for Dopri5Method {
             y_stage: vec![0.0; dim],
             k: vec![0.0; N_STAGES * dim],
             k_acc: vec![0.0; N_STAGES * dim],
+            err: vec![0.0; dim],
         }
     }
 
@@ -161,17 +164,16 @@ impl StepMethod for Dopri5Method {
             return Err(NON_FINITE);
         }
         let m = at.error_components();
-        let mut sum = 0.0;
-        for (i, (&y, &yn)) in at.y[..m].iter().zip(&y_new[..m]).enumerate() {
+        for (i, e_i) in self.err[..m].iter_mut().enumerate() {
             let mut e = 0.0;
             for (j, &ej) in E.iter().enumerate() {
                 if ej != 0.0 {
                     e += ej * self.k[j * n + i];
                 }
             }
-            sum += (h * e / at.weight(y, yn)).powi(2);
+            *e_i = h * e;
         }
-        Ok((sum / m as f64).sqrt())
+        Ok(at.error_norm(&self.err, y_new))
     }
 
     /// `f(t + h, y_new)` was evaluated (and checked) within the attempt.

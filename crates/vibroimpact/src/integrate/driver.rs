@@ -55,6 +55,9 @@ pub struct Point {
     opts: IntegratorOptions,
     /// Number of leading components entering the error norm.
     n_err: usize,
+    /// Size of the blocks whose norms are compared (see
+    /// [`OdeSystem::error_block`]); `n_err` for one block.
+    block: usize,
     /// Time after the last accepted step.
     pub t: f64,
     /// Time before the last accepted step.
@@ -95,16 +98,31 @@ impl Point {
         self.opts.atol + self.opts.rtol * a.abs().max(b.abs())
     }
 
-    /// Weighted RMS norm `sqrt(1/m Σ (err_i / sk_i)²)` of `err` over the
+    /// Size of the error norm's blocks (see [`OdeSystem::error_block`]):
+    /// the error-controlled components in consecutive blocks of this size
+    /// (the last may be shorter).
+    #[inline]
+    pub fn error_block(&self) -> usize {
+        self.block
+    }
+
+    /// Largest over the blocks of the weighted RMS norm
+    /// `sqrt(1/b Σ_block (err_i / sk_i)²)` of `err` over the
     /// error-controlled components, with weights from the current state and
-    /// the candidate `y_new`.
+    /// the candidate `y_new` (one block: the RMS norm over all of them).
     #[inline]
     pub fn error_norm(&self, err: &[f64], y_new: &[f64]) -> f64 {
-        let mut sum = 0.0;
-        for i in 0..self.n_err {
-            sum += (err[i] / self.weight(self.y[i], y_new[i])).powi(2);
+        let m = self.n_err;
+        let mut worst = 0.0f64;
+        for start in (0..m).step_by(self.block) {
+            let end = (start + self.block).min(m);
+            let mut sum = 0.0;
+            for i in start..end {
+                sum += (err[i] / self.weight(self.y[i], y_new[i])).powi(2);
+            }
+            worst = worst.max(sum / (end - start) as f64);
         }
-        (sum / self.n_err as f64).sqrt()
+        worst.sqrt()
     }
 }
 
@@ -249,6 +267,7 @@ impl<M: StepMethod> Driver<M> {
             at: Point {
                 opts,
                 n_err,
+                block: n_err,
                 t: 0.0,
                 t_prev: 0.0,
                 h_last: 0.0,
@@ -331,6 +350,9 @@ impl<M: StepMethod> Driver<M> {
             return Err(IntegrationError::NonFiniteInitialState { t: t0 });
         }
         self.method.reset(sys, n);
+        self.at.block = sys
+            .error_block()
+            .map_or(self.at.n_err, |b| b.clamp(1, self.at.n_err));
         self.at.y.copy_from_slice(y0);
         self.at.y_prev.copy_from_slice(y0);
         sys.rhs(t0, &self.at.y, &mut self.at.dydt);

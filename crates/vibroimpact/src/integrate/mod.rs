@@ -142,6 +142,17 @@ pub trait OdeSystem {
         true
     }
 
+    /// Size of the blocks of the error norm (None: one block, the weighted
+    /// RMS norm over all error-controlled components). With `Some(b)` the
+    /// components form consecutive blocks of `b` (a body's displacement and
+    /// velocity: `b = 2`) and a step's error is the largest block's RMS
+    /// norm, so that the error of a few moving bodies is not averaged away
+    /// by many at rest (docs/theory.md §10). Read when the integrator is
+    /// reset.
+    fn error_block(&self) -> Option<usize> {
+        None
+    }
+
     /// Lower and upper bandwidths of ∂f/∂y, if banded (None: dense).
     ///
     /// `Some((kl, ku))` promises `∂f_i/∂y_j = 0` unless
@@ -170,7 +181,8 @@ pub trait OdeSystem {
 ///
 /// The local error of every step is measured in the weighted RMS norm
 /// `sqrt(1/m · Σ_i (err_i / sk_i)²)` over the `m` error-controlled components
-/// (see [`error_components`](Self::error_components)), with the weights
+/// (see [`error_components`](Self::error_components)), or its largest value
+/// over blocks of components (see [`OdeSystem::error_block`]), with the weights
 /// `sk_i = atol + rtol · max(|y_old,i|, |y_new,i|)`; a step is accepted when
 /// this norm is at most 1.
 #[derive(Clone, Debug)]

@@ -106,6 +106,10 @@ impl<S: RecordedJacobian> OdeSystem for Recorder<S> {
         self.sys.jacobian_bandwidth()
     }
 
+    fn error_block(&self) -> Option<usize> {
+        self.sys.error_block()
+    }
+
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
         self.sys.jacobian(t, y, jac)
     }

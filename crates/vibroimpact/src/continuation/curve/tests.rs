@@ -172,8 +172,12 @@ fn branch_over(
     q: f64,
     (from, to): (f64, f64),
 ) -> crate::continuation::Branch {
-    let start = row(n, walls, from, q).unwrap();
-    let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
+    let guess = crate::continuation::amplitude_homotopy(
+        |a| row(n, walls, from, a),
+        q,
+        &ContinuationOptions::default(),
+    )
+    .unwrap();
     continue_branch(
         |w: f64| row(n, walls, w, q),
         from,

@@ -1,0 +1,248 @@
+//! Section 5: the local integrator (docs/theory.md §10).
+//!
+//! 1. R2, N = 1000, 3 periods: every solver's loosest robust rtol (all
+//!    tighter ones too) reaching error <= 1e-5 against ARKODE Verner 8 at
+//!    rtol 1e-11, timed; the fastest SUNDIALS configuration over ours.
+//! 2. The struck Hertzian chain in sonic vacuum (0.0286 kg beads, Hertz
+//!    k = 7e9 N/m^1.5, bead 1 at 1 m/s, 0.02 s: the wave reaches bead 605):
+//!    time and the wave's peak velocity error at default settings (rtol
+//!    1e-8, atol 1e-12) for N = 10³ … 10⁶ (local) and 10³, 10⁴ (global),
+//!    against the global integrator at rtol 1e-13 on N = 1000 (the wave
+//!    never reaches its end).
+//! 3. R2, N = 2 and 3, 20 periods at 0.95 ω0: the loosest robust rtol
+//!    reaching 1e-6 against rtol 1e-13, global and local, timed.
+
+use super::*;
+use vibroimpact::contact::ContactLaw;
+use vibroimpact::model::BaseExcitation;
+
+/// The loosest rtol (of a sweep from loose to tight) from which every
+/// tighter one meets `target`.
+fn robust_to(sweep: &[(f64, f64, Run)], target: f64) -> Option<&(f64, f64, Run)> {
+    let mut pick = None;
+    for entry in sweep.iter().rev() {
+        if entry.1 <= target {
+            pick = Some(entry);
+        } else {
+            break;
+        }
+    }
+    pick
+}
+
+/// The struck chain of `n` beads.
+fn chain(n: usize) -> Model {
+    let law = ContactLaw::hertz(7e9, 1.5).expect("valid law");
+    let m = Model::row(
+        n,
+        0.0286,
+        0.0,
+        0.0,
+        0.0,
+        law,
+        (false, false),
+        BaseExcitation::None,
+    )
+    .expect("valid chain");
+    let mut v = vec![0.0; n];
+    v[0] = 1.0;
+    m.with_initial_state(Vec::new(), v).expect("valid state")
+}
+
+/// Largest bead velocity at the end (the wave's peak).
+fn peak(run: &Run) -> f64 {
+    let n = run.state.len() / 2;
+    run.state[n..].iter().fold(0.0f64, |m, v| m.max(*v))
+}
+
+pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
+    let repeats = if quick { 2 } else { 5 };
+    let mut out = serde_json::Map::new();
+    // 1. R2 N = 1000, 3 periods.
+    println!("\n== local integrator: R2, N = 1000, 3 periods, error <= 1e-5 against ARKODE Verner 8 at rtol 1e-11 ==");
+    let model = r2(1000);
+    let t = t_end(3.0);
+    let reference = match peers {
+        Some(p) => {
+            p.run("arkode-verner8", 1000, 3.0, 1e-11, 1e-14, 1)
+                .unwrap_or_else(|e| {
+                    eprintln!("error: {e}");
+                    std::process::exit(1)
+                })
+                .state
+        }
+        None => ours_with(&model, t, 1e-12, 1e-15, 1, Integrator::Global).state,
+    };
+    let rtols: Vec<f64> = (6..=11).map(|k| 10f64.powi(-k)).collect();
+    let mut rows: Vec<(String, f64, f64, f64, u64)> = Vec::new();
+    for (name, integrator) in [
+        ("vibroimpact-local", Integrator::Local),
+        ("vibroimpact-global", Integrator::Global),
+    ] {
+        let sweep: Vec<(f64, f64, Run)> = rtols
+            .iter()
+            .map(|&rtol| {
+                let run = ours_with(&model, t, rtol, rtol * 1e-3, repeats, integrator);
+                (rtol, error(&run.state, &reference), run)
+            })
+            .collect();
+        for (rtol, err, run) in &sweep {
+            println!(
+                "{name:<20} rtol {rtol:.0e} error {err:.2e} {:>9.2} ms rhs {}",
+                run.seconds * 1e3,
+                run.rhs
+            );
+        }
+        if let Some((rtol, err, run)) = robust_to(&sweep, 1e-5) {
+            rows.push((name.into(), *rtol, *err, run.seconds, run.rhs));
+        }
+    }
+    if let Some(p) = peers {
+        for method in [
+            "arkode-dp5",
+            "arkode-verner8",
+            "arkode-fehlberg8",
+            "cvode-adams",
+        ] {
+            let mut sweep = Vec::new();
+            for &rtol in &rtols[..5] {
+                match p.run(method, 1000, 3.0, rtol, rtol * 1e-3, 3) {
+                    Ok(run) => sweep.push((rtol, error(&run.state, &reference), run)),
+                    Err(e) => eprintln!("{method} at rtol {rtol:e}: {e}"),
+                }
+            }
+            for (rtol, err, run) in &sweep {
+                println!(
+                    "{method:<20} rtol {rtol:.0e} error {err:.2e} {:>9.2} ms rhs {}",
+                    run.seconds * 1e3,
+                    run.rhs
+                );
+            }
+            if let Some((rtol, err, run)) = robust_to(&sweep, 1e-5) {
+                rows.push((method.into(), *rtol, *err, run.seconds, run.rhs));
+            }
+        }
+    }
+    let local_time = rows
+        .iter()
+        .find(|r| r.0 == "vibroimpact-local")
+        .map_or(f64::NAN, |r| r.3);
+    let fastest_sundials = rows
+        .iter()
+        .filter(|r| r.0.starts_with("arkode") || r.0.starts_with("cvode"))
+        .map(|r| r.3)
+        .fold(f64::INFINITY, f64::min);
+    println!("robust settings (atol = 1e-3 rtol):");
+    for (name, rtol, err, secs, rhs) in &rows {
+        println!(
+            "{name:<20} rtol {rtol:.0e} error {err:.2e} {:>9.2} ms rhs {rhs:>7}  time / local = {:.1}",
+            secs * 1e3,
+            secs / local_time
+        );
+    }
+    println!(
+        "fastest SUNDIALS / local = {:.1}",
+        fastest_sundials / local_time
+    );
+    out.insert(
+        "r2_n1000_3_periods".into(),
+        json!({"robust": rows.iter().map(|r| json!({"solver": r.0, "rtol": r.1, "error": r.2, "seconds": r.3, "rhs_evaluations": r.4})).collect::<Vec<_>>(),
+               "fastest_sundials_over_local": fastest_sundials / local_time}),
+    );
+
+    // 2. The struck chain.
+    println!("\n== local integrator: struck Hertzian chain, 0.02 s, default settings (rtol 1e-8, atol 1e-12) ==");
+    let duration = 0.02;
+    let converged = peak(&ours_with(
+        &chain(1000),
+        duration,
+        1e-13,
+        1e-17,
+        1,
+        Integrator::Global,
+    ));
+    println!("converged peak velocity (global, rtol 1e-13, N = 1000): {converged:.9} m/s");
+    let mut chain_rows = Vec::new();
+    let sizes: &[usize] = if quick {
+        &[1000, 10_000, 100_000]
+    } else {
+        &[1000, 10_000, 100_000, 1_000_000]
+    };
+    for &n in sizes {
+        let model = chain(n);
+        let local = ours_with(
+            &model,
+            duration,
+            1e-8,
+            1e-12,
+            if n >= 100_000 { 1 } else { repeats },
+            Integrator::Local,
+        );
+        let mut row = json!({"n": n, "local_seconds": local.seconds, "local_error": (peak(&local) - converged).abs(), "local_steps": local.steps});
+        let mut line = format!(
+            "N = {n:>8}: local {:>9.3} ms, error {:.1e}",
+            local.seconds * 1e3,
+            (peak(&local) - converged).abs()
+        );
+        if n <= 10_000 {
+            let global = ours_with(&model, duration, 1e-8, 1e-12, 1, Integrator::Global);
+            line += &format!(
+                "; global {:>9.3} ms, error {:.1e}",
+                global.seconds * 1e3,
+                (peak(&global) - converged).abs()
+            );
+            row["global_seconds"] = json!(global.seconds);
+            row["global_error"] = json!((peak(&global) - converged).abs());
+        }
+        println!("{line}");
+        chain_rows.push(row);
+    }
+    let time = |n: usize| {
+        chain_rows
+            .iter()
+            .find(|r| r["n"] == n)
+            .and_then(|r| r["local_seconds"].as_f64())
+            .unwrap_or(f64::NAN)
+    };
+    println!(
+        "local time(N = 10⁴) / time(N = 10³) = {:.2}",
+        time(10_000) / time(1000)
+    );
+    out.insert(
+        "struck_chain".into(),
+        json!({"converged_peak_velocity": converged, "rows": chain_rows}),
+    );
+
+    // 3. Small rows.
+    println!("\n== local integrator: R2, 20 periods, error <= 1e-6 against rtol 1e-13 ==");
+    let mut small = Vec::new();
+    for n in [2usize, 3] {
+        let model = r2(n);
+        let t = t_end(20.0);
+        let reference = ours_with(&model, t, 1e-13, 1e-16, 1, Integrator::Global).state;
+        let mut picks = Vec::new();
+        for (name, integrator) in [("global", Integrator::Global), ("local", Integrator::Local)] {
+            let sweep: Vec<(f64, f64, Run)> = (6..=12)
+                .map(|k| {
+                    let rtol = 10f64.powi(-k);
+                    let run = ours_with(&model, t, rtol, rtol * 1e-3, repeats * 4, integrator);
+                    (rtol, error(&run.state, &reference), run)
+                })
+                .collect();
+            if let Some((rtol, err, run)) = robust_to(&sweep, 1e-6) {
+                println!(
+                    "N = {n} {name:<6}: rtol {rtol:.0e} error {err:.2e} {:>8.3} ms rhs {}",
+                    run.seconds * 1e3,
+                    run.rhs
+                );
+                picks.push((name, run.seconds));
+                small.push(json!({"n": n, "integrator": name, "rtol": rtol, "error": err, "seconds": run.seconds, "rhs_evaluations": run.rhs}));
+            }
+        }
+        if let [(_, g), (_, l)] = picks[..] {
+            println!("N = {n}: global / local = {:.2}", g / l);
+        }
+    }
+    out.insert("small_rows".into(), Value::Array(small));
+    Value::Object(out)
+}

@@ -1,0 +1,445 @@
+//! Exact motion between contacts (docs/theory.md §10).
+//!
+//! With every contact open, a model's equations are linear with
+//! time-dependent forcing:
+//!
+//! ```text
+//! ẋ = A x + Σ_j b_j sin(Ω_j t + φ_j) − e z̈_rec(t)
+//! ```
+//!
+//! per group of bodies joined by springs and dampers (a body without
+//! couplings is a group of one); `x` is the group's interleaved state
+//! `[u_1, v_1, …]`, `e` has a 1 in every velocity row, and the harmonic
+//! terms are the base's and the forces'. The state is propagated exactly:
+//!
+//! * harmonic forcing by its steady state `x_p(t) = Σ_j Im(X_j e^{i(Ω_j t +
+//!   φ_j)})`, `(iΩ_j − A) X_j = b_j`, and the homogeneous rest by `e^{Aτ}`:
+//!   `x(t₀ + τ) = x_p(t₀ + τ) + e^{Aτ}(x(t₀) − x_p(t₀))`;
+//! * a recorded accelerogram (linear between samples, zero outside the
+//!   record) sample by sample under first-order hold:
+//!   `x(b) = e^{Aτ}x(a) + Γ₁ e f(a) + Γ₂ e f'` with `Γ₁ = ∫₀^τ e^{As} ds`,
+//!   `Γ₂ = ∫₀^τ e^{A(τ−s)} s ds`, read off the exponential of the augmented
+//!   matrix `[[A, e, 0], [0, 0, 1], [0, 0, 0]] τ` (Van Loan);
+//! * for a single body `e^{Aτ}` in closed form (under-, critically and
+//!   over-damped, and free bodies with ω0 = 0), for a group by
+//!   nalgebra's matrix exponential.
+//!
+//! It also bounds the motion ahead, for the contact scheduler: the group's
+//! mechanical energy `E` (kinetic and spring) can only grow by the work of
+//! the forcing, `d√E/dt ≤ G = ½ Σ_i |f_i|max √(2/m_i)`, so over a horizon
+//! `H` every velocity is at most `√(2E_H/m_i)` and every spring force at
+//! most `√(2 k E_H)` with `√E_H = √E₀ + G H`.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use crate::model::{BaseExcitation, Model};
+
+/// Why a model's free motion has no exact propagator.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FreeMotionError {
+    /// An undamped group has a natural frequency equal to a forcing
+    /// frequency: its steady state grows without bound.
+    #[error("the free motion of {bodies} is undamped and resonant at the forcing frequency {frequency} rad/s: it has no bounded steady state; use the global integrator")]
+    Resonant {
+        /// The group's body names.
+        bodies: String,
+        /// The forcing frequency (rad/s).
+        frequency: f64,
+    },
+}
+
+/// How a group's `e^{Aτ}` is computed.
+#[derive(Clone, Debug)]
+enum Propagator {
+    /// One body: `ü = −w2 u − c2 u̇` in closed form.
+    Single { w2: f64, c2: f64 },
+    /// A group: the matrix exponential of `A`.
+    Group(DMatrix<f64>),
+}
+
+/// One spring-coupled group of bodies and its exact propagator.
+#[derive(Clone, Debug)]
+pub struct Group {
+    bodies: Vec<usize>,
+    propagator: Propagator,
+    /// Steady states of the harmonic terms: (Ω, φ, Re X, Im X).
+    harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    /// Couplings inside the group: (local a, local b, k, c).
+    couplings: Vec<(usize, usize, f64, f64)>,
+    /// Largest |external force| on each body (N).
+    force_max: Vec<f64>,
+    /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
+    rate: f64,
+}
+
+/// The exact free motion of every group of a model.
+#[derive(Clone, Debug)]
+pub struct FreeMotion {
+    groups: Vec<Group>,
+    /// (group, index in the group) of every body.
+    place: Vec<(usize, usize)>,
+    base: BaseExcitation,
+}
+
+/// `e^{Aτ}` of `ü = −w2 u − c2 u̇` as `[[p00, p01], [p10, p11]]`:
+/// `e^{μτ}[C I + S (A − μ I)]` with `μ = −c2/2`, `δ = μ² − w2`, `C, S` the
+/// cosine and sine (hyperbolic for δ > 0) of `√|δ| τ` (S divided by
+/// `√|δ|`), by their series where `|δ| τ²` is small.
+fn single_exp(w2: f64, c2: f64, tau: f64) -> [f64; 4] {
+    let mu = -0.5 * c2;
+    let delta = mu * mu - w2;
+    let x = delta * tau * tau;
+    let (ec, es) = if x.abs() < 1e-4 {
+        let e = (mu * tau).exp();
+        (
+            e * (1.0 + x / 2.0 + x * x / 24.0),
+            e * tau * (1.0 + x / 6.0 + x * x / 120.0),
+        )
+    } else if delta < 0.0 {
+        let wd = (-delta).sqrt();
+        let e = (mu * tau).exp();
+        (e * (wd * tau).cos(), e * (wd * tau).sin() / wd)
+    } else {
+        // e^{μτ} cosh(rτ) and e^{μτ} sinh(rτ)/r from the two decaying
+        // exponentials (μ + r <= 0: no overflow).
+        let r = delta.sqrt();
+        let (ep, em) = (((mu + r) * tau).exp(), ((mu - r) * tau).exp());
+        (0.5 * (ep + em), 0.5 * (ep - em) / r)
+    };
+    [ec - mu * es, es, -w2 * es, ec + mu * es]
+}
+
+impl FreeMotion {
+    /// The groups of `model` and their propagators. Errors for an undamped
+    /// group in resonance with a harmonic forcing term.
+    pub fn new(model: &Model) -> Result<Self, FreeMotionError> {
+        let n = model.bodies().len();
+        // Groups: connected components of the couplings (union–find).
+        let mut root: Vec<usize> = (0..n).collect();
+        fn find(root: &mut [usize], mut i: usize) -> usize {
+            while root[i] != i {
+                root[i] = root[root[i]];
+                i = root[i];
+            }
+            i
+        }
+        for c in model.couplings() {
+            let (a, b) = (find(&mut root, c.a), find(&mut root, c.b));
+            root[a.max(b)] = a.min(b);
+        }
+        let mut place = vec![(usize::MAX, 0); n];
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for i in 0..n {
+            let r = find(&mut root, i);
+            if place[r].0 == usize::MAX {
+                place[r] = (members.len(), 0);
+                members.push(Vec::new());
+            }
+            let g = place[r].0;
+            place[i] = (g, members[g].len());
+            members[g].push(i);
+        }
+        let zdd_max = match model.base() {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
+            BaseExcitation::Record(r) => r.peak(),
+        };
+        let mut groups = Vec::with_capacity(members.len());
+        for bodies in members {
+            groups.push(Self::group(model, &place, bodies, zdd_max)?);
+        }
+        Ok(Self {
+            groups,
+            place,
+            base: model.base().clone(),
+        })
+    }
+
+    fn group(
+        model: &Model,
+        place: &[(usize, usize)],
+        bodies: Vec<usize>,
+        zdd_max: f64,
+    ) -> Result<Group, FreeMotionError> {
+        let m = bodies.len();
+        let all = model.bodies();
+        let mass: Vec<f64> = bodies.iter().map(|&i| all[i].mass).collect();
+        let stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let damping: Vec<f64> = bodies.iter().map(|&i| all[i].damping).collect();
+        let couplings: Vec<(usize, usize, f64, f64)> = model
+            .couplings()
+            .iter()
+            .filter(|c| place[c.a].0 == place[bodies[0]].0)
+            .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
+            .collect();
+        let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
+        for j in 0..m {
+            a[(2 * j, 2 * j + 1)] = 1.0;
+            a[(2 * j + 1, 2 * j)] = -stiffness[j] / mass[j];
+            a[(2 * j + 1, 2 * j + 1)] = -damping[j] / mass[j];
+        }
+        for &(p, q, k, c) in &couplings {
+            for (i, j) in [(p, q), (q, p)] {
+                a[(2 * i + 1, 2 * i)] -= k / mass[i];
+                a[(2 * i + 1, 2 * j)] += k / mass[i];
+                a[(2 * i + 1, 2 * i + 1)] -= c / mass[i];
+                a[(2 * i + 1, 2 * j + 1)] += c / mass[i];
+            }
+        }
+        // Harmonic terms b sin(Ω t + φ) (per unit mass, velocity rows).
+        let mut terms: Vec<(f64, f64, Vec<f64>)> = Vec::new();
+        if let BaseExcitation::Harmonic {
+            amplitude,
+            frequency,
+            phase,
+        } = *model.base()
+        {
+            let mut b = vec![0.0; 2 * m];
+            for j in 0..m {
+                b[2 * j + 1] = -amplitude;
+            }
+            terms.push((frequency, phase, b));
+        }
+        let mut force_max: Vec<f64> = mass.iter().map(|mi| mi * zdd_max).collect();
+        for f in model.forces() {
+            if place[f.body].0 != place[bodies[0]].0 {
+                continue;
+            }
+            let j = place[f.body].1;
+            let mut b = vec![0.0; 2 * m];
+            b[2 * j + 1] = f.amplitude / mass[j];
+            force_max[j] += f.amplitude.abs();
+            terms.push((f.frequency, f.phase, b));
+        }
+        let names = || {
+            bodies
+                .iter()
+                .map(|&i| all[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut harmonic = Vec::with_capacity(terms.len());
+        let mut rate = 0.0f64;
+        for (w, phi, b) in terms {
+            rate = rate.max(w);
+            let mut lhs = DMatrix::<Complex<f64>>::from_fn(2 * m, 2 * m, |i, j| {
+                Complex::new(-a[(i, j)], 0.0)
+            });
+            for i in 0..2 * m {
+                lhs[(i, i)] += Complex::new(0.0, w);
+            }
+            let rhs = DVector::<Complex<f64>>::from_fn(2 * m, |i, _| Complex::new(b[i], 0.0));
+            let scale = a.amax() + w;
+            let x = lhs
+                .lu()
+                .solve(&rhs)
+                .filter(|x| x.iter().all(|z| z.re.is_finite() && z.im.is_finite()))
+                // An exactly singular pivot may still solve to huge values:
+                // resonance shows as a response far beyond any physical one.
+                .filter(|x| {
+                    let bmax = b.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                    x.iter()
+                        .all(|z| z.norm() * scale * 1e-12 <= bmax.max(1e-300))
+                })
+                .ok_or_else(|| FreeMotionError::Resonant {
+                    bodies: names(),
+                    frequency: w,
+                })?;
+            harmonic.push((
+                w,
+                phi,
+                x.iter().map(|z| z.re).collect(),
+                x.iter().map(|z| z.im).collect(),
+            ));
+        }
+        for j in 0..m {
+            rate = rate.max((-a[(2 * j + 1, 2 * j)]).sqrt());
+        }
+        let propagator = if m == 1 {
+            Propagator::Single {
+                w2: stiffness[0] / mass[0],
+                c2: damping[0] / mass[0],
+            }
+        } else {
+            Propagator::Group(a)
+        };
+        Ok(Group {
+            bodies,
+            propagator,
+            harmonic,
+            mass,
+            stiffness,
+            damping,
+            couplings,
+            force_max,
+            rate,
+        })
+    }
+
+    /// The groups.
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
+    }
+
+    /// (group, index within the group) of body `i`.
+    pub fn place(&self, i: usize) -> (usize, usize) {
+        self.place[i]
+    }
+
+    /// Adds the harmonic steady state of group `g` at time `t`, times
+    /// `sign`, to `x`.
+    fn add_particular(&self, g: &Group, t: f64, sign: f64, x: &mut [f64]) {
+        for (w, phi, re, im) in &g.harmonic {
+            let (s, c) = (w * t + phi).sin_cos();
+            for (xi, (r, i)) in x.iter_mut().zip(re.iter().zip(im)) {
+                *xi += sign * (r * s + i * c);
+            }
+        }
+    }
+
+    /// `x ← e^{Aτ} x` for group `g`.
+    fn homogeneous(g: &Group, tau: f64, x: &mut [f64]) {
+        match &g.propagator {
+            Propagator::Single { w2, c2 } => {
+                let p = single_exp(*w2, *c2, tau);
+                let (u, v) = (x[0], x[1]);
+                x[0] = p[0] * u + p[1] * v;
+                x[1] = p[2] * u + p[3] * v;
+            }
+            Propagator::Group(a) => {
+                let phi = (a * tau).exp();
+                let y = &phi * DVector::from_column_slice(x);
+                x.copy_from_slice(y.as_slice());
+            }
+        }
+    }
+
+    /// `x ← x(b)` from `x = x(a)` under the forcing `f(t) = fa + slope (t −
+    /// a)` in every velocity row (first-order hold; the harmonic part
+    /// already removed).
+    fn hold(a: &DMatrix<f64>, tau: f64, fa: f64, slope: f64, x: &mut [f64]) {
+        let d = x.len();
+        let mut big = DMatrix::<f64>::zeros(d + 2, d + 2);
+        big.view_mut((0, 0), (d, d)).copy_from(&(a * tau));
+        for j in 0..d / 2 {
+            big[(2 * j + 1, d)] = tau;
+        }
+        big[(d, d + 1)] = tau;
+        let e = big.exp();
+        let y: Vec<f64> = (0..d)
+            .map(|i| {
+                (0..d).map(|j| e[(i, j)] * x[j]).sum::<f64>()
+                    + e[(i, d)] * fa
+                    + e[(i, d + 1)] * slope
+            })
+            .collect();
+        x.copy_from_slice(&y);
+    }
+
+    /// Propagates group `g`'s interleaved state `x` from `t0` to `t1 >= t0`
+    /// exactly (in place).
+    pub fn propagate(&self, g: usize, t0: f64, t1: f64, x: &mut [f64]) {
+        let group = &self.groups[g];
+        if t1 == t0 {
+            return;
+        }
+        self.add_particular(group, t0, -1.0, x);
+        match &self.base {
+            BaseExcitation::Record(rec) => {
+                let a = self.matrix(group);
+                let times = rec.times();
+                let (first, last) = (times[0], times[times.len() - 1]);
+                let start = times.partition_point(|&s| s <= t0);
+                let mut ta = t0;
+                let mut k = start;
+                while ta < t1 {
+                    let tb = if k < times.len() {
+                        times[k].min(t1)
+                    } else {
+                        t1
+                    };
+                    if tb > ta {
+                        let mid = 0.5 * (ta + tb);
+                        let (fa, fb) = if mid > first && mid < last {
+                            (-rec.at(ta), -rec.at(tb))
+                        } else {
+                            (0.0, 0.0)
+                        };
+                        let tau = tb - ta;
+                        Self::hold(&a, tau, fa, (fb - fa) / tau, x);
+                    }
+                    ta = tb;
+                    k += 1;
+                }
+            }
+            _ => Self::homogeneous(group, t1 - t0, x),
+        }
+        self.add_particular(group, t1, 1.0, x);
+    }
+
+    /// The group's system matrix `A` (interleaved).
+    fn matrix(&self, g: &Group) -> DMatrix<f64> {
+        match &g.propagator {
+            Propagator::Group(a) => a.clone(),
+            Propagator::Single { w2, c2 } => DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w2, -c2]),
+        }
+    }
+}
+
+impl Group {
+    /// The bodies, in order along the line.
+    pub fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+
+    /// Mechanical energy (kinetic and springs) of the interleaved state `x`.
+    pub fn energy(&self, x: &[f64]) -> f64 {
+        let mut e = 0.0;
+        for j in 0..self.mass.len() {
+            let (u, v) = (x[2 * j], x[2 * j + 1]);
+            e += 0.5 * self.mass[j] * v * v + 0.5 * self.stiffness[j] * u * u;
+        }
+        for &(a, b, k, _) in &self.couplings {
+            let du = x[2 * b] - x[2 * a];
+            e += 0.5 * k * du * du;
+        }
+        e
+    }
+
+    /// `G` of the module notes: `√E` grows at most this fast (√J/s).
+    pub fn growth(&self) -> f64 {
+        self.force_max
+            .iter()
+            .zip(&self.mass)
+            .map(|(f, m)| 0.5 * f * (2.0 / m).sqrt())
+            .sum()
+    }
+
+    /// Largest |acceleration| of body `j` (index in the group) while the
+    /// group's energy stays below `e_max` (m/s²).
+    pub fn acceleration_bound(&self, j: usize, e_max: f64) -> f64 {
+        let speed = |i: usize| (2.0 * e_max / self.mass[i]).sqrt();
+        let mut f = (2.0 * self.stiffness[j] * e_max).sqrt()
+            + self.damping[j] * speed(j)
+            + self.force_max[j];
+        for &(a, b, k, c) in &self.couplings {
+            if a == j || b == j {
+                f += (2.0 * k * e_max).sqrt() + c * (speed(a) + speed(b));
+            }
+        }
+        f / self.mass[j]
+    }
+
+    /// Fastest natural frequency or forcing frequency of the group (rad/s;
+    /// 0 for free bodies without forcing).
+    pub fn rate(&self) -> f64 {
+        self.rate
+    }
+}
+
+#[cfg(test)]
+#[path = "free_motion_tests.rs"]
+mod tests;
