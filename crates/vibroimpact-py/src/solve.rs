@@ -239,7 +239,7 @@ fn split_states<'py>(
 /// A time history: the `simulate` summary plus `t`, `displacement`,
 /// `velocity` (rows per output time) and the impact log as arrays.
 #[pyfunction]
-#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, progress = None))]
+#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, integrator, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -251,11 +251,13 @@ pub fn simulate<'py>(
     output_step: Option<f64>,
     energy: bool,
     impact_force_threshold: Option<f64>,
+    integrator: &str,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.loaded.model;
     let settings = &model.loaded.simulation;
     let method = method(method_name)?;
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     // The CLI's defaults: the model's [simulation] settings, else these.
     let rtol = rtol.or(settings.rtol).unwrap_or(1e-8);
     let atol = atol.or(settings.atol).unwrap_or(rtol * 1e-4);
@@ -281,6 +283,7 @@ pub fn simulate<'py>(
             impact_force_threshold,
             energy,
             method,
+            integrator,
             interrupt: Some(p.interrupt.clone()),
             ..SimulationOptions::default()
         };

@@ -85,6 +85,28 @@ def test_simulate(cli):
     close(h.displacement[-1], h.final_displacement)
 
 
+def test_simulate_local(cli):
+    # The local integrator (exact motion between contacts) from both faces:
+    # the same numbers and the same work counters; sampling a history does
+    # not move the trajectory.
+    doc = cli("simulate", EXAMPLES / "fujita-row.toml", "--periods", "5", "--integrator", "local")
+    r = vi.simulate(EXAMPLES / "fujita-row.toml", periods=5, output_step=0, integrator="local")
+    assert doc["integrator"] == r.integrator == "local"
+    for key in ("final_time", "final_displacement", "final_velocity"):
+        close(r[key], doc[key])
+    for key in ("impact_count", "rhs_evaluations", "steps", "completed"):
+        assert r[key] == doc[key], key
+    assert r.local.to_dict() == doc["local"]
+    assert doc["local"]["bodies_integrated"] == 3
+    h = vi.simulate(EXAMPLES / "fujita-row.toml", periods=5, integrator="local")
+    close(h.final_displacement, doc["final_displacement"])
+    close(h.displacement[-1], h.final_displacement)
+    g = vi.simulate(EXAMPLES / "fujita-row.toml", periods=5, output_step=0)
+    assert g.integrator == "global" and g.impact_count == r.impact_count
+    with pytest.raises(ValueError, match="integrator"):
+        vi.simulate(EXAMPLES / "fujita-row.toml", periods=1, integrator="fast")
+
+
 def test_periodic(cli):
     doc = cli("periodic", EXAMPLES / "fujita-row-n2.toml", "--symmetric")
     r = vi.periodic(EXAMPLES / "fujita-row-n2.toml", symmetric=True)

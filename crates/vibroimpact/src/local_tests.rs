@@ -331,3 +331,73 @@ fn what_the_local_integrator_cannot_do_is_refused() {
     .unwrap_err();
     assert!(e.0.contains("global"), "{e}");
 }
+
+/// The example's struck chain (examples/granular-chain.toml, sonic
+/// vacuum): a solitary wave forms whose speed scales as the 1/5 power of
+/// its peak particle velocity (Nesterenko, *Dynamics of Heterogeneous
+/// Materials*, 2001, §1.2), to 1 % over striker velocities 1 and 0.1 m/s,
+/// and which is five beads wide: as its peak passes a bead, the velocities
+/// are 0.009, 0.33, 1, 0.32, 0.009 of the peak over five beads and below
+/// 1e-5 beyond (counted above 1e-3).
+#[test]
+fn nesterenko_solitary_wave_in_the_granular_chain() {
+    let chain = crate::model_file::ModelDocument::from_toml(
+        include_str!("../../../examples/granular-chain.toml"),
+        "granular-chain.toml",
+    )
+    .unwrap()
+    .build()
+    .unwrap()
+    .model;
+    let n = chain.bodies().len();
+    assert_eq!(chain.initial_velocity()[0], 1.0);
+    assert!(chain.initial_velocity()[1..].iter().all(|&v| v == 0.0));
+    let dt = 1e-6;
+    // (speed in beads per second, peak velocity, width in beads)
+    let wave = |striker: f64| {
+        let mut v0 = vec![0.0; n];
+        v0[0] = striker;
+        let model = chain.clone().with_initial_state(vec![], v0).unwrap();
+        let t_end = 0.004 / striker.powf(0.2);
+        let sim = simulate(
+            &model,
+            &SimulationOptions {
+                t_end,
+                output_step: Some(dt),
+                integrator: Integrator::Local,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(sim.error.is_none(), "{:?}", sim.error);
+        let samples = sim.times.len();
+        let v = |k: usize, i: usize| sim.states[k * 2 * n + n + i];
+        // The time of bead i's largest velocity, refined by a parabola.
+        let peak = |i: usize| {
+            let k = (1..samples - 1)
+                .max_by(|&a, &b| v(a, i).total_cmp(&v(b, i)))
+                .unwrap();
+            let (a, b, c) = (v(k - 1, i), v(k, i), v(k + 1, i));
+            let shift = 0.5 * (a - c) / (a - 2.0 * b + c);
+            (sim.times[k] + shift * dt, b - 0.25 * (a - c) * shift)
+        };
+        let (t30, _) = peak(30);
+        let (t80, vm) = peak(80);
+        // The width when the peak is at bead 60.
+        let (t60, vm60) = peak(60);
+        let k60 = (t60 / dt).round() as usize;
+        let width = (0..n).filter(|&i| v(k60, i) > 1e-3 * vm60).count();
+        (50.0 / (t80 - t30), vm, width)
+    };
+    let (c1, v1, w1) = wave(1.0);
+    let (c2, v2, w2) = wave(0.1);
+    let ratio = (c1 / c2) / (v1 / v2).powf(0.2);
+    assert!(
+        (ratio - 1.0).abs() < 0.01,
+        "speed ratio / velocity ratio^(1/5) = {ratio}"
+    );
+    // The peak is a fixed part of the striker's velocity (a solitary wave
+    // of the same shape), and about five beads move.
+    assert!((v1 / v2 / 10.0 - 1.0).abs() < 0.01, "{v1} {v2}");
+    assert_eq!((w1, w2), (5, 5));
+}

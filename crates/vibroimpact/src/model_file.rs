@@ -283,8 +283,77 @@ pub(crate) struct ForceSpec {
 #[derive(Serialize, Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct InitialSpec {
-    pub(crate) displacement: Option<Vec<f64>>,
-    pub(crate) velocity: Option<Vec<f64>>,
+    pub(crate) displacement: Option<InitialValues>,
+    pub(crate) velocity: Option<InitialValues>,
+}
+
+/// `[initial]` values: one per body in order, or by body name (the others
+/// at 0), e.g. `velocity = { p1 = 1.0 }` for a struck row.
+#[derive(Serialize, Debug, Clone)]
+#[serde(untagged)]
+pub(crate) enum InitialValues {
+    /// One value per body.
+    List(Vec<f64>),
+    /// Values of named bodies.
+    Named(std::collections::BTreeMap<String, f64>),
+}
+
+/// An array or a table, read directly (an untagged enum would buffer the
+/// table, which the TOML reader refuses for a `[initial.velocity]` header).
+impl<'de> Deserialize<'de> for InitialValues {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Values;
+        impl<'de> serde::de::Visitor<'de> for Values {
+            type Value = InitialValues;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "an array of numbers (one per body) or a table of body names and numbers",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Self::Value, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    v.push(x);
+                }
+                Ok(InitialValues::List(v))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<Self::Value, A::Error> {
+                let mut m = std::collections::BTreeMap::new();
+                while let Some((k, x)) = map.next_entry::<String, f64>()? {
+                    m.insert(k, x);
+                }
+                Ok(InitialValues::Named(m))
+            }
+        }
+        d.deserialize_any(Values)
+    }
+}
+
+impl InitialValues {
+    /// The values in body order; `names` are the bodies' names. Errors name
+    /// an unknown body.
+    fn resolve(&self, names: &[&str], what: &str) -> Result<Vec<f64>, String> {
+        match self {
+            InitialValues::List(v) => Ok(v.clone()),
+            InitialValues::Named(map) => {
+                let mut v = vec![0.0; names.len()];
+                for (name, value) in map {
+                    let i = names
+                        .iter()
+                        .position(|n| n == name)
+                        .ok_or_else(|| format!("[initial] {what}: no body named {name:?}"))?;
+                    v[i] = *value;
+                }
+                Ok(v)
+            }
+        }
+    }
 }
 
 /// Optional simulation settings stored with the model.
@@ -507,6 +576,21 @@ impl ModelDocument {
                 *units = None;
                 *time = Some(r.times.clone());
                 *acceleration = Some(r.acceleration.clone());
+            }
+        }
+        // Initial values by body name are written one per body (TOML would
+        // write them under an `[initial.velocity]` header, which its reader
+        // refuses inside `[initial]`).
+        if let Some(init) = file.initial.as_mut() {
+            let spec = init.get_mut();
+            let named = |v: &Option<InitialValues>| matches!(v, Some(InitialValues::Named(_)));
+            if named(&spec.displacement) || named(&spec.velocity) {
+                if let Ok(loaded) = self.build() {
+                    let m = &loaded.model;
+                    spec.displacement =
+                        Some(InitialValues::List(m.initial_displacement().to_vec()));
+                    spec.velocity = Some(InitialValues::List(m.initial_velocity().to_vec()));
+                }
             }
         }
         // Serialising plain data (numbers, strings, arrays, tables) cannot fail.
@@ -815,8 +899,15 @@ impl ModelDocument {
                 ));
             }
             let spec = init.get_ref();
-            init_u = spec.displacement.clone().unwrap_or_default();
-            init_v = spec.velocity.clone().unwrap_or_default();
+            let names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+            let resolve = |values: &Option<InitialValues>, what: &str| match values {
+                Some(v) => v
+                    .resolve(&names, what)
+                    .map_err(|e| cx.err_at(span.clone(), e)),
+                None => Ok(Vec::new()),
+            };
+            init_u = resolve(&spec.displacement, "displacement")?;
+            init_v = resolve(&spec.velocity, "velocity")?;
         }
         let model = Model::new(bodies, couplings, contacts, base, forces, init_u, init_v)
             .map_err(|e| cx.plain(e))?;

@@ -167,3 +167,23 @@ fn round_trip() {
         assert_eq!(again.build().unwrap().model, doc.build().unwrap().model);
     }
 }
+
+/// `[initial]` by body name: the named bodies' values, the others at rest;
+/// an unknown name is an error with its line; the form survives the round
+/// trip; a dotted parameter into it does not exist.
+#[test]
+fn initial_state_by_body_name() {
+    let text = include_str!("../../../examples/granular-chain.toml");
+    let doc = ModelDocument::from_toml(text, "chain.toml").unwrap();
+    let m = doc.build().unwrap().model;
+    assert_eq!(m.initial_velocity()[0], 1.0);
+    assert!(m.initial_velocity()[1..].iter().all(|&v| v == 0.0));
+    assert!(m.initial_displacement().iter().all(|&u| u == 0.0));
+    let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+    assert_eq!(again.build().unwrap().model, m);
+    let bad = text.replace("{ p1 = 1.0 }", "{ p1 = 1.0, q7 = 2.0 }");
+    let e = err(&bad);
+    assert!(e.contains("chain.toml:") || e.contains(":2"), "{e}");
+    assert!(e.contains("no body named \"q7\""), "{e}");
+    assert!(doc.parameter("initial.velocity.1").is_err());
+}

@@ -10,7 +10,7 @@
 
 use crate::model::Model;
 use crate::model_file::{
-    ExcitationSpec, LawSpec, LoadedModel, ModelDocument, ModelFile, ModelFileError,
+    ExcitationSpec, InitialValues, LawSpec, LoadedModel, ModelDocument, ModelFile, ModelFileError,
 };
 
 /// The table a parameter lives in (indices of array tables are 0-based).
@@ -193,13 +193,15 @@ fn slot<'a>(file: &'a mut ModelFile, key: &ParameterKey) -> Option<Slot<'a>> {
             }
         }
         T::InitialDisplacement(i) => {
-            let v = file.initial.as_mut()?.get_mut().displacement.as_mut()?;
-            v.get_mut(i).map(Slot::Real)
+            match file.initial.as_mut()?.get_mut().displacement.as_mut()? {
+                InitialValues::List(v) => v.get_mut(i).map(Slot::Real),
+                InitialValues::Named(_) => None,
+            }
         }
-        T::InitialVelocity(i) => {
-            let v = file.initial.as_mut()?.get_mut().velocity.as_mut()?;
-            v.get_mut(i).map(Slot::Real)
-        }
+        T::InitialVelocity(i) => match file.initial.as_mut()?.get_mut().velocity.as_mut()? {
+            InitialValues::List(v) => v.get_mut(i).map(Slot::Real),
+            InitialValues::Named(_) => None,
+        },
         T::Simulation => {
             let s = file.simulation.as_mut()?;
             match f {

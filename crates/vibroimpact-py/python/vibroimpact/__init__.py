@@ -398,6 +398,7 @@ def simulate(
     output_step: Optional[float] = None,
     energy: bool = False,
     impact_force_threshold: Optional[float] = None,
+    integrator: str = "global",
     progress: Progress = None,
 ) -> Result:
     """A time history with its impact log (``vibroimpact simulate``).
@@ -407,6 +408,9 @@ def simulate(
     ``[simulation]`` settings, else 1e-8, rtol*1e-4, 1e-3 N. ``method``:
     "dop853", "dopri5", "rodas" or "auto". ``output_step`` (s): sampling of the
     history, default 1/100 forcing period (or duration/2000); 0: none.
+    ``integrator``: "global" (every body integrated at every step) or
+    "local" (exact motion between contacts, only bodies in touch
+    integrated; the summary then has ``local`` with its work counters).
 
     Returns the CLI's summary fields (``completed``, ``error``,
     ``final_time``, ``final_displacement``, ``final_velocity``,
@@ -447,6 +451,7 @@ def simulate(
             output_step,
             _flag(energy, "energy"),
             _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
+            _method(integrator, ("global", "local"), "integrator"),
             _progress(progress),
         )
     )
