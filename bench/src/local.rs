@@ -13,40 +13,10 @@
 //!    reaching 1e-6 against rtol 1e-13, global and local, timed.
 
 use super::*;
-use vibroimpact::contact::ContactLaw;
-use vibroimpact::model::BaseExcitation;
 
-/// The loosest rtol (of a sweep from loose to tight) from which every
-/// tighter one meets `target`.
-fn robust_to(sweep: &[(f64, f64, Run)], target: f64) -> Option<&(f64, f64, Run)> {
-    let mut pick = None;
-    for entry in sweep.iter().rev() {
-        if entry.1 <= target {
-            pick = Some(entry);
-        } else {
-            break;
-        }
-    }
-    pick
-}
-
-/// The struck chain of `n` beads.
+/// The struck chain of `n` beads, bead 1 at 1 m/s.
 fn chain(n: usize) -> Model {
-    let law = ContactLaw::hertz(7e9, 1.5).expect("valid law");
-    let m = Model::row(
-        n,
-        0.0286,
-        0.0,
-        0.0,
-        0.0,
-        law,
-        (false, false),
-        BaseExcitation::None,
-    )
-    .expect("valid chain");
-    let mut v = vec![0.0; n];
-    v[0] = 1.0;
-    m.with_initial_state(Vec::new(), v).expect("valid state")
+    reference::struck_chain(n, 1.0).expect("valid chain")
 }
 
 /// Largest bead velocity at the end (the wave's peak).

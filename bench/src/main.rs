@@ -218,9 +218,15 @@ fn error(state: &[f64], reference: &[f64]) -> f64 {
 /// The robust setting of a sweep (rtol descending): the loosest rtol from
 /// which every tighter one meets the target.
 fn robust(sweep: &[(f64, f64, Run)]) -> Option<&(f64, f64, Run)> {
+    robust_to(sweep, TARGET_ERROR)
+}
+
+/// The loosest rtol (of a sweep from loose to tight) from which every
+/// tighter one meets `target`.
+fn robust_to(sweep: &[(f64, f64, Run)], target: f64) -> Option<&(f64, f64, Run)> {
     let mut pick = None;
     for entry in sweep.iter().rev() {
-        if entry.1 <= TARGET_ERROR {
+        if entry.1 <= target {
             pick = Some(entry);
         } else {
             break;

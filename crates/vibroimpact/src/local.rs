@@ -60,8 +60,8 @@ enum Activation {
     Compact,
     /// `F <= k s^n (1 + factor |ṡ|)` for s > 0 (Hertz, Hunt–Crossley,
     /// Lankarani–Nikravesh): active where that bound exceeds `f_neg`, the
-    /// force that changes the lighter body's velocity by less than `atol`
-    /// over the whole run.
+    /// force that changes the lighter of the contact's bodies' velocity by
+    /// less than `atol` over the whole run.
     Power {
         k: f64,
         n: f64,
@@ -74,9 +74,9 @@ enum Activation {
 }
 
 impl Activation {
-    fn new(model: &Model, k: usize, opts: &SimulationOptions, s_on: f64) -> Self {
+    fn new(model: &Model, k_index: usize, opts: &SimulationOptions, s_on: f64) -> Self {
         let rtol = opts.rtol;
-        let c = &model.contacts()[k];
+        let c = &model.contacts()[k_index];
         match *c.law.kind() {
             LawKind::Exponential { a, b, alpha } => {
                 let bodies = model.bodies();
@@ -103,8 +103,8 @@ impl Activation {
                     limit,
                 }
             }
-            LawKind::Hertz { k, n } => Self::power(model, k, n, 0.0, opts),
-            LawKind::HuntCrossley { k, n, chi } => Self::power(model, k, n, chi, opts),
+            LawKind::Hertz { k, n } => Self::power(model, k_index, (k, n, 0.0), opts),
+            LawKind::HuntCrossley { k, n, chi } => Self::power(model, k_index, (k, n, chi), opts),
             LawKind::LankaraniNikravesh {
                 k,
                 n,
@@ -112,23 +112,30 @@ impl Activation {
                 min_impact_velocity,
             } => {
                 let factor = 0.75 * (1.0 - restitution * restitution) / min_impact_velocity;
-                Self::power(model, k, n, factor, opts)
+                Self::power(model, k_index, (k, n, factor), opts)
             }
             LawKind::KelvinVoigt { .. } => Activation::Compact,
         }
     }
 
-    fn power(model: &Model, k: f64, n: f64, factor: f64, opts: &SimulationOptions) -> Self {
-        let lightest = model
-            .bodies()
-            .iter()
-            .map(|b| b.mass)
+    fn power(
+        model: &Model,
+        contact: usize,
+        law: (f64, f64, f64),
+        opts: &SimulationOptions,
+    ) -> Self {
+        let c = &model.contacts()[contact];
+        let lighter = [c.pair.left(), c.pair.right()]
+            .into_iter()
+            .flatten()
+            .map(|i| model.bodies()[i].mass)
             .fold(f64::INFINITY, f64::min);
+        let (k, n, factor) = law;
         Activation::Power {
             k,
             n,
             factor,
-            f_neg: lightest * opts.atol / opts.t_end,
+            f_neg: lighter * opts.atol / opts.t_end,
         }
     }
 

@@ -44,14 +44,7 @@ fn difference(a: &Simulation, b: &Simulation) -> f64 {
 /// scatters between 2e-10 and 6e-7 with the rtol, in both integrators.)
 #[test]
 fn r2_by_the_local_integrator_agrees_with_scipy() {
-    let scipy: [f64; 6] = [
-        0.00026822438569644924,
-        5.387370645080881e-05,
-        0.0006982749704558822,
-        -0.00995929240162609,
-        -0.0035041867100254133,
-        0.005716496838870423,
-    ];
+    let scipy = crate::reference::R2_N3_SCIPY;
     let omega = 0.95 * W0;
     let t_end = 5.0 * 2.0 * std::f64::consts::PI / omega;
     for (rtol, tol) in [(1e-10, 1e-6), (1e-13, 1e-7)] {
@@ -257,23 +250,7 @@ fn a_grazing_contact_is_never_missed() {
 /// bit) whether 800 more beads rest beyond them or not.
 #[test]
 fn bodies_at_rest_are_never_evaluated() {
-    let chain = |n: usize| {
-        let law = ContactLaw::hertz(7e9, 1.5).unwrap();
-        let m = Model::row(
-            n,
-            0.0286,
-            0.0,
-            0.0,
-            0.0,
-            law,
-            (false, false),
-            BaseExcitation::None,
-        )
-        .unwrap();
-        let mut v = vec![0.0; n];
-        v[0] = 1.0;
-        m.with_initial_state(vec![], v).unwrap()
-    };
+    let chain = |n: usize| crate::reference::struck_chain(n, 1.0).unwrap();
     let opts = SimulationOptions {
         t_end: 2e-3,
         integrator: Integrator::Local,

@@ -334,15 +334,20 @@ pub struct Model {
     initial_velocity: Vec<f64>,
 }
 
-/// `v` must be finite and >= 0; `key` is its path, `what` names it.
-fn nonneg(key: String, what: String, v: f64) -> Result<(), ModelError> {
+/// `v` must be finite and >= 0; `key` is its path, `what` names it (both
+/// made only for the error: a row of 10⁶ bodies formats nothing).
+fn nonneg(
+    key: impl FnOnce() -> String,
+    what: impl FnOnce() -> String,
+    v: f64,
+) -> Result<(), ModelError> {
     if v >= 0.0 && v.is_finite() {
         Ok(())
     } else {
         Err(ModelError::new(
             ModelErrorKind::InvalidValue,
-            key,
-            format!("{what} = {v}: must be finite and >= 0"),
+            key(),
+            format!("{} = {v}: must be finite and >= 0", what()),
         ))
     }
 }
@@ -377,13 +382,13 @@ impl Model {
                 ));
             }
             nonneg(
-                key("stiffness"),
-                format!("body {}: stiffness", b.name),
+                || key("stiffness"),
+                || format!("body {}: stiffness", b.name),
                 b.stiffness,
             )?;
             nonneg(
-                key("damping"),
-                format!("body {}: damping", b.name),
+                || key("damping"),
+                || format!("body {}: damping", b.name),
                 b.damping,
             )?;
         }
@@ -397,23 +402,23 @@ impl Model {
                 ));
             }
             nonneg(
-                key("stiffness"),
-                format!("spring {}: stiffness", k + 1),
+                || key("stiffness"),
+                || format!("spring {}: stiffness", k + 1),
                 c.stiffness,
             )?;
             nonneg(
-                key("damping"),
-                format!("spring {}: damping", k + 1),
+                || key("damping"),
+                || format!("spring {}: damping", k + 1),
                 c.damping,
             )?;
         }
         let name = |i: usize| bodies[i].name.clone();
         for (k, c) in contacts.iter().enumerate() {
-            let between = format!("contact.{}.between", k + 1);
+            let between = || format!("contact.{}.between", k + 1);
             let unknown = || {
                 ModelError::new(
                     ModelErrorKind::UnknownBody,
-                    between.clone(),
+                    between(),
                     format!("contact {}: unknown body", k + 1),
                 )
             };
@@ -425,7 +430,7 @@ impl Model {
                     if left >= right {
                         return Err(ModelError::new(
                             ModelErrorKind::Order,
-                            between,
+                            between(),
                             format!(
                                 "contact {}: bodies must be given left first in their order along the line ({} is not left of {})",
                                 k + 1,
@@ -442,8 +447,8 @@ impl Model {
                 }
             }
             nonneg(
-                format!("contact.{}.clearance", k + 1),
-                format!("contact {}: clearance", k + 1),
+                || format!("contact.{}.clearance", k + 1),
+                || format!("contact {}: clearance", k + 1),
                 c.clearance,
             )?;
         }

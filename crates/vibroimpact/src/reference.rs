@@ -117,6 +117,49 @@ pub(crate) fn r2_primary_orbit(n: usize, clearance: f64, frequency: f64) -> Vec<
     .unwrap()
 }
 
+/// The struck granular chain in "sonic vacuum" (docs/theory.md §10):
+/// `n` steel beads of 0.0286 kg touching without precompression, Hertz
+/// contacts `7e9 s^1.5` N between neighbours, no springs, no walls, the
+/// first bead moving at `striker` m/s (examples/granular-chain.toml with
+/// N = 100 and 1 m/s).
+pub fn struck_chain(n: usize, striker: f64) -> Result<Model, ModelError> {
+    let law = crate::contact::ContactLaw::hertz(7e9, 1.5).map_err(|e| {
+        ModelError::new(
+            crate::model::ModelErrorKind::InvalidValue,
+            "row.contact",
+            e.to_string(),
+        )
+    })?;
+    let m = Model::row(
+        n,
+        0.0286,
+        0.0,
+        0.0,
+        0.0,
+        law,
+        (false, false),
+        BaseExcitation::None,
+    )?;
+    let mut v = vec![0.0; n];
+    if let Some(first) = v.first_mut() {
+        *first = striker;
+    }
+    m.with_initial_state(Vec::new(), v)
+}
+
+/// R2 with N = 3 at 0.95 ω0 after 5 periods from rest, `[u.., v..]`, by
+/// SciPy's DOP853 at rtol 1e-13, atol 1e-16 (bench/peers,
+/// results-2026-11-22.json; SUNDIALS' CVODE agrees to 6e-9).
+#[cfg(test)]
+pub(crate) const R2_N3_SCIPY: [f64; 6] = [
+    0.00026822438569644924,
+    5.387370645080881e-05,
+    0.0006982749704558822,
+    -0.00995929240162609,
+    -0.0035041867100254133,
+    0.005716496838870423,
+];
+
 /// [`r2`] under the base acceleration `amplitude · sin(frequency·t)` m/s²
 /// (branches and curves in the forcing amplitude; 0 is the rest state).
 pub fn r2_forced(

@@ -928,11 +928,7 @@ pub fn simulate_streaming(
     }
     let y = st.y().to_vec();
     let mut impacts = scan.impacts;
-    impacts.sort_by(|a, b| {
-        a.start_time
-            .total_cmp(&b.start_time)
-            .then(a.contact.cmp(&b.contact))
-    });
+    by_start(&mut impacts);
     let energy = opts.energy.then(|| EnergyBalance {
         initial: e0,
         mechanical: sys.mechanical_energy(&y),
@@ -945,16 +941,8 @@ pub fn simulate_streaming(
             IntegrationError::StepSizeUnderflow { y, .. } => y.clone(),
             _ => st.y().to_vec(),
         };
-        let deepest = (0..model.contacts().len())
-            .map(|k| (k, sys.approach(k, &state).0))
-            .max_by(|a, b| {
-                (a.1 - scan.trackers[a.0].s_on).total_cmp(&(b.1 - scan.trackers[b.0].s_on))
-            });
-        SimulationFailure {
-            source,
-            contact: deepest.map(|(k, _)| model.contact_name(k)),
-            approach: deepest.map_or(f64::NAN, |d| d.1),
-        }
+        let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
+        failure(model, source, &state, &s_on)
     });
     Ok(Simulation {
         times: Vec::new(),
@@ -972,6 +960,30 @@ pub fn simulate_streaming(
     })
 }
 
+/// Impacts in order of start time, then contact.
+fn by_start(impacts: &mut [ImpactRecord]) {
+    impacts.sort_by(|a, b| {
+        a.start_time
+            .total_cmp(&b.start_time)
+            .then(a.contact.cmp(&b.contact))
+    });
+}
+
+/// The failure `source` at the interleaved state `y`, with the contact
+/// engaged deepest past its impact threshold `s_on`.
+fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> SimulationFailure {
+    let n = model.bodies().len();
+    let u: Vec<f64> = (0..n).map(|i| y[2 * i]).collect();
+    let deepest = (0..model.contacts().len())
+        .map(|k| (k, model.approach(k, &u)))
+        .max_by(|a, b| (a.1 - s_on[a.0]).total_cmp(&(b.1 - s_on[b.0])));
+    SimulationFailure {
+        source,
+        contact: deepest.map(|(k, _)| model.contact_name(k)),
+        approach: deepest.map_or(f64::NAN, |d| d.1),
+    }
+}
+
 /// [`simulate_streaming`] by the local integrator.
 fn simulate_local(
     model: &Model,
@@ -984,28 +996,16 @@ fn simulate_local(
     let run = local::run(model, opts, method, y0, breakpoints, sink)?;
     let n = model.bodies().len();
     let mut impacts = run.impacts;
-    impacts.sort_by(|a, b| {
-        a.start_time
-            .total_cmp(&b.start_time)
-            .then(a.contact.cmp(&b.contact))
-    });
+    by_start(&mut impacts);
     let error = run.error.or(run
         .sink_stopped
         .map(|t| IntegrationError::Interrupted { t }));
-    let error = error.map(|source| {
-        let y = &run.y;
-        let deepest = (0..model.contacts().len())
-            .map(|k| {
-                let u: Vec<f64> = (0..n).map(|i| y[2 * i]).collect();
-                (k, model.approach(k, &u))
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        SimulationFailure {
-            source,
-            contact: deepest.map(|(k, _)| model.contact_name(k)),
-            approach: deepest.map_or(f64::NAN, |d| d.1),
-        }
-    });
+    let s_on: Vec<f64> = model
+        .contacts()
+        .iter()
+        .map(|c| c.law.onset_approach(opts.impact_force_threshold))
+        .collect();
+    let error = error.map(|source| failure(model, source, &run.y, &s_on));
     Ok(Simulation {
         times: Vec::new(),
         states: Vec::new(),

@@ -17,7 +17,7 @@ use vibroimpact::integrate::Method;
 use vibroimpact::model::{BaseExcitation, Model};
 use vibroimpact::model_file::{parse_accelerogram_csv, ModelDocument, ModelFileError};
 use vibroimpact::parameter::ParameterizedModel;
-use vibroimpact::simulate::{simulate, SimulationOptions};
+use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
 
 #[path = "support/mutate.rs"]
 mod mutate;
@@ -72,23 +72,26 @@ fn loader(name: &str) -> Result<vibroimpact::record::Record, ModelFileError> {
     }
 }
 
-/// A short simulation, bounded by a small step limit.
+/// A short simulation by both integrators, bounded by a small step limit.
 fn short_run(model: &Model, method: Method) {
     let t_end = model
         .forcing_frequency()
         .map_or(0.05, |w| (2.0 * std::f64::consts::PI / w).min(0.5));
-    let opts = SimulationOptions {
-        t_end,
-        max_steps: 20_000,
-        method,
-        ..SimulationOptions::default()
-    };
-    if let Ok(sim) = simulate(model, &opts) {
-        if sim.error.is_none() {
-            assert!(
-                sim.final_displacement.iter().all(|x| x.is_finite()),
-                "a completed run has a finite state"
-            );
+    for integrator in [Integrator::Global, Integrator::Local] {
+        let opts = SimulationOptions {
+            t_end,
+            max_steps: 20_000,
+            method,
+            integrator,
+            ..SimulationOptions::default()
+        };
+        if let Ok(sim) = simulate(model, &opts) {
+            if sim.error.is_none() {
+                assert!(
+                    sim.final_displacement.iter().all(|x| x.is_finite()),
+                    "a completed run has a finite state"
+                );
+            }
         }
     }
 }
