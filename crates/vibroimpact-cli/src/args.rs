@@ -206,6 +206,10 @@ pub struct AttractorRuns {
     /// lightly damped free oscillation).
     #[arg(long)]
     pub cluster_tolerance: Option<f64>,
+    /// Integrator of the transients: `local` moves bodies out of contact
+    /// exactly (the recorded periods run the global one).
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    pub integrator: IntegratorName,
 }
 
 impl AttractorRuns {
@@ -222,6 +226,7 @@ impl AttractorRuns {
             method: self.method.method(),
             cluster_tolerance: self.cluster_tolerance,
             interrupt: Some(interrupt),
+            integrator: self.integrator.integrator(),
             ..vibroimpact::sweep::SweepOptions::default()
         }
     }

@@ -17,7 +17,7 @@ use crate::solve::method;
 /// (`u1`, `v2`, …); `base`: the other components (None: the model's initial
 /// state); `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None))]
+#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "global"))]
 #[allow(clippy::too_many_arguments)]
 pub fn basins<'py>(
     py: Python<'py>,
@@ -35,7 +35,9 @@ pub fn basins<'py>(
     cluster_tolerance: Option<f64>,
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     let xs = floats(&x_values, "x_values")?;
     let ys = floats(&y_values, "y_values")?;
     let base = base.map(|b| floats(&b, "base")).transpose()?;
@@ -61,6 +63,7 @@ pub fn basins<'py>(
             method,
             cluster_tolerance,
             interrupt: Some(p.interrupt.clone()),
+            integrator,
             ..SweepOptions::default()
         };
         pool.install(|| {

@@ -16,7 +16,7 @@ use crate::solve::method;
 /// each with its `runs`). `lyapunov`: each run's largest exponent;
 /// `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None))]
+#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "global"))]
 #[allow(clippy::too_many_arguments)]
 pub fn chart<'py>(
     py: Python<'py>,
@@ -35,7 +35,9 @@ pub fn chart<'py>(
     cluster_tolerance: Option<f64>,
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     let xs = floats(&x_values, "x_values")?;
     let ys = floats(&y_values, "y_values")?;
     let method = method(method_name)?;
@@ -55,6 +57,7 @@ pub fn chart<'py>(
                 cluster_tolerance,
                 lyapunov: lyapunov.then_some(1),
                 interrupt: Some(p.interrupt.clone()),
+                integrator,
                 ..SweepOptions::default()
             },
             starts,

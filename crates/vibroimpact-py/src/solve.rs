@@ -504,7 +504,7 @@ pub fn parameter_values<'py>(
 /// `lyapunov = k` its k largest Lyapunov exponents. `threads`: the size of
 /// the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None))]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None, integrator = "global"))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -522,8 +522,10 @@ pub fn sweep<'py>(
     only: Option<&str>,
     progress: Option<&Bound<'py, PyAny>>,
     lyapunov: Option<usize>,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     let values = floats(&values, "values")?;
     let method = method(method_name)?;
     let pool = thread_pool(threads)?;
@@ -551,6 +553,7 @@ pub fn sweep<'py>(
             cluster_tolerance,
             lyapunov,
             interrupt: Some(p.interrupt.clone()),
+            integrator,
         };
         pool.install(|| run_sweep(&family, &values, &options, &|| p.tick()))
     })?

@@ -144,13 +144,16 @@ def test_continue(cli, parameter, from_, to):
         np.testing.assert_allclose(ratio, ratio[0], rtol=1e-8)
 
 
-def test_sweep(cli):
+@pytest.mark.parametrize("integrator", ["global", "local"])
+def test_sweep(cli, integrator):
     m = EXAMPLES / "fujita-row.toml"
     doc = cli(
         "sweep", m, "--parameter", "frequency", "--from", "5.9", "--to", "8.9",
         "--points", "5", "--transient", "20", "--record", "5", "--up-down",
+        "--integrator", integrator,
     )
-    r = vi.sweep(m, "frequency", from_=5.9, to=8.9, points=5, transient=20, record=5, up_down=True)
+    r = vi.sweep(m, "frequency", from_=5.9, to=8.9, points=5, transient=20, record=5, up_down=True,
+                 integrator=integrator)
     assert len(r.points) == len(doc["points"]) == 10
     for p, q in zip(r.points, doc["points"]):
         assert (p.direction, p.distinct_section_points, p.completed) == (q["direction"], q["distinct_section_points"], q["completed"])
@@ -182,6 +185,8 @@ def test_chart_matches_the_cli(cli):
               "--transient", "20", "--record", "6", "--starts", "2", "--lyapunov")
     r = vi.chart(m, "frequency", vi.parameter_values(6.5, 8.5, 3), "row.clearance",
                  vi.parameter_values(1e-3, 2e-3, 2), transient=20, record=6, starts=2, lyapunov=True)
+    with pytest.raises(ValueError, match="integrator"):
+        vi.chart(m, "frequency", [7.0], "amplitude", [0.05], integrator="exact")
     assert len(r.cells) == len(doc["cells"]) == 6
     for c, d in zip(r.cells, doc["cells"]):
         assert (c.x, c.y, c.attractors) == (d["x"], d["y"], d["attractors"])

@@ -299,16 +299,39 @@ impl Run<'_> {
             .flatten()
             .map(|&i| self.free.groups()[self.free.place(i).0].rate())
             .fold(0.0f64, f64::max);
-        let horizon = if rate > 0.0 {
+        // The bound is tightest over a short horizon (the energy may grow
+        // with it): start at a quarter of the fastest period and double it
+        // while the bound lasts the whole horizon (a stiff body whose
+        // motion is tiny is safe for far longer than its period).
+        let mut horizon = if rate > 0.0 {
             remaining.min(0.5 * std::f64::consts::PI / rate)
         } else {
             remaining
         };
+        let floor = 1e-10 * horizon;
+        loop {
+            let tau = self.bound_over(c, k, horizon, &state)?;
+            if tau < horizon || horizon >= remaining {
+                return (tau > floor && t + tau > t).then_some(t + tau);
+            }
+            horizon = remaining.min(2.0 * horizon);
+        }
+    }
+
+    /// The time within `horizon` until which contact `c` (index `k`) stays
+    /// inactive by the bound from the sides' states; None: active now.
+    fn bound_over<'s>(
+        &self,
+        c: &Contact,
+        k: usize,
+        horizon: f64,
+        state: &impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
         let (mut s0, mut sd0, mut acc) = (-c.clearance, 0.0, 0.0);
         // The rounding of s: a gap that close to activation and closing is
         // active (else checks would hover there at rounding-sized steps).
         let mut size = c.clearance;
-        for (side, sign) in sides.into_iter().zip([1.0, -1.0]) {
+        for (side, sign) in [c.pair.left(), c.pair.right()].into_iter().zip([1.0, -1.0]) {
             let Some(i) = side else { continue };
             let (g, j) = self.free.place(i);
             let x = state(g);
@@ -341,12 +364,7 @@ impl Run<'_> {
                 (root - b) / (2.0 * cq)
             }
         };
-        let tau = tau.min(horizon);
-        if tau <= 1e-10 * horizon.min(1.0 / rate.max(1e-300)) || t + tau <= t {
-            None
-        } else {
-            Some(t + tau)
-        }
+        Some(tau.min(horizon))
     }
 
     /// Schedules contact k's next check (both sides exact) from `t`, or
@@ -1144,10 +1162,27 @@ pub(super) fn run(
     let mut pending: Crossing = None;
     let mut t = 0.0;
     let mut steps: u64 = 0;
+    let mut next_guard = PROGRESS_CHECK;
     while out.error.is_none() && out.sink_stopped.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
                 out.error = Some(e);
+                break;
+            }
+        }
+        // Checks that crawl (bounds so loose that every check looks only a
+        // hair ahead) end the run with the reason, as steps that crawl do.
+        let checks = run.local.contact_checks;
+        if checks >= next_guard {
+            next_guard = checks + PROGRESS_CHECK;
+            let projected = checks as f64 * opts.t_end / t.max(f64::MIN_POSITIVE);
+            if projected > CRAWL_FACTOR * opts.max_steps as f64 {
+                out.error = Some(IntegrationError::ChecksCrawl {
+                    t,
+                    checks,
+                    projected,
+                    limit: opts.max_steps,
+                });
                 break;
             }
         }

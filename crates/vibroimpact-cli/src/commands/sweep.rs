@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, SweepSummary};
 
-use crate::args::MethodName;
 use crate::args::ParameterRange;
+use crate::args::{IntegratorName, MethodName};
 use crate::error::CliError;
 use crate::figures::{diagram_figure, lyapunov_figure, parameter_label, sweep_directions};
 use crate::format::{CsvText, Format};
@@ -42,6 +42,10 @@ pub struct SweepArgs {
     /// Integration method.
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     method: MethodName,
+    /// Integrator of the transient: `local` moves bodies out of contact
+    /// exactly (the recorded periods run the global one).
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    integrator: IntegratorName,
     /// Relative tolerance under which two Poincaré samples count as the same
     /// point (relative to the largest |u| and |v| in the recorded window);
     /// default max(1e-5, 1000 rtol), above the integration noise of
@@ -266,6 +270,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         cluster_tolerance: args.cluster_tolerance,
         lyapunov,
         interrupt: Some(interrupt.clone()),
+        integrator: args.integrator.integrator(),
     };
     let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
         .with_prefix("sweep");

@@ -623,6 +623,7 @@ def sweep(
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
     lyapunov: Optional[int] = None,
+    integrator: str = "global",
     client: Any = None,
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
@@ -649,6 +650,10 @@ def sweep(
     and ``sections``, the Poincaré samples as a record x 2N array). A value
     that fails numerically is kept with its ``error``.
 
+    ``integrator="local"``: the transients move bodies out of contact
+    exactly (docs/theory.md §10); the recorded periods run the global
+    integrator.
+
     ``lyapunov = k``: every point also gains ``lyapunov``, its k largest
     Lyapunov exponents (1/s, largest first, averaged over the recorded
     periods; a positive first one marks chaos) and
@@ -667,6 +672,7 @@ def sweep(
         method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         lyapunov=None if lyapunov is None else _count(lyapunov, "lyapunov", minimum=1, maximum=10**6),
+        integrator=_method(integrator, ("global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -713,6 +719,7 @@ def _sweep_local(
         only,
         _progress(progress),
         options["lyapunov"],
+        options.get("integrator", "global"),
     )
     return d if raw else Result(d)
 
@@ -732,6 +739,7 @@ def chart(
     atol: Optional[float] = None,
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
+    integrator: str = "global",
     client: Any = None,
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
@@ -745,6 +753,8 @@ def chart(
     per period, its largest |u| and, with ``lyapunov``, its largest Lyapunov
     exponent. Defaults as the CLI: ``rtol`` 1e-7 unless the model's
     ``[simulation]`` gives one, ``cluster_tolerance`` 1e-3.
+    ``integrator="local"``: the transients move bodies out of contact
+    exactly; the recorded periods run the global integrator.
 
     Without ``client`` the cells run on this machine's cores (``threads``:
     pool size). With a ``dask.distributed.Client`` the rows of the grid run
@@ -776,6 +786,7 @@ def chart(
         atol=_real(atol, "atol", positive=True, optional=True),
         method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        integrator=_method(integrator, ("global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -813,6 +824,7 @@ def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: P
         options["cluster_tolerance"],
         threads,
         _progress(progress),
+        options.get("integrator", "global"),
     )
     return d if raw else Result(d)
 
@@ -831,6 +843,7 @@ def basins(
     atol: Optional[float] = None,
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
+    integrator: str = "global",
     threads: Optional[int] = None,
     progress: Progress = None,
 ) -> Result:
@@ -838,8 +851,8 @@ def basins(
     the grid ``x_values`` × ``y_values`` of the state components ``x`` and
     ``y`` (``"u1"``, ``"v2"``, …; the other components from ``base``, u then
     v, default the model's initial state) run to its attractor in parallel
-    (``transient`` periods, then ``record`` recorded ones). Defaults as
-    :func:`chart`.
+    (``transient`` periods, then ``record`` recorded ones). Defaults and
+    ``integrator`` as :func:`chart`.
 
     Returns ``x_component``, ``y_component``, ``x_values``, ``y_values``,
     ``base_state``, ``transient_periods``, ``record_periods``,
@@ -873,6 +886,7 @@ def basins(
         _real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         threads,
         _progress(progress),
+        _method(integrator, ("global", "local"), "integrator"),
     )
     return Result(d)
 

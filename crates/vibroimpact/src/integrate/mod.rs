@@ -399,6 +399,20 @@ pub enum IntegrationError {
         /// The step limit.
         limit: u64,
     },
+    /// The local integrator's checks of contacts between exactly moving
+    /// bodies advance so little that finishing would take `projected`
+    /// checks, beyond `CRAWL_FACTOR` × the step limit (docs/theory.md §10).
+    #[error("no progress: {checks} contact checks reached only t = {t:e}; at this pace the run needs {projected:.1e}, far beyond 100 x the step limit {limit}: a body moves far faster than the bound of its motion can follow (check its parameters), or use the global integrator")]
+    ChecksCrawl {
+        /// Time reached.
+        t: f64,
+        /// Checks made.
+        checks: u64,
+        /// Checks the whole run would take at this pace.
+        projected: f64,
+        /// The step limit.
+        limit: u64,
+    },
     /// The caller's [`Interrupt`] was requested; `t` is the time reached.
     #[error("interrupted at t = {t:e}")]
     Interrupted {
