@@ -226,6 +226,11 @@ struct Run<'a> {
     in_set: Vec<bool>,
     /// Per group: when it last joined the set.
     joined: Vec<f64>,
+    /// While the set steps: checks do not move exact groups' reference
+    /// states (samples and a step taken back still need earlier times);
+    /// the moves wait in `deferred` (group, time, state).
+    defer: bool,
+    deferred: Vec<(usize, f64, Vec<f64>)>,
     /// Per body: index in the active set.
     slot: Vec<Option<usize>>,
     activation: Vec<Activation>,
@@ -258,21 +263,14 @@ fn side_groups(free: &FreeMotion, c: &Contact) -> [Option<usize>; 2] {
 }
 
 impl Run<'_> {
-    /// State (u, v) of body `i` moving exactly, at `t`; updates its group's
-    /// reference time when `keep`.
-    fn exact_body(&mut self, i: usize, t: f64, keep: bool) -> (f64, f64) {
+    /// State (u, v) of body `i` moving exactly, at `t` (not before its
+    /// group's reference time).
+    fn exact_body(&self, i: usize, t: f64) -> (f64, f64) {
         let (g, j) = self.free.place(i);
         let (t0, x) = &self.exact[g];
-        if keep {
-            let mut x = x.clone();
-            self.free.propagate(g, *t0, t, &mut x);
-            self.exact[g] = (t, x);
-            (self.exact[g].1[2 * j], self.exact[g].1[2 * j + 1])
-        } else {
-            let mut x = x.clone();
-            self.free.propagate(g, *t0, t, &mut x);
-            (x[2 * j], x[2 * j + 1])
-        }
+        let mut x = x.clone();
+        self.free.propagate(g, *t0, t, &mut x);
+        (x[2 * j], x[2 * j + 1])
     }
 
     /// The time until which contact k (both sides moving exactly) surely
@@ -281,11 +279,51 @@ impl Run<'_> {
     fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
         self.local.contact_checks += 1;
         let c = &self.model.contacts()[k];
+        // The sides' groups at t. Inside a step of the set they only go into
+        // `deferred`: samples and a step taken back still ask for earlier
+        // times of these groups, and exact motion never runs backward.
+        let mut at: Vec<(usize, Vec<f64>)> = Vec::with_capacity(2);
         for i in [c.pair.left(), c.pair.right()].into_iter().flatten() {
-            self.exact_body(i, t, true);
+            let g = self.free.place(i).0;
+            if at.iter().any(|(h, _)| *h == g) {
+                continue;
+            }
+            let (t0, x) = &self.exact[g];
+            let mut x = x.clone();
+            self.free.propagate(g, *t0, t, &mut x);
+            at.push((g, x));
         }
-        let exact = &self.exact;
-        self.bound(k, t, |g| &exact[g].1)
+        let until = {
+            let at = &at;
+            let exact = &self.exact;
+            self.bound(k, t, move |g| {
+                at.iter()
+                    .find(|(h, _)| *h == g)
+                    .map_or(exact[g].1.as_slice(), |(_, x)| x.as_slice())
+            })
+        };
+        for (g, x) in at {
+            if self.defer {
+                self.deferred.push((g, t, x));
+            } else {
+                self.exact[g] = (t, x);
+            }
+        }
+        until
+    }
+
+    /// Moves the exact groups' reference states deferred during a step of
+    /// the set up to `t` (the time everything has been sampled to).
+    fn apply_deferred(&mut self, t: f64) {
+        let mut later = Vec::new();
+        for (g, tc, x) in std::mem::take(&mut self.deferred) {
+            if tc > t {
+                later.push((g, tc, x));
+            } else if !self.in_set[g] && tc > self.exact[g].0 {
+                self.exact[g] = (tc, x);
+            }
+        }
+        self.deferred = later;
     }
 
     /// [`safe_until`](Self::safe_until) from the groups' interleaved states
@@ -469,7 +507,7 @@ impl Run<'_> {
         for (j, &i) in bodies.iter().enumerate() {
             let (u, v) = match old_bodies.binary_search(&i) {
                 Ok(o) => (old_y[2 * o], old_y[2 * o + 1]),
-                Err(_) => self.exact_body(i, t, false),
+                Err(_) => self.exact_body(i, t),
             };
             y[2 * j] = u;
             y[2 * j + 1] = v;
@@ -677,7 +715,7 @@ impl Run<'_> {
                         )
                     }
                 }
-                None => self.exact_body(i, t, false),
+                None => self.exact_body(i, t),
             };
             s += sign * u;
             sd += sign * v;
@@ -979,9 +1017,8 @@ impl Run<'_> {
         let t = set.st.t();
         let next_break = self
             .breakpoints
-            .iter()
+            .get(self.breakpoints.partition_point(|&b| b <= t))
             .copied()
-            .find(|&b| b > t)
             .unwrap_or(f64::INFINITY);
         let bound = self
             .opts
@@ -1024,6 +1061,13 @@ impl Run<'_> {
         if let Some(p) = *pending {
             if p.0 <= t1 {
                 *pending = None;
+                // Another activation at the same time is checked again
+                // there, once p's groups have joined.
+                if let Some(f) = first.filter(|f| f.1 != p.1) {
+                    self.generation[f.1] += 1;
+                    self.queue
+                        .push(Reverse((Time(f.0), f.1, self.generation[f.1])));
+                }
                 return Ok(Stepped::Kept(Some(p)));
             }
         }
@@ -1100,6 +1144,8 @@ pub(super) fn run(
         exact,
         in_set: vec![false; ng],
         joined: vec![0.0; ng],
+        defer: false,
+        deferred: Vec::new(),
         slot: vec![None; n],
         activation,
         group_contacts,
@@ -1203,7 +1249,9 @@ pub(super) fn run(
         let Some(mut set) = run.set.take() else {
             continue;
         };
+        run.defer = true;
         let stepped = run.step_set(&mut set, &mut pending);
+        run.defer = false;
         t = set.st.t();
         run.set = Some(set);
         match stepped {
@@ -1219,6 +1267,7 @@ pub(super) fn run(
                     break;
                 }
                 emit(&mut run, t, &mut out.sink_stopped);
+                run.apply_deferred(t);
                 let result = match reached {
                     Some((_, k)) => run.join(k, t).map(|_| None),
                     None if pending.is_none() => run.release(),
