@@ -1209,6 +1209,7 @@ pub(super) fn run(
     let mut t = 0.0;
     let mut steps: u64 = 0;
     let mut next_guard = PROGRESS_CHECK;
+    let initial_checks = run.local.contact_checks;
     while out.error.is_none() && out.sink_stopped.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
@@ -1218,11 +1219,12 @@ pub(super) fn run(
         }
         // Checks that crawl (bounds so loose that every check looks only a
         // hair ahead) end the run with the reason, as steps that crawl do.
-        let checks = run.local.contact_checks;
-        if checks >= next_guard {
+        // (The first check of every contact at t = 0 is not pace.)
+        let checks = run.local.contact_checks - initial_checks;
+        if checks >= next_guard && t > 0.0 {
             next_guard = checks + PROGRESS_CHECK;
-            let projected = checks as f64 * opts.t_end / t.max(f64::MIN_POSITIVE);
-            if projected > CRAWL_FACTOR * opts.max_steps as f64 {
+            let projected = checks as f64 * opts.t_end / t;
+            if projected > CRAWL_FACTOR * (opts.max_steps as f64).max(nc as f64) {
                 out.error = Some(IntegrationError::ChecksCrawl {
                     t,
                     checks,

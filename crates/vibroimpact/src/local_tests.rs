@@ -430,3 +430,19 @@ fn histories_match_the_global_integrator() {
         assert!(l.local.as_ref().unwrap().set_changes > 2);
     }
 }
+
+/// The first check of every contact at t = 0 is not taken for a crawl: a
+/// chain of 150 000 beads (more first checks than the pace test's period)
+/// runs to the end.
+#[test]
+fn a_long_chain_is_not_taken_for_a_crawl() {
+    let model = crate::reference::struck_chain(150_000, 1.0).unwrap();
+    let opts = SimulationOptions {
+        t_end: 2e-4,
+        integrator: Integrator::Local,
+        ..Default::default()
+    };
+    let sim = simulate(&model, &opts).unwrap();
+    assert!(sim.error.is_none(), "{:?}", sim.error);
+    assert!(sim.local.unwrap().bodies_integrated() < 20);
+}
