@@ -1,0 +1,357 @@
+//! The local integrator's event loop (docs/theory.md §10): the set's
+//! steps with roll-back, the history sampled from exact and integrated
+//! motion, and the run from start to end.
+
+use super::*;
+
+/// How a step of the active set ended.
+pub(super) enum Stepped {
+    /// Taken back: an activation inside it; the set goes on to that time.
+    RolledBack,
+    /// Kept, with the activation reached at its end if any.
+    Kept(Crossing),
+}
+
+/// What [`run`] returns to [`simulate_streaming`]: the result, the state
+/// at its final time (interleaved) and the work.
+pub(in crate::simulate) struct LocalRun {
+    pub t: f64,
+    pub y: Vec<f64>,
+    pub impacts: Vec<ImpactRecord>,
+    pub stats: Stats,
+    pub contact_evaluations: u64,
+    pub local: LocalStats,
+    pub error: Option<IntegrationError>,
+    pub sink_stopped: Option<f64>,
+}
+
+impl Run<'_> {
+    /// Writes the whole interleaved state at `t` into `out`: the set's
+    /// bodies from its dense output (its last step holds `t`), the others
+    /// from their exact motion.
+    pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
+        for g in 0..self.exact.len() {
+            if self.in_set[g] {
+                continue;
+            }
+            let (t0, x) = &self.exact[g];
+            let mut x = x.clone();
+            self.free.propagate(g, *t0, t, &mut x);
+            for (j, &i) in self.free.groups()[g].bodies().iter().enumerate() {
+                out[2 * i] = x[2 * j];
+                out[2 * i + 1] = x[2 * j + 1];
+            }
+        }
+        if let Some(set) = self.set.as_mut() {
+            let mut y = vec![0.0; 2 * set.bodies.len()];
+            set.st.dense_output(&mut set.sys, t, &mut y);
+            for (j, &i) in set.bodies.iter().enumerate() {
+                out[2 * i] = y[2 * j];
+                out[2 * i + 1] = y[2 * j + 1];
+            }
+        }
+    }
+
+    /// One step of the active set, with its events: a boundary contact or
+    /// a due check that becomes active inside the step sends the set back
+    /// to the step's start and on to that time (`pending`); otherwise the
+    /// step's impacts are logged. Returns the activation reached at the
+    /// step's end, if any.
+    pub(super) fn step_set(
+        &mut self,
+        set: &mut ActiveSet,
+        pending: &mut Crossing,
+    ) -> Result<Stepped, IntegrationError> {
+        let t = set.st.t();
+        let next_break = self
+            .breakpoints
+            .get(self.breakpoints.partition_point(|&b| b <= t))
+            .copied()
+            .unwrap_or(f64::INFINITY);
+        let bound = self
+            .opts
+            .t_end
+            .min(next_break)
+            .min(pending.map_or(f64::INFINITY, |p| p.0));
+        set.saved.0 = t;
+        set.saved.1.clear();
+        set.saved.1.extend_from_slice(set.st.y());
+        set.st.step(&mut set.sys, bound)?;
+        let t1 = set.st.t();
+        let mut first = self.boundary_crossing(set);
+        if let Some(due) = self.due_checks(first.map_or(t1, |f| f.0)) {
+            first = Some(due);
+        }
+        if let Some((ts, k)) = first.filter(|f| f.0 < t1) {
+            // Back to the step's start; on to the activation.
+            if let Some(p) = pending.take() {
+                if p.0 > ts {
+                    self.generation[p.1] += 1;
+                    self.queue
+                        .push(Reverse((Time(p.0), p.1, self.generation[p.1])));
+                }
+            }
+            let (t0, y0) = (set.saved.0, set.saved.1.clone());
+            self.absorb(set);
+            set.st.reset(&mut set.sys, t0, &y0)?;
+            if ts <= t0 {
+                // Active where the step began: joined there.
+                return Ok(Stepped::Kept(Some((t0, k))));
+            }
+            *pending = Some((ts, k));
+            set.st.limit_next_step(ts - t0);
+            return Ok(Stepped::RolledBack);
+        }
+        set.scan.scan(&mut set.st, &mut set.sys);
+        if let Some(h) = set.scan.entry_limit(set.st.h_next()) {
+            set.st.limit_next_step(h);
+        }
+        if let Some(p) = *pending {
+            if p.0 <= t1 {
+                *pending = None;
+                // Another activation at the same time is checked again
+                // there, once p's groups have joined.
+                if let Some(f) = first.filter(|f| f.1 != p.1) {
+                    self.generation[f.1] += 1;
+                    self.queue
+                        .push(Reverse((Time(f.0), f.1, self.generation[f.1])));
+                }
+                return Ok(Stepped::Kept(Some(p)));
+            }
+        }
+        Ok(Stepped::Kept(first))
+    }
+}
+
+/// Simulates `model` over `[0, opts.t_end]` by the local integrator,
+/// handing samples to `record` as [`simulate_streaming`] does.
+pub(in crate::simulate) fn run(
+    model: &Model,
+    opts: &SimulationOptions,
+    method: Method,
+    y0: &[f64],
+    breakpoints: Vec<f64>,
+    record: &mut dyn FnMut(f64, &[f64]) -> bool,
+) -> Result<LocalRun, OptionsError> {
+    if opts.energy {
+        return Err(OptionsError(
+            "the energy audit needs the global integrator (integrator = global)".into(),
+        ));
+    }
+    if opts.extrema_window.is_some() {
+        return Err(OptionsError(
+            "exact extrema need the global integrator (integrator = global)".into(),
+        ));
+    }
+    let free = FreeMotion::new(model).map_err(|e| OptionsError(e.to_string()))?;
+    let n = model.bodies().len();
+    let ng = free.groups().len();
+    let nc = model.contacts().len();
+    let mut group_contacts = vec![Vec::new(); ng];
+    for (k, c) in model.contacts().iter().enumerate() {
+        let sides = side_groups(&free, c);
+        for g in sides.iter().flatten() {
+            if group_contacts[*g].last() != Some(&k) {
+                group_contacts[*g].push(k);
+            }
+        }
+    }
+    let mut group_couplings = vec![Vec::new(); ng];
+    for (i, c) in model.couplings().iter().enumerate() {
+        group_couplings[free.place(c.a).0].push(i);
+    }
+    let mut group_forces = vec![Vec::new(); ng];
+    for (i, f) in model.forces().iter().enumerate() {
+        group_forces[free.place(f.body).0].push(i);
+    }
+    let exact = free
+        .groups()
+        .iter()
+        .map(|g| {
+            let x = g
+                .bodies()
+                .iter()
+                .flat_map(|&i| [y0[2 * i], y0[2 * i + 1]])
+                .collect();
+            (0.0, x)
+        })
+        .collect();
+    let activation = (0..nc)
+        .map(|k| {
+            let s_on = model.contacts()[k]
+                .law
+                .onset_approach(opts.impact_force_threshold);
+            Activation::new(model, k, opts, s_on)
+        })
+        .collect();
+    let mut run = Run {
+        model,
+        opts,
+        method,
+        free,
+        exact,
+        in_set: vec![false; ng],
+        joined: vec![0.0; ng],
+        defer: false,
+        deferred: Vec::new(),
+        slot: vec![None; n],
+        activation,
+        group_contacts,
+        group_couplings,
+        group_forces,
+        generation: vec![0; nc],
+        queue: BinaryHeap::new(),
+        set: None,
+        impacts: Vec::new(),
+        onset: vec![(None, 0.0); nc],
+        stats: Stats::default(),
+        contact_evaluations: 0,
+        local: LocalStats {
+            body_evaluations: vec![0; n],
+            ..LocalStats::default()
+        },
+        breakpoints,
+    };
+    let mut out = LocalRun {
+        t: 0.0,
+        y: y0.to_vec(),
+        impacts: Vec::new(),
+        stats: Stats::default(),
+        contact_evaluations: 0,
+        local: LocalStats::default(),
+        error: None,
+        sink_stopped: None,
+    };
+    let mut sample = vec![0.0; 2 * n];
+    let mut next_sample = 0usize;
+    // Emits the samples up to `t` (inclusive) from the current motion.
+    let mut emit = |run: &mut Run, t: f64, stopped: &mut Option<f64>| {
+        let Some(dt) = opts.output_step else { return };
+        while stopped.is_none() {
+            let ts = next_sample as f64 * dt;
+            if ts > t || ts > opts.t_end {
+                break;
+            }
+            run.state_at(ts, &mut sample);
+            let body: Vec<f64> = (0..n)
+                .map(|i| sample[2 * i])
+                .chain((0..n).map(|i| sample[2 * i + 1]))
+                .collect();
+            next_sample += 1;
+            if !record(ts, &body) {
+                *stopped = Some(ts);
+            }
+        }
+    };
+    // Contacts active at the start form the first set; the others are
+    // scheduled.
+    for k in 0..nc {
+        if !run.touches_set(k) && run.schedule(k, 0.0) {
+            if let Err(e) = run.join(k, 0.0) {
+                out.error = Some(e);
+                break;
+            }
+        }
+    }
+    let mut pending: Crossing = None;
+    let mut t = 0.0;
+    let mut steps: u64 = 0;
+    let mut next_guard = PROGRESS_CHECK;
+    let initial_checks = run.local.contact_checks;
+    while out.error.is_none() && out.sink_stopped.is_none() && t < opts.t_end {
+        if let Some(stop) = &opts.interrupt {
+            if let Err(e) = stop.check(t) {
+                out.error = Some(e);
+                break;
+            }
+        }
+        // Checks that crawl (bounds so loose that every check looks only a
+        // hair ahead) end the run with the reason, as steps that crawl do.
+        // (The first check of every contact at t = 0 is not pace.)
+        let checks = run.local.contact_checks - initial_checks;
+        if checks >= next_guard && t > 0.0 {
+            next_guard = checks + PROGRESS_CHECK;
+            let projected = checks as f64 * opts.t_end / t;
+            if projected > CRAWL_FACTOR * (opts.max_steps as f64).max(nc as f64) {
+                out.error = Some(IntegrationError::ChecksCrawl {
+                    t,
+                    checks,
+                    projected,
+                    limit: opts.max_steps,
+                });
+                break;
+            }
+        }
+        if run.set.is_none() {
+            let next = run.next_check().map_or(opts.t_end, |c| c.0.min(opts.t_end));
+            emit(&mut run, next, &mut out.sink_stopped);
+            t = next;
+            if next >= opts.t_end {
+                break;
+            }
+            if let Some(at) = run.due_checks(next) {
+                if let Err(e) = run.join(at.1, at.0) {
+                    out.error = Some(e);
+                }
+            }
+            continue;
+        }
+        let Some(mut set) = run.set.take() else {
+            continue;
+        };
+        run.defer = true;
+        let stepped = run.step_set(&mut set, &mut pending);
+        run.defer = false;
+        t = set.st.t();
+        run.set = Some(set);
+        match stepped {
+            Err(e) => {
+                out.error = Some(e);
+                break;
+            }
+            Ok(Stepped::RolledBack) => {}
+            Ok(Stepped::Kept(reached)) => {
+                steps += 1;
+                if steps > opts.max_steps {
+                    out.error = Some(IntegrationError::TooManySteps { t, steps });
+                    break;
+                }
+                emit(&mut run, t, &mut out.sink_stopped);
+                run.apply_deferred(t);
+                let result = match reached {
+                    Some((_, k)) => run.join(k, t).map(|_| None),
+                    None if pending.is_none() => run.release(),
+                    None => Ok(None),
+                };
+                match result {
+                    Err(e) => out.error = Some(e),
+                    Ok(Some((ta, k))) => {
+                        if let Err(e) = run.join(k, ta) {
+                            out.error = Some(e);
+                        }
+                    }
+                    Ok(None) => {}
+                }
+            }
+        }
+    }
+    // The state at the end (or where it stopped).
+    let t_final = match &run.set {
+        Some(set) => set.st.t(),
+        None => t.min(opts.t_end),
+    };
+    let mut y = vec![0.0; 2 * n];
+    run.state_at(t_final, &mut y);
+    if let Some(mut set) = run.set.take() {
+        run.absorb(&mut set);
+        run.contact_evaluations += set.sys.contact_evaluations();
+        run.impacts = set.scan.impacts;
+    }
+    out.t = t_final;
+    out.y = y;
+    out.impacts = std::mem::take(&mut run.impacts);
+    out.stats = run.stats;
+    out.contact_evaluations = run.contact_evaluations;
+    out.local = run.local;
+    Ok(out)
+}

@@ -1,0 +1,270 @@
+//! The active set's edge and membership (docs/theory.md §10): contacts
+//! with exactly moving bodies followed over the set's steps, due checks,
+//! groups joining and leaving.
+
+use super::*;
+
+/// Where the active set's last step meets an activation: the earliest
+/// time and the contact.
+pub(super) type Crossing = Option<(f64, usize)>;
+
+impl Run<'_> {
+    /// Contact k's (s, ṡ) at `t` within the set's last step, for a contact
+    /// with one side in the set and the other moving exactly (or a wall).
+    pub(super) fn boundary_state(&mut self, set: &mut ActiveSet, k: usize, t: f64) -> (f64, f64) {
+        let c = &self.model.contacts()[k];
+        let mut s = -c.clearance;
+        let mut sd = 0.0;
+        for (side, sign) in [(c.pair.left(), 1.0), (c.pair.right(), -1.0)] {
+            let Some(i) = side else { continue };
+            let (u, v) = match self.slot[i] {
+                Some(j) => {
+                    if t == set.saved.0 {
+                        (set.saved.1[2 * j], set.saved.1[2 * j + 1])
+                    } else {
+                        (
+                            set.st.dense_component(&mut set.sys, 2 * j, t),
+                            set.st.dense_component(&mut set.sys, 2 * j + 1, t),
+                        )
+                    }
+                }
+                None => self.exact_body(i, t),
+            };
+            s += sign * u;
+            sd += sign * v;
+        }
+        (s, sd)
+    }
+
+    /// The first time in the set's last step where a boundary contact
+    /// becomes active.
+    pub(super) fn boundary_crossing(&mut self, set: &mut ActiveSet) -> Crossing {
+        let (ta, tb) = (set.saved.0, set.st.t());
+        let mut first: Crossing = None;
+        for bi in 0..set.boundary.len() {
+            let k = set.boundary[bi];
+            let act = self.activation[k];
+            let (sa, sda) = self.boundary_state(set, k, ta);
+            let (sb, sdb) = self.boundary_state(set, k, tb);
+            let (ga, gb) = (act.margin(sa, sda), act.margin(sb, sdb));
+            let margin = |run: &mut Self, set: &mut ActiveSet, t: f64| {
+                let (s, sd) = run.boundary_state(set, k, t);
+                act.margin(s, sd)
+            };
+            let at = if ga > 0.0 {
+                Some(ta)
+            } else if gb > 0.0 {
+                EventLocator::FINE
+                    .locate(|t| margin(self, set, t), (ta, ga), (tb, gb))
+                    .ok()
+                    .or(Some(tb))
+            } else if sda > 0.0 && sdb < 0.0 {
+                // The gap's interior maximum.
+                let tm = EventLocator::FINE
+                    .locate(|t| self.boundary_state(set, k, t).1, (ta, sda), (tb, sdb))
+                    .unwrap_or(0.5 * (ta + tb));
+                let gm = margin(self, set, tm);
+                (gm > 0.0).then(|| {
+                    EventLocator::FINE
+                        .locate(|t| margin(self, set, t), (ta, ga), (tm, gm))
+                        .unwrap_or(tm)
+                })
+            } else {
+                None
+            };
+            if let Some(t) = at {
+                if first.is_none_or(|(f, fk)| (t, k) < (f, fk)) {
+                    first = Some((t, k));
+                }
+            }
+        }
+        first
+    }
+
+    /// Processes the checks due up to `until` (both sides moving exactly):
+    /// reschedules the safe ones and returns the first that is active.
+    pub(super) fn due_checks(&mut self, until: f64) -> Crossing {
+        while let Some((t, k)) = self.next_check() {
+            if t > until {
+                break;
+            }
+            self.queue.pop();
+            if self.touches_set(k) {
+                continue;
+            }
+            if self.schedule(k, t) {
+                return Some((t, k));
+            }
+        }
+        None
+    }
+
+    /// The groups of contact k's bodies.
+    pub(super) fn groups_of(&self, k: usize) -> Vec<usize> {
+        side_groups(&self.free, &self.model.contacts()[k])
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+
+    /// Joins the groups of contact k to the set at `t` (the set, if any, is
+    /// at `t`); the checks of the contacts that now touch the set lapse.
+    pub(super) fn join(&mut self, k: usize, t: f64) -> Result<(), IntegrationError> {
+        let mut groups = self.set.as_ref().map_or(Vec::new(), |s| s.groups.clone());
+        for g in self.groups_of(k) {
+            if !groups.contains(&g) {
+                groups.push(g);
+            }
+        }
+        groups.sort_unstable();
+        for g in self.groups_of(k) {
+            for i in 0..self.group_contacts[g].len() {
+                let kk = self.group_contacts[g][i];
+                self.generation[kk] += 1;
+            }
+        }
+        self.rebuild(groups, t)
+    }
+
+    /// Whether contact `kl` of the set is engaged at the set's current
+    /// point: active now or within `lookahead` by its rate and
+    /// acceleration. (An impact whose force has fallen below the
+    /// negligible level is not: it ends when its bodies are released.)
+    pub(super) fn engaged(set: &ActiveSet, act: Activation, kl: usize, lookahead: f64) -> bool {
+        let (s, sd) = set.sys.approach(kl, set.st.y());
+        let idx = set.sys.contact_indices(kl);
+        let dy = set.st.dydt();
+        let sdd = idx[1].map_or(0.0, |i| dy[i]) - idx[3].map_or(0.0, |i| dy[i]);
+        let reach = s + sd.max(0.0) * lookahead + 0.5 * sdd.max(0.0) * lookahead * lookahead;
+        act.margin(reach, sd.abs() + sdd.abs() * lookahead) > 0.0
+    }
+
+    /// Lets the groups of the set whose contacts have all separated move
+    /// exactly again; their contacts with other exact groups or walls are
+    /// scheduled. Returns a contact that is active at once, if any.
+    pub(super) fn release(&mut self) -> Result<Crossing, IntegrationError> {
+        let Some(set) = self.set.as_ref() else {
+            return Ok(None);
+        };
+        let t = set.st.t();
+        // How soon counts as engaged: a few steps, and a small part of the
+        // fastest oscillation; a set stays that long before it may shrink.
+        let steps = 4.0 * set.st.h_next();
+        let lookahead = if set.rate > 0.0 {
+            steps.max(RELEASE_PERIOD_FRACTION / set.rate)
+        } else {
+            steps
+        };
+        // A group that joined within the lookahead stays (no chatter).
+        let mut engaged: Vec<bool> = set
+            .groups
+            .iter()
+            .map(|&g| t - self.joined[g] < lookahead)
+            .collect();
+        for (kl, &k) in set.scan.ids.iter().enumerate() {
+            if Self::engaged(set, self.activation[k], kl, lookahead) {
+                for g in self.groups_of(k) {
+                    if let Ok(p) = set.groups.binary_search(&g) {
+                        engaged[p] = true;
+                    }
+                }
+            }
+        }
+        // A group leaves only if its contacts that would join two exactly
+        // moving groups (or a wall) stay safe for a while by the bound: no
+        // release that the next check would undo at once.
+        let states: Vec<Vec<f64>> = set
+            .groups
+            .iter()
+            .map(|&g| {
+                self.free.groups()[g]
+                    .bodies()
+                    .iter()
+                    .flat_map(|&i| {
+                        let j = self.slot[i].unwrap_or(0);
+                        [set.st.y()[2 * j], set.st.y()[2 * j + 1]]
+                    })
+                    .collect()
+            })
+            .collect();
+        loop {
+            let mut changed = false;
+            for p in 0..set.groups.len() {
+                if engaged[p] {
+                    continue;
+                }
+                for &k in &self.group_contacts[set.groups[p]] {
+                    let sides = self.groups_of(k);
+                    let stays = sides
+                        .iter()
+                        .any(|g| set.groups.binary_search(g).is_ok_and(|q| engaged[q]));
+                    if stays {
+                        continue;
+                    }
+                    let exact = &self.exact;
+                    let groups = &set.groups;
+                    let state = |g: usize| match groups.binary_search(&g) {
+                        Ok(q) => states[q].as_slice(),
+                        Err(_) => exact[g].1.as_slice(),
+                    };
+                    // Exact sides are at their own reference time: only
+                    // contacts among set groups and walls are judged here.
+                    if sides.iter().all(|g| groups.binary_search(g).is_ok())
+                        && self
+                            .bound(k, t, state)
+                            .is_none_or(|until| until - t < lookahead)
+                    {
+                        engaged[p] = true;
+                        changed = true;
+                        break;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        if engaged.iter().all(|&e| e) {
+            return Ok(None);
+        }
+        let keep: Vec<usize> = set
+            .groups
+            .iter()
+            .zip(&engaged)
+            .filter(|(_, &e)| e)
+            .map(|(&g, _)| g)
+            .collect();
+        let leaving: Vec<usize> = set
+            .groups
+            .iter()
+            .filter(|g| !keep.contains(g))
+            .copied()
+            .collect();
+        // Impacts of released contacts end here.
+        if let Some(set) = self.set.as_mut() {
+            for kl in 0..set.scan.ids.len() {
+                let released = side_groups(&self.free, &self.model.contacts()[set.scan.ids[kl]])
+                    .into_iter()
+                    .flatten()
+                    .any(|g| leaving.contains(&g));
+                if released && set.scan.trackers[kl].active.is_some() {
+                    set.scan.finish(&mut set.st, &mut set.sys, kl, t);
+                }
+            }
+        }
+        self.rebuild(keep, t)?;
+        let mut first: Crossing = None;
+        let mut freed: Vec<usize> = leaving
+            .iter()
+            .flat_map(|&g| self.group_contacts[g].iter().copied())
+            .collect();
+        freed.sort_unstable();
+        freed.dedup();
+        for k in freed {
+            if !self.touches_set(k) && self.schedule(k, t) && first.is_none() {
+                first = Some((t, k));
+            }
+        }
+        Ok(first)
+    }
+}
