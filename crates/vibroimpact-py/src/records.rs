@@ -78,12 +78,13 @@ fn inputs(
     pair_text: &str,
     source: &str,
     (times, acceleration): (&PyReadonlyArray1<'_, f64>, &PyReadonlyArray1<'_, f64>),
-    (sample, rtol, method): (f64, f64, &str),
+    (sample, rtol, method, integrator): (f64, f64, &str, &str),
 ) -> PyResult<(PoundingPair, Record, RunSettings)> {
     let run = RunSettings {
         sample,
         rtol,
         method: crate::solve::method(method)?,
+        integrator: integrator.parse().map_err(value_error)?,
     };
     let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
     let t = floats(times, "times")?;
@@ -99,7 +100,7 @@ fn inputs(
 /// `required_gap` and `code_gaps`; with `free` false, the pounding run
 /// alone (`pounding` and the periods).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, free))]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, integrator, free))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding<'py>(
     py: Python<'py>,
@@ -111,13 +112,14 @@ pub fn pounding<'py>(
     sample: f64,
     rtol: f64,
     method: &str,
+    integrator: &str,
     free: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (pair, record, run) = inputs(
         pair_text,
         source,
         (&times, &acceleration),
-        (sample, rtol, method),
+        (sample, rtol, method, integrator),
     )?;
     let response = |r: &vibroimpact::pounding::Response| -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -165,7 +167,7 @@ pub fn pounding<'py>(
 /// floors × samples, m), and the impact log `impact_time`,
 /// `impact_floor` (1-based), `impact_peak_force` (N).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method))]
+#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, integrator))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding_history<'py>(
     py: Python<'py>,
@@ -177,12 +179,13 @@ pub fn pounding_history<'py>(
     sample: f64,
     rtol: f64,
     method: &str,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (pair, record, run) = inputs(
         pair_text,
         source,
         (&times, &acceleration),
-        (sample, rtol, method),
+        (sample, rtol, method, integrator),
     )?;
     let sim = py
         .detach(|| pair.history(&record, scale, &run))

@@ -32,7 +32,9 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use crate::model::{BaseExcitation, Model};
+use crate::model::{Accelerogram, BaseExcitation, Model};
+
+use modal::Modal;
 
 /// Why a model's free motion has no exact propagator.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -73,6 +75,22 @@ pub struct Group {
     force_max: Vec<f64>,
     /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
     rate: f64,
+    /// The complex modes, where they can be trusted (not for a single
+    /// body under harmonic forcing: closed form).
+    modal: Option<Modal>,
+    /// Without modes, under a uniform record: the matrix form of a whole
+    /// sample step, computed once.
+    hold_step: Option<HoldStep>,
+}
+
+/// The first-order-hold step of one record sample interval `τ`: `x(b) =
+/// Φ x(a) + γ₀ f(a) + γ₁ f'` (the columns of the augmented exponential).
+#[derive(Clone, Debug)]
+struct HoldStep {
+    tau: f64,
+    phi: DMatrix<f64>,
+    g0: Vec<f64>,
+    g1: Vec<f64>,
 }
 
 /// The exact free motion of every group of a model.
@@ -82,6 +100,46 @@ pub struct FreeMotion {
     /// (group, index in the group) of every body.
     place: Vec<(usize, usize)>,
     base: BaseExcitation,
+}
+
+/// Calls `step(τ, f(a), f')` for every interval `[a, a + τ]` between
+/// `t0`, the record's samples and `t1`: the forcing `f = −z̈` (zero
+/// outside the record) is linear over each. A sample within 1e-12 of a
+/// record step of `t0` or `t1` (rounding of the same time) is not a
+/// breakpoint: the sliver would cost a step of its own for a change of
+/// the state far below any tolerance.
+fn record_intervals(rec: &Accelerogram, t0: f64, t1: f64, mut step: impl FnMut(f64, f64, f64)) {
+    let times = rec.times();
+    let (first, last) = (times[0], times[times.len() - 1]);
+    let sliver = 1e-12 * (last - first) / (times.len().max(2) - 1) as f64;
+    let mut ta = t0;
+    let mut k = times.partition_point(|&s| s <= t0 + sliver);
+    while ta < t1 {
+        let tb = match times.get(k) {
+            Some(&s) if s < t1 - sliver => s,
+            _ => t1,
+        };
+        let mid = 0.5 * (ta + tb);
+        let (fa, fb) = if mid > first && mid < last {
+            (-rec.at(ta), -rec.at(tb))
+        } else {
+            (0.0, 0.0)
+        };
+        let tau = tb - ta;
+        step(tau, fa, (fb - fa) / tau);
+        ta = tb;
+        k += 1;
+    }
+}
+
+/// The sample step of `times` if uniform (to 1e-9 of it, as a record's
+/// `dt`).
+fn uniform_step(times: &[f64]) -> Option<f64> {
+    let steps = times.windows(2).map(|w| w[1] - w[0]);
+    let (lo, hi) = steps.fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
+        (lo.min(d), hi.max(d))
+    });
+    (times.len() >= 2 && hi - lo <= 1e-9 * hi).then_some(times[1] - times[0])
 }
 
 /// `e^{Aτ}` of `ü = −w2 u − c2 u̇` as `[[p00, p01], [p10, p11]]`:
@@ -150,6 +208,19 @@ impl FreeMotion {
         let mut groups = Vec::with_capacity(members.len());
         for bodies in members {
             groups.push(Self::group(model, &place, bodies, zdd_max)?);
+        }
+        let record_step = match model.base() {
+            BaseExcitation::Record(rec) => Some(uniform_step(rec.times())),
+            _ => None,
+        };
+        for g in &mut groups {
+            if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
+                g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
+            }
+            if let (None, Some(Some(tau))) = (&g.modal, record_step) {
+                let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(g), tau);
+                g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
+            }
         }
         Ok(Self {
             groups,
@@ -276,6 +347,8 @@ impl FreeMotion {
             couplings,
             force_max,
             rate,
+            modal: None,
+            hold_step: None,
         })
     }
 
@@ -317,11 +390,10 @@ impl FreeMotion {
         }
     }
 
-    /// `x ← x(b)` from `x = x(a)` under the forcing `f(t) = fa + slope (t −
-    /// a)` in every velocity row (first-order hold; the harmonic part
-    /// already removed).
-    fn hold(a: &DMatrix<f64>, tau: f64, fa: f64, slope: f64, x: &mut [f64]) {
-        let d = x.len();
+    /// `Φ = e^{Aτ}`, `γ₀` and `γ₁` of the first-order hold over `τ`: the
+    /// exponential of the augmented matrix (Van Loan).
+    fn hold_matrices(a: &DMatrix<f64>, tau: f64) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
+        let d = a.nrows();
         let mut big = DMatrix::<f64>::zeros(d + 2, d + 2);
         big.view_mut((0, 0), (d, d)).copy_from(&(a * tau));
         for j in 0..d / 2 {
@@ -329,14 +401,31 @@ impl FreeMotion {
         }
         big[(d, d + 1)] = tau;
         let e = big.exp();
-        let y: Vec<f64> = (0..d)
-            .map(|i| {
-                (0..d).map(|j| e[(i, j)] * x[j]).sum::<f64>()
-                    + e[(i, d)] * fa
-                    + e[(i, d + 1)] * slope
-            })
-            .collect();
-        x.copy_from_slice(&y);
+        (
+            e.view((0, 0), (d, d)).into_owned(),
+            (0..d).map(|i| e[(i, d)]).collect(),
+            (0..d).map(|i| e[(i, d + 1)]).collect(),
+        )
+    }
+
+    /// `x ← Φ x + γ₀ fa + γ₁ slope`: `x(b)` from `x = x(a)` under the
+    /// forcing `f(t) = fa + slope (t − a)` in every velocity row (the
+    /// harmonic part already removed); `y` is scratch of `x`'s length.
+    fn hold(
+        step: (&DMatrix<f64>, &[f64], &[f64]),
+        fa: f64,
+        slope: f64,
+        x: &mut [f64],
+        y: &mut [f64],
+    ) {
+        let (phi, g0, g1) = step;
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = g0[i] * fa + g1[i] * slope;
+            for (j, xj) in x.iter().enumerate() {
+                *yi += phi[(i, j)] * xj;
+            }
+        }
+        x.copy_from_slice(y);
     }
 
     /// Propagates group `g`'s interleaved state `x` from `t0` to `t1 >= t0`
@@ -347,41 +436,43 @@ impl FreeMotion {
             return;
         }
         self.add_particular(group, t0, -1.0, x);
-        match &self.base {
-            BaseExcitation::Record(rec) => {
-                let a = self.matrix(group);
-                let times = rec.times();
-                let (first, last) = (times[0], times[times.len() - 1]);
-                let start = times.partition_point(|&s| s <= t0);
-                let mut ta = t0;
-                let mut k = start;
-                while ta < t1 {
-                    let tb = if k < times.len() {
-                        times[k].min(t1)
-                    } else {
-                        t1
-                    };
-                    if tb > ta {
-                        let mid = 0.5 * (ta + tb);
-                        let (fa, fb) = if mid > first && mid < last {
-                            (-rec.at(ta), -rec.at(tb))
-                        } else {
-                            (0.0, 0.0)
-                        };
-                        let tau = tb - ta;
-                        Self::hold(&a, tau, fa, (fb - fa) / tau, x);
-                    }
-                    ta = tb;
-                    k += 1;
-                }
+        match (&self.base, &group.modal) {
+            (BaseExcitation::Record(rec), Some(modal)) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                record_intervals(rec, t0, t1, |tau, fa, slope| {
+                    modal.hold(tau, fa, slope, &mut z)
+                });
+                modal.to_state(&z, x);
             }
-            _ => Self::homogeneous(group, t1 - t0, x),
+            (BaseExcitation::Record(rec), None) => {
+                let mut y = vec![0.0; x.len()];
+                record_intervals(rec, t0, t1, |tau, fa, slope| match &group.hold_step {
+                    // A whole sample step (to rounding of the sample times:
+                    // 1e-12 of a step moves the state by far less than any
+                    // tolerance).
+                    Some(h) if (tau - h.tau).abs() <= 1e-12 * h.tau => {
+                        Self::hold((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
+                    }
+                    _ => {
+                        let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(group), tau);
+                        Self::hold((&phi, &g0, &g1), fa, slope, x, &mut y)
+                    }
+                });
+            }
+            (_, Some(modal)) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                modal.free(t1 - t0, &mut z);
+                modal.to_state(&z, x);
+            }
+            (_, None) => Self::homogeneous(group, t1 - t0, x),
         }
         self.add_particular(group, t1, 1.0, x);
     }
 
     /// The group's system matrix `A` (interleaved).
-    fn matrix(&self, g: &Group) -> DMatrix<f64> {
+    fn matrix(g: &Group) -> DMatrix<f64> {
         match &g.propagator {
             Propagator::Group(a) => a.clone(),
             Propagator::Single { w2, c2 } => DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w2, -c2]),
@@ -439,6 +530,9 @@ impl Group {
         self.rate
     }
 }
+
+#[path = "free_motion_modal.rs"]
+mod modal;
 
 #[cfg(test)]
 #[path = "free_motion_tests.rs"]

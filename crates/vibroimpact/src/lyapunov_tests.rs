@@ -204,3 +204,46 @@ fn bad_input_is_refused() {
     let err = lyapunov_spectrum(&recorded, &x, 0.0, &LyapunovOptions::default()).unwrap_err();
     assert!(err.to_string().contains("periodic forcing"), "{err}");
 }
+
+/// The stated uncertainty is the scatter of repeated runs: on the chaotic
+/// attractor of R2 N = 2 at 0.8409 ω0, sixteen consecutive windows of 200
+/// periods each give largest exponents whose standard deviation is the
+/// mean stated standard error to within a factor 2 (measured 0.034
+/// against 0.049, ratio 0.70; twelve windows of 400 periods 0.95, of 100
+/// periods 1.32; the former estimate, the running average's settling,
+/// stated about half the scatter).
+#[test]
+fn the_uncertainty_is_the_scatter_of_repeated_runs() {
+    let model = r2(2, 1e-3, 0.8409 * W0).unwrap();
+    let settle = LyapunovOptions {
+        count: Some(1),
+        transient: 200,
+        periods: 2,
+        ..LyapunovOptions::default()
+    };
+    let mut x = lyapunov_spectrum(&model, &[1e-4, 0.0, 0.0, 0.0], 0.0, &settle)
+        .unwrap()
+        .final_state;
+    let window = LyapunovOptions {
+        count: Some(1),
+        transient: 0,
+        periods: 200,
+        ..LyapunovOptions::default()
+    };
+    let (mut largest, mut stated) = (Vec::new(), Vec::new());
+    for _ in 0..16 {
+        let ly = lyapunov_spectrum(&model, &x, 0.0, &window).unwrap();
+        x = ly.final_state;
+        largest.push(ly.exponents[0]);
+        stated.push(ly.uncertainty[0]);
+    }
+    let n = largest.len() as f64;
+    let mean = largest.iter().sum::<f64>() / n;
+    assert!(mean > 0.3, "not chaotic: {largest:?}");
+    let sd = (largest.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let se = stated.iter().sum::<f64>() / n;
+    assert!(
+        (0.5..=2.0).contains(&(sd / se)),
+        "scatter {sd} against stated {se}"
+    );
+}

@@ -19,7 +19,7 @@ use crate::dynamics::ChainDynamics;
 use crate::integrate::{Method, OdeSystem};
 use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
 use crate::record::Record;
-use crate::simulate::{simulate_streaming, SimulationOptions};
+use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
 
 /// A shear frame: floors from the ground up.
 #[derive(Clone, Debug, PartialEq)]
@@ -142,15 +142,19 @@ pub struct RunSettings {
     /// Integration method: DOP853, or DOPRI5 for loose tolerances (a
     /// record's samples limit the step; docs/earthquakes.md).
     pub method: Method,
+    /// Global, or local: each frame moves exactly between poundings, per
+    /// record sample (docs/theory.md §10).
+    pub integrator: Integrator,
 }
 
 impl RunSettings {
-    /// Sampling every `sample` s at tolerance `rtol` with DOP853.
+    /// Sampling every `sample` s at tolerance `rtol` with DOP853, global.
     pub fn new(sample: f64, rtol: f64) -> Self {
         Self {
             sample,
             rtol,
             method: Method::Dop853,
+            integrator: Integrator::Global,
         }
     }
 }
@@ -380,6 +384,7 @@ impl PoundingPair {
             atol: run.rtol * 1e-4 * self.gap.max(1e-3),
             output_step: Some(run.sample),
             method: run.method,
+            integrator: run.integrator,
             ..SimulationOptions::default()
         })
     }

@@ -2,6 +2,7 @@
 //! rules.
 
 use super::*;
+use crate::simulate::Integrator;
 
 fn frame(n: usize, m: f64, k: f64) -> ShearFrame {
     ShearFrame {
@@ -169,6 +170,43 @@ fn dopri5_at_loose_tolerance_matches_dop853() {
     }
     // Measured 2.1e-4 (33 impacts).
     assert!(worst < 1e-3, "{worst:e}");
+}
+
+/// The local integrator (each frame exact per record sample between
+/// poundings, the pair integrated while in touch) gives the peaks of the
+/// global one at the same tolerance: the same impacts, drifts, floor
+/// accelerations and impact force.
+#[test]
+fn the_local_integrator_matches_the_global_one() {
+    let pair = PoundingPair {
+        left: frame(3, 2.0e5, 6.0e7),
+        right: frame(2, 3.0e5, 1.5e8),
+        gap: 0.01,
+        floors: vec![1, 2],
+        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    };
+    let rec = record();
+    let run = RunSettings::new(0.005, 1e-9);
+    let local = RunSettings {
+        integrator: Integrator::Local,
+        ..run
+    };
+    for contacts in [true, false] {
+        let g = pair.respond(&rec, 1.0, contacts, &run).unwrap();
+        let l = pair.respond(&rec, 1.0, contacts, &local).unwrap();
+        assert_eq!(l.impacts, g.impacts);
+        assert_eq!(contacts, g.impacts > 0);
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+        let mut worst = rel(l.peak_impact_force, g.peak_impact_force);
+        for side in 0..2 {
+            for (a, b) in [(&l.drift, &g.drift), (&l.acceleration, &g.acceleration)] {
+                for (x, y) in a[side].iter().zip(&b[side]) {
+                    worst = worst.max(rel(*x, *y));
+                }
+            }
+        }
+        assert!(worst < 1e-6, "contacts {contacts}: {worst:e}");
+    }
 }
 
 #[test]

@@ -12,7 +12,7 @@ use vibroimpact::pounding::{
     parse_pair, pounding_spectrum, quantile, PoundingPair, Response, RunSettings, SpectrumCell,
 };
 
-use crate::args::MethodName;
+use crate::args::{IntegratorName, MethodName};
 
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
@@ -46,6 +46,10 @@ pub struct PoundingArgs {
     /// to 1e-5, where the record's samples limit the step).
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     method: MethodName,
+    /// Integrator: `local` moves each frame exactly between poundings, per
+    /// record sample.
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    integrator: IntegratorName,
     /// Pounding spectrum: gaps FROM:TO:N (m), with --ratios.
     #[arg(long, requires = "ratios")]
     gaps: Option<String>,
@@ -184,6 +188,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         sample: args.sample,
         rtol: args.rtol,
         method: args.method.method(),
+        integrator: args.integrator.integrator(),
     };
     let source = args.pair.display().to_string();
     let text =

@@ -657,7 +657,7 @@ def sweep(
     ``lyapunov = k``: every point also gains ``lyapunov``, its k largest
     Lyapunov exponents (1/s, largest first, averaged over the recorded
     periods; a positive first one marks chaos) and
-    ``lyapunov_uncertainty``, their convergence estimates.
+    ``lyapunov_uncertainty``, their standard errors (batch means).
     """
     m = _model(model)
     if not isinstance(parameter, str):
@@ -978,19 +978,22 @@ def _record_arrays(record: Any):
         raise TypeError("record: expected a read_record result or a file name") from None
 
 
-def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any) -> None:
+def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any, integrator: Any) -> None:
     """Checks the settings of a pounding run (the binding checks their
     ranges)."""
     for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
     _method(method, ("dop853", "dopri5", "rodas", "auto"))
+    _method(integrator, ("global", "local"), "integrator")
 
 
-def _pounding_args(pair: Any, record: Any, scale: Any, sample: Any, rtol: Any, method: Any) -> tuple:
+def _pounding_args(
+    pair: Any, record: Any, scale: Any, sample: Any, rtol: Any, method: Any, integrator: Any
+) -> tuple:
     """The binding's leading arguments of a pounding run, checked."""
     source, text = _pair_text(pair)
-    _pounding_settings(scale, sample, rtol, method)
+    _pounding_settings(scale, sample, rtol, method, integrator)
     times, acc = _record_arrays(record)
     return (
         text,
@@ -1001,6 +1004,7 @@ def _pounding_args(pair: Any, record: Any, scale: Any, sample: Any, rtol: Any, m
         float(sample),
         float(rtol),
         method,
+        integrator,
     )
 
 
@@ -1012,6 +1016,7 @@ def pounding(
     sample: float = 0.0025,
     rtol: float = 1e-8,
     method: str = "dop853",
+    integrator: str = "global",
     free: bool = True,
 ) -> Result:
     """Pounding of two shear frames under one record (``vibroimpact
@@ -1020,7 +1025,9 @@ def pounding(
     ``scale``. ``sample`` (s): the sampling of drifts and floor
     accelerations. ``method``: "dop853", or "dopri5", the faster at
     ``rtol`` 1e-3 to 1e-5 (the record's samples limit the step; peaks
-    within 1 % there, docs/earthquakes.md). ``free=False`` runs the pair
+    within 1 % there, docs/earthquakes.md). ``integrator="local"``: each
+    frame moves exactly between poundings, per record sample, and only the
+    pounding pair is integrated. ``free=False`` runs the pair
     with its contacts only (half the work; no ``free``, ``required_gap``
     or ``code_gaps``).
 
@@ -1029,7 +1036,7 @@ def pounding(
     [left, right] lists per floor, ``peak_impact_force``, ``impacts``,
     ``closing``), ``required_gap`` and ``code_gaps`` (``absolute_sum``,
     ``srss``, ``double_difference``, ``correlation``)."""
-    args = _pounding_args(pair, record, scale, sample, rtol, method)
+    args = _pounding_args(pair, record, scale, sample, rtol, method, integrator)
     if not isinstance(free, bool):
         raise TypeError(f"free: expected True or False, got {free!r}")
     return Result(_core.pounding(*args, free))
@@ -1043,6 +1050,7 @@ def pounding_history(
     sample: float = 0.01,
     rtol: float = 1e-8,
     method: str = "dop853",
+    integrator: str = "global",
 ) -> Result:
     """The time history of a pounding pair with its contacts under one
     record (as :func:`pounding` takes them), sampled every ``sample``
@@ -1050,7 +1058,7 @@ def pounding_history(
     to the ground, floors × samples, m) and the impact log
     ``impact_time`` (s), ``impact_floor`` (1-based), ``impact_peak_force``
     (N)."""
-    d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method))
+    d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method, integrator))
     d["left"] = np.asarray(d["left"])
     d["right"] = np.asarray(d["right"])
     d["impact_floor"] = np.asarray(d["impact_floor"], dtype=np.int64)

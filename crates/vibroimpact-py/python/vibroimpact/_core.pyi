@@ -91,9 +91,9 @@ def response_spectrum(
 ) -> dict[str, Any]: ...
 def pounding(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
-    rtol: float, method: str, free: bool,
+    rtol: float, method: str, integrator: str, free: bool,
 ) -> dict[str, Any]: ...
 def pounding_history(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
-    rtol: float, method: str,
+    rtol: float, method: str, integrator: str,
 ) -> dict[str, Any]: ...

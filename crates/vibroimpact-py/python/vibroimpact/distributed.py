@@ -184,8 +184,8 @@ def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
     # binding reads them.
     t = _floats(times, "times", allow_scalar=False)
     a = _floats(acc, "acceleration", allow_scalar=False)
-    sample, rtol, method = run
-    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, method, True))
+    sample, rtol, method, integrator = run
+    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, method, integrator, True))
 
 
 def ida(
@@ -198,6 +198,7 @@ def ida(
     sample: float = 0.0025,
     rtol: float = 1e-8,
     method: str = "dop853",
+    integrator: str = "global",
     retries: int = 2,
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Result:
@@ -206,7 +207,8 @@ def ida(
     (else here, one after the other; the same numbers either way). The
     intensity is the scaled record's pseudo-spectral acceleration Sa(T1) at
     the left frame's fundamental period and ``damping``. ``sample``,
-    ``rtol`` and ``method`` as :func:`vibroimpact.pounding` takes them.
+    ``rtol``, ``method`` and ``integrator`` as :func:`vibroimpact.pounding`
+    takes them.
 
     Returns arrays over the runs, record-major: ``record`` (index),
     ``scale``, ``sa`` (m/s²), ``peak_impact_force`` (N), ``impacts``,
@@ -218,8 +220,8 @@ def ida(
     import vibroimpact as vi
 
     source, text = vi._pair_text(pair)
-    vi._pounding_settings(1.0, sample, rtol, method)
-    run = (float(sample), float(rtol), method)
+    vi._pounding_settings(1.0, sample, rtol, method, integrator)
+    run = (float(sample), float(rtol), method, integrator)
     recs = [vi.read_record(r) if isinstance(r, (str, os.PathLike)) else r for r in records]
     scales = np.asarray(scales, dtype=np.float64)
     if scales.ndim != 1 or scales.size == 0 or not np.all(np.isfinite(scales)):
