@@ -151,29 +151,15 @@ impl ChainDynamics {
     pub fn new(model: &Model, energy: bool) -> Self {
         let bodies = model.bodies();
         let n = bodies.len();
-        let base_peak = match model.base() {
-            BaseExcitation::None => 0.0,
-            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
-            BaseExcitation::Record(r) => r.peak(),
-        };
         let contacts = model
             .contacts()
             .iter()
-            .map(|c| {
-                let scale_of =
-                    |i: usize| bodies[i].stiffness * c.clearance + bodies[i].mass * base_peak;
-                let f_ref = [c.pair.left(), c.pair.right()]
-                    .into_iter()
-                    .flatten()
-                    .map(scale_of)
-                    .fold(f64::INFINITY, f64::min);
+            .enumerate()
+            .map(|(k, c)| {
+                let f_ref = model.contact_force_scale(k);
                 let (screen, absurd) = match *c.law.kind() {
                     LawKind::Exponential { a, b, alpha } => {
-                        let f_ref = if f_ref > 0.0 && f_ref.is_finite() {
-                            f_ref
-                        } else {
-                            a
-                        };
+                        let f_ref = f_ref.unwrap_or(a);
                         let limit = (1e-3 * f64::EPSILON * f_ref).ln() - a.ln();
                         // Beyond α s = 100 the force exceeds a e^100: no physical state.
                         (

@@ -200,11 +200,7 @@ impl FreeMotion {
             place[i] = (g, members[g].len());
             members[g].push(i);
         }
-        let zdd_max = match model.base() {
-            BaseExcitation::None => 0.0,
-            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
-            BaseExcitation::Record(r) => r.peak(),
-        };
+        let zdd_max = model.base().peak();
         let mut groups = Vec::with_capacity(members.len());
         for bodies in members {
             groups.push(Self::group(model, &place, bodies, zdd_max)?);

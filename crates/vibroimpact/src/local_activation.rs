@@ -31,22 +31,7 @@ impl Activation {
         let c = &model.contacts()[k_index];
         match *c.law.kind() {
             LawKind::Exponential { a, b, alpha } => {
-                let bodies = model.bodies();
-                let peak = match model.base() {
-                    BaseExcitation::None => 0.0,
-                    BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
-                    BaseExcitation::Record(r) => r.peak(),
-                };
-                let f_ref = [c.pair.left(), c.pair.right()]
-                    .into_iter()
-                    .flatten()
-                    .map(|i| bodies[i].stiffness * c.clearance + bodies[i].mass * peak)
-                    .fold(f64::INFINITY, f64::min);
-                let f_ref = if f_ref > 0.0 && f_ref.is_finite() {
-                    f_ref
-                } else {
-                    a
-                };
+                let f_ref = model.contact_force_scale(k_index).unwrap_or(a);
                 // Never later than the impact threshold.
                 let limit = ((1e-3 * rtol * f_ref) / a).ln().min(alpha * s_on);
                 Activation::Exponential {

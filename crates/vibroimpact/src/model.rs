@@ -255,6 +255,15 @@ impl BaseExcitation {
             BaseExcitation::Record(r) => r.at(t),
         }
     }
+
+    /// The largest |z̈| (m/s²).
+    pub fn peak(&self) -> f64 {
+        match self {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
+            BaseExcitation::Record(r) => r.peak(),
+        }
+    }
 }
 
 /// A harmonic force `P sin(Ω t + φ)` on one body.
@@ -353,6 +362,23 @@ fn nonneg(
 }
 
 impl Model {
+    /// The force scale `F_ref` of contact `k`: over its sides, the smaller
+    /// of `k_i g + m_i |z̈|max` (the spring force at the gap plus the peak
+    /// base inertia: what the contact must balance); None where that is
+    /// not positive and finite (free bodies, no gap, no base). The
+    /// exponential law's negligible force is a part of it
+    /// (docs/theory.md §10).
+    pub fn contact_force_scale(&self, k: usize) -> Option<f64> {
+        let c = &self.contacts[k];
+        let peak = self.base.peak();
+        let f = [c.pair.left(), c.pair.right()]
+            .into_iter()
+            .flatten()
+            .map(|i| self.bodies[i].stiffness * c.clearance + self.bodies[i].mass * peak)
+            .fold(f64::INFINITY, f64::min);
+        (f > 0.0 && f.is_finite()).then_some(f)
+    }
+
     /// Builds and validates a model. Initial displacements and velocities
     /// default to rest when empty.
     pub fn new(
