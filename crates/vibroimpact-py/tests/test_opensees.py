@@ -36,6 +36,14 @@ def _relative_errors(force, drift, reference):
     return np.array(errors)
 
 
+def _against_converged_opensees(pair, record, ours):
+    """Relative errors of our peak force and drifts against OpenSees at
+    dt_rec/16."""
+    t, a = np.asarray(record["times"]), np.asarray(record["acceleration"])
+    o = run(pair, t, a, 1.0, record["dt"] / 16)
+    return _relative_errors(ours["peak_impact_force"], ours["peak_drift"], (o["peak_impact_force"], o["peak_drift"]))
+
+
 @pytest.mark.parametrize("name", sorted(LAWS))
 def test_opensees_converges_to_our_peaks_with_its_time_step(northridge, name):
     pair, text = pair_with(LAWS[name])
@@ -81,9 +89,7 @@ def test_dopri5_at_a_loose_tolerance_agrees_with_converged_opensees(northridge, 
     pair, text = pair_with(LAWS[name])
     dt = northridge["dt"]
     fast = vi.pounding(text, northridge, sample=dt / 2, rtol=1e-3, method="dopri5", free=False)["pounding"]
-    t, a = np.asarray(northridge["times"]), np.asarray(northridge["acceleration"])
-    o = run(pair, t, a, 1.0, dt / 16)
-    errors = _relative_errors(fast["peak_impact_force"], fast["peak_drift"], (o["peak_impact_force"], o["peak_drift"]))
+    errors = _against_converged_opensees(pair, northridge, fast)
     assert errors.max() < 0.01, errors
     with pytest.raises(ValueError, match="method"):
         vi.pounding(text, northridge, method="rk4")
@@ -99,9 +105,7 @@ def test_the_local_integrator_agrees_with_converged_opensees(northridge, name):
     local = vi.pounding(text, northridge, sample=dt / 2, rtol=1e-6, integrator="local", free=False)["pounding"]
     full = vi.pounding(text, northridge, sample=dt / 2, rtol=1e-6, free=False)["pounding"]
     assert local["impacts"] == full["impacts"]
-    t, a = np.asarray(northridge["times"]), np.asarray(northridge["acceleration"])
-    o = run(pair, t, a, 1.0, dt / 16)
-    errors = _relative_errors(local["peak_impact_force"], local["peak_drift"], (o["peak_impact_force"], o["peak_drift"]))
+    errors = _against_converged_opensees(pair, northridge, local)
     assert errors.max() < 0.01, errors
     with pytest.raises(ValueError, match="integrator"):
         vi.pounding(text, northridge, integrator="exact")

@@ -83,6 +83,21 @@ fn free_model(
     Model::new(bodies, couplings, vec![], base, forces, u0, v0).unwrap()
 }
 
+/// Two bodies joined by a spring and a damper under `base`.
+fn coupled_pair(base: BaseExcitation) -> Model {
+    free_model(
+        vec![body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
+        vec![Coupling {
+            a: 0,
+            b: 1,
+            stiffness: 40.0,
+            damping: 0.3,
+        }],
+        base,
+        vec![],
+    )
+}
+
 fn harmonic(amplitude: f64, frequency: f64, phase: f64) -> BaseExcitation {
     BaseExcitation::Harmonic {
         amplitude,
@@ -188,17 +203,7 @@ fn a_record_is_exact_under_first_order_hold() {
         rec.clone(),
         vec![],
     );
-    let pair = free_model(
-        vec![body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 40.0,
-            damping: 0.3,
-        }],
-        rec,
-        vec![],
-    );
+    let pair = coupled_pair(rec);
     for m in [single, pair] {
         let t_end = 2.09;
         let reference = integrated(&m, t_end);
@@ -214,17 +219,7 @@ fn a_record_is_exact_under_first_order_hold() {
 /// propagation by the exponential still matches the integration.
 #[test]
 fn modes_agree_with_the_matrix_exponential() {
-    let pair = free_model(
-        vec![body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 40.0,
-            damping: 0.3,
-        }],
-        BaseExcitation::None,
-        vec![],
-    );
+    let pair = coupled_pair(BaseExcitation::None);
     let free = FreeMotion::new(&pair).unwrap();
     let a = FreeMotion::matrix(&free.groups()[0]);
     let modal = Modal::new(&a, Some(0.01)).unwrap();
