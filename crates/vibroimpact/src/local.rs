@@ -137,6 +137,8 @@ struct Run<'a> {
     stats: Stats,
     contact_evaluations: u64,
     local: LocalStats,
+    /// Per contact: the checks made (which one crawls).
+    checks_per_contact: Vec<u64>,
     breakpoints: Vec<f64>,
 }
 
@@ -164,6 +166,7 @@ impl Run<'_> {
     /// bound cannot tell).
     fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
         self.local.contact_checks += 1;
+        self.checks_per_contact[k] += 1;
         let c = &self.model.contacts()[k];
         // The sides' groups at t. Inside a step of the set they only go into
         // `deferred`: samples and a step taken back still ask for earlier

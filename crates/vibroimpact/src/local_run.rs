@@ -22,6 +22,9 @@ pub(in crate::simulate) struct LocalRun {
     pub contact_evaluations: u64,
     pub local: LocalStats,
     pub error: Option<IntegrationError>,
+    /// With [`IntegrationError::ChecksCrawl`]: the contact checked most
+    /// since the previous progress check (model index).
+    pub crawling: Option<usize>,
     pub sink_stopped: Option<f64>,
 }
 
@@ -221,6 +224,7 @@ pub(in crate::simulate) fn run(
             body_evaluations: vec![0; n],
             ..LocalStats::default()
         },
+        checks_per_contact: vec![0; nc],
         breakpoints,
     };
     let mut out = LocalRun {
@@ -231,6 +235,7 @@ pub(in crate::simulate) fn run(
         contact_evaluations: 0,
         local: LocalStats::default(),
         error: None,
+        crawling: None,
         sink_stopped: None,
     };
     let mut sample = vec![0.0; 2 * n];
@@ -269,6 +274,7 @@ pub(in crate::simulate) fn run(
     let mut steps: u64 = 0;
     let mut next_guard = PROGRESS_CHECK;
     let initial_checks = run.local.contact_checks;
+    let mut checks_before = run.checks_per_contact.clone();
     while out.error.is_none() && out.sink_stopped.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
@@ -290,8 +296,11 @@ pub(in crate::simulate) fn run(
                     projected,
                     limit: opts.max_steps,
                 });
+                out.crawling = (0..nc)
+                    .max_by_key(|&k| (run.checks_per_contact[k] - checks_before[k], Reverse(k)));
                 break;
             }
+            checks_before.clone_from(&run.checks_per_contact);
         }
         if run.set.is_none() {
             let next = run.next_check().map_or(opts.t_end, |c| c.0.min(opts.t_end));

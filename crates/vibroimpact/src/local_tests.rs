@@ -309,6 +309,54 @@ fn what_the_local_integrator_cannot_do_is_refused() {
     assert!(e.0.contains("global"), "{e}");
 }
 
+/// Checks that crawl end the run and name their contact: a stiff body
+/// (ω0 = 2e4 rad/s, 1 mm amplitude) beside a wall 2 mm away is checked
+/// several times a period; with a step limit of 100 the projected 10⁶
+/// checks are taken for a crawl. The error names that contact, not the
+/// deepest one (a slow body resting 0.1 mm from its wall).
+#[test]
+fn crawling_checks_name_their_contact() {
+    let contact = |body| Contact {
+        pair: ContactPair::RightWall { body },
+        clearance: 2e-3,
+        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+    };
+    let model = Model::new(
+        vec![
+            Body::from_frequency("slow", 1.0, 0.01, 0.01),
+            Body::from_frequency("fast", 1.0, 2e4, 0.0),
+        ],
+        vec![],
+        vec![contact(0), contact(1)],
+        BaseExcitation::None,
+        vec![],
+        vec![1.9e-3, 1e-3],
+        vec![0.0, 0.0],
+    )
+    .unwrap();
+    let sim = simulate(
+        &model,
+        &SimulationOptions {
+            t_end: 100.0,
+            max_steps: 100,
+            // (Implicit: an explicit method is refused for so stiff a body
+            // within 100 steps before the run starts.)
+            method: Method::Rodas,
+            integrator: Integrator::Local,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let e = sim.error.expect("a crawl");
+    assert!(
+        matches!(e.source, IntegrationError::ChecksCrawl { .. }),
+        "{e}"
+    );
+    assert_eq!(e.contact.as_deref(), Some("fast|wall"), "{e}");
+    assert!(e.to_string().contains("fast|wall"), "{e}");
+    assert!(sim.final_time < 100.0);
+}
+
 /// The example's struck chain (examples/granular-chain.toml, sonic
 /// vacuum): a solitary wave forms whose speed scales as the 1/5 power of
 /// its peak particle velocity (Nesterenko, *Dynamics of Heterogeneous

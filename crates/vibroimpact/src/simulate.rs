@@ -1005,7 +1005,18 @@ fn simulate_local(
         .iter()
         .map(|c| c.law.onset_approach(opts.impact_force_threshold))
         .collect();
-    let error = error.map(|source| failure(model, source, &run.y, &s_on));
+    let error = error.map(|source| match run.crawling {
+        // The contact whose checks crawl, not the deepest one.
+        Some(k) => {
+            let u: Vec<f64> = (0..n).map(|i| run.y[2 * i]).collect();
+            SimulationFailure {
+                source,
+                contact: Some(model.contact_name(k)),
+                approach: model.approach(k, &u),
+            }
+        }
+        None => failure(model, source, &run.y, &s_on),
+    });
     Ok(Simulation {
         times: Vec::new(),
         states: Vec::new(),
