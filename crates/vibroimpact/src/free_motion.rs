@@ -73,6 +73,8 @@ pub struct Group {
     couplings: Vec<(usize, usize, f64, f64)>,
     /// Largest |external force| on each body (N).
     force_max: Vec<f64>,
+    /// Harmonic forces: (body in the group, P, Ω, φ).
+    forces: Vec<(usize, f64, f64, f64)>,
     /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
     rate: f64,
     /// The complex modes, where they can be trusted (not for a single
@@ -271,6 +273,7 @@ impl FreeMotion {
             terms.push((frequency, phase, b));
         }
         let mut force_max: Vec<f64> = mass.iter().map(|mi| mi * zdd_max).collect();
+        let mut forces = Vec::new();
         for f in model.forces() {
             if place[f.body].0 != place[bodies[0]].0 {
                 continue;
@@ -279,6 +282,7 @@ impl FreeMotion {
             let mut b = vec![0.0; 2 * m];
             b[2 * j + 1] = f.amplitude / mass[j];
             force_max[j] += f.amplitude.abs();
+            forces.push((j, f.amplitude, f.frequency, f.phase));
             terms.push((f.frequency, f.phase, b));
         }
         let names = || {
@@ -342,6 +346,7 @@ impl FreeMotion {
             damping,
             couplings,
             force_max,
+            forces,
             rate,
             modal: None,
             hold_step: None,
@@ -465,6 +470,28 @@ impl FreeMotion {
             (_, None) => Self::homogeneous(group, t1 - t0, x),
         }
         self.add_particular(group, t1, 1.0, x);
+    }
+
+    /// Acceleration of body `j` of group `g` (index in the group) in the
+    /// group's interleaved state `x` at `t`: springs, dampers, couplings,
+    /// forces and the base (m/s², relative to the base).
+    pub fn acceleration(&self, g: usize, t: f64, x: &[f64], j: usize) -> f64 {
+        let group = &self.groups[g];
+        let mut f = -group.stiffness[j] * x[2 * j] - group.damping[j] * x[2 * j + 1];
+        for &(a, b, k, c) in &group.couplings {
+            let other = match (a == j, b == j) {
+                (true, _) => b,
+                (_, true) => a,
+                _ => continue,
+            };
+            f += k * (x[2 * other] - x[2 * j]) + c * (x[2 * other + 1] - x[2 * j + 1]);
+        }
+        for &(i, p, w, phi) in &group.forces {
+            if i == j {
+                f += p * (w * t + phi).sin();
+            }
+        }
+        f / group.mass[j] - self.base.at(t)
     }
 
     /// The group's system matrix `A` (interleaved).

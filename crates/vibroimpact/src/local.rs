@@ -35,11 +35,14 @@ use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce};
 mod activation;
 #[path = "local_run.rs"]
 mod driver;
+#[path = "local_extrema.rs"]
+mod extrema;
 #[path = "local_set.rs"]
 mod membership;
 
 use activation::{first_step, Activation};
 pub(super) use driver::run;
+use extrema::LocalExtrema;
 use membership::Crossing;
 
 /// Work of the local integrator, beside the integrator's counters.
@@ -98,6 +101,8 @@ struct ActiveSet {
     saved: (f64, Vec<f64>),
     /// The fastest natural or forcing rate of its groups (rad/s).
     rate: f64,
+    /// The extrema of its steps, when asked for.
+    extrema: Option<ExtremaScan>,
 }
 
 /// The local integrator's run.
@@ -139,6 +144,8 @@ struct Run<'a> {
     local: LocalStats,
     /// Per contact: the checks made (which one crawls).
     checks_per_contact: Vec<u64>,
+    /// The extrema over the window, when asked for.
+    extrema: Option<LocalExtrema>,
     breakpoints: Vec<f64>,
 }
 
@@ -343,6 +350,9 @@ impl Run<'_> {
         if let Some(mut old) = self.set.take() {
             h_prev = Some(old.st.h_next());
             self.absorb(&mut old);
+            if let (Some(ex), Some(scan)) = (self.extrema.as_mut(), &old.extrema) {
+                ex.merge(&old, scan);
+            }
             self.contact_evaluations += old.sys.contact_evaluations();
             old_y = old.st.y().to_vec();
             for &i in &old.bodies {
@@ -553,6 +563,10 @@ impl Run<'_> {
                 st.limit_next_step(first_step(impulse, self.opts.atol * mu, h));
             }
         }
+        let extrema = self
+            .extrema
+            .as_ref()
+            .map(|ex| ex.set_scan(&scan.ids, bodies.len(), &st, &sys));
         self.set = Some(ActiveSet {
             groups,
             bodies,
@@ -562,6 +576,7 @@ impl Run<'_> {
             scan,
             saved: (t, y),
             rate,
+            extrema,
         });
         Ok(())
     }

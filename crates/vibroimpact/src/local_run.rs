@@ -25,6 +25,8 @@ pub(in crate::simulate) struct LocalRun {
     /// With [`IntegrationError::ChecksCrawl`]: the contact checked most
     /// since the previous progress check (model index).
     pub crawling: Option<usize>,
+    /// The exact extrema over the options' window, if asked for.
+    pub extrema: Option<Extrema>,
     pub sink_stopped: Option<f64>,
 }
 
@@ -33,6 +35,7 @@ impl Run<'_> {
     /// bodies from its dense output (its last step holds `t`), the others
     /// from their exact motion.
     pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
+        self.scan_exact_to(t);
         let Run {
             free,
             exact,
@@ -152,11 +155,6 @@ pub(in crate::simulate) fn run(
             "the energy audit needs the global integrator (integrator = global)".into(),
         ));
     }
-    if opts.extrema_window.is_some() {
-        return Err(OptionsError(
-            "exact extrema need the global integrator (integrator = global)".into(),
-        ));
-    }
     let free = FreeMotion::new(model).map_err(|e| OptionsError(e.to_string()))?;
     let n = model.bodies().len();
     let ng = free.groups().len();
@@ -225,8 +223,17 @@ pub(in crate::simulate) fn run(
             ..LocalStats::default()
         },
         checks_per_contact: vec![0; nc],
+        extrema: None,
         breakpoints,
     };
+    if let Some(window) = opts.extrema_window {
+        let s_on = model
+            .contacts()
+            .iter()
+            .map(|c| c.law.onset_approach(opts.impact_force_threshold))
+            .collect();
+        run.extrema = Some(LocalExtrema::new(window, model, &run.free, s_on));
+    }
     let mut out = LocalRun {
         t: 0.0,
         y: y0.to_vec(),
@@ -236,6 +243,7 @@ pub(in crate::simulate) fn run(
         local: LocalStats::default(),
         error: None,
         crawling: None,
+        extrema: None,
         sink_stopped: None,
     };
     let mut sample = vec![0.0; 2 * n];
@@ -259,6 +267,7 @@ pub(in crate::simulate) fn run(
             }
         }
     };
+    run.scan_exact_to(0.0);
     // Contacts active at the start form the first set; the others are
     // scheduled.
     for k in 0..nc {
@@ -305,6 +314,7 @@ pub(in crate::simulate) fn run(
         if run.set.is_none() {
             let next = run.next_check().map_or(opts.t_end, |c| c.0.min(opts.t_end));
             emit(&mut run, next, &mut out.sink_stopped);
+            run.scan_exact_to(next);
             t = next;
             if next >= opts.t_end {
                 break;
@@ -336,7 +346,13 @@ pub(in crate::simulate) fn run(
                     out.error = Some(IntegrationError::TooManySteps { t, steps });
                     break;
                 }
+                if let Some(set) = run.set.as_mut() {
+                    if let Some(scan) = set.extrema.as_mut() {
+                        scan.step(&mut set.st, &mut set.sys);
+                    }
+                }
                 emit(&mut run, t, &mut out.sink_stopped);
+                run.scan_exact_to(t);
                 run.apply_deferred(t);
                 let result = match reached {
                     Some((_, k)) => run.join(k, t).map(|_| None),
@@ -362,8 +378,12 @@ pub(in crate::simulate) fn run(
     };
     let mut y = vec![0.0; 2 * n];
     run.state_at(t_final, &mut y);
+    run.scan_exact_to(t_final);
     if let Some(mut set) = run.set.take() {
         run.absorb(&mut set);
+        if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
+            ex.merge(&set, scan);
+        }
         run.contact_evaluations += set.sys.contact_evaluations();
         run.impacts = set.scan.impacts;
     }
@@ -373,5 +393,6 @@ pub(in crate::simulate) fn run(
     out.stats = run.stats;
     out.contact_evaluations = run.contact_evaluations;
     out.local = run.local;
+    out.extrema = run.extrema.map(LocalExtrema::into_found);
     Ok(out)
 }

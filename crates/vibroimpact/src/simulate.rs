@@ -1028,7 +1028,7 @@ fn simulate_local(
         contact_evaluations: run.contact_evaluations,
         energy: None,
         error,
-        extrema: None,
+        extrema: run.extrema,
         local: Some(run.local),
     })
 }
