@@ -206,8 +206,9 @@ pub struct AttractorRuns {
     /// lightly damped free oscillation).
     #[arg(long)]
     pub cluster_tolerance: Option<f64>,
-    /// Integrator of the transients: `local` moves bodies out of contact
-    /// exactly (the recorded periods run the global one).
+    /// Integrator of the transients and recorded periods: `local` moves
+    /// bodies out of contact exactly (Lyapunov exponents run the global
+    /// one).
     #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
     pub integrator: IntegratorName,
 }

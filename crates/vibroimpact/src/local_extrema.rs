@@ -101,7 +101,9 @@ enum Side {
 impl Run<'_> {
     /// Scans the exact motion from where it was scanned to `t`: every group
     /// moving exactly, and every contact with a side moving exactly. (The
-    /// set, if any, holds `t` and the scanned time in its last step.)
+    /// set, if any, holds `t` and the scanned time in its last step; the
+    /// motion before `t` is sampled and checked, so that the exact groups'
+    /// reference states may move up to `t`.)
     pub(super) fn scan_exact_to(&mut self, t: f64) {
         let Some(mut ex) = self.extrema.take() else {
             return;
@@ -193,6 +195,14 @@ impl Run<'_> {
                 }
             }
             (xa, sa, ta) = (xb, sb, tb);
+        }
+        // Everything up to b is scanned (and sampled and checked: the
+        // callers' condition): the groups' reference states move there, so
+        // that the samples at b do not propagate again.
+        for (x, &g) in xa.into_iter().zip(&groups) {
+            if b > self.exact[g].0 {
+                self.exact[g] = (b, x);
+            }
         }
     }
 

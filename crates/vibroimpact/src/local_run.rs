@@ -252,7 +252,7 @@ pub(in crate::simulate) fn run(
     let mut emit = |run: &mut Run, t: f64, stopped: &mut Option<f64>| {
         let Some(dt) = opts.output_step else { return };
         while stopped.is_none() {
-            let ts = next_sample as f64 * dt;
+            let ts = opts.output_from + next_sample as f64 * dt;
             if ts > t || ts > opts.t_end {
                 break;
             }

@@ -47,6 +47,10 @@ pub struct SimulationOptions {
     pub atol: f64,
     /// Output sampling interval (s) for the time history; None: no history.
     pub output_step: Option<f64>,
+    /// Time of the first output sample (s, in `[0, t_end]`; default 0), the
+    /// others every `output_step` after it: a history at chosen instants
+    /// (a sweep's Poincaré sections) without the samples in between.
+    pub output_from: f64,
     /// Force level F_on (N) delimiting impacts of the exponential law.
     pub impact_force_threshold: f64,
     /// Integrate the energy audit.
@@ -117,6 +121,7 @@ impl Default for SimulationOptions {
             rtol: 1e-8,
             atol: 1e-12,
             output_step: None,
+            output_from: 0.0,
             impact_force_threshold: 1e-3,
             energy: false,
             max_steps: 50_000_000,
@@ -625,6 +630,12 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
             return bad("output step", dt);
         }
     }
+    if !(opts.output_from >= 0.0 && opts.output_from <= opts.t_end) {
+        return Err(OptionsError(format!(
+            "first output time = {}: must lie in [0, duration = {}]",
+            opts.output_from, opts.t_end
+        )));
+    }
     Ok(())
 }
 
@@ -702,7 +713,8 @@ pub const MAX_SAMPLES: f64 = 1e9;
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
     if let Some(dt) = opts.output_step {
-        let values = (opts.t_end / dt + 1.0) * (2 * model.bodies().len() + 1) as f64;
+        let values =
+            ((opts.t_end - opts.output_from) / dt + 1.0) * (2 * model.bodies().len() + 1) as f64;
         if values > MAX_HISTORY_VALUES {
             return Err(OptionsError(format!(
                 "output step = {dt} s over {} s: the history would hold {values:.3e} values, more than {MAX_HISTORY_VALUES:e}; take a larger output step or a shorter duration",
@@ -733,7 +745,7 @@ pub fn simulate_streaming(
 ) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
     if let Some(dt) = opts.output_step {
-        let samples = opts.t_end / dt + 1.0;
+        let samples = (opts.t_end - opts.output_from) / dt + 1.0;
         if samples > MAX_SAMPLES {
             return Err(OptionsError(format!(
                 "output step = {dt} s over {} s: {samples:.3e} samples, more than {MAX_SAMPLES:e}; take a larger output step or a shorter duration",
@@ -814,7 +826,7 @@ pub fn simulate_streaming(
     };
     let mut next_sample = 0usize;
     let mut sink_stopped = None;
-    if opts.output_step.is_some() {
+    if opts.output_step.is_some() && opts.output_from == 0.0 {
         if !record(0.0, &y0) {
             sink_stopped = Some(0.0);
         }
@@ -910,7 +922,7 @@ pub fn simulate_streaming(
         }
         if let Some(dt) = opts.output_step {
             loop {
-                let ts = next_sample as f64 * dt;
+                let ts = opts.output_from + next_sample as f64 * dt;
                 if ts > st.t() || ts > opts.t_end {
                     break;
                 }

@@ -74,9 +74,9 @@ pub struct SweepOptions {
     pub lyapunov: Option<usize>,
     /// Stop request (see [`Interrupt`]).
     pub interrupt: Option<Interrupt>,
-    /// The integrator of the transient (docs/theory.md §10); the recorded
-    /// window (its exact extrema and Lyapunov exponents) runs the global
-    /// integrator.
+    /// The integrator of the transient and the recorded window, with its
+    /// exact extrema (docs/theory.md §10); the Lyapunov exponents run the
+    /// global integrator.
     pub integrator: Integrator,
 }
 
@@ -206,8 +206,8 @@ pub(crate) struct Settings {
     record: usize,
     lyapunov: Option<usize>,
     opts: SimulationOptions,
-    /// The transient's integrator.
-    transient_integrator: Integrator,
+    /// The integrator of the transient and the recorded window.
+    integrator: Integrator,
     pub(crate) cluster_tolerance: f64,
 }
 
@@ -272,7 +272,7 @@ impl Settings {
                 interrupt: options.interrupt.clone(),
                 ..SimulationOptions::default()
             },
-            transient_integrator: options.integrator,
+            integrator: options.integrator,
             cluster_tolerance,
         })
     }
@@ -446,7 +446,7 @@ pub(crate) fn run_value(
         let opts = SimulationOptions {
             t_end: (settings.transient * COARSE) as f64 * dt,
             output_step: Some(dt),
-            integrator: settings.transient_integrator,
+            integrator: settings.integrator,
             ..settings.opts.clone()
         };
         let sim = match simulate(&m, &opts) {
@@ -479,10 +479,13 @@ pub(crate) fn run_value(
     let dt = period / FINE as f64;
     let j0 = (FINE - start.phase % FINE) % FINE;
     let j_end = j0 + settings.record * FINE;
+    // Samples at the section instants only: the first, then one a period.
     let opts = SimulationOptions {
         t_end: j_end as f64 * dt,
-        output_step: Some(dt),
+        output_step: Some(period),
+        output_from: j0 as f64 * dt,
         extrema_window: Some((j0 as f64 * dt, j_end as f64 * dt)),
+        integrator: settings.integrator,
         ..settings.opts.clone()
     };
     let sim = match simulate(&m, &opts) {
@@ -490,16 +493,14 @@ pub(crate) fn run_value(
         Err(e) => return fail(point, e.to_string()),
     };
     let samples = sim.times.len();
-    let row = |j: usize| &sim.states[j * 2 * n..(j + 1) * 2 * n];
+    let row = |k: usize| &sim.states[k * 2 * n..(k + 1) * 2 * n];
     point.sections = (1..=settings.record)
-        .map(|k| j0 + k * FINE)
-        .filter(|&j| j < samples)
-        .map(|j| row(j).to_vec())
+        .filter(|&k| k < samples)
+        .map(|k| row(k).to_vec())
         .collect();
     point.recorded_periods = point.sections.len();
-    let window_end = (j0 + point.recorded_periods * FINE).min(samples.saturating_sub(1));
     let mut max_v: f64 = 0.0;
-    if window_end > j0 {
+    if point.recorded_periods > 0 {
         // The exact extrema over the recorded periods (dense output).
         if let Some(x) = &sim.extrema {
             point.max_displacement.clone_from(&x.max_displacement);
@@ -539,7 +540,7 @@ pub(crate) fn run_value(
             rtol: settings.opts.rtol,
             interrupt: settings.opts.interrupt.clone(),
         };
-        match lyapunov_spectrum(&m, row(j0), j0 as f64 * dt, &opts) {
+        match lyapunov_spectrum(&m, row(0), j0 as f64 * dt, &opts) {
             Ok(ly) => {
                 point.lyapunov = Some(ly.exponents);
                 point.lyapunov_uncertainty = Some(ly.uncertainty);
@@ -548,7 +549,8 @@ pub(crate) fn run_value(
         }
     }
     point.completed = true;
-    let next = handover(&m, &sim, start.phase, 1, start.phase + j_end);
+    // Every sample is a section instant (phase 0).
+    let next = handover(&m, &sim, 0, FINE, start.phase + j_end);
     (point, next)
 }
 
@@ -810,12 +812,13 @@ mod tests {
 
     /// R2 N = 2 (the rows of `ROW` at 0.05 m/s²) at frequencies where it
     /// settles on period-2 orbits with six impacts a period within 150
-    /// periods: with the transient by the local integrator the Poincaré
-    /// samples are those of the global one to 1e-5 of the motion (the
-    /// sweep's own cluster tolerance: 150 lightly damped periods leave about
-    /// e^-12 of the transient, so the two runs end 2.5e-6 apart).
+    /// periods: by the local integrator (transient and recorded window) the
+    /// Poincaré samples are those of the global one to 1e-5 of the motion
+    /// (the sweep's own cluster tolerance: 150 lightly damped periods leave
+    /// about e^-12 of the transient, so the two runs end 2.5e-6 apart), and
+    /// the exact extrema too.
     #[test]
-    fn a_local_transient_reaches_the_same_attractors() {
+    fn the_local_integrator_reaches_the_same_attractors() {
         let text = ROW.replace("amplitude = 0.5", "amplitude = 0.05");
         let doc = crate::model_file::ModelDocument::from_toml(&text, "m.toml").unwrap();
         let family = ParameterizedModel::new(doc, "frequency").unwrap();
@@ -842,6 +845,9 @@ mod tests {
             for (a, b) in g.sections.iter().flatten().zip(l.sections.iter().flatten()) {
                 let s = scale * g.parameter;
                 assert!((a - b).abs() < 1e-5 * s, "{a} {b} at {}", g.parameter);
+            }
+            for (a, b) in g.max_displacement.iter().zip(&l.max_displacement) {
+                assert!((a - b).abs() < 1e-5 * scale, "{a} {b} at {}", g.parameter);
             }
         }
     }

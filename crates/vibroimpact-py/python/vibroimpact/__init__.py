@@ -650,9 +650,9 @@ def sweep(
     and ``sections``, the Poincaré samples as a record x 2N array). A value
     that fails numerically is kept with its ``error``.
 
-    ``integrator="local"``: the transients move bodies out of contact
-    exactly (docs/theory.md §10); the recorded periods run the global
-    integrator.
+    ``integrator="local"``: the transients and recorded periods move
+    bodies out of contact exactly (docs/theory.md §10); the Lyapunov
+    exponents run the global integrator.
 
     ``lyapunov = k``: every point also gains ``lyapunov``, its k largest
     Lyapunov exponents (1/s, largest first, averaged over the recorded
@@ -753,8 +753,8 @@ def chart(
     per period, its largest |u| and, with ``lyapunov``, its largest Lyapunov
     exponent. Defaults as the CLI: ``rtol`` 1e-7 unless the model's
     ``[simulation]`` gives one, ``cluster_tolerance`` 1e-3.
-    ``integrator="local"``: the transients move bodies out of contact
-    exactly; the recorded periods run the global integrator.
+    ``integrator="local"``: the transients and recorded periods move
+    bodies out of contact exactly.
 
     Without ``client`` the cells run on this machine's cores (``threads``:
     pool size). With a ``dask.distributed.Client`` the rows of the grid run
