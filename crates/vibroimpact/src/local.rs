@@ -202,6 +202,7 @@ impl Run<'_> {
             if self.defer {
                 self.deferred.push((g, t, x));
             } else {
+                self.scan_group_to(g, t);
                 self.exact[g] = (t, x);
             }
         }
@@ -216,6 +217,7 @@ impl Run<'_> {
             if tc > t {
                 later.push((g, tc, x));
             } else if !self.in_set[g] && tc > self.exact[g].0 {
+                self.scan_group_to(g, tc);
                 self.exact[g] = (tc, x);
             }
         }
@@ -341,6 +343,12 @@ impl Run<'_> {
     /// set's state and the exact motion of the others.
     fn rebuild(&mut self, groups: Vec<usize>, t: f64) -> Result<(), IntegrationError> {
         let model = self.model;
+        // Groups joining leave their exact motion: scanned up to here.
+        for &g in &groups {
+            if !self.in_set[g] {
+                self.scan_group_to(g, t);
+            }
+        }
         let mut h_prev = None;
         // The old set's groups, bodies (ascending) and state.
         let (mut old_bodies, mut old_y) = (Vec::new(), Vec::new());
@@ -380,6 +388,7 @@ impl Run<'_> {
                         })
                         .collect();
                     self.exact[g] = (t, x);
+                    self.extrema_from(g, t);
                 }
             }
         }

@@ -1,25 +1,32 @@
 //! Exact extrema under the local integrator (docs/theory.md §10): the
 //! active set's steps are scanned on its dense output as the global
-//! integrator's are ([`ExtremaScan`]); the exact motion of the other
-//! groups, and the contacts with a side moving exactly, on their own
-//! propagation. Over a grid of a sixteenth of the fastest period (and a
-//! record's samples) an interior maximum of |u_i| lies where v_i changes
-//! sign (Brent), one of |v_i| where the acceleration does (golden section),
-//! one of a contact's approach where ṡ does: the same tests as on the
-//! global integrator's steps, on intervals no longer than its steps over
-//! free flight.
+//! integrator's are ([`ExtremaScan`]), with the contacts between the set
+//! and an exactly moving group; the exact motion of a group, and its
+//! contacts with other exact groups or walls, on its own propagation,
+//! just before its reference state moves (so no interval is skipped, and
+//! a group at rest costs nothing until then). Over a grid of a sixteenth
+//! of the group's fastest period (and a record's samples) an interior
+//! maximum of |u_i| lies where v_i changes sign (Brent), one of |v_i| where
+//! the acceleration does (golden section), one of a contact's approach
+//! where ṡ does: the same tests as on the global integrator's steps, on
+//! intervals no longer than its steps over free flight.
 
 use super::*;
 
-/// Extrema over the window, and how far the exact motion has been scanned.
+/// Extrema over the window, and how far each group and contact has been
+/// scanned.
 pub(super) struct LocalExtrema {
     window: (f64, f64),
-    /// The exact motion is scanned up to this time (−∞: not yet at all).
-    scanned: f64,
+    /// Per group: its bodies are scanned up to this time while it moves
+    /// exactly (−∞: not yet).
+    group_scanned: Vec<f64>,
+    /// Per contact: its approach is scanned up to this time (by its exact
+    /// groups, or the set's steps while a side is in the set).
+    contact_scanned: Vec<f64>,
+    /// Per group: grid step of its exact motion (s).
+    grid: Vec<f64>,
     /// The impact threshold of every contact.
     s_on: Vec<f64>,
-    /// Grid step of the exact motion (s).
-    grid: f64,
     found: Extrema,
 }
 
@@ -31,23 +38,29 @@ impl LocalExtrema {
         free: &FreeMotion,
         s_on: Vec<f64>,
     ) -> Self {
-        let rate = free
+        let record_step = match model.base() {
+            BaseExcitation::Record(r) => {
+                let t = r.times();
+                (t[t.len() - 1] - t[0]) / (t.len().max(2) - 1) as f64
+            }
+            _ => f64::INFINITY,
+        };
+        let grid = free
             .groups()
             .iter()
-            .map(|g| g.rate())
-            .fold(0.0f64, f64::max);
-        let mut grid = if rate > 0.0 {
-            std::f64::consts::PI / (8.0 * rate)
-        } else {
-            f64::INFINITY
-        };
-        if let BaseExcitation::Record(r) = model.base() {
-            let t = r.times();
-            grid = grid.min((t[t.len() - 1] - t[0]) / (t.len().max(2) - 1) as f64);
-        }
+            .map(|g| {
+                let natural = if g.rate() > 0.0 {
+                    std::f64::consts::PI / (8.0 * g.rate())
+                } else {
+                    f64::INFINITY
+                };
+                natural.min(record_step)
+            })
+            .collect();
         Self {
             window,
-            scanned: f64::NEG_INFINITY,
+            group_scanned: vec![f64::NEG_INFINITY; free.groups().len()],
+            contact_scanned: vec![f64::NEG_INFINITY; s_on.len()],
             grid,
             found: Extrema {
                 max_displacement: vec![0.0; model.bodies().len()],
@@ -86,85 +99,96 @@ impl LocalExtrema {
         let s_on = ids.iter().map(|&k| self.s_on[k]).collect();
         ExtremaScan::new(self.window, bodies, s_on, st, sys)
     }
-}
 
-/// A side of a contact at the grid's points: a body moving exactly (its
-/// group's place among the scanned groups, the group, index in the group)
-/// or in the set (state index), or a wall.
-#[derive(Clone, Copy)]
-enum Side {
-    Exact(usize, usize, usize),
-    Set(usize),
-    Wall,
+    /// The part of `[from, t]` inside the window, if any (a point counts).
+    fn span(&self, from: f64, t: f64) -> Option<(f64, f64)> {
+        let (a, b) = (from.max(self.window.0), t.min(self.window.1));
+        (a <= b).then_some((a, b))
+    }
+
+    fn note_margin(&mut self, k: usize, s: f64) {
+        let m = &mut self.found.impact_margin[k];
+        *m = m.max(s - self.s_on[k]);
+    }
+
+    fn note_body(&mut self, i: usize, u: f64, v: f64) {
+        let f = &mut self.found;
+        f.max_displacement[i] = f.max_displacement[i].max(u.abs());
+        f.max_velocity[i] = f.max_velocity[i].max(v.abs());
+    }
 }
 
 impl Run<'_> {
-    /// Scans the exact motion from where it was scanned to `t`: every group
-    /// moving exactly, and every contact with a side moving exactly. (The
-    /// set, if any, holds `t` and the scanned time in its last step; the
-    /// motion before `t` is sampled and checked, so that the exact groups'
-    /// reference states may move up to `t`.)
-    pub(super) fn scan_exact_to(&mut self, t: f64) {
+    /// Scans group `g`'s exact motion, and its contacts with other exact
+    /// groups or walls, up to `t`: called before its reference state moves
+    /// to `t` or it joins the set at `t`.
+    pub(super) fn scan_group_to(&mut self, g: usize, t: f64) {
         let Some(mut ex) = self.extrema.take() else {
             return;
         };
-        self.scan_exact(&mut ex, t);
+        let from = ex.group_scanned[g].max(self.exact[g].0);
+        if let Some((a, b)) = ex.span(from, t) {
+            self.scan_bodies(&mut ex, g, a, b);
+        }
+        ex.group_scanned[g] = ex.group_scanned[g].max(t);
+        for c in 0..self.group_contacts[g].len() {
+            let k = self.group_contacts[g][c];
+            if self.touches_set(k) {
+                continue;
+            }
+            if let Some((a, b)) = ex.span(ex.contact_scanned[k], t) {
+                self.scan_contact(&mut ex, k, a, b);
+            }
+            ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
+        }
         self.extrema = Some(ex);
     }
 
-    /// [`scan_exact_to`](Self::scan_exact_to) into `ex`.
-    fn scan_exact(&mut self, ex: &mut LocalExtrema, t: f64) {
-        let first = ex.scanned == f64::NEG_INFINITY;
-        if t < ex.scanned || (t == ex.scanned && !first) {
+    /// A group leaves the set at `t`: its exact motion, and its contacts,
+    /// are scanned from there (the set's scan covered them so far).
+    pub(super) fn extrema_from(&mut self, g: usize, t: f64) {
+        if let Some(ex) = self.extrema.as_mut() {
+            ex.group_scanned[g] = t;
+            for &k in &self.group_contacts[g] {
+                ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
+            }
+        }
+    }
+
+    /// After a kept step of the set: the set's scan, and the contacts
+    /// between the set and an exact group over the step.
+    pub(super) fn scan_set_step(&mut self) {
+        let Some(mut ex) = self.extrema.take() else {
             return;
-        }
-        let (a, b) = (ex.scanned.max(ex.window.0), t.min(ex.window.1));
-        ex.scanned = t;
-        if a > b || (a == b && !first) {
-            return;
-        }
-        let grid = ex.grid;
-        let groups: Vec<usize> = (0..self.exact.len()).filter(|&g| !self.in_set[g]).collect();
-        let mut place = vec![usize::MAX; self.exact.len()];
-        for (p, &g) in groups.iter().enumerate() {
-            place[g] = p;
-        }
-        let side = |i: Option<usize>| match i {
-            None => Side::Wall,
-            Some(i) => match self.slot[i] {
-                Some(j) => Side::Set(2 * j),
-                None => {
-                    let (g, j) = self.free.place(i);
-                    Side::Exact(place[g], g, j)
-                }
-            },
         };
-        let contacts: Vec<(usize, [Side; 2])> = (0..self.model.contacts().len())
-            .filter_map(|k| {
-                let c = &self.model.contacts()[k];
-                let sides = [side(c.pair.left()), side(c.pair.right())];
-                sides
-                    .iter()
-                    .any(|s| matches!(s, Side::Exact(..)))
-                    .then_some((k, sides))
-            })
-            .collect();
-        let mut xa: Vec<Vec<f64>> = groups
-            .iter()
-            .map(|&g| {
-                let (t0, x) = &self.exact[g];
-                let mut x = x.clone();
-                self.free.propagate(g, *t0, a, &mut x);
-                x
-            })
-            .collect();
-        let pieces = ((b - a) / grid).ceil().clamp(1.0, 1e9) as usize;
+        if let Some(set) = self.set.as_mut() {
+            if let Some(scan) = set.extrema.as_mut() {
+                scan.step(&mut set.st, &mut set.sys);
+            }
+            let t = set.st.t();
+            let boundary = set.boundary.clone();
+            for k in boundary {
+                if let Some((a, b)) = ex.span(ex.contact_scanned[k], t) {
+                    self.scan_contact(&mut ex, k, a, b);
+                }
+                ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
+            }
+        }
+        self.extrema = Some(ex);
+    }
+
+    /// |u|, |v| of group `g`'s bodies on `[a, b]` (its exact motion).
+    fn scan_bodies(&self, ex: &mut LocalExtrema, g: usize, a: f64, b: f64) {
+        let free = &self.free;
+        let (t0, x0) = &self.exact[g];
+        let mut xa = x0.clone();
+        free.propagate(g, *t0, a, &mut xa);
+        let bodies = free.groups()[g].bodies();
+        for (j, &i) in bodies.iter().enumerate() {
+            ex.note_body(i, xa[2 * j], xa[2 * j + 1]);
+        }
+        let pieces = ((b - a) / ex.grid[g]).ceil().clamp(1.0, 1e9) as usize;
         let mut ta = a;
-        let mut sa: Vec<(f64, f64)> = contacts
-            .iter()
-            .map(|&(k, sides)| self.approach_at(k, sides, &xa, ta))
-            .collect();
-        self.note_points(ex, &groups, &xa, &contacts, &sa);
         for p in 1..=pieces {
             let tb = if p == pieces {
                 b
@@ -175,134 +199,89 @@ impl Run<'_> {
                 continue;
             }
             let mut xb = xa.clone();
-            for (x, &g) in xb.iter_mut().zip(&groups) {
-                self.free.propagate(g, ta, tb, x);
-            }
-            let sb: Vec<(f64, f64)> = contacts
-                .iter()
-                .map(|&(k, sides)| self.approach_at(k, sides, &xb, tb))
-                .collect();
-            self.note_points(ex, &groups, &xb, &contacts, &sb);
-            self.interior_of_groups(ex, &groups, (ta, &xa), (tb, &xb));
-            for (c, &(k, sides)) in contacts.iter().enumerate() {
-                let (sda, sdb) = (sa[c].1, sb[c].1);
-                if sda > 0.0 && sdb < 0.0 {
-                    let rate = |t: f64| self.approach_from(k, sides, &xa, ta, t).1;
-                    if let Ok(tm) = EventLocator::FINE.locate(rate, (ta, sda), (tb, sdb)) {
-                        let s = self.approach_from(k, sides, &xa, ta, tm).0;
-                        ex.found.impact_margin[k] = ex.found.impact_margin[k].max(s - ex.s_on[k]);
-                    }
-                }
-            }
-            (xa, sa, ta) = (xb, sb, tb);
-        }
-        // Everything up to b is scanned (and sampled and checked: the
-        // callers' condition): the groups' reference states move there, so
-        // that the samples at b do not propagate again.
-        for (x, &g) in xa.into_iter().zip(&groups) {
-            if b > self.exact[g].0 {
-                self.exact[g] = (b, x);
-            }
-        }
-    }
-
-    /// The ends: |u|, |v| of the exact bodies and the contacts' approach.
-    fn note_points(
-        &self,
-        ex: &mut LocalExtrema,
-        groups: &[usize],
-        x: &[Vec<f64>],
-        contacts: &[(usize, [Side; 2])],
-        s: &[(f64, f64)],
-    ) {
-        for (xg, &g) in x.iter().zip(groups) {
-            for (j, &i) in self.free.groups()[g].bodies().iter().enumerate() {
-                let f = &mut ex.found;
-                f.max_displacement[i] = f.max_displacement[i].max(xg[2 * j].abs());
-                f.max_velocity[i] = f.max_velocity[i].max(xg[2 * j + 1].abs());
-            }
-        }
-        for (&(k, _), &(sk, _)) in contacts.iter().zip(s) {
-            ex.found.impact_margin[k] = ex.found.impact_margin[k].max(sk - ex.s_on[k]);
-        }
-    }
-
-    /// Interior extrema of the exact bodies on `[ta, tb]`.
-    fn interior_of_groups(
-        &self,
-        ex: &mut LocalExtrema,
-        groups: &[usize],
-        (ta, xa): (f64, &[Vec<f64>]),
-        (tb, xb): (f64, &[Vec<f64>]),
-    ) {
-        for (p, &g) in groups.iter().enumerate() {
-            let free = &self.free;
+            free.propagate(g, ta, tb, &mut xb);
             let at = |t: f64| {
-                let mut y = xa[p].clone();
+                let mut y = xa.clone();
                 free.propagate(g, ta, t, &mut y);
                 y
             };
-            for (j, &i) in free.groups()[g].bodies().iter().enumerate() {
-                let (va, vb) = (xa[p][2 * j + 1], xb[p][2 * j + 1]);
-                let mut max_u = 0.0f64;
-                let mut max_v = 0.0f64;
+            for (j, &i) in bodies.iter().enumerate() {
+                ex.note_body(i, xb[2 * j], xb[2 * j + 1]);
+                let (va, vb) = (xa[2 * j + 1], xb[2 * j + 1]);
                 if va * vb < 0.0 {
                     let v = |t: f64| at(t)[2 * j + 1];
                     if let Ok(tm) = EventLocator::FINE.locate(v, (ta, va), (tb, vb)) {
-                        max_u = at(tm)[2 * j].abs();
+                        ex.note_body(i, at(tm)[2 * j], 0.0);
                     }
                 }
                 let (aa, ab) = (
-                    free.acceleration(g, ta, &xa[p], j),
-                    free.acceleration(g, tb, &xb[p], j),
+                    free.acceleration(g, ta, &xa, j),
+                    free.acceleration(g, tb, &xb, j),
                 );
                 if aa * ab < 0.0 {
-                    max_v = golden_max(|t| at(t)[2 * j + 1].abs(), ta, tb).0;
+                    let v = golden_max(|t| at(t)[2 * j + 1].abs(), ta, tb).0;
+                    ex.note_body(i, 0.0, v);
                 }
-                let f = &mut ex.found;
-                f.max_displacement[i] = f.max_displacement[i].max(max_u);
-                f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
+            (xa, ta) = (xb, tb);
         }
     }
 
-    /// Contact k's (s, ṡ) at `t` from the exact groups' states `x` at `t`
-    /// and the set's dense output.
-    fn approach_at(&mut self, k: usize, sides: [Side; 2], x: &[Vec<f64>], t: f64) -> (f64, f64) {
-        self.approach_from(k, sides, x, t, t)
+    /// Contact k's approach on `[a, b]`: its ends, and an interior maximum
+    /// where ṡ changes sign on the grid of its exact sides.
+    fn scan_contact(&mut self, ex: &mut LocalExtrema, k: usize, a: f64, b: f64) {
+        let c = &self.model.contacts()[k];
+        let grid = [c.pair.left(), c.pair.right()]
+            .into_iter()
+            .flatten()
+            .filter(|&i| self.slot[i].is_none())
+            .map(|i| ex.grid[self.free.place(i).0])
+            .fold(f64::INFINITY, f64::min);
+        let pieces = ((b - a) / grid).ceil().clamp(1.0, 1e9) as usize;
+        let (mut ta, mut sa) = (a, self.approach(k, a));
+        ex.note_margin(k, sa.0);
+        for p in 1..=pieces {
+            let tb = if p == pieces {
+                b
+            } else {
+                a + (b - a) * p as f64 / pieces as f64
+            };
+            if tb <= ta {
+                continue;
+            }
+            let sb = self.approach(k, tb);
+            ex.note_margin(k, sb.0);
+            if sa.1 > 0.0 && sb.1 < 0.0 {
+                let rate = |t: f64| self.approach(k, t).1;
+                if let Ok(tm) = EventLocator::FINE.locate(rate, (ta, sa.1), (tb, sb.1)) {
+                    let s = self.approach(k, tm).0;
+                    ex.note_margin(k, s);
+                }
+            }
+            (ta, sa) = (tb, sb);
+        }
     }
 
-    /// Contact k's (s, ṡ) at `t`, its exact sides propagated from their
-    /// groups' states `x` at `t0 <= t`.
-    fn approach_from(
-        &mut self,
-        k: usize,
-        sides: [Side; 2],
-        x: &[Vec<f64>],
-        t0: f64,
-        t: f64,
-    ) -> (f64, f64) {
+    /// Contact k's (s, ṡ) at `t`: exact sides from their reference states,
+    /// a side in the set from its dense output.
+    fn approach(&mut self, k: usize, t: f64) -> (f64, f64) {
+        let c = &self.model.contacts()[k];
+        let clearance = c.clearance;
         let mut uv = [(0.0, 0.0); 2];
-        for (slot, side) in uv.iter_mut().zip(sides) {
-            *slot = match side {
-                Side::Wall => (0.0, 0.0),
-                Side::Exact(p, _, j) if t == t0 => (x[p][2 * j], x[p][2 * j + 1]),
-                Side::Exact(p, g, j) => {
-                    let mut y = x[p].clone();
-                    self.free.propagate(g, t0, t, &mut y);
-                    (y[2 * j], y[2 * j + 1])
-                }
-                // (A set side exists only with a set: `slot` says so.)
-                Side::Set(iu) => match self.set.as_mut() {
+        for (slot, side) in uv.iter_mut().zip([c.pair.left(), c.pair.right()]) {
+            let Some(i) = side else { continue };
+            *slot = match self.slot[i] {
+                None => self.exact_body(i, t),
+                // (A body has a slot only while the set exists.)
+                Some(j) => match self.set.as_mut() {
                     Some(set) => (
-                        set.st.dense_component(&mut set.sys, iu, t),
-                        set.st.dense_component(&mut set.sys, iu + 1, t),
+                        set.st.dense_component(&mut set.sys, 2 * j, t),
+                        set.st.dense_component(&mut set.sys, 2 * j + 1, t),
                     ),
                     None => (f64::NAN, f64::NAN),
                 },
             };
         }
-        let clearance = self.model.contacts()[k].clearance;
         (uv[0].0 - uv[1].0 - clearance, uv[0].1 - uv[1].1)
     }
 }

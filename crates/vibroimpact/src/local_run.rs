@@ -35,7 +35,13 @@ impl Run<'_> {
     /// bodies from its dense output (its last step holds `t`), the others
     /// from their exact motion.
     pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
-        self.scan_exact_to(t);
+        if self.extrema.is_some() {
+            for g in 0..self.exact.len() {
+                if !self.in_set[g] {
+                    self.scan_group_to(g, t);
+                }
+            }
+        }
         let Run {
             free,
             exact,
@@ -267,7 +273,6 @@ pub(in crate::simulate) fn run(
             }
         }
     };
-    run.scan_exact_to(0.0);
     // Contacts active at the start form the first set; the others are
     // scheduled.
     for k in 0..nc {
@@ -314,7 +319,6 @@ pub(in crate::simulate) fn run(
         if run.set.is_none() {
             let next = run.next_check().map_or(opts.t_end, |c| c.0.min(opts.t_end));
             emit(&mut run, next, &mut out.sink_stopped);
-            run.scan_exact_to(next);
             t = next;
             if next >= opts.t_end {
                 break;
@@ -346,13 +350,8 @@ pub(in crate::simulate) fn run(
                     out.error = Some(IntegrationError::TooManySteps { t, steps });
                     break;
                 }
-                if let Some(set) = run.set.as_mut() {
-                    if let Some(scan) = set.extrema.as_mut() {
-                        scan.step(&mut set.st, &mut set.sys);
-                    }
-                }
+                run.scan_set_step();
                 emit(&mut run, t, &mut out.sink_stopped);
-                run.scan_exact_to(t);
                 run.apply_deferred(t);
                 let result = match reached {
                     Some((_, k)) => run.join(k, t).map(|_| None),
@@ -378,7 +377,6 @@ pub(in crate::simulate) fn run(
     };
     let mut y = vec![0.0; 2 * n];
     run.state_at(t_final, &mut y);
-    run.scan_exact_to(t_final);
     if let Some(mut set) = run.set.take() {
         run.absorb(&mut set);
         if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
