@@ -26,6 +26,7 @@
 use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian};
 use crate::model::{BaseExcitation, Model};
+use crate::variational::Variational;
 
 /// Index in the interleaved state `[u_1, v_1, …]` of component k of a
 /// body-order state `[u_1..u_N, v_1..v_N]` of N bodies.
@@ -411,6 +412,36 @@ impl ChainDynamics {
             } => alpha * s + b_over_a * sdot.abs() < limit,
             Screen::CompactSupport => s <= 0.0,
         }
+    }
+}
+
+/// A system whose state begins with a row's interleaved `[u, v]`: the row
+/// itself, or the row with carried columns ([`Variational`]), so that the
+/// event scan of a step reads the row whichever is integrated.
+pub trait Chain: OdeSystem {
+    /// The row's dynamics.
+    fn chain(&self) -> &ChainDynamics;
+    /// The row's dynamics, mutably (an impact's onset velocity).
+    fn chain_mut(&mut self) -> &mut ChainDynamics;
+}
+
+impl Chain for ChainDynamics {
+    fn chain(&self) -> &ChainDynamics {
+        self
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self
+    }
+}
+
+impl Chain for Variational<ChainDynamics> {
+    fn chain(&self) -> &ChainDynamics {
+        self.system()
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self.system_mut()
     }
 }
 

@@ -28,8 +28,10 @@ use std::collections::BinaryHeap;
 
 use super::*;
 use crate::contact::LawKind;
+use crate::dynamics::Chain;
 use crate::free_motion::FreeMotion;
 use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce};
+use crate::variational::Variational;
 
 #[path = "local_activation.rs"]
 mod activation;
@@ -94,7 +96,8 @@ struct ActiveSet {
     /// Model contacts joining the set to an exactly moving group: (contact,
     /// whether its left side is in the set).
     boundary: Vec<usize>,
-    sys: ChainDynamics,
+    /// The set's row, with the tangent columns when they are carried.
+    sys: Variational<ChainDynamics>,
     st: Stepper,
     scan: StepScan,
     /// The set's state at the start of its last step.
@@ -361,14 +364,17 @@ impl Run<'_> {
             if let (Some(ex), Some(scan)) = (self.extrema.as_mut(), &old.extrema) {
                 ex.merge(&old, scan);
             }
-            self.contact_evaluations += old.sys.contact_evaluations();
+            self.contact_evaluations += old.sys.chain().contact_evaluations();
             old_y = old.st.y().to_vec();
             for &i in &old.bodies {
                 self.slot[i] = None;
             }
             old_bodies = old.bodies;
             for (kl, &k) in old.scan.ids.iter().enumerate() {
-                self.onset[k] = (old.scan.trackers[kl].active, old.sys.onset_velocity(kl));
+                self.onset[k] = (
+                    old.scan.trackers[kl].active,
+                    old.sys.chain().onset_velocity(kl),
+                );
             }
             impacts = old.scan.impacts;
             for &g in &old.groups {
@@ -490,7 +496,7 @@ impl Run<'_> {
             Vec::new(),
         )
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let mut sys = ChainDynamics::new(&sub, false);
+        let mut sys = Variational::new(ChainDynamics::new(&sub, false), 0);
         let trackers = ids
             .iter()
             .enumerate()
@@ -498,7 +504,7 @@ impl Run<'_> {
                 let mut tr =
                     Tracker::new(&model.contacts()[k].law, self.opts.impact_force_threshold);
                 tr.active = self.onset[k].0;
-                sys.set_onset_velocity(kl, self.onset[k].1);
+                sys.chain_mut().set_onset_velocity(kl, self.onset[k].1);
                 tr
             })
             .collect();
@@ -513,7 +519,7 @@ impl Run<'_> {
         // The onset velocity of an impact that begins as the contact enters
         // is the law's before the first evaluation.
         for (kl, &k) in ids.iter().enumerate() {
-            let (s, sd) = sys.approach(kl, &y);
+            let (s, sd) = sys.chain().approach(kl, &y);
             let s_on = model.contacts()[k]
                 .law
                 .onset_approach(self.opts.impact_force_threshold);
@@ -521,13 +527,13 @@ impl Run<'_> {
                 && s > s_on
                 && model.contacts()[k].law.needs_impact_velocity()
             {
-                sys.set_onset_velocity(kl, sd);
+                sys.chain_mut().set_onset_velocity(kl, sd);
             }
         }
         let mut st = Stepper::new(self.method, y.len(), int_opts)?;
         st.reset(&mut sys, t, &y)?;
         let previous = (0..ids.len())
-            .map(|kl| contact_end(&sys, kl, st.y(), st.dydt()))
+            .map(|kl| contact_end(sys.chain(), kl, st.y(), st.dydt()))
             .collect();
         self.local.largest_set = self.local.largest_set.max(bodies.len());
         let rate = groups
@@ -560,14 +566,14 @@ impl Run<'_> {
             if old_contacts.binary_search(&k).is_ok() {
                 continue;
             }
-            let (s, sd) = sys.approach(kl, st.y());
+            let (s, sd) = sys.chain().approach(kl, st.y());
             let h = st.h_next();
             if self.activation[k].margin(s + sd.max(0.0) * h, sd) > 0.0 {
                 let c = &model.contacts()[k];
                 let mass = |i: Option<usize>| i.map_or(f64::INFINITY, |i| model.bodies()[i].mass);
                 let (ml, mr) = (mass(c.pair.left()), mass(c.pair.right()));
                 let mu = 1.0 / (1.0 / ml + 1.0 / mr);
-                let onset = sys.onset_velocity(kl);
+                let onset = sys.chain().onset_velocity(kl);
                 let impulse = |h: f64| c.law.force(s + sd.max(0.0) * h, sd, onset).abs() * h;
                 st.limit_next_step(first_step(impulse, self.opts.atol * mu, h));
             }

@@ -94,10 +94,10 @@ impl LocalExtrema {
         ids: &[usize],
         bodies: usize,
         st: &Stepper,
-        sys: &ChainDynamics,
+        sys: &Variational<ChainDynamics>,
     ) -> ExtremaScan {
         let s_on = ids.iter().map(|&k| self.s_on[k]).collect();
-        ExtremaScan::new(self.window, bodies, s_on, st, sys)
+        ExtremaScan::new(self.window, bodies, s_on, st, sys.chain())
     }
 
     /// The part of `[from, t]` inside the window, if any (a point counts).

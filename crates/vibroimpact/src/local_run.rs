@@ -393,7 +393,7 @@ pub(in crate::simulate) fn run(
         if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
             ex.merge(&set, scan);
         }
-        run.contact_evaluations += set.sys.contact_evaluations();
+        run.contact_evaluations += set.sys.chain().contact_evaluations();
         run.impacts = set.scan.impacts;
     }
     out.t = t_final;

@@ -131,8 +131,8 @@ impl Run<'_> {
     /// acceleration. (An impact whose force has fallen below the
     /// negligible level is not: it ends when its bodies are released.)
     pub(super) fn engaged(set: &ActiveSet, act: Activation, kl: usize, lookahead: f64) -> bool {
-        let (s, sd) = set.sys.approach(kl, set.st.y());
-        let idx = set.sys.contact_indices(kl);
+        let (s, sd) = set.sys.chain().approach(kl, set.st.y());
+        let idx = set.sys.chain().contact_indices(kl);
         let dy = set.st.dydt();
         let sdd = idx[1].map_or(0.0, |i| dy[i]) - idx[3].map_or(0.0, |i| dy[i]);
         let reach = s + sd.max(0.0) * lookahead + 0.5 * sdd.max(0.0) * lookahead * lookahead;

@@ -30,7 +30,7 @@
 //! in the message), the result keeps everything computed up to the failure
 //! and carries the error.
 
-use crate::dynamics::ChainDynamics;
+use crate::dynamics::{Chain, ChainDynamics};
 use crate::integrate::events::EventLocator;
 use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
@@ -254,9 +254,9 @@ pub struct Extrema {
 }
 
 /// Dense-output values of two components at time t.
-fn dense_pair(
+fn dense_pair<S: Chain>(
     st: &mut Stepper,
-    sys: &mut ChainDynamics,
+    sys: &mut S,
     (i, j): (usize, usize),
     t: f64,
 ) -> (f64, f64) {
@@ -311,16 +311,16 @@ impl ExtremaScan {
 
     /// The contacts' approach maxima on [a, b] within the step ending at
     /// `st.t()`: at the ends, and inside where ṡ changes sign.
-    fn contact_step(&mut self, st: &mut Stepper, sys: &mut ChainDynamics, a: f64, b: f64) {
+    fn contact_step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, a: f64, b: f64) {
         let t1 = st.t();
         for k in 0..self.s_on.len() {
             let (sa, sda) = if a == self.t {
-                sys.approach(k, &self.y)
+                sys.chain().approach(k, &self.y)
             } else {
                 contact_at(st, sys, k, a)
             };
             let (sb, sdb) = if b == t1 {
-                sys.approach(k, st.y())
+                sys.chain().approach(k, st.y())
             } else {
                 contact_at(st, sys, k, b)
             };
@@ -337,7 +337,7 @@ impl ExtremaScan {
     }
 
     /// Processes the accepted step from the previous end to `st.t()`.
-    fn step(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) {
+    fn step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
         let t1 = st.t();
         let (a, b) = (self.t.max(self.from), t1.min(self.to));
         if a <= b {
@@ -438,20 +438,20 @@ fn contact_end(sys: &ChainDynamics, k: usize, y: &[f64], dydt: &[f64]) -> (f64, 
 }
 
 /// Dense-output evaluation of contact k's (s, ṡ) at time t.
-fn contact_at(st: &mut Stepper, sys: &mut ChainDynamics, k: usize, t: f64) -> (f64, f64) {
+fn contact_at<S: Chain>(st: &mut Stepper, sys: &mut S, k: usize, t: f64) -> (f64, f64) {
     let mut v = [0.0; 4];
-    for (j, i) in sys.contact_indices(k).iter().enumerate() {
+    for (j, i) in sys.chain().contact_indices(k).iter().enumerate() {
         if let Some(i) = *i {
             v[j] = st.dense_component(sys, i, t);
         }
     }
-    (v[0] - v[2] - sys.clearance(k), v[1] - v[3])
+    (v[0] - v[2] - sys.chain().clearance(k), v[1] - v[3])
 }
 
 impl StepScan {
-    fn locate(
+    fn locate<S: Chain>(
         st: &mut Stepper,
-        sys: &mut ChainDynamics,
+        sys: &mut S,
         k: usize,
         s_on: f64,
         (ta, ga): (f64, f64),
@@ -465,9 +465,9 @@ impl StepScan {
     /// Largest force of contact k on [ta, tb]. `interior`: the force rate
     /// says the maximum may lie inside (rising at ta or unknown, falling at tb
     /// or unknown), then a golden-section search on the dense output finds it.
-    fn peak(
+    fn peak<S: Chain>(
         st: &mut Stepper,
-        sys: &mut ChainDynamics,
+        sys: &mut S,
         k: usize,
         ta: f64,
         tb: f64,
@@ -475,7 +475,7 @@ impl StepScan {
     ) -> (f64, f64) {
         let mut force = |t: f64| {
             let (s, sd) = contact_at(st, sys, k, t);
-            sys.contact_force(k, s, sd)
+            sys.chain().contact_force(k, s, sd)
         };
         let (fa, fb) = (force(ta), force(tb));
         let tm = 0.5 * (ta + tb);
@@ -495,10 +495,10 @@ impl StepScan {
         best
     }
 
-    fn start(&mut self, st: &mut Stepper, sys: &mut ChainDynamics, k: usize, t: f64) {
+    fn start<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, k: usize, t: f64) {
         let (_, sd) = contact_at(st, sys, k, t);
-        if sys.contact_law(k).needs_impact_velocity() {
-            sys.set_onset_velocity(k, sd);
+        if sys.chain().contact_law(k).needs_impact_velocity() {
+            sys.chain_mut().set_onset_velocity(k, sd);
         }
         self.trackers[k].active = Some(self.impacts.len());
         self.impacts.push(ImpactRecord {
@@ -515,10 +515,10 @@ impl StepScan {
     /// Updates the running peak of contact k's impact over [ta, tb] given
     /// the force rates at the ends (None where unknown).
     #[allow(clippy::too_many_arguments)]
-    fn update_peak(
+    fn update_peak<S: Chain>(
         &mut self,
         st: &mut Stepper,
-        sys: &mut ChainDynamics,
+        sys: &mut S,
         k: usize,
         ta: f64,
         tb: f64,
@@ -535,7 +535,7 @@ impl StepScan {
         }
     }
 
-    fn finish(&mut self, st: &mut Stepper, sys: &mut ChainDynamics, k: usize, t: f64) {
+    fn finish<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, k: usize, t: f64) {
         if let Some(i) = self.trackers[k].active.take() {
             let (_, sd) = contact_at(st, sys, k, t);
             self.impacts[i].end_time = t;
@@ -564,11 +564,11 @@ impl StepScan {
     }
 
     /// Processes the events of the accepted step [t0, t1].
-    fn scan(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) {
+    fn scan<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
         let (t0, t1) = (st.t_prev(), st.t());
         for k in 0..self.trackers.len() {
             let (s0, sd0, r0) = self.previous[k];
-            let (s1, sd1, r1) = contact_end(sys, k, st.y(), st.dydt());
+            let (s1, sd1, r1) = contact_end(sys.chain(), k, st.y(), st.dydt());
             self.previous[k] = (s1, sd1, r1);
             let s_on = self.trackers[k].s_on;
             let (g0, g1) = (s0 - s_on, s1 - s_on);

@@ -165,6 +165,9 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
     fn rhs(&mut self, t: f64, z: &[f64], dzdt: &mut [f64]) {
         let d = self.dim;
         self.sys.rhs(t, &z[..d], &mut dzdt[..d]);
+        if self.carried() == 0 {
+            return;
+        }
         self.jacobian_at(t, &z[..d]);
         for c in 0..self.carried() {
             let range = d * (1 + c)..d * (2 + c);
@@ -186,6 +189,20 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
 
     fn error_block(&self) -> Option<usize> {
         self.sys.error_block()
+    }
+
+    // Without carried columns the extended system is the system: its
+    // Jacobian (for an implicit method) is the system's.
+    fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
+        if self.carried() == 0 {
+            self.sys.jacobian_bandwidth()
+        } else {
+            None
+        }
+    }
+
+    fn jacobian(&mut self, t: f64, z: &[f64], jac: &mut BandMatrix) -> bool {
+        self.carried() == 0 && self.sys.jacobian(t, z, jac)
     }
 }
 
