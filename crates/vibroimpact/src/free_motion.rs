@@ -494,6 +494,24 @@ impl FreeMotion {
         f / group.mass[j] - self.base.at(t)
     }
 
+    /// `x ← e^{Aτ} x` for group `g`: a tangent vector of the free motion
+    /// (the forcing does not enter the variational equations).
+    pub fn propagate_homogeneous(&self, g: usize, tau: f64, x: &mut [f64]) {
+        let group = &self.groups[g];
+        if tau == 0.0 {
+            return;
+        }
+        match &group.modal {
+            Some(modal) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                modal.free(tau, &mut z);
+                modal.to_state(&z, x);
+            }
+            None => Self::homogeneous(group, tau, x),
+        }
+    }
+
     /// The group's system matrix `A` (interleaved).
     fn matrix(g: &Group) -> DMatrix<f64> {
         match &g.propagator {

@@ -43,7 +43,7 @@ mod extrema;
 mod membership;
 
 use activation::{first_step, Activation};
-pub(super) use driver::run;
+pub(super) use driver::{run, Tangents};
 use extrema::LocalExtrema;
 use membership::Crossing;
 
@@ -149,6 +149,12 @@ struct Run<'a> {
     checks_per_contact: Vec<u64>,
     /// The extrema over the window, when asked for.
     extrema: Option<LocalExtrema>,
+    /// Tangent columns carried (0: none).
+    columns: usize,
+    /// Per group: time and tangent columns (each of the group's
+    /// interleaved rows, one after the other) of its exact motion; the
+    /// set's are in its state.
+    tangents: Vec<(f64, Vec<f64>)>,
     breakpoints: Vec<f64>,
 }
 
@@ -395,6 +401,19 @@ impl Run<'_> {
                         .collect();
                     self.exact[g] = (t, x);
                     self.extrema_from(g, t);
+                    let b2 = old_bodies.len() * 2;
+                    let mut w = Vec::new();
+                    for c in 0..self.columns {
+                        for &i in self.free.groups()[g].bodies() {
+                            w.extend(match old_bodies.binary_search(&i) {
+                                Ok(j) => {
+                                    [old_y[b2 * (1 + c) + 2 * j], old_y[b2 * (1 + c) + 2 * j + 1]]
+                                }
+                                Err(_) => [f64::NAN; 2],
+                            });
+                        }
+                    }
+                    self.tangents[g] = (t, w);
                 }
             }
         }
@@ -425,6 +444,32 @@ impl Run<'_> {
             };
             y[2 * j] = u;
             y[2 * j + 1] = v;
+        }
+        // Tangent columns after the state: rows from the old set, or
+        // from the joining groups' exact homogeneous motion.
+        if self.columns > 0 {
+            let (b2, o2) = (2 * bodies.len(), 2 * old_bodies.len());
+            for &g in &groups {
+                if !old_groups.contains(&g) {
+                    self.tangents_to(g, t);
+                }
+            }
+            y.resize(b2 * (1 + self.columns), 0.0);
+            for c in 0..self.columns {
+                for (j, &i) in bodies.iter().enumerate() {
+                    let (u, v) = match old_bodies.binary_search(&i) {
+                        Ok(o) => (old_y[o2 * (1 + c) + 2 * o], old_y[o2 * (1 + c) + 2 * o + 1]),
+                        Err(_) => {
+                            let (g, jg) = self.free.place(i);
+                            let m2 = 2 * self.free.groups()[g].bodies().len();
+                            let w = &self.tangents[g].1;
+                            (w[c * m2 + 2 * jg], w[c * m2 + 2 * jg + 1])
+                        }
+                    };
+                    y[b2 * (1 + c) + 2 * j] = u;
+                    y[b2 * (1 + c) + 2 * j + 1] = v;
+                }
+            }
         }
         let local = |i: Option<usize>| i.map(|i| self.slot[i]);
         let mut ids = Vec::new();
@@ -496,7 +541,7 @@ impl Run<'_> {
             Vec::new(),
         )
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let mut sys = Variational::new(ChainDynamics::new(&sub, false), 0);
+        let mut sys = Variational::new(ChainDynamics::new(&sub, false), self.columns);
         let trackers = ids
             .iter()
             .enumerate()

@@ -27,10 +27,65 @@ pub(in crate::simulate) struct LocalRun {
     pub crawling: Option<usize>,
     /// The exact extrema over the options' window, if asked for.
     pub extrema: Option<Extrema>,
+    /// The tangent columns at the final time, if carried (as given).
+    pub tangents: Option<Vec<f64>>,
     pub sink_stopped: Option<f64>,
 }
 
+/// Tangent columns carried by a run: `columns` vectors of the interleaved
+/// state, one after the other.
+#[derive(Clone, Copy, Debug)]
+pub(in crate::simulate) struct Tangents<'w> {
+    pub values: &'w [f64],
+    pub columns: usize,
+}
+
 impl Run<'_> {
+    /// The tangent columns at `t` (the set's last step ends there): the
+    /// set's rows from its state, the others by their groups' exact
+    /// homogeneous motion.
+    pub(super) fn tangents_at(&mut self, t: f64) -> Vec<f64> {
+        let n2 = 2 * self.model.bodies().len();
+        let mut w = vec![0.0; self.columns * n2];
+        for g in 0..self.tangents.len() {
+            if self.in_set[g] {
+                continue;
+            }
+            self.tangents_to(g, t);
+            let m2 = 2 * self.free.groups()[g].bodies().len();
+            for c in 0..self.columns {
+                for (j, &i) in self.free.groups()[g].bodies().iter().enumerate() {
+                    w[c * n2 + 2 * i] = self.tangents[g].1[c * m2 + 2 * j];
+                    w[c * n2 + 2 * i + 1] = self.tangents[g].1[c * m2 + 2 * j + 1];
+                }
+            }
+        }
+        if let Some(set) = &self.set {
+            let b2 = 2 * set.bodies.len();
+            let z = set.st.y();
+            for c in 0..self.columns {
+                for (j, &i) in set.bodies.iter().enumerate() {
+                    w[c * n2 + 2 * i] = z[b2 * (1 + c) + 2 * j];
+                    w[c * n2 + 2 * i + 1] = z[b2 * (1 + c) + 2 * j + 1];
+                }
+            }
+        }
+        w
+    }
+
+    /// Moves group `g`'s tangent columns to `t` by its exact homogeneous
+    /// motion.
+    pub(super) fn tangents_to(&mut self, g: usize, t: f64) {
+        let (t0, w) = &mut self.tangents[g];
+        if t > *t0 && self.columns > 0 {
+            let m2 = w.len() / self.columns;
+            for col in w.chunks_mut(m2) {
+                self.free.propagate_homogeneous(g, t - *t0, col);
+            }
+            *t0 = t;
+        }
+    }
+
     /// Writes the whole interleaved state at `t` into `out`: the set's
     /// bodies from its dense output (its last step holds `t`), the others
     /// from their exact motion.
@@ -77,7 +132,7 @@ impl Run<'_> {
             }
         }
         if let Some(set) = self.set.as_mut() {
-            let mut y = vec![0.0; 2 * set.bodies.len()];
+            let mut y = vec![0.0; set.st.y().len()];
             set.st.dense_output(&mut set.sys, t, &mut y);
             for (j, &i) in set.bodies.iter().enumerate() {
                 out[2 * i] = y[2 * j];
@@ -163,7 +218,7 @@ pub(in crate::simulate) fn run(
     model: &Model,
     opts: &SimulationOptions,
     method: Method,
-    y0: &[f64],
+    (y0, tangents): (&[f64], Option<Tangents<'_>>),
     breakpoints: Vec<f64>,
     record: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<LocalRun, OptionsError> {
@@ -205,6 +260,24 @@ pub(in crate::simulate) fn run(
             (0.0, x)
         })
         .collect();
+    let columns = tangents.map_or(0, |w| w.columns);
+    let tangent_refs = free
+        .groups()
+        .iter()
+        .map(|g| {
+            let m2 = 2 * g.bodies().len();
+            let mut w = vec![0.0; columns * m2];
+            if let Some(tw) = tangents {
+                for c in 0..columns {
+                    for (j, &i) in g.bodies().iter().enumerate() {
+                        w[c * m2 + 2 * j] = tw.values[c * 2 * n + 2 * i];
+                        w[c * m2 + 2 * j + 1] = tw.values[c * 2 * n + 2 * i + 1];
+                    }
+                }
+            }
+            (0.0, w)
+        })
+        .collect();
     let activation = (0..nc)
         .map(|k| {
             let s_on = model.contacts()[k]
@@ -241,6 +314,8 @@ pub(in crate::simulate) fn run(
         },
         checks_per_contact: vec![0; nc],
         extrema: None,
+        columns,
+        tangents: tangent_refs,
         breakpoints,
     };
     if let Some(window) = opts.extrema_window {
@@ -261,6 +336,7 @@ pub(in crate::simulate) fn run(
         error: None,
         crawling: None,
         extrema: None,
+        tangents: None,
         sink_stopped: None,
     };
     let mut sample = vec![0.0; 2 * n];
@@ -388,6 +464,9 @@ pub(in crate::simulate) fn run(
     };
     let mut y = vec![0.0; 2 * n];
     run.state_at(t_final, &mut y);
+    if columns > 0 {
+        out.tangents = Some(run.tangents_at(t_final));
+    }
     if let Some(mut set) = run.set.take() {
         run.absorb(&mut set);
         if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {

@@ -29,6 +29,7 @@ use crate::dynamics::{from_interleaved, to_interleaved, ChainDynamics};
 use crate::integrate::{Dop853, IntegrationError, IntegratorOptions, Interrupt, OdeSystem};
 use crate::model::Model;
 use crate::periodic::forcing_period;
+use crate::simulate::{local_tangent_flow, Integrator, SimulationOptions};
 use crate::variational::Variational;
 
 /// Batches of the standard error (fewer for windows under 200 periods).
@@ -58,6 +59,10 @@ pub struct LyapunovOptions {
     pub rtol: f64,
     /// Cooperative interruption (Ctrl-C).
     pub interrupt: Option<Interrupt>,
+    /// Global: the state and tangents integrated together; local: the
+    /// tangents carried by the exact transition matrices of the free
+    /// motion and integrated in the active set only (docs/theory.md §10).
+    pub integrator: Integrator,
 }
 
 impl Default for LyapunovOptions {
@@ -68,6 +73,7 @@ impl Default for LyapunovOptions {
             periods: 200,
             rtol: 1e-9,
             interrupt: None,
+            integrator: Integrator::Global,
         }
     }
 }
@@ -164,8 +170,31 @@ pub fn lyapunov_spectrum(
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
-    let mut solver = Dop853::new(var.dim(), int_opts)?;
-    solver.reset(&mut var, t0, &z)?;
+    let mut flow = match opts.integrator {
+        Integrator::Global => {
+            let mut solver = Dop853::new(var.dim(), int_opts)?;
+            solver.reset(&mut var, t0, &z)?;
+            Flow::Global {
+                var,
+                solver,
+                fresh: true,
+            }
+        }
+        Integrator::Local => Flow::Local {
+            model: model.delayed(t0).ok_or_else(|| {
+                LyapunovError::Invalid("a recorded excitation has no forcing period".into())
+            })?,
+            options: SimulationOptions {
+                t_end: period,
+                rtol: opts.rtol,
+                atol: opts.rtol * 1e-3,
+                interrupt: opts.interrupt.clone(),
+                integrator: Integrator::Local,
+                ..SimulationOptions::default()
+            },
+            k,
+        },
+    };
     let total = opts.transient + opts.periods;
     let batches = (opts.periods / MIN_BATCH_PERIODS).clamp(2, BATCHES);
     // Per batch: the sum of each column's logs, and its periods.
@@ -173,10 +202,7 @@ pub fn lyapunov_spectrum(
     let mut batch_periods = vec![0usize; batches];
     for j in 1..=total {
         let t_end = t0 + period * j as f64;
-        while solver.t() < t_end {
-            solver.step(&mut var, t_end)?;
-        }
-        z.copy_from_slice(solver.y());
+        flow.advance(t_end, &mut z)?;
         let logs = orthonormalise(&mut z[d..], d, k, &weights, t_end)?;
         let averaged = j.saturating_sub(opts.transient);
         if averaged > 0 {
@@ -186,7 +212,6 @@ pub fn lyapunov_spectrum(
                 *s += l;
             }
         }
-        solver.restart(&mut var, &z)?;
     }
     let window = period * opts.periods as f64;
     let mut pairs: Vec<(f64, f64)> = (0..k)
@@ -207,6 +232,54 @@ pub fn lyapunov_spectrum(
         period,
         final_state: from_interleaved(&z[..d], n),
     })
+}
+
+/// How the state and its tangent columns `z = [y, w_1, …, w_k]` advance
+/// by one forcing period. (One lives per spectrum: the size difference of
+/// the variants does not matter.)
+#[allow(clippy::large_enum_variant)]
+enum Flow {
+    /// The variational equations integrated with the state.
+    Global {
+        var: Variational<ChainDynamics>,
+        solver: Dop853,
+        /// Reset at the start: no restart before the first period.
+        fresh: bool,
+    },
+    /// The local integrator's flow with tangents, of the model delayed to
+    /// the start (each period starts at the same phase).
+    Local {
+        model: Model,
+        options: SimulationOptions,
+        k: usize,
+    },
+}
+
+impl Flow {
+    /// `z` (its columns re-orthonormalised since the last call) carried to
+    /// `t_end`, one period on.
+    fn advance(&mut self, t_end: f64, z: &mut [f64]) -> Result<(), LyapunovError> {
+        match self {
+            Flow::Global { var, solver, fresh } => {
+                if !*fresh {
+                    solver.restart(var, z)?;
+                }
+                *fresh = false;
+                while solver.t() < t_end {
+                    solver.step(var, t_end)?;
+                }
+                z.copy_from_slice(solver.y());
+            }
+            Flow::Local { model, options, k } => {
+                let d = 2 * model.bodies().len();
+                let (y, w) = local_tangent_flow(model, options, &z[..d], (&z[d..], *k))
+                    .map_err(|e| LyapunovError::Invalid(e.to_string()))??;
+                z[..d].copy_from_slice(&y);
+                z[d..].copy_from_slice(&w);
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Weights of the interleaved state components in the QR inner product:

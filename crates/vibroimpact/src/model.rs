@@ -647,6 +647,24 @@ impl Model {
         )
     }
 
+    /// The model whose time 0 is this model's time `t0`: every harmonic
+    /// term's phase advanced by `Ω t0`. None under a record (its time
+    /// axis is its own).
+    pub fn delayed(&self, t0: f64) -> Option<Self> {
+        let mut m = self.clone();
+        match &mut m.base {
+            BaseExcitation::Record(_) => return None,
+            BaseExcitation::Harmonic {
+                frequency, phase, ..
+            } => *phase += *frequency * t0,
+            BaseExcitation::None => {}
+        }
+        for f in &mut m.forces {
+            f.phase += f.frequency * t0;
+        }
+        Some(m)
+    }
+
     /// Replaces the base excitation.
     pub fn with_base(mut self, base: BaseExcitation) -> Self {
         self.base = base;

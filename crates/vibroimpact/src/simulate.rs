@@ -791,15 +791,7 @@ pub fn simulate_streaming(
     let method = effective_method(model, opts)?;
     let mut st =
         Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
-    let breakpoints: Vec<f64> = match model.base() {
-        BaseExcitation::Record(r) => r
-            .times()
-            .iter()
-            .copied()
-            .filter(|&t| t > 0.0 && t < opts.t_end)
-            .collect(),
-        _ => Vec::new(),
-    };
+    let breakpoints = breakpoints(model, opts.t_end);
     if opts.integrator == Integrator::Local {
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
@@ -996,6 +988,55 @@ fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> 
     }
 }
 
+/// An interleaved state and tangent columns (each an interleaved state
+/// vector, one after the other).
+pub(crate) type StateAndColumns = (Vec<f64>, Vec<f64>);
+
+/// A record's sample times inside `(0, t_end)`: the steps end there.
+fn breakpoints(model: &Model, t_end: f64) -> Vec<f64> {
+    match model.base() {
+        BaseExcitation::Record(r) => r
+            .times()
+            .iter()
+            .copied()
+            .filter(|&t| t > 0.0 && t < t_end)
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// The local integrator's flow with tangent columns: from the interleaved
+/// state `y0` at 0 to `opts.t_end`, `k` tangent vectors (`columns`: each an
+/// interleaved state vector, one after the other) carried by the
+/// variational equations in the active set and by the exact homogeneous
+/// motion elsewhere (docs/theory.md §10). Returns the final interleaved
+/// state and columns, or where the run failed.
+pub(crate) fn local_tangent_flow(
+    model: &Model,
+    opts: &SimulationOptions,
+    y0: &[f64],
+    (columns, k): (&[f64], usize),
+) -> Result<Result<StateAndColumns, IntegrationError>, OptionsError> {
+    check_options(opts)?;
+    let method = effective_method(model, opts)?;
+    let tangents = local::Tangents {
+        values: columns,
+        columns: k,
+    };
+    let run = local::run(
+        model,
+        opts,
+        method,
+        (y0, Some(tangents)),
+        breakpoints(model, opts.t_end),
+        &mut |_, _| true,
+    )?;
+    Ok(match run.error {
+        Some(e) => Err(e),
+        None => Ok((run.y, run.tangents.unwrap_or_default())),
+    })
+}
+
 /// [`simulate_streaming`] by the local integrator.
 fn simulate_local(
     model: &Model,
@@ -1005,7 +1046,7 @@ fn simulate_local(
     breakpoints: Vec<f64>,
     sink: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<Simulation, OptionsError> {
-    let run = local::run(model, opts, method, y0, breakpoints, sink)?;
+    let run = local::run(model, opts, method, (y0, None), breakpoints, sink)?;
     let n = model.bodies().len();
     let mut impacts = run.impacts;
     by_start(&mut impacts);

@@ -539,6 +539,7 @@ pub(crate) fn run_value(
             periods: settings.record,
             rtol: settings.opts.rtol,
             interrupt: settings.opts.interrupt.clone(),
+            integrator: settings.integrator,
         };
         match lyapunov_spectrum(&m, row(0), j0 as f64 * dt, &opts) {
             Ok(ly) => {

@@ -38,11 +38,11 @@ pub struct Variational<S> {
 }
 
 impl<S: OdeSystem> Variational<S> {
-    /// Extends `sys` by `columns` columns of Φ (`0..=dim`; 0 with a
-    /// parameter: the state and its parameter sensitivity alone).
+    /// Extends `sys` by `columns` columns of Φ (0 with a parameter: the
+    /// state and its parameter sensitivity alone; more than the dimension:
+    /// tangent vectors of a larger system restricted to this one's rows).
     pub fn new(sys: S, columns: usize) -> Self {
         let dim = sys.dim();
-        let columns = columns.min(dim);
         let jac = match sys.jacobian_bandwidth() {
             Some((kl, ku)) => BandMatrix::new(dim, kl, ku),
             None => BandMatrix::dense(dim),
@@ -105,7 +105,7 @@ impl<S: OdeSystem> Variational<S> {
     pub fn initial_state(&self, y0: &[f64]) -> Vec<f64> {
         let mut z = vec![0.0; self.dim * (1 + self.carried())];
         z[..self.dim].copy_from_slice(y0);
-        for c in 0..self.columns {
+        for c in 0..self.columns.min(self.dim) {
             z[self.dim * (1 + c) + c] = 1.0;
         }
         z
