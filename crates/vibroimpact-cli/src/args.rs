@@ -207,8 +207,7 @@ pub struct AttractorRuns {
     #[arg(long)]
     pub cluster_tolerance: Option<f64>,
     /// Integrator of the transients and recorded periods: `local` moves
-    /// bodies out of contact exactly (Lyapunov exponents run the global
-    /// one).
+    /// bodies out of contact exactly.
     #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
     pub integrator: IntegratorName,
 }

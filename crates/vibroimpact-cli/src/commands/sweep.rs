@@ -42,8 +42,8 @@ pub struct SweepArgs {
     /// Integration method.
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     method: MethodName,
-    /// Integrator of the transient and the recorded periods: `local` moves
-    /// bodies out of contact exactly (`--lyapunov` runs the global one).
+    /// Integrator of the transient, the recorded periods and `--lyapunov`:
+    /// `local` moves bodies out of contact exactly.
     #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
     integrator: IntegratorName,
     /// Relative tolerance under which two Poincaré samples count as the same

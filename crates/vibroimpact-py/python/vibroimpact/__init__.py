@@ -650,9 +650,8 @@ def sweep(
     and ``sections``, the Poincaré samples as a record x 2N array). A value
     that fails numerically is kept with its ``error``.
 
-    ``integrator="local"``: the transients and recorded periods move
-    bodies out of contact exactly (docs/theory.md §10); the Lyapunov
-    exponents run the global integrator.
+    ``integrator="local"``: the transients, recorded periods and Lyapunov
+    exponents move bodies out of contact exactly (docs/theory.md §10).
 
     ``lyapunov = k``: every point also gains ``lyapunov``, its k largest
     Lyapunov exponents (1/s, largest first, averaged over the recorded
