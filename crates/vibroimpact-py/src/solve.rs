@@ -318,7 +318,7 @@ pub fn simulate<'py>(
 /// A periodic solution: the `periodic` document plus the orbit over one
 /// period (`orbit_t`, `orbit_displacement`, `orbit_velocity`).
 #[pyfunction]
-#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None))]
+#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None, integrator = "global"))]
 #[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
@@ -332,6 +332,7 @@ pub fn periodic<'py>(
     arnoldi: usize,
     symmetric: bool,
     progress: Option<&Bound<'py, PyAny>>,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.loaded.model;
     if m.forcing_frequency().is_none() {
@@ -348,6 +349,12 @@ pub fn periodic<'py>(
             "{}: symmetric=True needs a mirror-symmetric model (mirrored bodies, contacts, walls and forcing) and an odd subharmonic",
             model.document.source()
         )));
+    }
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
+    if krylov && integrator == vibroimpact::simulate::Integrator::Local {
+        return Err(value_error(
+            "integrator = 'local': the dense period map only; Newton-Krylov (krylov=True, the default from 200 bodies) runs the global integrator (pass krylov=False)",
+        ));
     }
     let need = vibroimpact::periodic::MIN_ARNOLDI.min(2 * m.bodies().len());
     if krylov && arnoldi < need {
@@ -384,6 +391,7 @@ pub fn periodic<'py>(
             tol,
             symmetric,
             interrupt,
+            integrator,
             ..ShootingOptions::default()
         };
         let sol = if krylov {

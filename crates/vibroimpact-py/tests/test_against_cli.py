@@ -107,6 +107,20 @@ def test_simulate_local(cli):
         vi.simulate(EXAMPLES / "fujita-row.toml", periods=1, integrator="fast")
 
 
+def test_periodic_local(cli):
+    # The dense period map by the local integrator, from both faces; the
+    # orbit of the global integrator's to the tolerance.
+    doc = cli("periodic", EXAMPLES / "fujita-row.toml", "--symmetric", "--integrator", "local")
+    r = vi.periodic(EXAMPLES / "fujita-row.toml", symmetric=True, integrator="local")
+    for key in ("period", "initial_state", "floquet_multipliers", "spectral_radius"):
+        close(r[key], doc[key])
+    g = vi.periodic(EXAMPLES / "fujita-row.toml", symmetric=True)
+    np.testing.assert_allclose(r.initial_state, g.initial_state, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(r.floquet_multipliers, g.floquet_multipliers, rtol=0, atol=1e-6)
+    with pytest.raises(ValueError, match="integrator"):
+        vi.periodic(EXAMPLES / "fujita-row.toml", krylov=True, integrator="local")
+
+
 def test_periodic(cli):
     # The three-pendulum row's unstable symmetric orbit from the simulated
     # guess (the two-pendulum row's motion at 0.95 omega0 is irregular too:

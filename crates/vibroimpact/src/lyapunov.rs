@@ -272,7 +272,7 @@ impl Flow {
             }
             Flow::Local { model, options, k } => {
                 let d = 2 * model.bodies().len();
-                let (y, w) = local_tangent_flow(model, options, &z[..d], (&z[d..], *k))
+                let (y, w, _) = local_tangent_flow(model, options, &z[..d], (&z[d..], *k))
                     .map_err(|e| LyapunovError::Invalid(e.to_string()))??;
                 z[..d].copy_from_slice(&y);
                 z[d..].copy_from_slice(&w);

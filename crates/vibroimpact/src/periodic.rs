@@ -34,7 +34,7 @@ use crate::integrate::{
 };
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
-use crate::simulate::{simulate, OptionsError, SimulationOptions};
+use crate::simulate::{local_tangent_flow, simulate, Integrator, OptionsError, SimulationOptions};
 use crate::variational::Variational;
 
 /// Largest Newton step in the scaled norm (displacement scales).
@@ -85,6 +85,12 @@ pub struct ShootingOptions {
     pub control_monodromy: bool,
     /// Stop request checked at every integration step (see [`Interrupt`]).
     pub interrupt: Option<Interrupt>,
+    /// The dense period map's integrator: global, or local (the state and
+    /// Φ's columns by the exact free motion between contacts, integrated
+    /// only where bodies touch; Φ then enters the step control, as with
+    /// `control_monodromy`). Newton–Krylov and a parameter's column run
+    /// the global integrator.
+    pub integrator: Integrator,
 }
 
 impl ShootingOptions {
@@ -92,7 +98,11 @@ impl ShootingOptions {
     /// `max_steps` steps, the stop request; with `state` = Some(d) carried
     /// columns (variational, tangent) ride along on the steps of the first
     /// d components (the state) unless `control_monodromy`.
-    pub(crate) fn integrator(&self, max_steps: u64, state: Option<usize>) -> IntegratorOptions {
+    pub(crate) fn integrator_options(
+        &self,
+        max_steps: u64,
+        state: Option<usize>,
+    ) -> IntegratorOptions {
         IntegratorOptions {
             rtol: self.rtol,
             atol: self.rtol * self.displacement_scale,
@@ -115,6 +125,7 @@ impl Default for ShootingOptions {
             symmetric: false,
             control_monodromy: false,
             interrupt: None,
+            integrator: Integrator::Global,
         }
     }
 }
@@ -347,6 +358,9 @@ pub(crate) fn period_map_with(
             return forced_map(model, x, opts, (model_p, dp, t_p), t, max_steps);
         }
     }
+    if dense && shifted.is_none() && opts.integrator == Integrator::Local {
+        return local_map(model, x, opts, t);
+    }
     let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
     let columns = if dense { d } else { 0 };
     let (mut var, dt_dp) = match shifted {
@@ -361,7 +375,7 @@ pub(crate) fn period_map_with(
     let z0 = var.initial_state(&to_interleaved(x));
     // The state controls the steps: Φ rides along on the same steps, so a
     // period map costs O(N) steps × O(N² · bandwidth) per step.
-    let int_opts = opts.integrator(max_steps, Some(d));
+    let int_opts = opts.integrator_options(max_steps, Some(d));
     let (z, stats, tangent) = if dense {
         let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
         (z, stats, None)
@@ -371,7 +385,6 @@ pub(crate) fn period_map_with(
         let symmetric = opts.symmetric;
         (z, stats, Some(MapTangent { tape, n, symmetric }))
     };
-    let inter = |k: usize| interleaved_index(k, n);
     let image = from_interleaved(&z, n);
     let phi = var.sensitivity(&z);
     let dp_column = var.parameter_sensitivity(&z).map(|s| {
@@ -380,25 +393,68 @@ pub(crate) fn period_map_with(
         let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
         from_interleaved(&column, n)
     });
-    let k = columns;
-    let (map, dp_column) = if opts.symmetric {
-        // G = S P_{nT/2}: DG = S Φ_{1/2}, rows mirrored and negated.
-        let monodromy =
-            DMatrix::from_fn(k, k, |r, c| -phi[inter(c) * d + inter(mirror_index(r, n))]);
-        let map = PeriodMap {
-            image: mirror(&image),
-            monodromy,
-        };
-        (map, dp_column.map(|c| mirror(&c)))
-    } else {
-        let monodromy = DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]);
-        (PeriodMap { image, monodromy }, dp_column)
-    };
+    let map = shooting_map(image, phi, columns, n, opts.symmetric);
+    let dp_column = dp_column.map(|c| if opts.symmetric { mirror(&c) } else { c });
     Ok(MapDerivatives {
         map,
         dp_column,
         steps: stats.steps,
         tangent,
+    })
+}
+
+/// The shooting map from the flow's image (body order) and Φ's `k`
+/// columns (interleaved, column-major): the period map, or for the half map
+/// `G = S P_{nT/2}` the mirrored image and `DG = S Φ_{1/2}` (rows mirrored
+/// and negated).
+fn shooting_map(image: Vec<f64>, phi: &[f64], k: usize, n: usize, symmetric: bool) -> PeriodMap {
+    let d = 2 * n;
+    let inter = |k: usize| interleaved_index(k, n);
+    if symmetric {
+        PeriodMap {
+            image: mirror(&image),
+            monodromy: DMatrix::from_fn(k, k, |r, c| {
+                -phi[inter(c) * d + inter(mirror_index(r, n))]
+            }),
+        }
+    } else {
+        PeriodMap {
+            image,
+            monodromy: DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]),
+        }
+    }
+}
+
+/// The dense period map by the local integrator: the state and the
+/// identity's columns carried over the map time `t` (docs/theory.md §10).
+fn local_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    t: f64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let mut identity = vec![0.0; d * d];
+    for c in 0..d {
+        identity[c * d + c] = 1.0;
+    }
+    let sim_opts = SimulationOptions {
+        t_end: t,
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps: MAX_STEPS,
+        interrupt: opts.interrupt.clone(),
+        integrator: Integrator::Local,
+        ..SimulationOptions::default()
+    };
+    let (y, phi, stats) = local_tangent_flow(model, &sim_opts, &to_interleaved(x), (&identity, d))
+        .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+    Ok(MapDerivatives {
+        map: shooting_map(from_interleaved(&y, n), &phi, d, n, opts.symmetric),
+        dp_column: None,
+        steps: stats.steps,
+        tangent: None,
     })
 }
 
@@ -421,7 +477,7 @@ fn forced_map(
     let n = model.bodies().len();
     let d = 2 * n;
     let mut sys = Recorder::new(ChainDynamics::new(model, false), true);
-    let int_opts = opts.integrator(max_steps, None);
+    let int_opts = opts.integrator_options(max_steps, None);
     fn identity(r: &mut Recorder<ChainDynamics>) -> &mut Recorder<ChainDynamics> {
         r
     }
@@ -839,7 +895,7 @@ pub(crate) fn map_and_product(
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
     let mut var = Variational::new(ChainDynamics::new(model, false), 1);
     let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
-    let int_opts = opts.integrator(MAX_STEPS, Some(d));
+    let int_opts = opts.integrator_options(MAX_STEPS, Some(d));
     let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
     let (image, product) = (from_interleaved(&z, n), from_interleaved(&z[d..], n));
     if opts.symmetric {

@@ -1,6 +1,7 @@
 //! Tests of periodic.rs.
 use super::*;
 use crate::model::BaseExcitation;
+use crate::simulate::Integrator;
 
 use crate::reference::{DAMPING_RATIO as ZETA, NATURAL_FREQUENCY as W0};
 
@@ -404,6 +405,62 @@ fn replayed_parameter_columns_equal_integrated_ones() {
                     "{name}, symmetric {symmetric}: integrated {x} vs replayed {y}"
                 );
             }
+        }
+    }
+}
+
+/// Dense shooting by the local integrator (the state and Φ's columns by
+/// the exact free motion between contacts): R3's exact steady state and
+/// multipliers to 1e-10; R2 N = 2's impacting orbit at 0.7 ω0 on the full
+/// and the half map with the global integrator's state (1e-8 of the
+/// amplitude) and multipliers (1e-6).
+#[test]
+fn local_dense_shooting_matches_global() {
+    let local = |opts: ShootingOptions| ShootingOptions {
+        integrator: Integrator::Local,
+        ..opts
+    };
+    let tight = ShootingOptions {
+        rtol: 1e-12,
+        tol: 1e-12,
+        ..Default::default()
+    };
+    let omega = 0.95 * W0;
+    let model = r2(2, 1e3, omega);
+    let (g, l) = (
+        shoot(&model, &[0.0; 4], &tight).unwrap(),
+        shoot(&model, &[0.0; 4], &local(tight.clone())).unwrap(),
+    );
+    assert!(l.converged, "{:?}", l.residual_history);
+    let t = l.period;
+    let wd = W0 * (1.0 - ZETA * ZETA).sqrt();
+    let modulus = (-ZETA * W0 * t).exp();
+    let exact = Complex::new(modulus * (wd * t).cos(), modulus * (wd * t).sin());
+    for mu in &l.multipliers {
+        let err = (mu - exact).norm().min((mu - exact.conj()).norm());
+        assert!(err < 1e-10, "multiplier {mu} vs {exact}");
+    }
+    for (a, b) in g.initial_state.iter().zip(&l.initial_state) {
+        assert!((a - b).abs() < 1e-10 * 1e-3, "{a} vs {b}");
+    }
+    let model = r2(2, 1e-3, 0.7 * W0);
+    let guess = guess_by_simulation(&model, 100.0, 1e-9).unwrap();
+    for symmetric in [false, true] {
+        let opts = ShootingOptions {
+            symmetric,
+            ..Default::default()
+        };
+        let (g, l) = (
+            shoot(&model, &guess, &opts).unwrap(),
+            shoot(&model, &guess, &local(opts.clone())).unwrap(),
+        );
+        assert!(g.converged && l.converged, "{symmetric}");
+        let amp = g.initial_state.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (a, b) in g.initial_state.iter().zip(&l.initial_state) {
+            assert!((a - b).abs() < 1e-8 * amp, "{symmetric}: {a} vs {b}");
+        }
+        for (a, b) in g.multipliers.iter().zip(&l.multipliers) {
+            assert!((a - b).norm() < 1e-6, "{symmetric}: {a} vs {b}");
         }
     }
 }

@@ -988,9 +988,9 @@ fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> 
     }
 }
 
-/// An interleaved state and tangent columns (each an interleaved state
-/// vector, one after the other).
-pub(crate) type StateAndColumns = (Vec<f64>, Vec<f64>);
+/// An interleaved state, tangent columns (each an interleaved state
+/// vector, one after the other) and the integrator's work.
+pub(crate) type StateAndColumns = (Vec<f64>, Vec<f64>, Stats);
 
 /// A record's sample times inside `(0, t_end)`: the steps end there.
 fn breakpoints(model: &Model, t_end: f64) -> Vec<f64> {
@@ -1033,7 +1033,7 @@ pub(crate) fn local_tangent_flow(
     )?;
     Ok(match run.error {
         Some(e) => Err(e),
-        None => Ok((run.y, run.tangents.unwrap_or_default())),
+        None => Ok((run.y, run.tangents.unwrap_or_default(), run.stats)),
     })
 }
 

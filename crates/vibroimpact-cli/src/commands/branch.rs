@@ -17,7 +17,7 @@ use vibroimpact::periodic::{
     OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
-use crate::args::{LinearAlgebra, ParameterRange, StartMethod};
+use crate::args::{IntegratorName, LinearAlgebra, ParameterRange, StartMethod};
 use crate::curves::{self, SecondParameter};
 use crate::error::CliError;
 use crate::figures::branch_figure;
@@ -57,6 +57,11 @@ pub struct PeriodicArgs {
     /// a mirror-symmetric model and an odd --subharmonic.
     #[arg(long)]
     symmetric: bool,
+    /// Integrator of the dense period map: `local` carries the state and
+    /// the monodromy matrix by the exact motion between contacts
+    /// (Newton–Krylov runs the global one).
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    integrator: IntegratorName,
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
     format: SummaryFormat,
@@ -133,6 +138,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         tol: args.tol,
         symmetric: args.symmetric,
         interrupt: Some(interrupt.clone()),
+        integrator: args.integrator.integrator(),
         ..ShootingOptions::default()
     };
     if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic % 2 == 0) {
@@ -143,6 +149,11 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     }
     let arnoldi = args.linear.krylov(model.bodies().len());
     let krylov = arnoldi.is_some();
+    if krylov && args.integrator == IntegratorName::Local {
+        return Err(CliError::new(
+            "--integrator local: the dense period map only; Newton–Krylov (--krylov, the default from 200 bodies) runs the global integrator (pass --dense for the local one)",
+        ));
+    }
     let sol = if let Some(arnoldi) = arnoldi {
         shoot_krylov(&model, &guess, &opts, arnoldi)
     } else {

@@ -469,6 +469,7 @@ def periodic(
     arnoldi: int = 20,
     symmetric: bool = False,
     progress: Progress = None,
+    integrator: str = "global",
 ) -> Result:
     """A periodic solution by shooting, with its Floquet multipliers
     (``vibroimpact periodic``).
@@ -478,6 +479,8 @@ def periodic(
     earlier result with ``initial_state``. ``krylov``: matrix-free
     Newton-Krylov with Arnoldi multipliers (default from 200 bodies on).
     ``symmetric``: shoot on the half map of a mirror-symmetric row.
+    ``integrator="local"``: the dense period map and its monodromy matrix
+    by the exact motion between contacts (not with ``krylov``).
 
     Returns ``converged``, ``method``, ``period``, ``subharmonic``,
     ``initial_state``, ``residual_history``, ``floquet_multipliers`` ([re,
@@ -511,6 +514,7 @@ def periodic(
             _count(arnoldi, "arnoldi", minimum=1, maximum=10**5),
             _flag(symmetric, "symmetric"),
             _progress(progress),
+            _method(integrator, ("global", "local"), "integrator"),
         )
     )
     if not r.converged:

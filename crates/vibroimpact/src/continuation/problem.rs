@@ -300,7 +300,7 @@ fn period_image_within(
     let t = map_time(model, opts).ok()?;
     let mut sys = crate::dynamics::ChainDynamics::new(model, false);
     let y0 = crate::dynamics::to_interleaved(x);
-    let int_opts = opts.integrator(max_steps, None);
+    let int_opts = opts.integrator_options(max_steps, None);
     let (y, stats) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
     let image = crate::dynamics::from_interleaved(&y, n);
     let image = if opts.symmetric {
