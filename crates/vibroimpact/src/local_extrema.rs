@@ -118,6 +118,24 @@ impl LocalExtrema {
     }
 }
 
+/// The ends of the equal pieces of `[a, b]` no longer than `step` (at
+/// least one; the last exactly `b`; none that does not advance).
+fn grid(a: f64, b: f64, step: f64) -> impl Iterator<Item = f64> {
+    let pieces = ((b - a) / step).ceil().clamp(1.0, 1e9) as usize;
+    let mut last = a;
+    (1..=pieces).filter_map(move |p| {
+        let t = if p == pieces {
+            b
+        } else {
+            a + (b - a) * p as f64 / pieces as f64
+        };
+        (t > last).then(|| {
+            last = t;
+            t
+        })
+    })
+}
+
 impl Run<'_> {
     /// Scans group `g`'s exact motion, and its contacts with other exact
     /// groups or walls, up to `t`: called before its reference state moves
@@ -187,17 +205,8 @@ impl Run<'_> {
         for (j, &i) in bodies.iter().enumerate() {
             ex.note_body(i, xa[2 * j], xa[2 * j + 1]);
         }
-        let pieces = ((b - a) / ex.grid[g]).ceil().clamp(1.0, 1e9) as usize;
         let mut ta = a;
-        for p in 1..=pieces {
-            let tb = if p == pieces {
-                b
-            } else {
-                a + (b - a) * p as f64 / pieces as f64
-            };
-            if tb <= ta {
-                continue;
-            }
+        for tb in grid(a, b, ex.grid[g]) {
             let mut xb = xa.clone();
             free.propagate(g, ta, tb, &mut xb);
             let at = |t: f64| {
@@ -231,24 +240,15 @@ impl Run<'_> {
     /// where ṡ changes sign on the grid of its exact sides.
     fn scan_contact(&mut self, ex: &mut LocalExtrema, k: usize, a: f64, b: f64) {
         let c = &self.model.contacts()[k];
-        let grid = [c.pair.left(), c.pair.right()]
+        let step = [c.pair.left(), c.pair.right()]
             .into_iter()
             .flatten()
             .filter(|&i| self.slot[i].is_none())
             .map(|i| ex.grid[self.free.place(i).0])
             .fold(f64::INFINITY, f64::min);
-        let pieces = ((b - a) / grid).ceil().clamp(1.0, 1e9) as usize;
         let (mut ta, mut sa) = (a, self.approach(k, a));
         ex.note_margin(k, sa.0);
-        for p in 1..=pieces {
-            let tb = if p == pieces {
-                b
-            } else {
-                a + (b - a) * p as f64 / pieces as f64
-            };
-            if tb <= ta {
-                continue;
-            }
+        for tb in grid(a, b, step) {
             let sb = self.approach(k, tb);
             ex.note_margin(k, sb.0);
             if sa.1 > 0.0 && sb.1 < 0.0 {

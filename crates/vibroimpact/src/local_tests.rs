@@ -23,6 +23,47 @@ fn run(model: &Model, t_end: f64, rtol: f64, integrator: Integrator) -> Simulati
     sim
 }
 
+/// `examples/fujita-row-n2.toml`.
+fn example_row() -> Model {
+    crate::model_file::ModelDocument::from_toml(
+        include_str!("../../../examples/fujita-row-n2.toml"),
+        "fujita-row-n2.toml",
+    )
+    .unwrap()
+    .build()
+    .unwrap()
+    .model
+}
+
+/// Two pounding storeys under a `duration`-second record (a 9 rad/s burst
+/// at 3 s, 0.01 s samples), Lankarani–Nikravesh across a 2 cm gap.
+fn pounding_pair(duration: f64) -> Model {
+    let samples = (duration / 0.01).round() as usize;
+    let times: Vec<f64> = (0..=samples).map(|k| 0.01 * k as f64).collect();
+    let quake: Vec<f64> = times
+        .iter()
+        .map(|t| 3.0 * (-(t - 3.0) * (t - 3.0) / 4.0).exp() * (9.0 * t).sin())
+        .collect();
+    Model::new(
+        vec![
+            crate::model::Body::from_frequency("A", 2e5, 12.566, 0.05),
+            crate::model::Body::from_frequency("B", 3e5, 6.0, 0.05),
+        ],
+        vec![],
+        vec![crate::model::Contact {
+            pair: crate::model::ContactPair::Bodies { left: 0, right: 1 },
+            clearance: 0.02,
+            law: ContactLaw::lankarani_nikravesh(2.75e9, 1.5, 0.65, 1e-3, ForceForm::Published)
+                .unwrap(),
+        }],
+        BaseExcitation::Record(Accelerogram::new(times, quake, 1.0).unwrap()),
+        vec![],
+        vec![],
+        vec![],
+    )
+    .unwrap()
+}
+
 /// Largest difference of two final states relative to the largest
 /// displacement (u rows) and velocity (v rows) of the first.
 fn difference(a: &Simulation, b: &Simulation) -> f64 {
@@ -68,38 +109,9 @@ fn r2_by_the_local_integrator_agrees_with_scipy() {
 /// state's size.
 #[test]
 fn local_matches_global_on_the_examples() {
-    let row = crate::model_file::ModelDocument::from_toml(
-        include_str!("../../../examples/fujita-row-n2.toml"),
-        "fujita-row-n2.toml",
-    )
-    .unwrap()
-    .build()
-    .unwrap()
-    .model;
+    let row = example_row();
     let t_row = 10.0 * 2.0 * std::f64::consts::PI / row.forcing_frequency().unwrap();
-    let times: Vec<f64> = (0..=1000).map(|k| 0.01 * k as f64).collect();
-    let quake: Vec<f64> = times
-        .iter()
-        .map(|t| 3.0 * (-(t - 3.0) * (t - 3.0) / 4.0).exp() * (9.0 * t).sin())
-        .collect();
-    let pair = Model::new(
-        vec![
-            crate::model::Body::from_frequency("A", 2e5, 12.566, 0.05),
-            crate::model::Body::from_frequency("B", 3e5, 6.0, 0.05),
-        ],
-        vec![],
-        vec![crate::model::Contact {
-            pair: crate::model::ContactPair::Bodies { left: 0, right: 1 },
-            clearance: 0.02,
-            law: ContactLaw::lankarani_nikravesh(2.75e9, 1.5, 0.65, 1e-3, ForceForm::Published)
-                .unwrap(),
-        }],
-        BaseExcitation::Record(Accelerogram::new(times, quake, 1.0).unwrap()),
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
+    let pair = pounding_pair(10.0);
     for (model, t_end) in [(row, t_row), (pair, 10.0)] {
         let global = run(&model, t_end, 1e-10, Integrator::Global);
         let local = run(&model, t_end, 1e-10, Integrator::Local);
@@ -128,14 +140,7 @@ fn local_matches_global_on_the_examples() {
 #[test]
 fn extrema_match_the_global_integrator() {
     use crate::model::{Body, Contact, ContactPair, Coupling};
-    let row = crate::model_file::ModelDocument::from_toml(
-        include_str!("../../../examples/fujita-row-n2.toml"),
-        "fujita-row-n2.toml",
-    )
-    .unwrap()
-    .build()
-    .unwrap()
-    .model;
+    let row = example_row();
     let t_row = 2.0 * std::f64::consts::PI / row.forcing_frequency().unwrap();
     let hertz = || ContactLaw::hertz(1e7, 1.5).unwrap();
     let coupled = Model::new(
@@ -178,29 +183,7 @@ fn extrema_match_the_global_integrator() {
         vec![],
     )
     .unwrap();
-    let times: Vec<f64> = (0..=600).map(|k| 0.01 * k as f64).collect();
-    let quake: Vec<f64> = times
-        .iter()
-        .map(|t| 3.0 * (-(t - 3.0) * (t - 3.0) / 4.0).exp() * (9.0 * t).sin())
-        .collect();
-    let pair = Model::new(
-        vec![
-            Body::from_frequency("A", 2e5, 12.566, 0.05),
-            Body::from_frequency("B", 3e5, 6.0, 0.05),
-        ],
-        vec![],
-        vec![Contact {
-            pair: ContactPair::Bodies { left: 0, right: 1 },
-            clearance: 0.02,
-            law: ContactLaw::lankarani_nikravesh(2.75e9, 1.5, 0.65, 1e-3, ForceForm::Published)
-                .unwrap(),
-        }],
-        BaseExcitation::Record(Accelerogram::new(times, quake, 1.0).unwrap()),
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
+    let pair = pounding_pair(6.0);
     for (model, t_end) in [(row, 6.0 * t_row), (coupled, 6.0), (pair, 6.0)] {
         for window in [(0.0, t_end), (0.37 * t_end, 0.81 * t_end)] {
             let extrema = |integrator| {
