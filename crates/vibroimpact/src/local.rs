@@ -352,10 +352,13 @@ impl Run<'_> {
     /// set's state and the exact motion of the others.
     fn rebuild(&mut self, groups: Vec<usize>, t: f64) -> Result<(), IntegrationError> {
         let model = self.model;
-        // Groups joining leave their exact motion: scanned up to here.
+        // Groups joining leave their exact motion: scanned up to here, and
+        // their deferred reference states (of the motion before they
+        // joined) lapse.
         for &g in &groups {
             if !self.in_set[g] {
                 self.scan_group_to(g, t);
+                self.deferred.retain(|(h, ..)| *h != g);
             }
         }
         let mut h_prev = None;

@@ -11,7 +11,8 @@
 //! stretching them, so that the exponents of a complex pair of
 //! multipliers (equal moduli) converge with an error ~ ζ / t instead of ~ 1
 //! / t. The uncertainty of each exponent is its standard error by batch
-//! means: the window cut into [`BATCHES`] batches of consecutive periods,
+//! means: the window cut into [`BATCHES`] batches of consecutive periods
+//! (fewer, of 10 periods at least, in a short window),
 //! the standard deviation of the batches' exponents divided by
 //! √batches. It estimates the scatter that repeated runs show (the
 //! running average's settling, used before, understated it by about half
@@ -180,20 +181,32 @@ pub fn lyapunov_spectrum(
                 fresh: true,
             }
         }
-        Integrator::Local => Flow::Local {
-            model: model.delayed(t0).ok_or_else(|| {
-                LyapunovError::Invalid("a recorded excitation has no forcing period".into())
-            })?,
-            options: SimulationOptions {
-                t_end: period,
-                rtol: opts.rtol,
-                atol: opts.rtol * 1e-3,
-                interrupt: opts.interrupt.clone(),
-                integrator: Integrator::Local,
-                ..SimulationOptions::default()
-            },
-            k,
-        },
+        Integrator::Local => {
+            // Each period is a run of its own: an impact under way at a
+            // period's end would restart with the rate of that instant.
+            if let Some(k) = (0..model.contacts().len())
+                .find(|&k| model.contacts()[k].law.needs_impact_velocity())
+            {
+                return Err(LyapunovError::Invalid(format!(
+                    "contact {}: its law needs the impact's onset velocity, which the local integrator's period-by-period runs do not carry; use the global integrator",
+                    model.contact_name(k)
+                )));
+            }
+            Flow::Local {
+                model: model.delayed(t0).ok_or_else(|| {
+                    LyapunovError::Invalid("a recorded excitation has no forcing period".into())
+                })?,
+                options: SimulationOptions {
+                    t_end: period,
+                    rtol: opts.rtol,
+                    atol: opts.rtol * 1e-3,
+                    interrupt: opts.interrupt.clone(),
+                    integrator: Integrator::Local,
+                    ..SimulationOptions::default()
+                },
+                k,
+            }
+        }
     };
     let total = opts.transient + opts.periods;
     let batches = (opts.periods / MIN_BATCH_PERIODS).clamp(2, BATCHES);

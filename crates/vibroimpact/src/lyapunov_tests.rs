@@ -324,3 +324,35 @@ fn local_exponents_match_independent_values() {
     let (sg, sl): (f64, f64) = (g.exponents.iter().sum(), l.exponents.iter().sum());
     assert!((sg - sl).abs() < 1e-3 * sg.abs(), "{sg} vs {sl}");
 }
+
+/// A law that needs the impact's onset velocity (Lankarani–Nikravesh) is
+/// refused by the local integrator's period-by-period runs, by contact.
+#[test]
+fn local_exponents_refuse_onset_velocity_laws() {
+    use crate::contact::{ContactLaw, ForceForm};
+    use crate::simulate::Integrator;
+    let model = r2(2, 1e-3, 0.9 * W0).unwrap();
+    let law = ContactLaw::lankarani_nikravesh(1e7, 1.5, 0.8, 1e-3, ForceForm::Published).unwrap();
+    let contacts: Vec<_> = model
+        .contacts()
+        .iter()
+        .map(|c| crate::model::Contact { law, ..c.clone() })
+        .collect();
+    let model = Model::new(
+        model.bodies().to_vec(),
+        vec![],
+        contacts,
+        model.base().clone(),
+        vec![],
+        vec![],
+        vec![],
+    )
+    .unwrap();
+    let opts = LyapunovOptions {
+        integrator: Integrator::Local,
+        ..LyapunovOptions::default()
+    };
+    let e = lyapunov_spectrum(&model, &[0.0; 4], 0.0, &opts).unwrap_err();
+    assert!(e.to_string().contains("onset velocity"), "{e}");
+    assert!(e.to_string().contains(&model.contact_name(0)), "{e}");
+}

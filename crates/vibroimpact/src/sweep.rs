@@ -74,9 +74,8 @@ pub struct SweepOptions {
     pub lyapunov: Option<usize>,
     /// Stop request (see [`Interrupt`]).
     pub interrupt: Option<Interrupt>,
-    /// The integrator of the transient and the recorded window, with its
-    /// exact extrema (docs/theory.md §10); the Lyapunov exponents run the
-    /// global integrator.
+    /// The integrator of the transient, the recorded window with its exact
+    /// extrema, and the Lyapunov exponents (docs/theory.md §10).
     pub integrator: Integrator,
 }
 
@@ -476,15 +475,14 @@ pub(crate) fn run_value(
         Ok(m) => m,
         Err(e) => return fail(point, format!("cannot start: {e}")),
     };
-    let dt = period / FINE as f64;
     let j0 = (FINE - start.phase % FINE) % FINE;
     let j_end = j0 + settings.record * FINE;
-    // Samples at the section instants only: the first, then one a period.
+    let (w0, w1) = recorded_window(period, j0, settings.record);
     let opts = SimulationOptions {
-        t_end: j_end as f64 * dt,
+        t_end: w1,
         output_step: Some(period),
-        output_from: j0 as f64 * dt,
-        extrema_window: Some((j0 as f64 * dt, j_end as f64 * dt)),
+        output_from: w0,
+        extrema_window: Some((w0, w1)),
         integrator: settings.integrator,
         ..settings.opts.clone()
     };
@@ -508,8 +506,8 @@ pub(crate) fn run_value(
         }
     }
     if point.recorded_periods > 0 {
-        let t0 = j0 as f64 * dt;
-        let t1 = (j0 + point.recorded_periods * FINE) as f64 * dt;
+        let t0 = w0;
+        let t1 = w0 + point.recorded_periods as f64 * period;
         let count = sim
             .impacts
             .iter()
@@ -541,7 +539,7 @@ pub(crate) fn run_value(
             interrupt: settings.opts.interrupt.clone(),
             integrator: settings.integrator,
         };
-        match lyapunov_spectrum(&m, row(0), j0 as f64 * dt, &opts) {
+        match lyapunov_spectrum(&m, row(0), w0, &opts) {
             Ok(ly) => {
                 point.lyapunov = Some(ly.exponents);
                 point.lyapunov_uncertainty = Some(ly.uncertainty);
@@ -553,6 +551,16 @@ pub(crate) fn run_value(
     // Every sample is a section instant (phase 0).
     let next = handover(&m, &sim, 0, FINE, start.phase + j_end);
     (point, next)
+}
+
+/// The recorded window from section sample `j0` (of `FINE` a period) over
+/// `record` periods, sampled at the section instants only: its end is the
+/// last sample's time as the sampling computes it, `from + record ·
+/// period` (`(j0 + record FINE) dt` may differ from it by an ulp, and the
+/// last section would be lost).
+fn recorded_window(period: f64, j0: usize, record: usize) -> (f64, f64) {
+    let from = j0 as f64 * (period / FINE as f64);
+    (from, from + record as f64 * period)
 }
 
 /// Runs the values in order, each from the previous one's final state; stops
@@ -849,6 +857,37 @@ mod tests {
             }
             for (a, b) in g.max_displacement.iter().zip(&l.max_displacement) {
                 assert!((a - b).abs() < 1e-5 * scale, "{a} {b} at {}", g.parameter);
+            }
+        }
+    }
+
+    /// The recorded window keeps every section: sampled from its start
+    /// every period, the last sample is its end (ω = 0.5, j0 = 1, 50
+    /// periods: (j0 + 50 FINE) dt lies an ulp below that sample, which the
+    /// window ending there lost).
+    #[test]
+    fn the_recorded_window_keeps_its_last_section() {
+        let model = row_model();
+        for (omega, j0, record) in [(0.5, 1, 50), (7.3, 37, 13), (12.0, 255, 20)] {
+            let period = 2.0 * std::f64::consts::PI / omega;
+            let (w0, w1) = recorded_window(period, j0, record);
+            let opts = SimulationOptions {
+                t_end: w1,
+                output_step: Some(period),
+                output_from: w0,
+                ..SimulationOptions::default()
+            };
+            for integrator in [Integrator::Global, Integrator::Local] {
+                let sim = simulate(
+                    &model,
+                    &SimulationOptions {
+                        integrator,
+                        ..opts.clone()
+                    },
+                )
+                .unwrap();
+                assert_eq!(sim.times.len(), record + 1, "{omega} {j0} {record}");
+                assert_eq!(sim.times[record], w1);
             }
         }
     }
