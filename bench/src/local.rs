@@ -11,6 +11,10 @@
 //!    never reaches its end).
 //! 3. R2, N = 2 and 3, 20 periods at 0.95 ω0: the loosest robust rtol
 //!    reaching 1e-6 against rtol 1e-13, global and local, timed.
+//! 4. Sweeps of the example row (`examples/fujita-row-n2.toml`, its
+//!    `count` set to N) over frequency, with and without Lyapunov
+//!    exponents, global and local: the values one after the other (one
+//!    thread), timed, with the largest exponents side by side.
 
 use super::*;
 
@@ -220,5 +224,77 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
         }
     }
     out.insert("small_rows".into(), Value::Array(small));
+    out.insert("sweeps".into(), sweeps(quick));
     Value::Object(out)
+}
+
+/// A sweep of section 4: bodies, values, transient and recorded periods,
+/// Lyapunov exponents.
+type SweepCase = (usize, &'static [f64], usize, usize, Option<usize>);
+
+/// Section 4: sweeps of R2 rows, global against local.
+fn sweeps(quick: bool) -> Value {
+    use vibroimpact::model_file::ModelDocument;
+    use vibroimpact::parameter::ParameterizedModel;
+    use vibroimpact::sweep::{sweep, SweepOptions};
+    println!("\n== local integrator: sweeps of R2 (examples/fujita-row-n2.toml), values one after the other ==");
+    let cases: &[SweepCase] = if quick {
+        &[(100, &[6.0, 14.0], 10, 5, Some(2))]
+    } else {
+        &[
+            (100, &[6.0, 26.0 / 3.0, 34.0 / 3.0, 14.0], 50, 20, None),
+            (100, &[6.0, 14.0], 20, 20, Some(2)),
+            (1000, &[6.0, 14.0], 10, 5, None),
+            (1000, &[6.0, 14.0], 10, 10, Some(2)),
+        ]
+    };
+    let mut rows = Vec::new();
+    for &(n, values, transient, record, lyapunov) in cases {
+        let text = include_str!("../../examples/fujita-row-n2.toml")
+            .replace("count = 2", &format!("count = {n}"));
+        let doc = ModelDocument::from_toml(&text, "row").expect("the example row");
+        let family = ParameterizedModel::new(doc, "frequency").expect("a frequency");
+        let mut seconds = [0.0f64; 2];
+        let mut largest: [Vec<Option<f64>>; 2] = [Vec::new(), Vec::new()];
+        for (side, integrator) in [Integrator::Global, Integrator::Local]
+            .into_iter()
+            .enumerate()
+        {
+            let options = SweepOptions {
+                transient,
+                record,
+                lyapunov,
+                integrator,
+                ..SweepOptions::default()
+            };
+            for &v in values {
+                let start = Instant::now();
+                let summary = sweep(&family, &[v], &options, &|| {}).expect("sweep");
+                seconds[side] += start.elapsed().as_secs_f64();
+                let point = &summary.points[0];
+                assert!(point.error.is_none(), "{n} {v}: {:?}", point.error);
+                largest[side].push(point.lyapunov.as_ref().map(|l| l[0]));
+            }
+        }
+        println!(
+            "N = {n:>4}, {} values, {transient} + {record} periods{}: global {:.2} s, local {:.2} s, global / local = {:.1}",
+            values.len(),
+            if lyapunov.is_some() { ", --lyapunov 2" } else { "" },
+            seconds[0],
+            seconds[1],
+            seconds[0] / seconds[1]
+        );
+        if lyapunov.is_some() {
+            println!(
+                "         largest exponents: global {:?}, local {:?}",
+                largest[0], largest[1]
+            );
+        }
+        rows.push(
+            json!({"n": n, "values": values, "transient": transient, "record": record,
+            "lyapunov": lyapunov, "global_seconds": seconds[0], "local_seconds": seconds[1],
+            "global_largest_exponent": largest[0], "local_largest_exponent": largest[1]}),
+        );
+    }
+    Value::Array(rows)
 }
