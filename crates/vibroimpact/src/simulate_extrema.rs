@@ -1,0 +1,148 @@
+//! Exact extrema over a window on the integrator's dense output
+//! (docs/theory.md §10 for the local integrator's exact motion).
+
+use super::*;
+
+/// Largest |u_i| and |v_i| of every body over a time window, located on the
+/// integrator's dense output rather than sampled: an interior maximum of
+/// |u_i| lies where v_i changes sign within a step (Brent on the dense
+/// v_i), one of |v_i| where the acceleration changes sign (golden section
+/// on the dense v_i); otherwise the maximum is at a step end. Contact pulses
+/// shorter than any output interval (the deepest penetration, the fastest
+/// approach) are therefore caught to the integration tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Extrema {
+    /// max |u_i| (m), body order.
+    pub max_displacement: Vec<f64>,
+    /// max |v_i| (m/s), body order.
+    pub max_velocity: Vec<f64>,
+    /// Per contact, max (s − s_on): how far the approach s passed the
+    /// impact threshold s_on (positive: an impact in the window; it
+    /// crosses zero where an impact grazes into or out of existence).
+    /// Interior maxima where ṡ changes sign are located like those of |u_i|.
+    pub impact_margin: Vec<f64>,
+}
+
+/// Dense-output values of two components at time t.
+pub(super) fn dense_pair<S: Chain>(
+    st: &mut Stepper,
+    sys: &mut S,
+    (i, j): (usize, usize),
+    t: f64,
+) -> (f64, f64) {
+    (st.dense_component(sys, i, t), st.dense_component(sys, j, t))
+}
+
+/// Running state of the extrema search: the window start and the previous
+/// step end (interleaved state and its derivative).
+pub(super) struct ExtremaScan {
+    pub(super) from: f64,
+    pub(super) to: f64,
+    pub(super) t: f64,
+    pub(super) y: Vec<f64>,
+    pub(super) dydt: Vec<f64>,
+    /// The impact threshold s_on of every contact.
+    pub(super) s_on: Vec<f64>,
+    pub(super) found: Extrema,
+}
+
+impl ExtremaScan {
+    pub(super) fn new(
+        (from, to): (f64, f64),
+        bodies: usize,
+        s_on: Vec<f64>,
+        st: &Stepper,
+        sys: &ChainDynamics,
+    ) -> Self {
+        let mut scan = Self {
+            from,
+            to,
+            t: st.t(),
+            y: st.y().to_vec(),
+            dydt: st.dydt().to_vec(),
+            found: Extrema {
+                max_displacement: vec![0.0; bodies],
+                max_velocity: vec![0.0; bodies],
+                impact_margin: vec![f64::NEG_INFINITY; s_on.len()],
+            },
+            s_on,
+        };
+        if from <= scan.t && scan.t <= to {
+            for i in 0..bodies {
+                scan.found.max_displacement[i] = scan.y[2 * i].abs();
+                scan.found.max_velocity[i] = scan.y[2 * i + 1].abs();
+            }
+            for (k, m) in scan.found.impact_margin.iter_mut().enumerate() {
+                *m = sys.approach(k, &scan.y).0 - scan.s_on[k];
+            }
+        }
+        scan
+    }
+
+    /// The contacts' approach maxima on [a, b] within the step ending at
+    /// `st.t()`: at the ends, and inside where ṡ changes sign.
+    pub(super) fn contact_step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, a: f64, b: f64) {
+        let t1 = st.t();
+        for k in 0..self.s_on.len() {
+            let (sa, sda) = if a == self.t {
+                sys.chain().approach(k, &self.y)
+            } else {
+                contact_at(st, sys, k, a)
+            };
+            let (sb, sdb) = if b == t1 {
+                sys.chain().approach(k, st.y())
+            } else {
+                contact_at(st, sys, k, b)
+            };
+            let mut max_s = sa.max(sb);
+            if sda > 0.0 && sdb < 0.0 {
+                let rate = |t| contact_at(st, sys, k, t).1;
+                if let Ok(t) = EventLocator::FINE.locate(rate, (a, sda), (b, sdb)) {
+                    max_s = max_s.max(contact_at(st, sys, k, t).0);
+                }
+            }
+            let m = &mut self.found.impact_margin[k];
+            *m = m.max(max_s - self.s_on[k]);
+        }
+    }
+
+    /// Processes the accepted step from the previous end to `st.t()`.
+    pub(super) fn step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
+        let t1 = st.t();
+        let (a, b) = (self.t.max(self.from), t1.min(self.to));
+        if a <= b {
+            for i in 0..self.found.max_displacement.len() {
+                let (iu, iv) = (2 * i, 2 * i + 1);
+                let (ua, va) = if a == self.t {
+                    (self.y[iu], self.y[iv])
+                } else {
+                    dense_pair(st, sys, (iu, iv), a)
+                };
+                let (ub, vb) = if b == t1 {
+                    (st.y()[iu], st.y()[iv])
+                } else {
+                    dense_pair(st, sys, (iu, iv), b)
+                };
+                let mut max_u = ua.abs().max(ub.abs());
+                let mut max_v = va.abs().max(vb.abs());
+                if va * vb < 0.0 {
+                    let v = |t| st.dense_component(sys, iv, t);
+                    if let Ok(t) = EventLocator::FINE.locate(v, (a, va), (b, vb)) {
+                        max_u = max_u.max(st.dense_component(sys, iu, t).abs());
+                    }
+                }
+                if self.dydt[iv] * st.dydt()[iv] < 0.0 {
+                    let speed = |t| st.dense_component(sys, iv, t).abs();
+                    max_v = max_v.max(golden_max(speed, a, b).0);
+                }
+                let f = &mut self.found;
+                f.max_displacement[i] = f.max_displacement[i].max(max_u);
+                f.max_velocity[i] = f.max_velocity[i].max(max_v);
+            }
+            self.contact_step(st, sys, a, b);
+        }
+        self.t = t1;
+        self.y.copy_from_slice(st.y());
+        self.dydt.copy_from_slice(st.dydt());
+    }
+}
