@@ -1,0 +1,269 @@
+//! The shooting map and its derivatives (docs/theory.md §5): the period
+//! (or half) map, its dense Jacobian, the parameter's column, and products
+//! replayed on the integration's tape; by the global integrator, or the
+//! dense map by the local one (§10).
+
+use super::*;
+
+/// Evaluates the shooting map (the period map, or the symmetric half map
+/// with `opts.symmetric`) and its Jacobian at `x` (body order).
+pub fn period_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+) -> Result<PeriodMap, IntegrationError> {
+    period_map_with(model, x, opts, None, true, MAX_STEPS).map(|m| m.map)
+}
+
+/// What [`period_map_with`] computes besides the map.
+pub(crate) struct MapDerivatives {
+    /// The map and, dense, its Jacobian (0 × 0 otherwise).
+    pub(crate) map: PeriodMap,
+    /// `∂P/∂p`, with a shifted model.
+    pub(crate) dp_column: Option<Vec<f64>>,
+    /// Integration steps taken.
+    pub(crate) steps: u64,
+    /// Without the dense Jacobian: products with it, replayed on the
+    /// integration's own steps.
+    pub(crate) tangent: Option<MapTangent>,
+}
+
+/// Products with the shooting map's Jacobian (Φ, or DG = S Φ_{1/2} for the
+/// half map) replayed on the steps of the integration that computed the
+/// map (`integrate::tangent`): the same numbers, to rounding, as one
+/// integration of the state with the column, without integrating.
+#[derive(Clone, Debug)]
+pub(crate) struct MapTangent {
+    pub(super) tape: TangentTape<ChainDynamics>,
+    n: usize,
+    symmetric: bool,
+}
+
+impl MapTangent {
+    /// `Φ v` (or `DG v`), body order.
+    pub(crate) fn product(&self, v: &[f64]) -> Vec<f64> {
+        let w = from_interleaved(&self.tape.apply(&to_interleaved(v)), self.n);
+        if self.symmetric {
+            mirror(&w)
+        } else {
+            w
+        }
+    }
+
+    /// `Φ v` in scaled variables: `v` in units of `scale · unit`, the
+    /// product in units of `scale`, i.e. `Φ (s u v) / s`.
+    pub(crate) fn scaled_product(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
+        let unscaled: Vec<f64> = v.iter().zip(scale).map(|(a, s)| a * s * unit).collect();
+        let mut phi_v = self.product(&unscaled);
+        phi_v.iter_mut().zip(scale).for_each(|(a, s)| *a /= s);
+        phi_v
+    }
+
+    /// `(Φ − I) v` in the same variables: `Φ (s u v) / s − u v`.
+    pub(crate) fn shifted_scaled(&self, v: &[f64], scale: &[f64], unit: f64) -> Vec<f64> {
+        let mut w = self.scaled_product(v, scale, unit);
+        w.iter_mut().zip(v).for_each(|(a, b)| *a -= unit * b);
+        w
+    }
+}
+
+/// [`period_map`] and, with `shifted = Some((model at p + dp, dp))`, the
+/// derivative `∂P/∂p` of the map with respect to the parameter p of the
+/// family: the sensitivity column of the variational equations at the
+/// end time plus the flow times the change of the end time,
+/// `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (mirrored for the half map); at
+/// most `max_steps` integration steps. Without `dense` no column of Φ is
+/// carried (the monodromy is 0 × 0) and the integration records its tape
+/// for products with Φ: the map, its parameter derivative and the
+/// products for matrix-free continuation.
+pub(crate) fn period_map_with(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    shifted: Option<(&Model, f64)>,
+    dense: bool,
+    max_steps: u64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    if dense && d > MAX_DENSE_DIM {
+        // About 40 state-sized vectors of d(d + 1) values in the integrator.
+        let gb = 40.0 * (d * (d + 1)) as f64 * 8.0 / 1e9;
+        return Err(IntegrationError::InvalidOptions(format!(
+            "a dense period map of {n} bodies integrates {d}×{d} variational equations (about {gb:.0} GB); \
+             above {} bodies use Newton–Krylov shooting (matrix-free)",
+            MAX_DENSE_DIM / 2
+        )));
+    }
+    let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
+    let t = map_time(model, opts).map_err(invalid)?;
+    if let Some((model_p, dp)) = shifted {
+        // The state's steps alone choose the steps, with or without the
+        // column: the column can then be replayed on the tape.
+        if !dense && !opts.control_monodromy && model.differs_only_in_forcing(model_p) {
+            let t_p = map_time(model_p, opts).map_err(invalid)?;
+            return forced_map(model, x, opts, (model_p, dp, t_p), t, max_steps);
+        }
+    }
+    if dense && shifted.is_none() && opts.integrator == Integrator::Local {
+        return local_map(model, x, opts, t);
+    }
+    let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
+    let columns = if dense { d } else { 0 };
+    let (mut var, dt_dp) = match shifted {
+        Some((model_p, dp)) => {
+            let t_p = map_time(model_p, opts).map_err(invalid)?;
+            let shifted_sys = Recorder::new(ChainDynamics::new(model_p, false), false);
+            let var = Variational::with_parameter(sys, columns, shifted_sys, dp);
+            (var, (t_p - t) / dp)
+        }
+        None => (Variational::new(sys, columns), 0.0),
+    };
+    let z0 = var.initial_state(&to_interleaved(x));
+    // The state controls the steps: Φ rides along on the same steps, so a
+    // period map costs O(N) steps × O(N² · bandwidth) per step.
+    let int_opts = opts.integrator_options(max_steps, Some(d));
+    let (z, stats, tangent) = if dense {
+        let (z, stats) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+        (z, stats, None)
+    } else {
+        let (z, stats, tape) =
+            integrate_recorded(&mut var, Variational::system_mut, 0.0, &z0, t, &int_opts)?;
+        let symmetric = opts.symmetric;
+        (z, stats, Some(MapTangent { tape, n, symmetric }))
+    };
+    let image = from_interleaved(&z, n);
+    let phi = var.sensitivity(&z);
+    let dp_column = var.parameter_sensitivity(&z).map(|s| {
+        let mut flow = vec![0.0; d];
+        var.system_mut().rhs(t, &z[..d], &mut flow);
+        let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
+        from_interleaved(&column, n)
+    });
+    let map = shooting_map(image, phi, columns, n, opts.symmetric);
+    let dp_column = dp_column.map(|c| if opts.symmetric { mirror(&c) } else { c });
+    Ok(MapDerivatives {
+        map,
+        dp_column,
+        steps: stats.steps,
+        tangent,
+    })
+}
+
+/// The shooting map from the flow's image (body order) and Φ's `k`
+/// columns (interleaved, column-major): the period map, or for the half map
+/// `G = S P_{nT/2}` the mirrored image and `DG = S Φ_{1/2}` (rows mirrored
+/// and negated).
+pub(super) fn shooting_map(
+    image: Vec<f64>,
+    phi: &[f64],
+    k: usize,
+    n: usize,
+    symmetric: bool,
+) -> PeriodMap {
+    let d = 2 * n;
+    let inter = |k: usize| interleaved_index(k, n);
+    if symmetric {
+        PeriodMap {
+            image: mirror(&image),
+            monodromy: DMatrix::from_fn(k, k, |r, c| {
+                -phi[inter(c) * d + inter(mirror_index(r, n))]
+            }),
+        }
+    } else {
+        PeriodMap {
+            image,
+            monodromy: DMatrix::from_fn(k, k, |r, c| phi[inter(c) * d + inter(r)]),
+        }
+    }
+}
+
+/// The dense period map by the local integrator: the state and the
+/// identity's columns carried over the map time `t` (docs/theory.md §10).
+pub(super) fn local_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    t: f64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let mut identity = vec![0.0; d * d];
+    for c in 0..d {
+        identity[c * d + c] = 1.0;
+    }
+    let sim_opts = SimulationOptions {
+        t_end: t,
+        rtol: opts.rtol,
+        atol: opts.rtol * opts.displacement_scale,
+        max_steps: MAX_STEPS,
+        interrupt: opts.interrupt.clone(),
+        integrator: Integrator::Local,
+        ..SimulationOptions::default()
+    };
+    let (y, phi, stats) = local_tangent_flow(model, &sim_opts, &to_interleaved(x), (&identity, d))
+        .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+    Ok(MapDerivatives {
+        map: shooting_map(from_interleaved(&y, n), &phi, d, n, opts.symmetric),
+        dp_column: None,
+        steps: stats.steps,
+        tangent: None,
+    })
+}
+
+/// [`period_map_with`] without the dense Jacobian for a parameter that
+/// only changes the forcing (`shifted = (model at p + dp, dp, its map
+/// time)`): the state alone is integrated, recording its tape, and the
+/// parameter's sensitivity column is replayed on the tape with the source
+/// `∂f/∂p = (q_{p+dp}(t) − q_p(t)) / dp`, `q` the time-only part of the
+/// equations (docs/theory.md §5): the recurrence of the integrated column,
+/// stage by stage, at the cost of one product instead of a state-sized
+/// column carried through every stage, error estimate and rejected step.
+pub(super) fn forced_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    (model_p, dp, t_p): (&Model, f64, f64),
+    t: f64,
+    max_steps: u64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let mut sys = Recorder::new(ChainDynamics::new(model, false), true);
+    let int_opts = opts.integrator_options(max_steps, None);
+    fn identity(r: &mut Recorder<ChainDynamics>) -> &mut Recorder<ChainDynamics> {
+        r
+    }
+    let (y, stats, tape) =
+        integrate_recorded(&mut sys, identity, 0.0, &to_interleaved(x), t, &int_opts)?;
+    let (here, shifted) = (sys.system(), ChainDynamics::new(model_p, false));
+    let mut q_p = vec![0.0; d];
+    let mut source = |time: f64, out: &mut [f64]| {
+        here.source(time, out);
+        shifted.source(time, &mut q_p);
+        out.iter_mut()
+            .zip(&q_p)
+            .for_each(|(o, s)| *o = (s - *o) / dp);
+    };
+    let s = tape.apply_with_source(&vec![0.0; d], &mut source);
+    let mut flow = vec![0.0; d];
+    sys.rhs(t, &y, &mut flow);
+    let dt_dp = (t_p - t) / dp;
+    let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
+    let (image, column) = (from_interleaved(&y, n), from_interleaved(&column, n));
+    let symmetric = opts.symmetric;
+    let (image, column) = if symmetric {
+        (mirror(&image), mirror(&column))
+    } else {
+        (image, column)
+    };
+    Ok(MapDerivatives {
+        map: PeriodMap {
+            image,
+            monodromy: DMatrix::zeros(0, 0),
+        },
+        dp_column: Some(column),
+        steps: stats.steps,
+        tangent: Some(MapTangent { tape, n, symmetric }),
+    })
+}
