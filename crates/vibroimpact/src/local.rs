@@ -4,7 +4,7 @@
 //! Every group of bodies joined by springs ([`FreeMotion`]) moves exactly
 //! while none of its contacts is active. A contact becomes active where its
 //! force stops being negligible at the run's tolerance (`s_act`, see
-//! [`Activation`]); the groups it joins are then integrated, with every
+//! `Activation`); the groups it joins are then integrated, with every
 //! other group that is integrated at that time, as one system of those
 //! bodies alone (the *active set*, its own [`Stepper`] with the error norm
 //! per body). A group leaves the set when all its contacts have separated

@@ -1,0 +1,172 @@
+//! What drives a model besides its initial state: the base's motion
+//! (harmonic or a recorded accelerogram) and harmonic forces on bodies.
+
+use super::*;
+
+/// A base accelerogram: samples (t_k, a_k), linear interpolation, times a
+/// scale factor; zero before the first and after the last sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accelerogram {
+    times: Vec<f64>,
+    values: Vec<f64>,
+    scale: f64,
+    /// Samples per second on average, `(n - 1) / (t_last - t_first)`: the
+    /// first guess of a sample's segment (exact for a uniform record).
+    rate: f64,
+}
+
+/// How far [`Accelerogram::at`] walks from its first guess before it falls
+/// back to bisection (a record whose spacing varies a lot).
+const SEGMENT_WALK: usize = 4;
+
+impl Accelerogram {
+    /// From strictly increasing times and accelerations (m/s²). Errors name
+    /// the first offending sample (0-based).
+    pub fn new(times: Vec<f64>, values: Vec<f64>, scale: f64) -> Result<Self, ModelError> {
+        if times.len() != values.len() || times.len() < 2 {
+            return Err(ModelError::new(
+                ModelErrorKind::Missing,
+                "excitation.acceleration",
+                "accelerogram: needs at least two (time, acceleration) samples",
+            ));
+        }
+        for (k, (t, a)) in times.iter().zip(&values).enumerate() {
+            if !t.is_finite() || !a.is_finite() {
+                return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    "excitation.acceleration",
+                    format!("accelerogram: sample {k} is not finite"),
+                ));
+            }
+            if k > 0 && *t <= times[k - 1] {
+                return Err(ModelError::new(
+                    ModelErrorKind::Order,
+                    "excitation.time",
+                    format!(
+                        "accelerogram: time is not increasing at sample {k} (t = {t} after {})",
+                        times[k - 1]
+                    ),
+                ));
+            }
+        }
+        if !scale.is_finite() {
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                "excitation.scale",
+                "accelerogram: scale must be finite",
+            ));
+        }
+        let rate = (times.len() - 1) as f64 / (times[times.len() - 1] - times[0]);
+        Ok(Self {
+            times,
+            values,
+            scale,
+            rate,
+        })
+    }
+
+    /// The segment `k` (samples `k - 1`, `k`) holding `t` inside the
+    /// record: the first `k` with `t < t_k`, or the last segment at the
+    /// record's end. Guessed from the average spacing and corrected by a
+    /// short walk (a uniform record: no walk), so that the integrator's
+    /// dozen evaluations per step do not each bisect the record; the
+    /// segment is exactly the bisection's.
+    pub(super) fn segment(&self, t: f64) -> usize {
+        let n = self.times.len();
+        let mut k = (((t - self.times[0]) * self.rate) as usize + 1).clamp(1, n - 1);
+        for _ in 0..SEGMENT_WALK {
+            if self.times[k - 1] > t {
+                k -= 1;
+            } else if t >= self.times[k] && k < n - 1 {
+                k += 1;
+            } else {
+                return k;
+            }
+        }
+        self.times.partition_point(|&x| x <= t).clamp(1, n - 1)
+    }
+
+    /// Scaled acceleration at time t (m/s²).
+    pub fn at(&self, t: f64) -> f64 {
+        let n = self.times.len();
+        if t < self.times[0] || t > self.times[n - 1] {
+            return 0.0;
+        }
+        let k = self.segment(t);
+        let (t0, t1) = (self.times[k - 1], self.times[k]);
+        let w = (t - t0) / (t1 - t0);
+        self.scale * (self.values[k - 1] + w * (self.values[k] - self.values[k - 1]))
+    }
+
+    /// Sample times (the interpolant's breakpoints).
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    /// The scale factor.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Largest |scaled acceleration|.
+    pub fn peak(&self) -> f64 {
+        self.values.iter().fold(0.0f64, |m, a| m.max(a.abs())) * self.scale.abs()
+    }
+}
+
+/// Base (frame) acceleration z̈(t).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum BaseExcitation {
+    /// No base motion.
+    #[default]
+    None,
+    /// `A sin(Ω t + φ)`.
+    Harmonic {
+        /// A (m/s²).
+        amplitude: f64,
+        /// Ω (rad/s) > 0.
+        frequency: f64,
+        /// φ (rad).
+        phase: f64,
+    },
+    /// A recorded accelerogram.
+    Record(Accelerogram),
+}
+
+impl BaseExcitation {
+    /// z̈(t) (m/s²).
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic {
+                amplitude,
+                frequency,
+                phase,
+            } => amplitude * (frequency * t + phase).sin(),
+            BaseExcitation::Record(r) => r.at(t),
+        }
+    }
+
+    /// The largest |z̈| (m/s²).
+    pub fn peak(&self) -> f64 {
+        match self {
+            BaseExcitation::None => 0.0,
+            BaseExcitation::Harmonic { amplitude, .. } => amplitude.abs(),
+            BaseExcitation::Record(r) => r.peak(),
+        }
+    }
+}
+
+/// A harmonic force `P sin(Ω t + φ)` on one body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HarmonicForce {
+    /// Body index.
+    pub body: usize,
+    /// P (N).
+    pub amplitude: f64,
+    /// Ω (rad/s) > 0.
+    pub frequency: f64,
+    /// φ (rad).
+    pub phase: f64,
+}
