@@ -17,7 +17,7 @@ use vibroimpact::integrate::{IntegrationError, Method};
 use vibroimpact::model_file::LawSpec;
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
-    guess_by_simulation_with, orbit_summary, shoot, shoot_krylov, ShootingOptions,
+    guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, ShootingOptions,
 };
 use vibroimpact::results::{
     branch_document, impact_document, periodic_document, simulation_summary, ImpactMethod,
@@ -351,11 +351,6 @@ pub fn periodic<'py>(
         )));
     }
     let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
-    if krylov && integrator == vibroimpact::simulate::Integrator::Local {
-        return Err(value_error(
-            "integrator = 'local': the dense period map only; Newton-Krylov (krylov=True, the default from 200 bodies) runs the global integrator (pass krylov=False)",
-        ));
-    }
     let need = vibroimpact::periodic::MIN_ARNOLDI.min(2 * m.bodies().len());
     if krylov && arnoldi < need {
         return Err(value_error(format!(
@@ -400,7 +395,7 @@ pub fn periodic<'py>(
             shoot(m, &x0, &opts)
         }
         .map_err(|e| e.to_string())?;
-        let orbit = orbit_summary(m, &sol.initial_state, sol.period, 512, rtol)
+        let orbit = orbit_summary_by(m, &sol.initial_state, (sol.period, 512), rtol, integrator)
             .map_err(|e| e.to_string())?;
         let symmetric_orbit = symmetric
             || vibroimpact::continuation::is_symmetric_orbit(m, &sol.initial_state, &opts);
@@ -420,7 +415,7 @@ pub fn periodic<'py>(
 /// A branch of periodic solutions: the `continue` document (with
 /// `switched_branch` when `switch_at` is given); progress counts points.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None))]
+#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "global"))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_branch<'py>(
     py: Python<'py>,
@@ -434,8 +429,10 @@ pub fn continue_branch<'py>(
     ds_max: f64,
     guess_periods: f64,
     progress: Option<&Bound<'py, PyAny>>,
+    integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     if !(from_.is_finite() && to.is_finite()) || from_ == to {
         return Err(value_error(format!(
             "from_ = {from_}, to = {to}: the range is empty or not finite"
@@ -464,6 +461,7 @@ pub fn continue_branch<'py>(
             shooting: ShootingOptions {
                 subharmonic,
                 interrupt: Some(p.interrupt.clone()),
+                integrator,
                 ..ContinuationOptions::default().shooting
             },
             ..ContinuationOptions::default()

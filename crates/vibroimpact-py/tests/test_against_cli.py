@@ -117,8 +117,29 @@ def test_periodic_local(cli):
     g = vi.periodic(EXAMPLES / "fujita-row.toml", symmetric=True)
     np.testing.assert_allclose(r.initial_state, g.initial_state, rtol=0, atol=1e-10)
     np.testing.assert_allclose(r.floquet_multipliers, g.floquet_multipliers, rtol=0, atol=1e-6)
+    # Newton-Krylov on the local integrator's tape: the same orbit.
+    doc = cli("periodic", EXAMPLES / "fujita-row.toml", "--symmetric", "--krylov", "--integrator", "local")
+    k = vi.periodic(EXAMPLES / "fujita-row.toml", symmetric=True, krylov=True, integrator="local")
+    close(k.initial_state, doc["initial_state"])
+    np.testing.assert_allclose(k.initial_state, g.initial_state, rtol=0, atol=1e-10)
     with pytest.raises(ValueError, match="integrator"):
-        vi.periodic(EXAMPLES / "fujita-row.toml", krylov=True, integrator="local")
+        vi.periodic(EXAMPLES / "fujita-row.toml", integrator="fast")
+
+
+def test_continue_local(cli):
+    # A branch by the local integrator, from both faces; its special points
+    # are the global integrator's to 1e-6 of the parameter.
+    m = EXAMPLES / "fujita-row-n2.toml"
+    args = ("--parameter", "frequency", "--from", "11.115", "--to", "3.705")
+    doc = cli("continue", m, *args, "--integrator", "local")
+    r = vi.continue_(m, "frequency", 11.115, 3.705, integrator="local")
+    g = vi.continue_(m, "frequency", 11.115, 3.705)
+    assert r.stop == doc["stop"] == "ReachedEnd"
+    close(r.column("parameter"), [p["parameter"] for p in doc["points"]])
+    assert [s.label for s in r.special_points] == [s.label for s in g.special_points]
+    np.testing.assert_allclose(
+        r.column("parameter", "special_points"), g.column("parameter", "special_points"), rtol=1e-6
+    )
 
 
 def test_periodic(cli):

@@ -24,7 +24,7 @@
 //! the number of contacts actually closing, and linearly with N.
 
 use crate::contact::{ContactForce, ContactLaw, LawKind};
-use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian};
+use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian, Recorder};
 use crate::model::{BaseExcitation, Model};
 use crate::variational::Variational;
 
@@ -359,6 +359,21 @@ impl ChainDynamics {
         }
     }
 
+    /// [`source`](Self::source) of the bodies `bodies` (ascending) alone,
+    /// into `out` (resized to their interleaved state).
+    pub fn source_of(&self, t: f64, bodies: &[usize], out: &mut Vec<f64>) {
+        let zdd = self.base.at(t);
+        out.clear();
+        for _ in bodies {
+            out.extend([0.0, -zdd]);
+        }
+        for &(body, p, w, phi) in &self.forces {
+            if let Ok(j) = bodies.binary_search(&body) {
+                out[2 * j + 1] += p * (w * t + phi).sin() * self.inv_mass[body];
+            }
+        }
+    }
+
     /// Number of contacts.
     pub fn contacts(&self) -> usize {
         self.contacts.len()
@@ -442,6 +457,20 @@ impl Chain for Variational<ChainDynamics> {
 
     fn chain_mut(&mut self) -> &mut ChainDynamics {
         self.system_mut()
+    }
+}
+
+/// The local integrator's active set: a row with tangent columns, its
+/// Jacobian recorded at every evaluation while a tangent tape is made.
+pub(crate) type SetSystem = Variational<Recorder<ChainDynamics>>;
+
+impl Chain for SetSystem {
+    fn chain(&self) -> &ChainDynamics {
+        self.system().system()
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self.system_mut().system_mut()
     }
 }
 

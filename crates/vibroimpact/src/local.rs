@@ -28,8 +28,9 @@ use std::collections::BinaryHeap;
 
 use super::*;
 use crate::contact::LawKind;
-use crate::dynamics::Chain;
+use crate::dynamics::{Chain, SetSystem};
 use crate::free_motion::FreeMotion;
+use crate::integrate::Recorder;
 use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce};
 use crate::variational::Variational;
 
@@ -41,11 +42,15 @@ mod driver;
 mod extrema;
 #[path = "local_set.rs"]
 mod membership;
+#[path = "local_tape.rs"]
+mod tape;
 
 use activation::{first_step, Activation};
 pub(super) use driver::{run, Tangents};
 use extrema::LocalExtrema;
 use membership::Crossing;
+pub use tape::LocalTape;
+use tape::TapeRecord;
 
 /// Work of the local integrator, beside the integrator's counters.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -97,7 +102,7 @@ struct ActiveSet {
     /// whether its left side is in the set).
     boundary: Vec<usize>,
     /// The set's row, with the tangent columns when they are carried.
-    sys: Variational<ChainDynamics>,
+    sys: SetSystem,
     st: Stepper,
     scan: StepScan,
     /// The set's state at the start of its last step.
@@ -156,6 +161,29 @@ struct Run<'a> {
     /// set's are in its state.
     tangents: Vec<(f64, Vec<f64>)>,
     breakpoints: Vec<f64>,
+    /// The record of the run's linearisation, when a tape is asked for.
+    tape: Option<TapeRecord>,
+    /// Per contact between two bodies that move alike (see
+    /// [`alike`]): their ω² = k/m.
+    alike: Vec<Option<f64>>,
+}
+
+/// ω² of the two bodies of contact `c` if they move alike: each a group
+/// of its own (no coupling), the same k/m > 0 and c/m, and no harmonic
+/// force on either. Then the base drives both alike and their difference
+/// `Δ = u_l − u_r` is a free damped oscillator: its energy
+/// `Δ̇² + ω²Δ²` never grows, so `|Δ| <= sqrt(E)/ω` for all time.
+fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
+    let (l, r) = (c.pair.left()?, c.pair.right()?);
+    let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
+    let forced = |i: usize| model.forces().iter().any(|f| f.body == i);
+    if !single(l) || !single(r) || forced(l) || forced(r) {
+        return None;
+    }
+    let (a, b) = (&model.bodies()[l], &model.bodies()[r]);
+    let w2 = a.stiffness / a.mass;
+    (w2 > 0.0 && w2 == b.stiffness / b.mass && a.damping / a.mass == b.damping / b.mass)
+        .then_some(w2)
 }
 
 /// Group of a contact's side, if a body.
@@ -237,6 +265,18 @@ impl Run<'_> {
     /// at `t` (`state(g)`), as if they moved exactly from there.
     fn bound<'s>(&self, k: usize, t: f64, state: impl Fn(usize) -> &'s [f64]) -> Option<f64> {
         let c = &self.model.contacts()[k];
+        if let (Some(w2), Some(l), Some(r)) = (self.alike[k], c.pair.left(), c.pair.right()) {
+            // Bodies that move alike: the gap's bound for all time.
+            let (xl, xr) = (state(self.free.place(l).0), state(self.free.place(r).0));
+            let (d, dv) = (xl[0] - xr[0], xl[1] - xr[1]);
+            let energy = dv * dv + w2 * d * d;
+            let reach = (energy / w2).sqrt();
+            let size = c.clearance + xl[0].abs() + xr[0].abs();
+            let gap = self.activation[k].gap(energy.sqrt());
+            if reach - c.clearance + 1e-12 * size < gap {
+                return Some(self.opts.t_end);
+            }
+        }
         let remaining = self.opts.t_end - t;
         let sides = [c.pair.left(), c.pair.right()];
         let rate = sides
@@ -423,6 +463,9 @@ impl Run<'_> {
         self.local.set_changes += 1;
         if groups.is_empty() {
             self.impacts = impacts;
+            if let Some(tape) = self.tape.as_mut() {
+                tape.form(t, &[], &[], None, &[]);
+            }
             return Ok(());
         }
         let mut bodies: Vec<usize> = groups
@@ -544,7 +587,8 @@ impl Run<'_> {
             Vec::new(),
         )
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let mut sys = Variational::new(ChainDynamics::new(&sub, false), self.columns);
+        let chain = Recorder::new(ChainDynamics::new(&sub, false), self.tape.is_some());
+        let mut sys = Variational::new(chain, self.columns);
         let trackers = ids
             .iter()
             .enumerate()
@@ -580,6 +624,15 @@ impl Run<'_> {
         }
         let mut st = Stepper::new(self.method, y.len(), int_opts)?;
         st.reset(&mut sys, t, &y)?;
+        if let Some(tape) = self.tape.as_mut() {
+            let rec = sys.system();
+            if rec.time(0) != Some(t) {
+                return Err(IntegrationError::InvalidOptions(
+                    "tangent tape: no record of the set's first point (internal error)".into(),
+                ));
+            }
+            tape.form(t, &groups, &bodies, Some(rec.system()), rec.evaluation(0));
+        }
         let previous = (0..ids.len())
             .map(|kl| contact_end(sys.chain(), kl, st.y(), st.dydt()))
             .collect();

@@ -94,7 +94,7 @@ impl LocalExtrema {
         ids: &[usize],
         bodies: usize,
         st: &Stepper,
-        sys: &Variational<ChainDynamics>,
+        sys: &SetSystem,
     ) -> ExtremaScan {
         let s_on = ids.iter().map(|&k| self.s_on[k]).collect();
         ExtremaScan::new(self.window, bodies, s_on, st, sys.chain())

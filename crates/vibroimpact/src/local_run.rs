@@ -29,6 +29,8 @@ pub(in crate::simulate) struct LocalRun {
     pub extrema: Option<Extrema>,
     /// The tangent columns at the final time, if carried (as given).
     pub tangents: Option<Vec<f64>>,
+    /// The tape of the run's linearisation, if asked for.
+    pub tape: Option<LocalTape>,
     pub sink_stopped: Option<f64>,
 }
 
@@ -90,20 +92,21 @@ impl Run<'_> {
     /// bodies from its dense output (its last step holds `t`), the others
     /// from their exact motion.
     pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
-        if self.extrema.is_some() {
+        // Under a record the reference states move up to the sample
+        // (everything before it has been sampled and checked): else every
+        // sample would propagate the record from the last check. That
+        // changes the trajectory by rounding; under harmonic forcing a
+        // propagation costs the same over any interval, and sampling does
+        // not touch the trajectory at all. (The extrema are scanned before
+        // a reference moves.)
+        let rebase = matches!(self.model.base(), BaseExcitation::Record(_));
+        if rebase && self.extrema.is_some() {
             for g in 0..self.exact.len() {
                 if !self.in_set[g] {
                     self.scan_group_to(g, t);
                 }
             }
         }
-        // Under a record the reference states move up to the sample
-        // (everything before it has been sampled and checked): else every
-        // sample would propagate the record from the last check. That
-        // changes the trajectory by rounding; under harmonic forcing a
-        // propagation costs the same over any interval, and sampling does
-        // not touch the trajectory at all.
-        let rebase = matches!(self.model.base(), BaseExcitation::Record(_));
         let Run {
             free,
             exact,
@@ -165,8 +168,16 @@ impl Run<'_> {
         set.saved.0 = t;
         set.saved.1.clear();
         set.saved.1.extend_from_slice(set.st.y());
+        if self.tape.is_some() {
+            set.sys.system_mut().clear();
+        }
         set.st.step(&mut set.sys, bound)?;
         let t1 = set.st.t();
+        let h = set.st.h_last();
+        let recorded = match self.tape {
+            Some(_) => Some(set.sys.system().accepted_step(t, h, t1)?),
+            None => None,
+        };
         let mut first = self.boundary_crossing(set);
         if let Some(due) = self.due_checks(first.map_or(t1, |f| f.0)) {
             first = Some(due);
@@ -190,6 +201,9 @@ impl Run<'_> {
             *pending = Some((ts, k));
             set.st.limit_next_step(ts - t0);
             return Ok(Stepped::RolledBack);
+        }
+        if let (Some(tape), Some(first)) = (self.tape.as_mut(), recorded) {
+            tape.step(t, h, set.sys.system(), first);
         }
         set.scan.scan(&mut set.st, &mut set.sys);
         if let Some(h) = set.scan.entry_limit(set.st.h_next()) {
@@ -220,12 +234,18 @@ pub(in crate::simulate) fn run(
     method: Method,
     (y0, tangents): (&[f64], Option<Tangents<'_>>),
     breakpoints: Vec<f64>,
+    tape: bool,
     record: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<LocalRun, OptionsError> {
     if opts.energy {
         return Err(OptionsError(
             "the energy audit needs the global integrator (integrator = global)".into(),
         ));
+    }
+    if tape && method != Method::Dop853 {
+        return Err(OptionsError(format!(
+            "a tangent tape replays DOP853's stages; the method here is {method:?}"
+        )));
     }
     let free = FreeMotion::new(model).map_err(|e| OptionsError(e.to_string()))?;
     let n = model.bodies().len();
@@ -317,7 +337,14 @@ pub(in crate::simulate) fn run(
         columns,
         tangents: tangent_refs,
         breakpoints,
+        tape: tape.then(TapeRecord::default),
+        alike: Vec::new(),
     };
+    run.alike = model
+        .contacts()
+        .iter()
+        .map(|c| alike(model, &run.free, c))
+        .collect();
     if let Some(window) = opts.extrema_window {
         let s_on = model
             .contacts()
@@ -337,6 +364,7 @@ pub(in crate::simulate) fn run(
         crawling: None,
         extrema: None,
         tangents: None,
+        tape: None,
         sink_stopped: None,
     };
     let mut sample = vec![0.0; 2 * n];
@@ -482,5 +510,6 @@ pub(in crate::simulate) fn run(
     out.contact_evaluations = run.contact_evaluations;
     out.local = run.local;
     out.extrema = run.extrema.map(LocalExtrema::into_found);
+    out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
     Ok(out)
 }

@@ -30,7 +30,7 @@ use crate::dynamics::{from_interleaved, to_interleaved, ChainDynamics};
 use crate::integrate::{Dop853, IntegrationError, IntegratorOptions, Interrupt, OdeSystem};
 use crate::model::Model;
 use crate::periodic::forcing_period;
-use crate::simulate::{local_tangent_flow, Integrator, SimulationOptions};
+use crate::simulate::{local_flow, Integrator, SimulationOptions};
 use crate::variational::Variational;
 
 /// Batches of the standard error (fewer for windows under 200 periods).
@@ -285,10 +285,10 @@ impl Flow {
             }
             Flow::Local { model, options, k } => {
                 let d = 2 * model.bodies().len();
-                let (y, w, _) = local_tangent_flow(model, options, &z[..d], (&z[d..], *k))
+                let flow = local_flow(model, options, &z[..d], (&z[d..], *k), false)
                     .map_err(|e| LyapunovError::Invalid(e.to_string()))??;
-                z[..d].copy_from_slice(&y);
-                z[d..].copy_from_slice(&w);
+                z[..d].copy_from_slice(&flow.y);
+                z[d..].copy_from_slice(&flow.columns);
             }
         }
         Ok(())

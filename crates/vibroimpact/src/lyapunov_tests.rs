@@ -321,8 +321,12 @@ fn local_exponents_match_independent_values() {
         (g.exponents[0] - l.exponents[0]).abs() < 3.0 * se && l.exponents[0] > 0.3,
         "{g:?} {l:?}"
     );
+    // The sums are time averages of the phase-space contraction (the
+    // contacts' damping along two trajectories that part after a few
+    // periods): estimates with a scatter of their own (measured: 4e-3
+    // apart over 1000 periods).
     let (sg, sl): (f64, f64) = (g.exponents.iter().sum(), l.exponents.iter().sum());
-    assert!((sg - sl).abs() < 1e-3 * sg.abs(), "{sg} vs {sl}");
+    assert!((sg - sl).abs() < 1e-2 * sg.abs(), "{sg} vs {sl}");
 }
 
 /// A law that needs the impact's onset velocity (Lankarani–Nikravesh) is

@@ -648,12 +648,23 @@ impl Model {
             ContactPair::LeftWall { body } => ContactPair::RightWall { body: m(body) },
             ContactPair::RightWall { body } => ContactPair::LeftWall { body: m(body) },
         };
+        let nc = self.contacts.len();
+        let image = |c: &Contact, o: &Contact| {
+            o.pair == mirror_pair(c.pair) && o.clearance == c.clearance && o.law == c.law
+        };
+        // A row lists its contacts in order, so the mirror of contact k is
+        // usually contact nc − 1 − k: tried first (a search of every
+        // contact for every contact is O(nc²), 10⁶ comparisons at N = 1000).
         self.contacts
             .iter()
-            .map(|c| {
-                self.contacts.iter().position(|o| {
-                    o.pair == mirror_pair(c.pair) && o.clearance == c.clearance && o.law == c.law
-                })
+            .enumerate()
+            .map(|(k, c)| {
+                let guess = nc - 1 - k;
+                if image(c, &self.contacts[guess]) {
+                    Some(guess)
+                } else {
+                    self.contacts.iter().position(|o| image(c, o))
+                }
             })
             .collect()
     }

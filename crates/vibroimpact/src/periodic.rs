@@ -34,7 +34,8 @@ use crate::integrate::{
 };
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
-use crate::simulate::{local_tangent_flow, simulate, Integrator, OptionsError, SimulationOptions};
+use crate::simulate::local::LocalTape;
+use crate::simulate::{local_flow, simulate, Integrator, OptionsError, SimulationOptions};
 use crate::variational::Variational;
 
 /// Largest Newton step in the scaled norm (displacement scales).
@@ -85,11 +86,13 @@ pub struct ShootingOptions {
     pub control_monodromy: bool,
     /// Stop request checked at every integration step (see [`Interrupt`]).
     pub interrupt: Option<Interrupt>,
-    /// The dense period map's integrator: global, or local (the state and
-    /// Φ's columns by the exact free motion between contacts, integrated
-    /// only where bodies touch; Φ then enters the step control, as with
-    /// `control_monodromy`). Newton–Krylov and a parameter's column run
-    /// the global integrator.
+    /// The period map's integrator: global, or local (docs/theory.md §10:
+    /// the state by the exact free motion between contacts, integrated
+    /// only where bodies touch). Dense, Φ's columns ride along and enter
+    /// the step control, as with `control_monodromy`; matrix-free, the
+    /// products with Φ and a forcing parameter's column are replayed on
+    /// the run's tape. A parameter beyond the forcing needs the global
+    /// integrator.
     pub integrator: Integrator,
 }
 
@@ -527,7 +530,8 @@ pub fn shoot(
 }
 
 /// `(G(x), DG v)` (the map and a product with its Jacobian) by one
-/// integration of the state with one tangent column, body order.
+/// integration of the state with one tangent column (by the options'
+/// integrator), body order.
 pub(crate) fn map_and_product(
     model: &Model,
     x: &[f64],
@@ -537,11 +541,21 @@ pub(crate) fn map_and_product(
     let n = model.bodies().len();
     let d = 2 * n;
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-    let mut var = Variational::new(ChainDynamics::new(model, false), 1);
-    let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
-    let int_opts = opts.integrator_options(MAX_STEPS, Some(d));
-    let (z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
-    let (image, product) = (from_interleaved(&z, n), from_interleaved(&z[d..], n));
+    let (y, w) = if opts.integrator == Integrator::Local {
+        let sim_opts = map::local_options(opts, t, MAX_STEPS);
+        let column = to_interleaved(v);
+        let flow = local_flow(model, &sim_opts, &to_interleaved(x), (&column, 1), false)
+            .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+        (flow.y, flow.columns)
+    } else {
+        let mut var = Variational::new(ChainDynamics::new(model, false), 1);
+        let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
+        let int_opts = opts.integrator_options(MAX_STEPS, Some(d));
+        let (mut z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+        let w = z.split_off(d);
+        (z, w)
+    };
+    let (image, product) = (from_interleaved(&y, n), from_interleaved(&w, n));
     if opts.symmetric {
         return Ok((mirror(&image), mirror(&product)));
     }
@@ -696,6 +710,17 @@ pub fn orbit_summary(
     samples: usize,
     rtol: f64,
 ) -> Result<OrbitSummary, PeriodicError> {
+    orbit_summary_by(model, state, (period, samples), rtol, Integrator::Global)
+}
+
+/// [`orbit_summary`] by the given integrator (`(period, samples)`).
+pub fn orbit_summary_by(
+    model: &Model,
+    state: &[f64],
+    (period, samples): (f64, usize),
+    rtol: f64,
+    integrator: Integrator,
+) -> Result<OrbitSummary, PeriodicError> {
     let n = model.bodies().len();
     // One period; a second only when an impact is still under way at its
     // end (its rebound and peak lie beyond).
@@ -707,6 +732,7 @@ pub fn orbit_summary(
             output_step: Some(period / samples.max(10) as f64),
             start: Some(state.to_vec()),
             extrema_window: Some((0.0, period)),
+            integrator,
             ..SimulationOptions::default()
         };
         simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))
@@ -765,7 +791,7 @@ mod map;
 
 pub(crate) use krylov::{arnoldi_matrix, gmres};
 pub use map::period_map;
-pub(crate) use map::{period_map_with, MapTangent};
+pub(crate) use map::{map_image, period_map_with, MapTangent};
 
 #[cfg(test)]
 #[path = "periodic_tests.rs"]

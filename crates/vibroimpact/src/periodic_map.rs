@@ -34,9 +34,36 @@ pub(crate) struct MapDerivatives {
 /// integration of the state with the column, without integrating.
 #[derive(Clone, Debug)]
 pub(crate) struct MapTangent {
-    pub(super) tape: TangentTape<ChainDynamics>,
+    pub(super) tape: Tape,
     n: usize,
     symmetric: bool,
+}
+
+/// The record of the integration that computed a map: the global
+/// integrator's steps, or the local integrator's sets and exact motion.
+#[derive(Clone, Debug)]
+pub(crate) enum Tape {
+    Global(Box<TangentTape<ChainDynamics>>),
+    Local(Box<LocalTape>),
+}
+
+impl Tape {
+    /// `Φ v`, interleaved.
+    fn apply(&self, v: &[f64]) -> Vec<f64> {
+        match self {
+            Tape::Global(tape) => tape.apply(v),
+            Tape::Local(tape) => tape.apply(v),
+        }
+    }
+
+    /// Contact Jacobian entries recorded.
+    #[cfg(test)]
+    pub(crate) fn entries(&self) -> usize {
+        match self {
+            Tape::Global(tape) => tape.entries(),
+            Tape::Local(tape) => tape.entries(),
+        }
+    }
 }
 
 impl MapTangent {
@@ -97,6 +124,9 @@ pub(crate) fn period_map_with(
     }
     let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
     let t = map_time(model, opts).map_err(invalid)?;
+    if opts.integrator == Integrator::Local {
+        return local_map(model, x, opts, (shifted, dense), t, max_steps);
+    }
     if let Some((model_p, dp)) = shifted {
         // The state's steps alone choose the steps, with or without the
         // column: the column can then be replayed on the tape.
@@ -104,9 +134,6 @@ pub(crate) fn period_map_with(
             let t_p = map_time(model_p, opts).map_err(invalid)?;
             return forced_map(model, x, opts, (model_p, dp, t_p), t, max_steps);
         }
-    }
-    if dense && shifted.is_none() && opts.integrator == Integrator::Local {
-        return local_map(model, x, opts, t);
     }
     let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
     let columns = if dense { d } else { 0 };
@@ -130,6 +157,7 @@ pub(crate) fn period_map_with(
         let (z, stats, tape) =
             integrate_recorded(&mut var, Variational::system_mut, 0.0, &z0, t, &int_opts)?;
         let symmetric = opts.symmetric;
+        let tape = Tape::Global(Box::new(tape));
         (z, stats, Some(MapTangent { tape, n, symmetric }))
     };
     let image = from_interleaved(&z, n);
@@ -148,6 +176,38 @@ pub(crate) fn period_map_with(
         steps: stats.steps,
         tangent,
     })
+}
+
+/// The shooting map's image alone (body order) in at most `max_steps`
+/// steps of the options' integrator, and the steps taken.
+pub(crate) fn map_image(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    max_steps: u64,
+) -> Result<(Vec<f64>, u64), IntegrationError> {
+    let n = model.bodies().len();
+    let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+    let y0 = to_interleaved(x);
+    let (y, stats) = if opts.integrator == Integrator::Local {
+        let sim_opts = local_options(opts, t, max_steps);
+        let flow = local_flow(model, &sim_opts, &y0, (&[], 0), false)
+            .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+        (flow.y, flow.stats)
+    } else {
+        let mut sys = ChainDynamics::new(model, false);
+        let int_opts = opts.integrator_options(max_steps, None);
+        integrate_to(&mut sys, 0.0, &y0, t, &int_opts)?
+    };
+    let image = from_interleaved(&y, n);
+    Ok((
+        if opts.symmetric {
+            mirror(&image)
+        } else {
+            image
+        },
+        stats.steps,
+    ))
 }
 
 /// The shooting map from the flow's image (body order) and Φ's `k`
@@ -178,36 +238,86 @@ pub(super) fn shooting_map(
     }
 }
 
-/// The dense period map by the local integrator: the state and the
-/// identity's columns carried over the map time `t` (docs/theory.md §10).
-pub(super) fn local_map(
-    model: &Model,
-    x: &[f64],
-    opts: &ShootingOptions,
-    t: f64,
-) -> Result<MapDerivatives, IntegrationError> {
-    let n = model.bodies().len();
-    let d = 2 * n;
-    let mut identity = vec![0.0; d * d];
-    for c in 0..d {
-        identity[c * d + c] = 1.0;
-    }
-    let sim_opts = SimulationOptions {
+/// The local integrator's options for a map over `t`: the shooting
+/// tolerances, at most `max_steps` steps, the stop request.
+pub(super) fn local_options(opts: &ShootingOptions, t: f64, max_steps: u64) -> SimulationOptions {
+    SimulationOptions {
         t_end: t,
         rtol: opts.rtol,
         atol: opts.rtol * opts.displacement_scale,
-        max_steps: MAX_STEPS,
+        max_steps,
         interrupt: opts.interrupt.clone(),
         integrator: Integrator::Local,
         ..SimulationOptions::default()
+    }
+}
+
+/// The shooting map over `t` by the local integrator (docs/theory.md §10):
+/// dense, Φ's columns carried by the exact free motion and in the active
+/// set (where they enter the step control, as with `control_monodromy`);
+/// otherwise the run records its tape for products with Φ. With `shifted =
+/// (model at p + dp, dp)` for a parameter of the forcing alone, the
+/// parameter's column `∂P/∂p = s(T) + f(T, y(T)) dT/dp` is replayed on the
+/// tape.
+fn local_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    (shifted, dense): (Option<(&Model, f64)>, bool),
+    t: f64,
+    max_steps: u64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let invalid = |e: String| IntegrationError::InvalidOptions(e);
+    if let Some((model_p, _)) = shifted {
+        if !model.differs_only_in_forcing(model_p) {
+            return Err(invalid(
+                "the local integrator continues in a parameter of the forcing (frequency, \
+                 amplitude) only; use the global integrator for this parameter"
+                    .into(),
+            ));
+        }
+    }
+    let k = if dense { d } else { 0 };
+    let mut identity = vec![0.0; k * k];
+    for c in 0..k {
+        identity[c * d + c] = 1.0;
+    }
+    let sim_opts = local_options(opts, t, max_steps);
+    let taped = !dense || shifted.is_some();
+    let flow = local_flow(model, &sim_opts, &to_interleaved(x), (&identity, k), taped)
+        .map_err(|e| invalid(e.to_string()))??;
+    let dp_column = match (shifted, &flow.tape) {
+        (Some((model_p, dp)), Some(tape)) => {
+            let t_p = map_time(model_p, opts).map_err(|e| invalid(e.to_string()))?;
+            let s = tape
+                .parameter_column(model, model_p, dp)
+                .map_err(|e| invalid(e.to_string()))?;
+            let mut f = vec![0.0; d];
+            ChainDynamics::new(model, false).rhs(t, &flow.y, &mut f);
+            let dt_dp = (t_p - t) / dp;
+            let column: Vec<f64> = s.iter().zip(&f).map(|(s, f)| s + f * dt_dp).collect();
+            let column = from_interleaved(&column, n);
+            Some(if opts.symmetric {
+                mirror(&column)
+            } else {
+                column
+            })
+        }
+        _ => None,
     };
-    let (y, phi, stats) = local_tangent_flow(model, &sim_opts, &to_interleaved(x), (&identity, d))
-        .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+    let symmetric = opts.symmetric;
+    let image = from_interleaved(&flow.y, n);
     Ok(MapDerivatives {
-        map: shooting_map(from_interleaved(&y, n), &phi, d, n, opts.symmetric),
-        dp_column: None,
-        steps: stats.steps,
-        tangent: None,
+        map: shooting_map(image, &flow.columns, k, n, symmetric),
+        dp_column,
+        steps: flow.stats.steps,
+        tangent: flow.tape.filter(|_| !dense).map(|tape| MapTangent {
+            tape: Tape::Local(Box::new(tape)),
+            n,
+            symmetric,
+        }),
     })
 }
 
@@ -264,6 +374,10 @@ pub(super) fn forced_map(
         },
         dp_column: Some(column),
         steps: stats.steps,
-        tangent: Some(MapTangent { tape, n, symmetric }),
+        tangent: Some(MapTangent {
+            tape: Tape::Global(Box::new(tape)),
+            n,
+            symmetric,
+        }),
     })
 }

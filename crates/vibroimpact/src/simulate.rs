@@ -640,9 +640,15 @@ fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> 
     }
 }
 
-/// An interleaved state, tangent columns (each an interleaved state
-/// vector, one after the other) and the integrator's work.
-pub(crate) type StateAndColumns = (Vec<f64>, Vec<f64>, Stats);
+/// What [`local_flow`] returns: the final interleaved state, the tangent
+/// columns (each an interleaved state vector, one after the other), the
+/// tape of the run's linearisation if asked for, and the integrator's work.
+pub(crate) struct LocalFlow {
+    pub y: Vec<f64>,
+    pub columns: Vec<f64>,
+    pub tape: Option<local::LocalTape>,
+    pub stats: Stats,
+}
 
 /// A record's sample times inside `(0, t_end)`: the steps end there.
 fn breakpoints(model: &Model, t_end: f64) -> Vec<f64> {
@@ -661,14 +667,16 @@ fn breakpoints(model: &Model, t_end: f64) -> Vec<f64> {
 /// state `y0` at 0 to `opts.t_end`, `k` tangent vectors (`columns`: each an
 /// interleaved state vector, one after the other) carried by the
 /// variational equations in the active set and by the exact homogeneous
-/// motion elsewhere (docs/theory.md §10). Returns the final interleaved
-/// state and columns, or where the run failed.
-pub(crate) fn local_tangent_flow(
+/// motion elsewhere, and with `tape` the record of the run's linearisation
+/// for products `Φ v` and a forcing parameter's column without integrating
+/// again (docs/theory.md §10). Returns the flow, or where the run failed.
+pub(crate) fn local_flow(
     model: &Model,
     opts: &SimulationOptions,
     y0: &[f64],
     (columns, k): (&[f64], usize),
-) -> Result<Result<StateAndColumns, IntegrationError>, OptionsError> {
+    tape: bool,
+) -> Result<Result<LocalFlow, IntegrationError>, OptionsError> {
     check_options(opts)?;
     let method = effective_method(model, opts)?;
     let tangents = local::Tangents {
@@ -681,11 +689,17 @@ pub(crate) fn local_tangent_flow(
         method,
         (y0, Some(tangents)),
         breakpoints(model, opts.t_end),
+        tape,
         &mut |_, _| true,
     )?;
     Ok(match run.error {
         Some(e) => Err(e),
-        None => Ok((run.y, run.tangents.unwrap_or_default(), run.stats)),
+        None => Ok(LocalFlow {
+            y: run.y,
+            columns: run.tangents.unwrap_or_default(),
+            tape: run.tape,
+            stats: run.stats,
+        }),
     })
 }
 
@@ -698,7 +712,7 @@ fn simulate_local(
     breakpoints: Vec<f64>,
     sink: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<Simulation, OptionsError> {
-    let run = local::run(model, opts, method, (y0, None), breakpoints, sink)?;
+    let run = local::run(model, opts, method, (y0, None), breakpoints, false, sink)?;
     let n = model.bodies().len();
     let mut impacts = run.impacts;
     by_start(&mut impacts);

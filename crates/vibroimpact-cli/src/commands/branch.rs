@@ -13,7 +13,7 @@ use vibroimpact::model::Model;
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
-    guess_by_simulation, guess_by_simulation_with, orbit_summary, shoot, shoot_krylov,
+    guess_by_simulation, guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov,
     OrbitSummary, PeriodicSolution, ShootingOptions,
 };
 
@@ -57,9 +57,9 @@ pub struct PeriodicArgs {
     /// a mirror-symmetric model and an odd --subharmonic.
     #[arg(long)]
     symmetric: bool,
-    /// Integrator of the dense period map: `local` carries the state and
-    /// the monodromy matrix by the exact motion between contacts
-    /// (Newton–Krylov runs the global one).
+    /// Integrator of the period map: `local` carries the state (and the
+    /// monodromy matrix, or the record its products replay) by the exact
+    /// motion between contacts.
     #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
     integrator: IntegratorName,
     /// Output format.
@@ -149,18 +149,19 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     }
     let arnoldi = args.linear.krylov(model.bodies().len());
     let krylov = arnoldi.is_some();
-    if krylov && args.integrator == IntegratorName::Local {
-        return Err(CliError::new(
-            "--integrator local: the dense period map only; Newton–Krylov (--krylov, the default from 200 bodies) runs the global integrator (pass --dense for the local one)",
-        ));
-    }
     let sol = if let Some(arnoldi) = arnoldi {
         shoot_krylov(&model, &guess, &opts, arnoldi)
     } else {
         shoot(&model, &guess, &opts)
     }
     .map_err(|e| stopped(&e))?;
-    let orbit = orbit_summary(&model, &sol.initial_state, sol.period, 512, args.rtol)?;
+    let orbit = orbit_summary_by(
+        &model,
+        &sol.initial_state,
+        (sol.period, 512),
+        args.rtol,
+        opts.integrator,
+    )?;
     let symmetric_orbit = args.symmetric
         || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts);
     let doc = periodic_document(
@@ -330,6 +331,11 @@ pub struct ContinueArgs {
     guess_periods: f64,
     #[command(flatten)]
     linear: LinearAlgebra,
+    /// Integrator of the period maps: `local` moves bodies out of contact
+    /// exactly and integrates only those in touch (for a parameter of the
+    /// forcing: frequency, amplitude).
+    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    integrator: IntegratorName,
     /// Output folder: branch.csv, branch_special_points.json, branch.json and
     /// the response figure branch_response.svg/.png (with --switch-at the
     /// same for switched_branch).
@@ -502,6 +508,7 @@ fn curves_from_file(
     let shooting = ShootingOptions {
         subharmonic,
         interrupt: Some(interrupt.clone()),
+        integrator: args.integrator.integrator(),
         ..ContinuationOptions::default().shooting
     };
     let bodies = pm.model_at(args.range.from)?.bodies().len();
@@ -567,6 +574,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         shooting: ShootingOptions {
             subharmonic: args.subharmonic,
             interrupt: Some(interrupt.clone()),
+            integrator: args.integrator.integrator(),
             ..ContinuationOptions::default().shooting
         },
         ..ContinuationOptions::default()

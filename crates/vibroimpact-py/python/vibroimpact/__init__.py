@@ -479,8 +479,9 @@ def periodic(
     earlier result with ``initial_state``. ``krylov``: matrix-free
     Newton-Krylov with Arnoldi multipliers (default from 200 bodies on).
     ``symmetric``: shoot on the half map of a mirror-symmetric row.
-    ``integrator="local"``: the dense period map and its monodromy matrix
-    by the exact motion between contacts (not with ``krylov``).
+    ``integrator="local"``: the period map by the exact motion between
+    contacts (its monodromy matrix, or with ``krylov`` the record that its
+    products replay).
 
     Returns ``converged``, ``method``, ``period``, ``subharmonic``,
     ``initial_state``, ``residual_history``, ``floquet_multipliers`` ([re,
@@ -540,6 +541,7 @@ def continue_(
     ds_max: float = 0.05,
     guess_periods: float = 200.0,
     progress: Progress = None,
+    integrator: str = "global",
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -548,6 +550,9 @@ def continue_(
     ("row.clearance", "body.2.mass"). ``switch_at``: a special point's
     label (e.g. "BP1", "PD1") whose crossing or period-doubled branch is
     continued too (``switched_branch``). ``progress(points, max_points)``.
+    ``integrator="local"``: the period maps by the exact motion between
+    contacts, integrating only the bodies in touch (a parameter of the
+    forcing: "frequency", "amplitude").
 
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop``,
     ``contacts``, ``points`` (each with ``parameter``, ``max_displacement``,
@@ -573,6 +578,7 @@ def continue_(
         _real(ds_max, "ds_max", positive=True),
         _real(guess_periods, "guess_periods", positive=True),
         _progress(progress),
+        _method(integrator, ("global", "local"), "integrator"),
     )
     r = Result(d)
     problem = None

@@ -63,7 +63,7 @@ def periodic(
 def continue_branch(
     model: Model, parameter: str, from_: float, to: float, subharmonic: int,
     switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
-    progress: Progress = None,
+    progress: Progress = None, integrator: str = "global",
 ) -> dict[str, Any]: ...
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,

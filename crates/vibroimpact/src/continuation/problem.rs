@@ -9,11 +9,10 @@ use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
 use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
-use crate::integrate::integrate_to;
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
-    forcing_period, map_multipliers, map_time, mirror, multipliers_of_map, orbit_summary,
+    forcing_period, map_image, map_multipliers, multipliers_of_map, orbit_summary_by,
     period_map_with, MapTangent, ShootingOptions, MAX_STEPS,
 };
 
@@ -296,19 +295,7 @@ fn period_image_within(
     opts: &ShootingOptions,
     max_steps: u64,
 ) -> Option<(Vec<f64>, u64)> {
-    let n = model.bodies().len();
-    let t = map_time(model, opts).ok()?;
-    let mut sys = crate::dynamics::ChainDynamics::new(model, false);
-    let y0 = crate::dynamics::to_interleaved(x);
-    let int_opts = opts.integrator_options(max_steps, None);
-    let (y, stats) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts).ok()?;
-    let image = crate::dynamics::from_interleaved(&y, n);
-    let image = if opts.symmetric {
-        mirror(&image)
-    } else {
-        image
-    };
-    Some((image, stats.steps))
+    map_image(model, x, opts, max_steps).ok()
 }
 
 /// A point in full detail (for test functions and output).
@@ -419,12 +406,12 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
         let period =
             forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
         let span = if symmetric { 0.5 * period } else { period };
-        let orbit = orbit_summary(
+        let orbit = orbit_summary_by(
             &model,
             &e.point.state,
-            span,
-            self.opts.orbit_samples,
+            (span, self.opts.orbit_samples),
             self.opts.shooting.rtol,
+            self.opts.shooting.integrator,
         )
         .ok()?;
         let mut impacts = orbit.impacts_per_period();

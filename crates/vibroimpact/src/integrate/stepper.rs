@@ -176,6 +176,11 @@ impl Stepper {
         active!(self, d => d.dydt())
     }
 
+    /// Size of the last accepted step (before rounding of its end time).
+    pub fn h_last(&self) -> f64 {
+        active!(self, d => d.h_last())
+    }
+
     /// Step size proposed for the next step.
     pub fn h_next(&self) -> f64 {
         active!(self, d => d.h_next())

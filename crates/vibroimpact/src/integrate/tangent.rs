@@ -26,6 +26,9 @@ use super::dop853_tableau::{A, B, C, N_STAGES};
 use super::explicit::combine;
 use super::{BandMatrix, Dop853, IntegrationError, IntegratorOptions, OdeSystem, Stats};
 
+/// The stages of a DOP853 step: the records of one replayed step.
+pub const STAGES: usize = N_STAGES;
+
 /// A system whose Jacobian `∂f/∂y` depends on the state alone and can be
 /// recorded compactly at a state and applied to vectors later.
 pub trait RecordedJacobian: OdeSystem {
@@ -72,16 +75,88 @@ impl<S: RecordedJacobian> Recorder<S> {
         &self.sys
     }
 
-    fn clear(&mut self) {
+    /// The wrapped system, mutably.
+    pub fn system_mut(&mut self) -> &mut S {
+        &mut self.sys
+    }
+
+    /// Whether evaluations are recorded.
+    pub fn recording(&self) -> bool {
+        self.on
+    }
+
+    /// Forgets the evaluations recorded so far.
+    pub fn clear(&mut self) {
         self.times.clear();
         self.offsets.truncate(1);
         self.entries.clear();
     }
 
+    /// Time of evaluation `i` since the last [`clear`](Self::clear).
+    pub fn time(&self, i: usize) -> Option<f64> {
+        self.times.get(i).copied()
+    }
+
     /// Evaluation `i`'s entries.
-    fn evaluation(&self, i: usize) -> &[S::Entry] {
+    pub fn evaluation(&self, i: usize) -> &[S::Entry] {
         &self.entries[self.offsets[i]..self.offsets[i + 1]]
     }
+
+    /// The index of the first of the `N_STAGES` evaluations of an accepted
+    /// DOP853 step of size `h` from `t` to `t1` (stages 1..11 at
+    /// `t + c_s h`, then `f` at `t1`): the last ones recorded, after any
+    /// rejected attempt. Fails if the record does not match the stages (an
+    /// internal error).
+    pub fn accepted_step(&self, t: f64, h: f64, t1: f64) -> Result<usize, IntegrationError> {
+        let n = self.times.len();
+        if n < N_STAGES {
+            return Err(tape_mismatch("fewer evaluations than stages"));
+        }
+        let first = n - N_STAGES;
+        let times = C[1..N_STAGES].iter().map(|c| t + c * h).chain([t1]);
+        if self.times[first..].iter().zip(times).any(|(a, b)| *a != b) {
+            return Err(tape_mismatch(
+                "an evaluation off the accepted step's stages",
+            ));
+        }
+        Ok(first)
+    }
+}
+
+fn tape_mismatch(what: &str) -> IntegrationError {
+    IntegrationError::InvalidOptions(format!("tangent tape: {what} (internal error)"))
+}
+
+/// Work space of [`replay_step`].
+#[derive(Clone, Debug, Default)]
+pub struct ReplayScratch {
+    w_new: Vec<f64>,
+    w_stage: Vec<f64>,
+    k: Vec<f64>,
+}
+
+/// One DOP853 step of size `h` from `t` of a linear recurrence (module
+/// docs): `K_s = stage(s, t + c_s h, W_s)` for the stages `s = 0..11`,
+/// then `w ← w + h Σ_s b_s K_s`, in place.
+pub fn replay_step(
+    w: &mut Vec<f64>,
+    t: f64,
+    h: f64,
+    scratch: &mut ReplayScratch,
+    mut stage: impl FnMut(usize, f64, &[f64], &mut [f64]),
+) {
+    let d = w.len();
+    let ReplayScratch { w_new, w_stage, k } = scratch;
+    w_new.resize(d, 0.0);
+    w_stage.resize(d, 0.0);
+    k.resize(N_STAGES * d, 0.0);
+    stage(0, t, w, &mut k[..d]);
+    for s in 1..N_STAGES {
+        combine(w, &k[..s * d], A[s], h, w_stage);
+        stage(s, t + C[s] * h, w_stage, &mut k[s * d..(s + 1) * d]);
+    }
+    combine(w, k, &B, h, w_new);
+    std::mem::swap(w, w_new);
 }
 
 impl<S: RecordedJacobian> OdeSystem for Recorder<S> {
@@ -175,24 +250,14 @@ impl<S: RecordedJacobian> TangentTape<S> {
     /// The recurrence with `add(t, k)` adding the source at stage time `t`
     /// to the stage derivative `k` (a no-op for `Φ v`, inlined away).
     fn replay(&self, v: &[f64], mut add: impl FnMut(f64, &mut [f64])) -> Vec<f64> {
-        let d = self.dim;
         let mut w = v.to_vec();
-        let mut w_new = vec![0.0; d];
-        let mut w_stage = vec![0.0; d];
-        let mut k = vec![0.0; N_STAGES * d];
+        let mut scratch = ReplayScratch::default();
         for (step, (&h, &t)) in self.steps.iter().zip(&self.starts).enumerate() {
             let first = N_STAGES * step;
-            self.sys.apply_recorded(self.record(first), &w, &mut k[..d]);
-            add(t, &mut k[..d]);
-            for s in 1..N_STAGES {
-                combine(&w, &k[..s * d], A[s], h, &mut w_stage);
-                let k_s = &mut k[s * d..(s + 1) * d];
-                self.sys
-                    .apply_recorded(self.record(first + s), &w_stage, k_s);
-                add(t + C[s] * h, k_s);
-            }
-            combine(&w, &k, &B, h, &mut w_new);
-            std::mem::swap(&mut w, &mut w_new);
+            replay_step(&mut w, t, h, &mut scratch, |s, ts, ws, ks| {
+                self.sys.apply_recorded(self.record(first + s), ws, ks);
+                add(ts, ks);
+            });
         }
         w
     }
@@ -221,15 +286,12 @@ where
             "integrate_recorded needs a finite t_end > t0, got t0 = {t0}, t_end = {t_end}"
         )));
     }
-    let mismatch = |what: &str| {
-        IntegrationError::InvalidOptions(format!("tangent tape: {what} (internal error)"))
-    };
     let mut solver = Dop853::new(sys.dim(), opts.clone())?;
     recorder(sys).clear();
     solver.reset(sys, t0, y0)?;
     let rec = recorder(sys);
-    if rec.times.first() != Some(&t0) {
-        return Err(mismatch("no record of f(t0, y0)"));
+    if rec.time(0) != Some(t0) {
+        return Err(tape_mismatch("no record of f(t0, y0)"));
     }
     let mut tape = TangentTape {
         sys: rec.sys.clone(),
@@ -246,19 +308,8 @@ where
         solver.step(sys, t_end)?;
         let h = solver.h_last();
         let rec = recorder(sys);
-        // The accepted attempt's 11 new stages and f at its end are the
-        // last 12 evaluations (rejected attempts come before them).
-        let n = rec.times.len();
-        if n < N_STAGES {
-            return Err(mismatch("fewer evaluations than stages"));
-        }
-        let first = n - N_STAGES;
-        // Stages 1..11 at t + c_s h, then the end: f(t + h, y_new).
-        let times = C[1..N_STAGES].iter().map(|c| t + c * h).chain([solver.t()]);
-        for (i, expected) in (first..n).zip(times) {
-            if rec.times[i] != expected {
-                return Err(mismatch("an evaluation off the accepted step's stages"));
-            }
+        let first = rec.accepted_step(t, h, solver.t())?;
+        for i in first..first + N_STAGES {
             tape.entries.extend_from_slice(rec.evaluation(i));
             tape.offsets.push(tape.entries.len());
         }
