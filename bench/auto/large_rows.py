@@ -2,10 +2,12 @@
 """Matrix-free continuation on long rows (issue 11, item 3): R2 with N bodies.
 
     python3 bench/auto/large_rows.py [--n 64,100,1000] [--budget 180]
-        [--out bench/auto/results/large-rows-DATE]
+        [--integrators global,local] [--out bench/auto/results/large-rows-DATE]
 
-Three tasks, all with `vibroimpact continue ROW --parameter frequency
---start homotopy` (ROW = examples/fujita-row-n2.toml with `count = N`):
+Four tasks, all with `vibroimpact continue ROW --parameter frequency`
+(ROW = examples/fujita-row-n2.toml with `count = N`), each by every
+integrator of --integrators (`--integrator global|local`, docs/theory.md
+§10):
 
 1. The window 0.5 -> 0.537 omega0 (the piece of the symmetric branch every
    N follows before its fold at 0.538, bench/auto/README.md "Any N") for
@@ -14,7 +16,11 @@ Three tasks, all with `vibroimpact continue ROW --parameter frequency
    multiplier at both ends, peak memory. Matrix-free and dense must give
    the same special points to 1e-6 omega0 and the same largest multiplier
    to 1e-6 (checked, printed).
-2. N = 100 from 0.5 omega0 towards 1.5 (`--to 11.115`), stopped by SIGINT
+2. N = 100 from 0.5 omega0 towards 1.5, the first 800 points (`--krylov
+   --max-points 800`, the default start): wall time of the whole command
+   per point; the integrators' special points matched by kind over the
+   parameter range both covered (the largest and median distance).
+3. N = 100 from 0.5 omega0 towards 1.5 (`--to 11.115`), stopped by SIGINT
    after --budget seconds (Ctrl-C keeps the points): how far the branch
    gets in that time, its folds and special points.
 3. N = 100 at 0.9 omega0: the branch in the forcing amplitude from 0 (the
@@ -125,47 +131,80 @@ def summary(doc):
     }
 
 
-def window(n, linear, workdir):
+def window(n, linear, integrator, workdir):
     cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
            "--from", str(0.5 * OMEGA0), "--to", str(0.537 * OMEGA0), "--start", "homotopy",
-           f"--{linear}", "--format", "json"]
+           f"--{linear}", "--integrator", integrator, "--format", "json"]
     seconds, rc, out, err, mb, _ = run(cmd)
     if rc != 0:
-        return {"n": n, "linear": linear, "error": err.strip()[-500:], "command": shown(cmd)}
-    return {"n": n, "linear": linear, "seconds": seconds, "peak_mb": mb,
-            "command": shown(cmd), **summary(json.loads(out))}
+        return {"n": n, "linear": linear, "integrator": integrator,
+                "error": err.strip()[-500:], "command": shown(cmd)}
+    return {"n": n, "linear": linear, "integrator": integrator, "seconds": seconds,
+            "peak_mb": mb, "command": shown(cmd), **summary(json.loads(out))}
 
 
-def budgeted(n, budget, workdir):
+def points800(n, integrator, workdir):
+    """Task 2: the first 800 points from 0.5 omega0, whole command."""
+    cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
+           "--from", str(0.5 * OMEGA0), "--to", str(1.5 * OMEGA0), "--krylov",
+           "--max-points", "800", "--integrator", integrator, "--format", "json"]
+    seconds, rc, out, err, mb, _ = run(cmd)
+    if rc != 0:
+        return {"n": n, "integrator": integrator, "error": err.strip()[-500:],
+                "command": shown(cmd)}
+    doc = summary(json.loads(out))
+    return {"n": n, "integrator": integrator, "seconds": seconds,
+            "seconds_per_point": seconds / doc["points"], "peak_mb": mb,
+            "command": shown(cmd), **doc}
+
+
+def matched(a, b):
+    """Special points of `a` matched by kind to the nearest of `b`, over
+    the parameter range both runs covered: the distances (omega0)."""
+    top = min(a["omega_range"][1], b["omega_range"][1])
+    gaps = []
+    for s in a["special_points"]:
+        if s["omega_over_omega0"] > top:
+            continue
+        near = [abs(s["omega_over_omega0"] - t["omega_over_omega0"])
+                for t in b["special_points"] if t["kind"] == s["kind"]]
+        gaps.append(min(near, default=float("inf")))
+    gaps.sort()
+    return {"compared": len(gaps), "median_gap_omega0": gaps[len(gaps) // 2] if gaps else None,
+            "largest_gaps_omega0": gaps[-3:]}
+
+
+def budgeted(n, budget, integrator, workdir):
     cmd = [EXE, "continue", row_file(n, workdir), "--parameter", "frequency",
            "--from", str(0.5 * OMEGA0), "--to", str(1.5 * OMEGA0), "--start", "homotopy",
-           "--krylov", "--format", "json"]
+           "--krylov", "--integrator", integrator, "--format", "json"]
     seconds, rc, out, err, mb, interrupted = run(cmd, budget)
     if not out.strip():
         return {"n": n, "error": err.strip()[-500:], "returncode": rc}
     doc = json.loads(out)
     # A stop request can end the run inside a correction, which then reads
     # as a corrector that does not converge: `interrupted` says it was ours.
-    return {"n": n, "budget_seconds": budget, "seconds": seconds, "returncode": rc,
-            "interrupted_by_budget": interrupted,
+    return {"n": n, "integrator": integrator, "budget_seconds": budget, "seconds": seconds,
+            "returncode": rc, "interrupted_by_budget": interrupted,
             "peak_mb": mb, "command": shown(cmd),
             "folds": [s["omega_over_omega0"] for s in summary(doc)["special_points"]
                       if s["kind"] == "fold"],
             **summary(doc)}
 
 
-def amplitude_branch(n, budget, workdir):
-    """Task 3: the branch in the forcing amplitude at 0.9 omega0."""
+def amplitude_branch(n, budget, integrator, workdir):
+    """Task 4: the branch in the forcing amplitude at 0.9 omega0."""
     cmd = [EXE, "continue", row_file(n, workdir, 0.9 * OMEGA0), "--parameter", "amplitude",
            "--from", "0", "--to", "0.05", "--krylov", "--max-points", "100000",
-           "--format", "json"]
+           "--integrator", integrator, "--format", "json"]
     seconds, rc, out, err, mb, interrupted = run(cmd, budget)
     if not out.strip():
         return {"n": n, "error": err.strip()[-500:], "returncode": rc, "command": shown(cmd)}
     doc = json.loads(out)
     points = doc["points"]
     amplitudes = [p["parameter"] for p in points]
-    return {"n": n, "omega_over_omega0": 0.9, "budget_seconds": budget, "seconds": seconds,
+    return {"n": n, "integrator": integrator, "omega_over_omega0": 0.9,
+            "budget_seconds": budget, "seconds": seconds,
             "returncode": rc, "interrupted_by_budget": interrupted, "peak_mb": mb,
             "command": shown(cmd), "points": len(points), "stop": doc["stop"],
             "amplitude_range": [min(amplitudes), max(amplitudes)],
@@ -193,63 +232,94 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", default="64,100,1000")
     ap.add_argument("--budget", type=float, default=180.0)
+    ap.add_argument("--integrators", default="global,local")
     ap.add_argument("--out", default=os.path.join(
         HERE, "results", f"large-rows-{datetime.date.today().isoformat()}"))
     args = ap.parse_args()
     if not os.path.exists(EXE):
         sys.exit(f"{EXE} missing: run `cargo build --release` first")
     ns = [int(x) for x in args.n.split(",")]
+    integrators = args.integrators.split(",")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                             capture_output=True, text=True).stdout.strip()
-    result = {"commit": commit, "load_before": loadavg(), "windows": [], "check": None}
+    result = {"commit": commit, "load_before": loadavg(), "windows": [], "checks": [],
+              "points800": [], "budgeted": [], "amplitude_branch": []}
     with tempfile.TemporaryDirectory() as workdir:
         smallest = min(ns)
-        dense = window(smallest, "dense", workdir)
-        result["windows"].append(dense)
-        for n in sorted(ns):
-            result["windows"].append(window(n, "krylov", workdir))
-            print(json.dumps(result["windows"][-1])[:300], file=sys.stderr)
-        krylov0 = result["windows"][1]
-        if "error" not in dense and "error" not in krylov0:
-            result["check"] = compare(dense, krylov0)
-        result["budgeted"] = budgeted(100, args.budget, workdir)
-        result["amplitude_branch"] = amplitude_branch(100, args.budget, workdir)
+        for integrator in integrators:
+            dense = window(smallest, "dense", integrator, workdir)
+            result["windows"].append(dense)
+            first = None
+            for n in sorted(ns):
+                result["windows"].append(window(n, "krylov", integrator, workdir))
+                first = first or result["windows"][-1]
+                print(json.dumps(result["windows"][-1])[:300], file=sys.stderr)
+            if "error" not in dense and "error" not in first:
+                result["checks"].append({"integrator": integrator, **compare(dense, first)})
+        for integrator in integrators:
+            result["points800"].append(points800(100, integrator, workdir))
+            print(json.dumps(result["points800"][-1])[:300], file=sys.stderr)
+        done = [r for r in result["points800"] if "error" not in r]
+        if len(done) == 2:
+            result["points800_match"] = matched(done[0], done[1])
+        if args.budget > 0:
+            for integrator in integrators:
+                result["budgeted"].append(budgeted(100, args.budget, integrator, workdir))
+                result["amplitude_branch"].append(
+                    amplitude_branch(100, args.budget, integrator, workdir))
     result["load_after"] = loadavg()
-    lines = ["| N | linear algebra | window 0.5 -> 0.537 (s) | points | special points (omega/omega0) "
-             "| largest multiplier at 0.537 | peak MB |", "|---|---|---|---|---|---|---|"]
+    lines = ["| N | linear algebra | integrator | window 0.5 -> 0.537 (s) | points "
+             "| special points (omega/omega0) | largest multiplier at 0.537 | peak MB |",
+             "|---|---|---|---|---|---|---|---|"]
     for w in result["windows"]:
         if "error" in w:
-            lines.append(f"| {w['n']} | {w['linear']} | error: {w['error'][:80]} | | | | |")
+            lines.append(f"| {w['n']} | {w['linear']} | {w['integrator']} "
+                         f"| error: {w['error'][:80]} | | | | |")
             continue
         sp = ", ".join(f"{s['label']} {s['omega_over_omega0']:.7f}" for s in w["special_points"])
         mb = f"{w['peak_mb']:.0f}"
-        lines.append(f"| {w['n']} | {w['linear']} | {w['seconds']:.2f} | {w['points']} | {sp} "
-                     f"| {w['largest_multiplier_ends'][1]:.6f} | {mb} |")
-    if result["check"]:
-        c = result["check"]
-        lines.append(f"\nN = {min(ns)} dense vs matrix-free: special points {c['special_point_gap_omega0']:.1e} "
-                     f"omega0 apart, largest multiplier {c['largest_multiplier_rel_diff']:.1e} relative: "
+        lines.append(f"| {w['n']} | {w['linear']} | {w['integrator']} | {w['seconds']:.2f} "
+                     f"| {w['points']} | {sp} | {w['largest_multiplier_ends'][1]:.6f} | {mb} |")
+    for c in result["checks"]:
+        lines.append(f"\nN = {min(ns)} dense vs matrix-free ({c['integrator']}): special points "
+                     f"{c['special_point_gap_omega0']:.1e} omega0 apart, largest multiplier "
+                     f"{c['largest_multiplier_rel_diff']:.1e} relative: "
                      f"{'PASS' if c['passed'] else 'FAIL'}")
-    b = result["budgeted"]
-    if "error" not in b:
+    lines.append("\nN = 100 from 0.5 omega0, the first 800 points (whole command):")
+    for r in result["points800"]:
+        if "error" in r:
+            lines.append(f"- {r['integrator']}: error {r['error'][:200]}")
+            continue
+        lines.append(f"- {r['integrator']}: {r['seconds']:.1f} s, {r['seconds_per_point']:.4f} s "
+                     f"a point, omega {r['omega_range'][0]:.4f}-{r['omega_range'][1]:.4f} (last "
+                     f"{r['last_omega']:.4f}), {len(r['special_points'])} special points, peak "
+                     f"{r['peak_mb']:.0f} MB")
+    if "points800_match" in result:
+        m = result["points800_match"]
+        lines.append(f"- special points of the first matched by kind in the second, over the range "
+                     f"both covered: {m['compared']}, median {m['median_gap_omega0']:.1e} omega0, "
+                     "largest " + ", ".join(f"{g:.1e}" for g in m["largest_gaps_omega0"]))
+    for b in result["budgeted"]:
+        if "error" in b:
+            lines.append(f"\nN = 100 budgeted run: error {b['error']}")
+            continue
         how = "stopped by SIGINT" if b["interrupted_by_budget"] else "ended"
-        lines.append(f"\nN = 100 from 0.5 omega0 towards 1.5, {how} after {b['seconds']:.0f} s: "
-                     f"{b['points']} points, omega {b['omega_range'][0]:.4f}-{b['omega_range'][1]:.4f} "
-                     f"(last {b['last_omega']:.4f}), {len(b['special_points'])} special points, folds "
+        lines.append(f"\nN = 100 from 0.5 omega0 towards 1.5 ({b['integrator']}), {how} after "
+                     f"{b['seconds']:.0f} s: {b['points']} points, omega {b['omega_range'][0]:.4f}-"
+                     f"{b['omega_range'][1]:.4f} (last {b['last_omega']:.4f}), "
+                     f"{len(b['special_points'])} special points, folds "
                      + ", ".join(f"{f:.7f}" for f in b["folds"]))
-    else:
-        lines.append(f"\nN = 100 budgeted run: error {b['error']}")
-    a = result["amplitude_branch"]
-    if "error" not in a:
+    for a in result["amplitude_branch"]:
+        if "error" in a:
+            lines.append(f"\nN = 100 amplitude branch: error {a['error']}")
+            continue
         how = "stopped by SIGINT" if a["interrupted_by_budget"] else "ended"
-        lines.append(f"\nN = 100 at 0.9 omega0, forcing amplitude from 0 towards 0.05 m/s^2, {how} "
-                     f"after {a['seconds']:.0f} s: {a['points']} points, amplitude "
+        lines.append(f"\nN = 100 at 0.9 omega0 ({a['integrator']}), forcing amplitude from 0 towards "
+                     f"0.05 m/s^2, {how} after {a['seconds']:.0f} s: {a['points']} points, amplitude "
                      f"{a['amplitude_range'][0]:.4f}-{a['amplitude_range'][1]:.4f} (last "
                      f"{a['last_amplitude']:.4f}), {a['unstable_points']} unstable, largest "
                      f"multiplier {a['largest_multiplier']:.1f}, {len(a['folds'])} folds "
                      + ", ".join(f"{f:.5f}" for f in a["folds"]))
-    else:
-        lines.append(f"\nN = 100 amplitude branch: error {a['error']}")
     text = "\n".join(lines)
     print(text)
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
