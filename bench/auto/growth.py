@@ -2,8 +2,8 @@
 """Cost growth with N: vibroimpact continuation against AUTO-07p on R2 with N
 bodies (N = 2, 4, 8, 16), the same task in one run.
 
-    python3 bench/auto/growth.py [--n 2,4,8,16] [--repeats 2] [--ntst 200,400]
-        [--timeout 900] [--out bench/auto/results/growth-DATE]
+    python3 bench/auto/growth.py [--n 2,4,8,16,32] [--repeats 2] [--ntst 200,400]
+        [--timeout 900] [--integrators global,local] [--out bench/auto/results/growth-DATE]
 
 The task, the same for every N and both tools: from the rest state (exact at
 zero forcing) a homotopy in the forcing amplitude at 0.5 omega0, then the
@@ -14,8 +14,10 @@ turns back (bench/auto/README.md, "Any N"), so both tools cover the same
 piece of the same branch at every N.
 
 - ours: `target/release/vibroimpact continue ROW.toml --parameter frequency
-  --from 3.705 --to 3.97917 --start homotopy --format json` (ROW = the N = 2
-  example with `count = N`), best wall time of --repeats, whole process.
+  --from 3.705 --to 3.97917 --start homotopy --integrator I --format json`
+  (ROW = the N = 2 example with `count = N`) for each integrator I of
+  --integrators, best wall time of --repeats, whole process; the table's
+  "ours" is the faster integrator.
 - AUTO-07p: run_auto.py --n N (rn.exe) with BP detection off (in-run
   detection leaves the symmetric branch at N = 4, README), DS 0.005, DSMAX
   0.05, EPSL/EPSU 1e-6, EPSS 1e-5, NCOL 4, OMP_NUM_THREADS=1, for each NTST
@@ -52,15 +54,17 @@ def loadavg():
         return [float(x) for x in f.read().split()[:3]]
 
 
-def ours(n, repeats, workdir):
-    """Best wall time of our continuation on the window, and its output."""
+def ours(n, repeats, workdir, integrator):
+    """Best wall time of our continuation on the window by `integrator`,
+    and its output."""
     src = open(os.path.join(ROOT, "examples", "fujita-row-n2.toml")).read()
     model = os.path.join(workdir, f"row-n{n}.toml")
     with open(model, "w") as f:
         f.write(src.replace("count = 2", f"count = {n}", 1))
     exe = os.path.join(ROOT, "target", "release", "vibroimpact")
     cmd = [exe, "continue", model, "--parameter", "frequency", "--from", str(0.5 * OMEGA0),
-           "--to", str(W_END * OMEGA0), "--start", "homotopy", "--format", "json"]
+           "--to", str(W_END * OMEGA0), "--start", "homotopy", "--integrator", integrator,
+           "--format", "json"]
     times, out = [], None
     for _ in range(repeats):
         t0 = time.perf_counter()
@@ -70,6 +74,7 @@ def ours(n, repeats, workdir):
             return {"error": p.stderr.strip(), "command": " ".join(cmd)}
         out = json.loads(p.stdout)
     return {
+        "integrator": integrator,
         "seconds": min(times),
         "seconds_all": times,
         "points": len(out["points"]),
@@ -151,13 +156,18 @@ def main(argv):
     ap.add_argument("--ntst", default="200,400")
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=900)
+    ap.add_argument("--integrators", default="global,local")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "growth-" + time.strftime("%Y-%m-%d")))
     args = ap.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
         for n in [int(x) for x in args.n.split(",")]:
             row = {"n": n, "load_before": loadavg()}
-            row["ours"] = ours(n, args.repeats, workdir)
+            row["ours_by_integrator"] = [ours(n, args.repeats, workdir, i)
+                                         for i in args.integrators.split(",")]
+            timed = [o for o in row["ours_by_integrator"] if "seconds" in o]
+            row["ours"] = (min(timed, key=lambda o: o["seconds"]) if timed
+                           else row["ours_by_integrator"][0])
             row["auto"] = [auto(n, int(t), args.repeats, args.timeout, workdir)
                            for t in args.ntst.split(",")]
             passing = [a for a in row["auto"] if a["passed"]]
@@ -167,12 +177,13 @@ def main(argv):
             row["load_after"] = loadavg()
             rows.append(row)
             print(json.dumps({k: row.get(k) for k in ("n", "ratio")}), file=sys.stderr, flush=True)
-    lines = ["| N | ours (s) | our points | AUTO best (s) | AUTO NTST | AUTO steps | AUTO / ours | load |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| N | ours (s) | integrator | our points | AUTO best (s) | AUTO NTST | AUTO steps "
+             "| AUTO / ours | load |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         o, a = r["ours"], r.get("auto_best") or {}
-        lines.append("| %d | %s | %s | %s | %s | %s | %s | %.1f |" % (
+        lines.append("| %d | %s | %s | %s | %s | %s | %s | %s | %.1f |" % (
             r["n"], "%.3f" % o["seconds"] if "seconds" in o else "error",
+            o.get("integrator", "-"),
             o.get("points", "-"), "%.2f" % a["seconds"] if a else "none passed",
             a.get("ntst", "-"), a.get("steps", "-"),
             "%.1f" % r["ratio"] if "ratio" in r else "-", r["load_before"][0]))

@@ -38,6 +38,8 @@ use crate::variational::Variational;
 mod activation;
 #[path = "local_run.rs"]
 mod driver;
+#[path = "local_energy.rs"]
+mod energy;
 #[path = "local_extrema.rs"]
 mod extrema;
 #[path = "local_set.rs"]
@@ -47,6 +49,7 @@ mod tape;
 
 use activation::{first_step, Activation};
 pub(super) use driver::{run, Tangents};
+use energy::LocalEnergy;
 use extrema::LocalExtrema;
 use membership::Crossing;
 pub use tape::LocalTape;
@@ -166,6 +169,8 @@ struct Run<'a> {
     /// Per contact between two bodies that move alike (see
     /// [`alike`]): their ω² = k/m.
     alike: Vec<Option<f64>>,
+    /// The energy audit's sums, when asked for.
+    energy: Option<LocalEnergy>,
 }
 
 /// ω² of the two bodies of contact `c` if they move alike: each a group
@@ -239,7 +244,7 @@ impl Run<'_> {
             if self.defer {
                 self.deferred.push((g, t, x));
             } else {
-                self.scan_group_to(g, t);
+                self.before_move(g, t);
                 self.exact[g] = (t, x);
             }
         }
@@ -254,7 +259,7 @@ impl Run<'_> {
             if tc > t {
                 later.push((g, tc, x));
             } else if !self.in_set[g] && tc > self.exact[g].0 {
-                self.scan_group_to(g, tc);
+                self.before_move(g, tc);
                 self.exact[g] = (tc, x);
             }
         }
@@ -397,7 +402,7 @@ impl Run<'_> {
         // joined) lapse.
         for &g in &groups {
             if !self.in_set[g] {
-                self.scan_group_to(g, t);
+                self.before_move(g, t);
                 self.deferred.retain(|(h, ..)| *h != g);
             }
         }
@@ -415,6 +420,7 @@ impl Run<'_> {
             }
             self.contact_evaluations += old.sys.chain().contact_evaluations();
             old_y = old.st.y().to_vec();
+            self.energy_of_set(&old_y, old.bodies.len());
             for &i in &old.bodies {
                 self.slot[i] = None;
             }
@@ -444,6 +450,7 @@ impl Run<'_> {
                         .collect();
                     self.exact[g] = (t, x);
                     self.extrema_from(g, t);
+                    self.energy_from(g, t);
                     let b2 = old_bodies.len() * 2;
                     let mut w = Vec::new();
                     for c in 0..self.columns {
@@ -490,6 +497,11 @@ impl Run<'_> {
             };
             y[2 * j] = u;
             y[2 * j + 1] = v;
+        }
+        // The audit's quadratures after the state (from 0: the old set's
+        // are in the sums).
+        if self.energy.is_some() {
+            y.extend([0.0; 3]);
         }
         // Tangent columns after the state: rows from the old set, or
         // from the joining groups' exact homogeneous motion.
@@ -587,7 +599,8 @@ impl Run<'_> {
             Vec::new(),
         )
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let chain = Recorder::new(ChainDynamics::new(&sub, false), self.tape.is_some());
+        let energy = self.energy.is_some();
+        let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
         let mut sys = Variational::new(chain, self.columns);
         let trackers = ids
             .iter()
@@ -605,6 +618,7 @@ impl Run<'_> {
             atol: self.opts.atol,
             max_steps: self.opts.max_steps,
             h_init: h_prev,
+            error_components: energy.then_some(2 * bodies.len()),
             interrupt: self.opts.interrupt.clone(),
             ..IntegratorOptions::default()
         };
@@ -699,6 +713,14 @@ impl Run<'_> {
 }
 
 impl Run<'_> {
+    /// Before group `g`'s reference state moves to `t` (or it joins the
+    /// set there): its exact motion up to `t` is scanned for extrema and
+    /// enters the energy audit.
+    fn before_move(&mut self, g: usize, t: f64) {
+        self.scan_group_to(g, t);
+        self.energy_to(g, t);
+    }
+
     /// Adds the set's integrator work since its last absorption to the
     /// run's counters (and to each of its bodies).
     fn absorb(&mut self, set: &mut ActiveSet) {

@@ -31,6 +31,9 @@ pub(in crate::simulate) struct LocalRun {
     pub tangents: Option<Vec<f64>>,
     /// The tape of the run's linearisation, if asked for.
     pub tape: Option<LocalTape>,
+    /// The energy audit's sums (excitation work, damper and contact
+    /// dissipation), if asked for.
+    pub energy: Option<[f64; 3]>,
     pub sink_stopped: Option<f64>,
 }
 
@@ -100,10 +103,10 @@ impl Run<'_> {
         // not touch the trajectory at all. (The extrema are scanned before
         // a reference moves.)
         let rebase = matches!(self.model.base(), BaseExcitation::Record(_));
-        if rebase && self.extrema.is_some() {
+        if rebase && (self.extrema.is_some() || self.energy.is_some()) {
             for g in 0..self.exact.len() {
                 if !self.in_set[g] {
-                    self.scan_group_to(g, t);
+                    self.before_move(g, t);
                 }
             }
         }
@@ -237,9 +240,9 @@ pub(in crate::simulate) fn run(
     tape: bool,
     record: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<LocalRun, OptionsError> {
-    if opts.energy {
+    if opts.energy && (tape || tangents.is_some_and(|w| w.columns > 0)) {
         return Err(OptionsError(
-            "the energy audit needs the global integrator (integrator = global)".into(),
+            "the energy audit carries no tangent columns or tape".into(),
         ));
     }
     if tape && method != Method::Dop853 {
@@ -339,7 +342,11 @@ pub(in crate::simulate) fn run(
         breakpoints,
         tape: tape.then(TapeRecord::default),
         alike: Vec::new(),
+        energy: None,
     };
+    if opts.energy {
+        run.energy = Some(LocalEnergy::new(model, &run.free));
+    }
     run.alike = model
         .contacts()
         .iter()
@@ -365,6 +372,7 @@ pub(in crate::simulate) fn run(
         extrema: None,
         tangents: None,
         tape: None,
+        energy: None,
         sink_stopped: None,
     };
     let mut sample = vec![0.0; 2 * n];
@@ -495,7 +503,13 @@ pub(in crate::simulate) fn run(
     if columns > 0 {
         out.tangents = Some(run.tangents_at(t_final));
     }
+    for g in 0..run.exact.len() {
+        if !run.in_set[g] {
+            run.energy_to(g, t_final);
+        }
+    }
     if let Some(mut set) = run.set.take() {
+        run.energy_of_set(set.st.y(), set.bodies.len());
         run.absorb(&mut set);
         if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
             ex.merge(&set, scan);
@@ -510,6 +524,7 @@ pub(in crate::simulate) fn run(
     out.contact_evaluations = run.contact_evaluations;
     out.local = run.local;
     out.extrema = run.extrema.map(LocalExtrema::into_found);
+    out.energy = run.energy.map(|e| e.sums);
     out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
     Ok(out)
 }

@@ -745,7 +745,18 @@ fn simulate_local(
         impacts,
         stats: run.stats,
         contact_evaluations: run.contact_evaluations,
-        energy: None,
+        energy: run
+            .energy
+            .map(|[input_work, damping_dissipation, contact_dissipation]| {
+                let sys = ChainDynamics::new(model, false);
+                EnergyBalance {
+                    initial: sys.mechanical_energy(y0),
+                    mechanical: sys.mechanical_energy(&run.y),
+                    input_work,
+                    damping_dissipation,
+                    contact_dissipation,
+                }
+            }),
         error,
         extrema: run.extrema,
         local: Some(run.local),
