@@ -503,9 +503,11 @@ pub(in crate::simulate) fn run(
     if columns > 0 {
         out.tangents = Some(run.tangents_at(t_final));
     }
+    // The exact motion since each group's last reference state: its
+    // extrema and its part of the energy audit.
     for g in 0..run.exact.len() {
         if !run.in_set[g] {
-            run.energy_to(g, t_final);
+            run.before_move(g, t_final);
         }
     }
     if let Some(mut set) = run.set.take() {
