@@ -377,8 +377,14 @@ pub fn periodic<'py>(
         let interrupt = Some(p.interrupt.clone());
         let x0 = match guess {
             Some(g) => g,
-            None => guess_by_simulation_with(m, guess_periods, rtol.max(1e-9), interrupt.clone())
-                .map_err(|e| format!("guess by simulation: {e}"))?,
+            None => guess_by_simulation_with(
+                m,
+                guess_periods,
+                rtol.max(1e-9),
+                interrupt.clone(),
+                integrator,
+            )
+            .map_err(|e| format!("guess by simulation: {e}"))?,
         };
         let opts = ShootingOptions {
             subharmonic,
@@ -466,9 +472,14 @@ pub fn continue_branch<'py>(
             },
             ..ContinuationOptions::default()
         };
-        let guess =
-            guess_by_simulation_with(&start_job, guess_periods, 1e-9, Some(p.interrupt.clone()))
-                .map_err(|e| format!("start guess: {e}"))?;
+        let guess = guess_by_simulation_with(
+            &start_job,
+            guess_periods,
+            1e-9,
+            Some(p.interrupt.clone()),
+            integrator,
+        )
+        .map_err(|e| format!("start guess: {e}"))?;
         let on_point = |_: &vibroimpact::continuation::BranchPoint| {
             p.tick();
             !p.interrupt.requested()

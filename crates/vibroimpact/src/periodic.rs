@@ -629,15 +629,17 @@ pub fn guess_by_simulation(
     periods: f64,
     rtol: f64,
 ) -> Result<Vec<f64>, PeriodicError> {
-    guess_by_simulation_with(model, periods, rtol, None)
+    guess_by_simulation_with(model, periods, rtol, None, Integrator::Global)
 }
 
-/// [`guess_by_simulation`] that stops when `interrupt` is requested.
+/// [`guess_by_simulation`] by `integrator` that stops when `interrupt` is
+/// requested.
 pub fn guess_by_simulation_with(
     model: &Model,
     periods: f64,
     rtol: f64,
     interrupt: Option<Interrupt>,
+    integrator: Integrator,
 ) -> Result<Vec<f64>, PeriodicError> {
     let t = forcing_period(model)?;
     let opts = SimulationOptions {
@@ -645,6 +647,7 @@ pub fn guess_by_simulation_with(
         rtol,
         atol: rtol * 1e-4,
         interrupt,
+        integrator,
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;

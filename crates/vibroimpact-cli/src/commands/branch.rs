@@ -124,6 +124,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
             args.guess_periods,
             args.rtol.max(1e-9),
             Some(interrupt.clone()),
+            args.integrator.integrator(),
         )
         .map_err(|e| stopped(&format!("guess by simulation: {e}")))?,
         "homotopy" => {
@@ -592,6 +593,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
             args.guess_periods,
             1e-9,
             Some(interrupt.clone()),
+            opts.shooting.integrator,
         )
         .map_err(|e| CliError::new(format!("start guess: {e}")))?,
     };

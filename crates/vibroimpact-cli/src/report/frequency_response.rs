@@ -14,7 +14,7 @@ use vibroimpact::integrate::Interrupt;
 use vibroimpact::model::Model;
 use vibroimpact::periodic::{guess_by_simulation_with, orbit_summary, ShootingOptions};
 use vibroimpact::reference;
-use vibroimpact::simulate::{simulate, SimulationOptions};
+use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
 
 use super::{html_escape, html_table, DataFile, Report};
 use crate::error::CliError;
@@ -59,7 +59,8 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
     let mut rows = Vec::new();
     for n in [2usize, 3] {
         let start = row(n, 1.5 * w0).map_err(CliError::new)?;
-        let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))?;
+        let guess =
+            guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()), Integrator::Global)?;
         let defaults = ContinuationOptions::default();
         let opts = ContinuationOptions {
             max_points: 900,
