@@ -229,6 +229,45 @@ impl Run<'_> {
     }
 }
 
+/// The set's pace after its `steps`-th kept step, as the global
+/// integrator judges its own: an explicit method whose step stability
+/// limits so far that the rest of the run would pass the step limit stops
+/// with [`IntegrationError::Stiff`]; any method that crawls (projected
+/// steps above `CRAWL_FACTOR` times the limit) with
+/// [`IntegrationError::NoProgress`].
+fn pace(
+    set: &ActiveSet,
+    method: Method,
+    opts: &SimulationOptions,
+    steps: u64,
+) -> Option<IntegrationError> {
+    let (t, limit) = (set.st.t(), opts.max_steps);
+    if matches!(method, Method::Dop853 | Method::Dopri5) && set.st.stiffness_detected() {
+        let h = t - set.st.t_prev();
+        let projected = (opts.t_end - t) / h;
+        if projected > limit.saturating_sub(steps) as f64 {
+            return Some(IntegrationError::Stiff {
+                t,
+                h,
+                projected,
+                limit,
+            });
+        }
+    }
+    if steps % PROGRESS_CHECK == 0 {
+        let projected = steps as f64 * opts.t_end / t;
+        if projected > CRAWL_FACTOR * limit as f64 {
+            return Some(IntegrationError::NoProgress {
+                t,
+                steps,
+                projected,
+                limit,
+            });
+        }
+    }
+    None
+}
+
 /// Simulates `model` over `[0, opts.t_end]` by the local integrator,
 /// handing samples to `record` as [`simulate_streaming`] does.
 pub(in crate::simulate) fn run(
@@ -471,6 +510,14 @@ pub(in crate::simulate) fn run(
                 steps += 1;
                 if steps > opts.max_steps {
                     out.error = Some(IntegrationError::TooManySteps { t, steps });
+                    break;
+                }
+                if let Some(e) = run
+                    .set
+                    .as_ref()
+                    .and_then(|set| pace(set, method, opts, steps))
+                {
+                    out.error = Some(e);
                     break;
                 }
                 run.scan_set_step();
