@@ -182,13 +182,14 @@ pub fn lyapunov_spectrum(
             }
         }
         Integrator::Local => {
-            // Each period is a run of its own: an impact under way at a
-            // period's end would restart with the rate of that instant.
+            // Each period is a run of its own (an impact under way at a
+            // period's end would restart with the rate of that instant);
+            // a law that needs the onset velocity is refused by the flow.
             if let Some(k) = (0..model.contacts().len())
                 .find(|&k| model.contacts()[k].law.needs_impact_velocity())
             {
                 return Err(LyapunovError::Invalid(format!(
-                    "contact {}: its law needs the impact's onset velocity, which the local integrator's period-by-period runs do not carry; use the global integrator",
+                    "contact {}: its law needs the impact's onset velocity, which the local integrator's tangents do not carry yet; use the global integrator",
                     model.contact_name(k)
                 )));
             }

@@ -544,6 +544,40 @@ fn local_tape_products_match_dense_columns() {
             }
         }
     }
+    // A law that needs the impact's onset velocity: refused by name.
+    let law = crate::contact::ContactLaw::lankarani_nikravesh(
+        1e7,
+        1.5,
+        0.8,
+        1e-3,
+        crate::contact::ForceForm::Published,
+    )
+    .unwrap();
+    let contacts: Vec<_> = model
+        .contacts()
+        .iter()
+        .map(|c| crate::model::Contact { law, ..c.clone() })
+        .collect();
+    let ln = Model::new(
+        model.bodies().to_vec(),
+        vec![],
+        contacts,
+        model.base().clone(),
+        vec![],
+        vec![],
+        vec![],
+    )
+    .unwrap();
+    for dense in [false, true] {
+        let err = period_map_with(&ln, &guess, &local(false), None, dense, MAX_STEPS)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            err.contains("onset velocity") && err.contains("wall|p1"),
+            "{err}"
+        );
+    }
     let clearance = r2(4, 1e-3 + 1e-9, omega);
     let err = period_map_with(
         &model,
