@@ -130,6 +130,9 @@ pub fn lyapunov_spectrum(
     opts: &LyapunovOptions,
 ) -> Result<LyapunovSpectrum, LyapunovError> {
     let invalid = |m: String| Err(LyapunovError::Invalid(m));
+    if let Err(m) = crate::periodic::refuse_onset_laws(model) {
+        return invalid(m);
+    }
     let n = model.bodies().len();
     let d = 2 * n;
     if x0.len() != d {
@@ -182,17 +185,7 @@ pub fn lyapunov_spectrum(
             }
         }
         Integrator::Local => {
-            // Each period is a run of its own (an impact under way at a
-            // period's end would restart with the rate of that instant);
-            // a law that needs the onset velocity is refused by the flow.
-            if let Some(k) = (0..model.contacts().len())
-                .find(|&k| model.contacts()[k].law.needs_impact_velocity())
-            {
-                return Err(LyapunovError::Invalid(format!(
-                    "contact {}: its law needs the impact's onset velocity, which the local integrator's tangents do not carry yet; use the global integrator",
-                    model.contact_name(k)
-                )));
-            }
+            // Each period is a run of its own.
             Flow::Local {
                 model: model.delayed(t0).ok_or_else(|| {
                     LyapunovError::Invalid("a recorded excitation has no forcing period".into())

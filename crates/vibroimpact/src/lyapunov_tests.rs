@@ -330,9 +330,9 @@ fn local_exponents_match_independent_values() {
 }
 
 /// A law that needs the impact's onset velocity (Lankarani–Nikravesh) is
-/// refused by the local integrator's period-by-period runs, by contact.
+/// refused by either integrator's exponents, by contact.
 #[test]
-fn local_exponents_refuse_onset_velocity_laws() {
+fn exponents_refuse_onset_velocity_laws() {
     use crate::contact::{ContactLaw, ForceForm};
     use crate::simulate::Integrator;
     let model = r2(2, 1e-3, 0.9 * W0).unwrap();
@@ -352,11 +352,13 @@ fn local_exponents_refuse_onset_velocity_laws() {
         vec![],
     )
     .unwrap();
-    let opts = LyapunovOptions {
-        integrator: Integrator::Local,
-        ..LyapunovOptions::default()
-    };
-    let e = lyapunov_spectrum(&model, &[0.0; 4], 0.0, &opts).unwrap_err();
-    assert!(e.to_string().contains("onset velocity"), "{e}");
-    assert!(e.to_string().contains(&model.contact_name(0)), "{e}");
+    for integrator in [Integrator::Global, Integrator::Local] {
+        let opts = LyapunovOptions {
+            integrator,
+            ..LyapunovOptions::default()
+        };
+        let e = lyapunov_spectrum(&model, &[0.0; 4], 0.0, &opts).unwrap_err();
+        assert!(e.to_string().contains("onset velocity"), "{e}");
+        assert!(e.to_string().contains(&model.contact_name(0)), "{e}");
+    }
 }

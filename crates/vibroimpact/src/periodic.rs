@@ -247,6 +247,7 @@ pub fn mirror(x: &[f64]) -> Vec<f64> {
 /// Time over which the shooting map integrates: nT, or nT/2 for the
 /// symmetric half map. Checks that the half map applies to `model`.
 pub(crate) fn map_time(model: &Model, opts: &ShootingOptions) -> Result<f64, PeriodicError> {
+    refuse_onset_laws(model).map_err(PeriodicError::Options)?;
     let n = opts.subharmonic.max(1);
     let period = forcing_period(model)? * f64::from(n);
     if !opts.symmetric {
@@ -259,6 +260,23 @@ pub(crate) fn map_time(model: &Model, opts: &ShootingOptions) -> Result<f64, Per
         )));
     }
     Ok(0.5 * period)
+}
+
+/// A contact law whose force depends on the impact's onset velocity
+/// (Lankarani–Nikravesh) is refused by the period maps, their derivatives
+/// and the Lyapunov exponents, by contact name: the global integrator's
+/// maps held the onset velocity at the law's floor (a shot orbit of R2
+/// N = 2 came back 3.2 mm off in a simulated period), the local
+/// integrator's track it but their derivatives miss its dependence on the
+/// state (Newton stalls at 0.04); docs/decisions.md D24.
+pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
+    match (0..model.contacts().len()).find(|&k| model.contacts()[k].law.needs_impact_velocity()) {
+        Some(k) => Err(format!(
+            "contact {}: its law needs the impact's onset velocity, whose dependence on the state the period map and its derivatives do not carry yet: no shooting, continuation or Lyapunov exponents with it (simulations, sweeps and pounding runs are fine)",
+            model.contact_name(k)
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Floquet multipliers from the Jacobian of the shooting map: its

@@ -678,20 +678,6 @@ pub(crate) fn local_flow(
     tape: bool,
 ) -> Result<Result<LocalFlow, IntegrationError>, OptionsError> {
     check_options(opts)?;
-    // The set's tangents through a law whose force depends on the impact's
-    // onset velocity disagree with the global integrator's (R2 N = 2, a
-    // Lankarani–Nikravesh law: Floquet exponents -0.02 … -1.7 against
-    // -1.22 … -8.3; docs/decisions.md D24): refused until understood.
-    if k > 0 || tape {
-        if let Some(c) =
-            (0..model.contacts().len()).find(|&c| model.contacts()[c].law.needs_impact_velocity())
-        {
-            return Err(OptionsError(format!(
-                "contact {}: its law needs the impact's onset velocity, and the local integrator's tangents through it are not trusted yet; use the global integrator",
-                model.contact_name(c)
-            )));
-        }
-    }
     let method = effective_method(model, opts)?;
     let tangents = local::Tangents {
         values: columns,
