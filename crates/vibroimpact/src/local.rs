@@ -278,6 +278,10 @@ impl Run<'_> {
             let reach = (energy / w2).sqrt();
             let size = c.clearance + xl[0].abs() + xr[0].abs();
             let gap = self.activation[k].gap(energy.sqrt());
+            // Safe to the end while both move exactly: no check is queued,
+            // so every path that changes either body's motion must lapse
+            // or reschedule this contact (`join` does, and `release`
+            // schedules the contacts it frees).
             if reach - c.clearance + 1e-12 * size < gap {
                 return Some(self.opts.t_end);
             }

@@ -284,6 +284,18 @@ pub(in crate::simulate) fn run(
             "the energy audit carries no tangent columns or tape".into(),
         ));
     }
+    // (Period maps refuse such laws before a tape is asked for; the tape
+    // would miss the onset velocity's dependence on the state.)
+    if tape
+        && model
+            .contacts()
+            .iter()
+            .any(|c| c.law.needs_impact_velocity())
+    {
+        return Err(OptionsError(
+            "a tangent tape cannot follow a law that needs the impact's onset velocity".into(),
+        ));
+    }
     if tape && method != Method::Dop853 {
         return Err(OptionsError(format!(
             "a tangent tape replays DOP853's stages; the method here is {method:?}"
