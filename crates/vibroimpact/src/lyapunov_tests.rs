@@ -335,23 +335,8 @@ fn local_exponents_match_independent_values() {
 fn exponents_refuse_onset_velocity_laws() {
     use crate::contact::{ContactLaw, ForceForm};
     use crate::simulate::Integrator;
-    let model = r2(2, 1e-3, 0.9 * W0).unwrap();
     let law = ContactLaw::lankarani_nikravesh(1e7, 1.5, 0.8, 1e-3, ForceForm::Published).unwrap();
-    let contacts: Vec<_> = model
-        .contacts()
-        .iter()
-        .map(|c| crate::model::Contact { law, ..c.clone() })
-        .collect();
-    let model = Model::new(
-        model.bodies().to_vec(),
-        vec![],
-        contacts,
-        model.base().clone(),
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
+    let model = r2(2, 1e-3, 0.9 * W0).unwrap().with_contact_law(law);
     for integrator in [Integrator::Global, Integrator::Local] {
         let opts = LyapunovOptions {
             integrator,

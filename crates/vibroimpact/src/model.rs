@@ -503,6 +503,14 @@ impl Model {
         self
     }
 
+    /// Gives every contact the law `law` (clearances and pairs kept).
+    pub fn with_contact_law(mut self, law: ContactLaw) -> Self {
+        for c in &mut self.contacts {
+            c.law = law;
+        }
+        self
+    }
+
     /// Bodies in order along the line.
     pub fn bodies(&self) -> &[Body] {
         &self.bodies

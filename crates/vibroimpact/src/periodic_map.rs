@@ -165,11 +165,9 @@ pub(crate) fn period_map_with(
     let dp_column = var.parameter_sensitivity(&z).map(|s| {
         let mut flow = vec![0.0; d];
         var.system_mut().rhs(t, &z[..d], &mut flow);
-        let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
-        from_interleaved(&column, n)
+        parameter_column(s, &flow, dt_dp, opts.symmetric)
     });
     let map = shooting_map(image, phi, columns, n, opts.symmetric);
-    let dp_column = dp_column.map(|c| if opts.symmetric { mirror(&c) } else { c });
     Ok(MapDerivatives {
         map,
         dp_column,
@@ -208,6 +206,19 @@ pub(crate) fn map_image(
         },
         stats.steps,
     ))
+}
+
+/// The parameter's column `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (docs/theory.md
+/// §5) in body order, mirrored for the half map, from the sensitivity
+/// column `s` and the flow `f(T, y(T))` (both interleaved).
+fn parameter_column(s: &[f64], flow: &[f64], dt_dp: f64, symmetric: bool) -> Vec<f64> {
+    let column: Vec<f64> = s.iter().zip(flow).map(|(s, f)| s + f * dt_dp).collect();
+    let column = from_interleaved(&column, column.len() / 2);
+    if symmetric {
+        mirror(&column)
+    } else {
+        column
+    }
 }
 
 /// The shooting map from the flow's image (body order) and Φ's `k`
@@ -296,14 +307,7 @@ fn local_map(
                 .map_err(|e| invalid(e.to_string()))?;
             let mut f = vec![0.0; d];
             ChainDynamics::new(model, false).rhs(t, &flow.y, &mut f);
-            let dt_dp = (t_p - t) / dp;
-            let column: Vec<f64> = s.iter().zip(&f).map(|(s, f)| s + f * dt_dp).collect();
-            let column = from_interleaved(&column, n);
-            Some(if opts.symmetric {
-                mirror(&column)
-            } else {
-                column
-            })
+            Some(parameter_column(&s, &f, (t_p - t) / dp, opts.symmetric))
         }
         _ => None,
     };
@@ -358,20 +362,10 @@ pub(super) fn forced_map(
     let s = tape.apply_with_source(&vec![0.0; d], &mut source);
     let mut flow = vec![0.0; d];
     sys.rhs(t, &y, &mut flow);
-    let dt_dp = (t_p - t) / dp;
-    let column: Vec<f64> = s.iter().zip(&flow).map(|(s, f)| s + f * dt_dp).collect();
-    let (image, column) = (from_interleaved(&y, n), from_interleaved(&column, n));
     let symmetric = opts.symmetric;
-    let (image, column) = if symmetric {
-        (mirror(&image), mirror(&column))
-    } else {
-        (image, column)
-    };
+    let column = parameter_column(&s, &flow, (t_p - t) / dp, symmetric);
     Ok(MapDerivatives {
-        map: PeriodMap {
-            image,
-            monodromy: DMatrix::zeros(0, 0),
-        },
+        map: shooting_map(from_interleaved(&y, n), &[], 0, n, symmetric),
         dp_column: Some(column),
         steps: stats.steps,
         tangent: Some(MapTangent {

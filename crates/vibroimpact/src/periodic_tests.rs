@@ -558,21 +558,7 @@ fn local_tape_products_match_dense_columns() {
         crate::contact::ForceForm::Published,
     )
     .unwrap();
-    let contacts: Vec<_> = model
-        .contacts()
-        .iter()
-        .map(|c| crate::model::Contact { law, ..c.clone() })
-        .collect();
-    let ln = Model::new(
-        model.bodies().to_vec(),
-        vec![],
-        contacts,
-        model.base().clone(),
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
+    let ln = model.clone().with_contact_law(law);
     let global = ShootingOptions::default();
     for (opts, dense) in [
         (&global, true),

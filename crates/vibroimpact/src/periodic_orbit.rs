@@ -1,0 +1,170 @@
+//! Periodic orbits from simulation: a start guess after a transient, and
+//! the summary of an orbit over its first period (samples, exact extrema,
+//! impacts).
+
+use super::*;
+
+/// A start guess by simulation: the state after `periods` forcing periods
+/// from the model's initial state.
+pub fn guess_by_simulation(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+) -> Result<Vec<f64>, PeriodicError> {
+    guess_by_simulation_with(model, periods, rtol, None, Integrator::Global)
+}
+
+/// [`guess_by_simulation`] by `integrator` that stops when `interrupt` is
+/// requested.
+pub fn guess_by_simulation_with(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+    interrupt: Option<Interrupt>,
+    integrator: Integrator,
+) -> Result<Vec<f64>, PeriodicError> {
+    let t = forcing_period(model)?;
+    let opts = SimulationOptions {
+        t_end: periods * t,
+        rtol,
+        atol: rtol * 1e-4,
+        interrupt,
+        integrator,
+        ..SimulationOptions::default()
+    };
+    let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;
+    if let Some(e) = sim.error {
+        return Err(PeriodicError::Integration {
+            iteration: 0,
+            source: e.source,
+        });
+    }
+    Ok(sim.final_state())
+}
+
+/// Impacts of one contact over one period of an orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactImpacts {
+    /// Contact index.
+    pub contact: usize,
+    /// Impact velocities (m/s) of the impacts starting within the period.
+    pub impact_velocities: Vec<f64>,
+    /// Their peak forces (N).
+    pub peak_forces: Vec<f64>,
+}
+
+/// Amplitudes and impacts of a periodic orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitSummary {
+    /// max |u_i| over the period, body order (m).
+    pub max_displacement: Vec<f64>,
+    /// max |v_i| over the period (m/s).
+    pub max_velocity: Vec<f64>,
+    /// Impacts per period per contact.
+    pub impacts: Vec<ContactImpacts>,
+    /// Per contact, how far the approach passed the impact threshold over
+    /// the period (m; [`Extrema::impact_margin`](crate::simulate::Extrema)).
+    pub impact_margin: Vec<f64>,
+    /// Sampled orbit over one period: times and states (body order).
+    pub times: Vec<f64>,
+    /// States at `times`, `[u.., v..]` each.
+    pub states: Vec<f64>,
+}
+
+impl OrbitSummary {
+    /// Total impacts per period.
+    pub fn impacts_per_period(&self) -> usize {
+        self.impacts.iter().map(|c| c.impact_velocities.len()).sum()
+    }
+}
+
+/// Integrates from a periodic state and summarises the first period: the
+/// samples and extrema of [0, T], and the impacts that start in (0, T] (an
+/// impact in progress at t = 0 is the one that starts before T; the
+/// integration runs on to 2T to complete it, so it is counted once, with
+/// its true impact velocity, rebound and peak). The first period, not the
+/// second: on an unstable orbit the state's error grows by the largest
+/// multiplier each period (~500 on R2's symmetric branch near 0.55 ω0). `samples` points per
+/// period are kept for plots; the amplitudes max |u_i|, max |v_i| are the
+/// exact extrema of the second period, located on the dense output (see
+/// [`crate::simulate::Extrema`]), independent of `samples`.
+pub fn orbit_summary(
+    model: &Model,
+    state: &[f64],
+    period: f64,
+    samples: usize,
+    rtol: f64,
+) -> Result<OrbitSummary, PeriodicError> {
+    orbit_summary_by(model, state, (period, samples), rtol, Integrator::Global)
+}
+
+/// [`orbit_summary`] by the given integrator (`(period, samples)`).
+pub fn orbit_summary_by(
+    model: &Model,
+    state: &[f64],
+    (period, samples): (f64, usize),
+    rtol: f64,
+    integrator: Integrator,
+) -> Result<OrbitSummary, PeriodicError> {
+    let n = model.bodies().len();
+    // One period; a second only when an impact is still under way at its
+    // end (its rebound and peak lie beyond).
+    let run = |periods: f64| {
+        let opts = SimulationOptions {
+            t_end: periods * period,
+            rtol,
+            atol: rtol * 1e-4,
+            output_step: Some(period / samples.max(10) as f64),
+            start: Some(state.to_vec()),
+            extrema_window: Some((0.0, period)),
+            integrator,
+            ..SimulationOptions::default()
+        };
+        simulate(model, &opts).map_err(|e| PeriodicError::Options(e.0))
+    };
+    let mut sim = run(1.0)?;
+    if sim.error.is_none() && sim.impacts.iter().any(|i| !i.complete()) {
+        sim = run(2.0)?;
+    }
+    if let Some(e) = sim.error {
+        return Err(PeriodicError::Integration {
+            iteration: 0,
+            source: e.source,
+        });
+    }
+    let mut times = Vec::new();
+    let mut states = Vec::new();
+    for (j, &t) in sim.times.iter().enumerate() {
+        if t > period * (1.0 + 1e-12) {
+            break;
+        }
+        let row = &sim.states[j * 2 * n..(j + 1) * 2 * n];
+        times.push(t);
+        states.extend_from_slice(row);
+    }
+    let impacts = (0..model.contacts().len())
+        .map(|k| {
+            let list: Vec<_> = sim
+                .impacts
+                .iter()
+                .filter(|i| i.contact == k && i.start_time > 0.0 && i.start_time <= period)
+                .collect();
+            ContactImpacts {
+                contact: k,
+                impact_velocities: list.iter().map(|i| i.impact_velocity).collect(),
+                peak_forces: list.iter().map(|i| i.peak_force).collect(),
+            }
+        })
+        .collect();
+    let extrema = sim
+        .extrema
+        .ok_or_else(|| PeriodicError::Options("the orbit's extrema were not tracked".into()))?;
+    Ok(OrbitSummary {
+        max_displacement: extrema.max_displacement,
+        max_velocity: extrema.max_velocity,
+        impacts,
+        impact_margin: extrema.impact_margin,
+        times,
+        states,
+    })
+}
