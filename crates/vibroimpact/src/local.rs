@@ -191,6 +191,24 @@ fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
         .then_some(w2)
 }
 
+/// The rows `[u, v]` of `bodies` in an interleaved state `v` of the whole
+/// model.
+fn rows_of(bodies: &[usize], v: &[f64]) -> Vec<f64> {
+    bodies
+        .iter()
+        .flat_map(|&i| [v[2 * i], v[2 * i + 1]])
+        .collect()
+}
+
+/// Writes the rows `x` of `bodies` into an interleaved state `out` of the
+/// whole model.
+fn put_rows(bodies: &[usize], x: &[f64], out: &mut [f64]) {
+    for (j, &i) in bodies.iter().enumerate() {
+        out[2 * i] = x[2 * j];
+        out[2 * i + 1] = x[2 * j + 1];
+    }
+}
+
 /// Group of a contact's side, if a body.
 fn side_groups(free: &FreeMotion, c: &Contact) -> [Option<usize>; 2] {
     [

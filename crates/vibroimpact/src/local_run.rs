@@ -57,22 +57,19 @@ impl Run<'_> {
                 continue;
             }
             self.tangents_to(g, t);
-            let m2 = 2 * self.free.groups()[g].bodies().len();
+            let bodies = self.free.groups()[g].bodies();
+            let m2 = 2 * bodies.len();
             for c in 0..self.columns {
-                for (j, &i) in self.free.groups()[g].bodies().iter().enumerate() {
-                    w[c * n2 + 2 * i] = self.tangents[g].1[c * m2 + 2 * j];
-                    w[c * n2 + 2 * i + 1] = self.tangents[g].1[c * m2 + 2 * j + 1];
-                }
+                let rows = &self.tangents[g].1[c * m2..(c + 1) * m2];
+                put_rows(bodies, rows, &mut w[c * n2..(c + 1) * n2]);
             }
         }
         if let Some(set) = &self.set {
             let b2 = 2 * set.bodies.len();
             let z = set.st.y();
             for c in 0..self.columns {
-                for (j, &i) in set.bodies.iter().enumerate() {
-                    w[c * n2 + 2 * i] = z[b2 * (1 + c) + 2 * j];
-                    w[c * n2 + 2 * i + 1] = z[b2 * (1 + c) + 2 * j + 1];
-                }
+                let rows = &z[b2 * (1 + c)..b2 * (2 + c)];
+                put_rows(&set.bodies, rows, &mut w[c * n2..(c + 1) * n2]);
             }
         }
         w
@@ -132,18 +129,12 @@ impl Run<'_> {
                 moved = y;
                 &moved
             };
-            for (j, &i) in free.groups()[g].bodies().iter().enumerate() {
-                out[2 * i] = x[2 * j];
-                out[2 * i + 1] = x[2 * j + 1];
-            }
+            put_rows(free.groups()[g].bodies(), x, out);
         }
         if let Some(set) = self.set.as_mut() {
             let mut y = vec![0.0; set.st.y().len()];
             set.st.dense_output(&mut set.sys, t, &mut y);
-            for (j, &i) in set.bodies.iter().enumerate() {
-                out[2 * i] = y[2 * j];
-                out[2 * i + 1] = y[2 * j + 1];
-            }
+            put_rows(&set.bodies, &y, out);
         }
     }
 
@@ -325,30 +316,18 @@ pub(in crate::simulate) fn run(
     let exact = free
         .groups()
         .iter()
-        .map(|g| {
-            let x = g
-                .bodies()
-                .iter()
-                .flat_map(|&i| [y0[2 * i], y0[2 * i + 1]])
-                .collect();
-            (0.0, x)
-        })
+        .map(|g| (0.0, rows_of(g.bodies(), y0)))
         .collect();
     let columns = tangents.map_or(0, |w| w.columns);
     let tangent_refs = free
         .groups()
         .iter()
         .map(|g| {
-            let m2 = 2 * g.bodies().len();
-            let mut w = vec![0.0; columns * m2];
-            if let Some(tw) = tangents {
-                for c in 0..columns {
-                    for (j, &i) in g.bodies().iter().enumerate() {
-                        w[c * m2 + 2 * j] = tw.values[c * 2 * n + 2 * i];
-                        w[c * m2 + 2 * j + 1] = tw.values[c * 2 * n + 2 * i + 1];
-                    }
-                }
-            }
+            let w = tangents.map_or(Vec::new(), |tw| {
+                (0..columns)
+                    .flat_map(|c| rows_of(g.bodies(), &tw.values[c * 2 * n..(c + 1) * 2 * n]))
+                    .collect()
+            });
             (0.0, w)
         })
         .collect();

@@ -190,14 +190,7 @@ impl LocalTape {
         // Per group: the time and rows of its exact motion.
         let mut exact: Vec<(f64, Vec<f64>)> = groups
             .iter()
-            .map(|g| {
-                let w = g
-                    .bodies()
-                    .iter()
-                    .flat_map(|&i| [v[2 * i], v[2 * i + 1]])
-                    .collect();
-                (0.0, w)
-            })
+            .map(|g| (0.0, rows_of(g.bodies(), v)))
             .collect();
         let mut in_set = vec![false; groups.len()];
         let mut set: Option<&Segment> = None;
@@ -268,16 +261,10 @@ impl LocalTape {
                 continue;
             }
             self.move_group(g, *t0, self.t_end, rows, &source);
-            for (j, &i) in groups[g].bodies().iter().enumerate() {
-                out[2 * i] = rows[2 * j];
-                out[2 * i + 1] = rows[2 * j + 1];
-            }
+            put_rows(groups[g].bodies(), rows, &mut out);
         }
         if let Some(seg) = set {
-            for (j, &i) in seg.bodies.iter().enumerate() {
-                out[2 * i] = w[2 * j];
-                out[2 * i + 1] = w[2 * j + 1];
-            }
+            put_rows(&seg.bodies, &w, &mut out);
         }
         out
     }

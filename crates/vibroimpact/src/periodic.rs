@@ -642,18 +642,18 @@ pub fn shoot_krylov(
 
 #[path = "periodic_krylov.rs"]
 mod krylov;
-#[path = "periodic_orbit.rs"]
-mod orbit;
 #[path = "periodic_map.rs"]
 mod map;
+#[path = "periodic_orbit.rs"]
+mod orbit;
 
 pub(crate) use krylov::{arnoldi_matrix, gmres};
 pub use map::period_map;
-pub use orbit::{
-    guess_by_simulation, guess_by_simulation_with, orbit_summary, orbit_summary_by,
-    ContactImpacts, OrbitSummary,
-};
 pub(crate) use map::{map_image, period_map_with, MapTangent};
+pub use orbit::{
+    guess_by_simulation, guess_by_simulation_with, orbit_summary, orbit_summary_by, ContactImpacts,
+    OrbitSummary,
+};
 
 #[cfg(test)]
 #[path = "periodic_tests.rs"]
