@@ -37,6 +37,8 @@ impl MethodName {
 /// `--integrator`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum IntegratorName {
+    /// Local from 16 groups of bodies (joined by springs) up, global below
+    Auto,
     /// Every body integrated at every step.
     Global,
     /// Exact motion between contacts; bodies in touch integrated.
@@ -47,6 +49,7 @@ impl IntegratorName {
     /// The library's integrator.
     pub fn integrator(self) -> Integrator {
         match self {
+            IntegratorName::Auto => Integrator::Auto,
             IntegratorName::Global => Integrator::Global,
             IntegratorName::Local => Integrator::Local,
         }
@@ -208,7 +211,7 @@ pub struct AttractorRuns {
     pub cluster_tolerance: Option<f64>,
     /// Integrator of the transients and recorded periods: `local` moves
     /// bodies out of contact exactly.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     pub integrator: IntegratorName,
 }
 

@@ -17,7 +17,7 @@ use crate::solve::method;
 /// (`u1`, `v2`, …); `base`: the other components (None: the model's initial
 /// state); `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "global"))]
+#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn basins<'py>(
     py: Python<'py>,

@@ -16,7 +16,7 @@ use crate::solve::method;
 /// each with its `runs`). `lyapunov`: each run's largest exponent;
 /// `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "global"))]
+#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn chart<'py>(
     py: Python<'py>,

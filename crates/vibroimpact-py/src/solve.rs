@@ -318,7 +318,7 @@ pub fn simulate<'py>(
 /// A periodic solution: the `periodic` document plus the orbit over one
 /// period (`orbit_t`, `orbit_displacement`, `orbit_velocity`).
 #[pyfunction]
-#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None, integrator = "global"))]
+#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None, integrator = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
@@ -421,7 +421,7 @@ pub fn periodic<'py>(
 /// A branch of periodic solutions: the `continue` document (with
 /// `switched_branch` when `switch_at` is given); progress counts points.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "global"))]
+#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_branch<'py>(
     py: Python<'py>,
@@ -521,7 +521,7 @@ pub fn parameter_values<'py>(
 /// `lyapunov = k` its k largest Lyapunov exponents. `threads`: the size of
 /// the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None, integrator = "global"))]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None, integrator = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,

@@ -172,36 +172,43 @@ fn single_exp(w2: f64, c2: f64, tau: f64) -> [f64; 4] {
     [ec - mu * es, es, -w2 * es, ec + mu * es]
 }
 
+/// The groups of `model`: the connected components of its couplings
+/// (union–find), as each body's (group, index in the group) and each
+/// group's bodies (ascending), groups in the order of their first body.
+pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usize>>) {
+    let n = model.bodies().len();
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    for c in model.couplings() {
+        let (a, b) = (find(&mut root, c.a), find(&mut root, c.b));
+        root[a.max(b)] = a.min(b);
+    }
+    let mut place = vec![(usize::MAX, 0); n];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for i in 0..n {
+        let r = find(&mut root, i);
+        if place[r].0 == usize::MAX {
+            place[r] = (members.len(), 0);
+            members.push(Vec::new());
+        }
+        let g = place[r].0;
+        place[i] = (g, members[g].len());
+        members[g].push(i);
+    }
+    (place, members)
+}
+
 impl FreeMotion {
     /// The groups of `model` and their propagators. Errors for an undamped
     /// group in resonance with a harmonic forcing term.
     pub fn new(model: &Model) -> Result<Self, FreeMotionError> {
-        let n = model.bodies().len();
-        // Groups: connected components of the couplings (union–find).
-        let mut root: Vec<usize> = (0..n).collect();
-        fn find(root: &mut [usize], mut i: usize) -> usize {
-            while root[i] != i {
-                root[i] = root[root[i]];
-                i = root[i];
-            }
-            i
-        }
-        for c in model.couplings() {
-            let (a, b) = (find(&mut root, c.a), find(&mut root, c.b));
-            root[a.max(b)] = a.min(b);
-        }
-        let mut place = vec![(usize::MAX, 0); n];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        for i in 0..n {
-            let r = find(&mut root, i);
-            if place[r].0 == usize::MAX {
-                place[r] = (members.len(), 0);
-                members.push(Vec::new());
-            }
-            let g = place[r].0;
-            place[i] = (g, members[g].len());
-            members[g].push(i);
-        }
+        let (place, members) = spring_groups(model);
         let zdd_max = model.base().peak();
         let mut groups = Vec::with_capacity(members.len());
         for bodies in members {

@@ -74,7 +74,7 @@ impl Default for LyapunovOptions {
             periods: 200,
             rtol: 1e-9,
             interrupt: None,
-            integrator: Integrator::Global,
+            integrator: Integrator::Auto,
         }
     }
 }
@@ -174,8 +174,9 @@ pub fn lyapunov_spectrum(
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
-    let mut flow = match opts.integrator {
-        Integrator::Global => {
+    let mut flow = match opts.integrator.resolve(model) {
+        // (`resolve` gives global or local.)
+        Integrator::Global | Integrator::Auto => {
             let mut solver = Dop853::new(var.dim(), int_opts)?;
             solver.reset(&mut var, t0, &z)?;
             Flow::Global {

@@ -128,7 +128,7 @@ impl Default for ShootingOptions {
             symmetric: false,
             control_monodromy: false,
             interrupt: None,
-            integrator: Integrator::Global,
+            integrator: Integrator::Auto,
         }
     }
 }
@@ -559,7 +559,7 @@ pub(crate) fn map_and_product(
     let n = model.bodies().len();
     let d = 2 * n;
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-    let (y, w) = if opts.integrator == Integrator::Local {
+    let (y, w) = if opts.integrator.resolve(model) == Integrator::Local {
         let sim_opts = map::local_options(opts, t, MAX_STEPS);
         let column = to_interleaved(v);
         let flow = local_flow(model, &sim_opts, &to_interleaved(x), (&column, 1), false)

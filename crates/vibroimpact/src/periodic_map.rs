@@ -124,7 +124,15 @@ pub(crate) fn period_map_with(
     }
     let invalid = |e: PeriodicError| IntegrationError::InvalidOptions(e.to_string());
     let t = map_time(model, opts).map_err(invalid)?;
-    if opts.integrator == Integrator::Local {
+    // Auto keeps a parameter beyond the forcing on the global integrator.
+    let local = match opts.integrator {
+        Integrator::Auto => {
+            opts.integrator.resolve(model) == Integrator::Local
+                && shifted.is_none_or(|(model_p, _)| model.differs_only_in_forcing(model_p))
+        }
+        chosen => chosen == Integrator::Local,
+    };
+    if local {
         return local_map(model, x, opts, (shifted, dense), t, max_steps);
     }
     if let Some((model_p, dp)) = shifted {
@@ -187,7 +195,7 @@ pub(crate) fn map_image(
     let n = model.bodies().len();
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
     let y0 = to_interleaved(x);
-    let (y, stats) = if opts.integrator == Integrator::Local {
+    let (y, stats) = if opts.integrator.resolve(model) == Integrator::Local {
         let sim_opts = local_options(opts, t, max_steps);
         let flow = local_flow(model, &sim_opts, &y0, (&[], 0), false)
             .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;

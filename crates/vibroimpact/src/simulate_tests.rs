@@ -467,3 +467,58 @@ fn stiff_models_end_early_with_the_reason() {
         other => panic!("expected stiffness, got {other:?}"),
     }
 }
+
+/// `Integrator::Auto` is the local integrator from [`AUTO_LOCAL_GROUPS`]
+/// groups up (the same bytes as asking for it) and the global one below,
+/// or where an undamped group is forced harmonically (its free motion may
+/// have no steady state).
+#[test]
+fn auto_chooses_the_integrator_by_groups() {
+    let auto = |m: &Model| Integrator::Auto.resolve(m);
+    let large = r2(AUTO_LOCAL_GROUPS, 1e-3, 0.5 * W0);
+    assert_eq!(auto(&r2(2, 1e-3, 0.95 * W0)), Integrator::Global);
+    assert_eq!(
+        auto(&r2(AUTO_LOCAL_GROUPS - 1, 1e-3, 0.5 * W0)),
+        Integrator::Global
+    );
+    assert_eq!(auto(&large), Integrator::Local);
+    assert_eq!(Integrator::Global.resolve(&large), Integrator::Global);
+    assert_eq!(
+        Integrator::Local.resolve(&r2(2, 1e-3, W0)),
+        Integrator::Local
+    );
+    let harmonic = large.base().clone();
+    let undamped = |base: BaseExcitation| {
+        Model::row(
+            AUTO_LOCAL_GROUPS,
+            0.227,
+            12.5,
+            0.0,
+            1e-3,
+            law(),
+            (true, true),
+            base,
+        )
+        .unwrap()
+    };
+    assert_eq!(auto(&undamped(harmonic)), Integrator::Global);
+    assert_eq!(auto(&undamped(BaseExcitation::None)), Integrator::Local);
+    let chain = crate::reference::struck_chain(AUTO_LOCAL_GROUPS, 1.0).unwrap();
+    assert_eq!(auto(&chain), Integrator::Local);
+    let opts = |integrator| SimulationOptions {
+        t_end: 2.0 * 2.0 * std::f64::consts::PI / (0.5 * W0),
+        integrator,
+        ..SimulationOptions::default()
+    };
+    let (a, l) = (
+        simulate(&large, &opts(Integrator::Auto)).unwrap(),
+        simulate(&large, &opts(Integrator::Local)).unwrap(),
+    );
+    assert!(a.local.is_some() && a.error.is_none());
+    assert_eq!(a.final_displacement, l.final_displacement);
+    assert_eq!(a.final_velocity, l.final_velocity);
+    let g = simulate(&large, &opts(Integrator::Global)).unwrap();
+    for (x, y) in a.final_displacement.iter().zip(&g.final_displacement) {
+        assert!((x - y).abs() < 1e-8, "{x} against {y}");
+    }
+}

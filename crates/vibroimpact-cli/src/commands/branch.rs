@@ -60,7 +60,7 @@ pub struct PeriodicArgs {
     /// Integrator of the period map: `local` carries the state (and the
     /// monodromy matrix, or the record its products replay) by the exact
     /// motion between contacts.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
@@ -335,7 +335,7 @@ pub struct ContinueArgs {
     /// Integrator of the period maps: `local` moves bodies out of contact
     /// exactly and integrates only those in touch (for a parameter of the
     /// forcing: frequency, amplitude).
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Output folder: branch.csv, branch_special_points.json, branch.json and
     /// the response figure branch_response.svg/.png (with --switch-at the

@@ -48,7 +48,7 @@ pub struct PoundingArgs {
     method: MethodName,
     /// Integrator: `local` moves each frame exactly between poundings, per
     /// record sample.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Pounding spectrum: gaps FROM:TO:N (m), with --ratios.
     #[arg(long, requires = "ratios")]

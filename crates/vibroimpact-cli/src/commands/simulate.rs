@@ -52,9 +52,10 @@ pub struct SimulateArgs {
     /// Integration method.
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     method: MethodName,
-    /// `global`: every body integrated at every step; `local`: exact
+    /// `auto` (local from 16 groups of bodies up); `global`: every body
+    /// integrated at every step; `local`: exact
     /// motion between contacts, only bodies in touch integrated.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Force level F_on (N) that delimits impacts of the exponential law
     /// (default: [simulation] impact_force_threshold, else 1e-3 N).

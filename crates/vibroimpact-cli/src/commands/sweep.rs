@@ -44,7 +44,7 @@ pub struct SweepArgs {
     method: MethodName,
     /// Integrator of the transient, the recorded periods and `--lyapunov`:
     /// `local` moves bodies out of contact exactly.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Global)]
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Relative tolerance under which two Poincaré samples count as the same
     /// point (relative to the largest |u| and |v| in the recorded window);

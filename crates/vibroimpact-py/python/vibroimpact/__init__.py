@@ -398,7 +398,7 @@ def simulate(
     output_step: Optional[float] = None,
     energy: bool = False,
     impact_force_threshold: Optional[float] = None,
-    integrator: str = "global",
+    integrator: str = "auto",
     progress: Progress = None,
 ) -> Result:
     """A time history with its impact log (``vibroimpact simulate``).
@@ -408,9 +408,10 @@ def simulate(
     ``[simulation]`` settings, else 1e-8, rtol*1e-4, 1e-3 N. ``method``:
     "dop853", "dopri5", "rodas" or "auto". ``output_step`` (s): sampling of the
     history, default 1/100 forcing period (or duration/2000); 0: none.
-    ``integrator``: "global" (every body integrated at every step) or
-    "local" (exact motion between contacts, only bodies in touch
-    integrated; the summary then has ``local`` with its work counters).
+    ``integrator``: "auto" (local from 16 groups of bodies up, global
+    below), "global" (every body integrated at every step) or "local"
+    (exact motion between contacts, only bodies in touch integrated; the
+    summary then has ``local`` with its work counters).
 
     Returns the CLI's summary fields (``completed``, ``error``,
     ``final_time``, ``final_displacement``, ``final_velocity``,
@@ -451,7 +452,7 @@ def simulate(
             output_step,
             _flag(energy, "energy"),
             _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
-            _method(integrator, ("global", "local"), "integrator"),
+            _method(integrator, ("auto", "global", "local"), "integrator"),
             _progress(progress),
         )
     )
@@ -469,7 +470,7 @@ def periodic(
     arnoldi: int = 20,
     symmetric: bool = False,
     progress: Progress = None,
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> Result:
     """A periodic solution by shooting, with its Floquet multipliers
     (``vibroimpact periodic``).
@@ -515,7 +516,7 @@ def periodic(
             _count(arnoldi, "arnoldi", minimum=1, maximum=10**5),
             _flag(symmetric, "symmetric"),
             _progress(progress),
-            _method(integrator, ("global", "local"), "integrator"),
+            _method(integrator, ("auto", "global", "local"), "integrator"),
         )
     )
     if not r.converged:
@@ -541,7 +542,7 @@ def continue_(
     ds_max: float = 0.05,
     guess_periods: float = 200.0,
     progress: Progress = None,
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -578,7 +579,7 @@ def continue_(
         _real(ds_max, "ds_max", positive=True),
         _real(guess_periods, "guess_periods", positive=True),
         _progress(progress),
-        _method(integrator, ("global", "local"), "integrator"),
+        _method(integrator, ("auto", "global", "local"), "integrator"),
     )
     r = Result(d)
     problem = None
@@ -633,7 +634,7 @@ def sweep(
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
     lyapunov: Optional[int] = None,
-    integrator: str = "global",
+    integrator: str = "auto",
     client: Any = None,
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
@@ -681,7 +682,7 @@ def sweep(
         method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         lyapunov=None if lyapunov is None else _count(lyapunov, "lyapunov", minimum=1, maximum=10**6),
-        integrator=_method(integrator, ("global", "local"), "integrator"),
+        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -728,7 +729,7 @@ def _sweep_local(
         only,
         _progress(progress),
         options["lyapunov"],
-        options.get("integrator", "global"),
+        options.get("integrator", "auto"),
     )
     return d if raw else Result(d)
 
@@ -748,7 +749,7 @@ def chart(
     atol: Optional[float] = None,
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
-    integrator: str = "global",
+    integrator: str = "auto",
     client: Any = None,
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
@@ -795,7 +796,7 @@ def chart(
         atol=_real(atol, "atol", positive=True, optional=True),
         method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
         cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
-        integrator=_method(integrator, ("global", "local"), "integrator"),
+        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -833,7 +834,7 @@ def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: P
         options["cluster_tolerance"],
         threads,
         _progress(progress),
-        options.get("integrator", "global"),
+        options.get("integrator", "auto"),
     )
     return d if raw else Result(d)
 
@@ -852,7 +853,7 @@ def basins(
     atol: Optional[float] = None,
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
-    integrator: str = "global",
+    integrator: str = "auto",
     threads: Optional[int] = None,
     progress: Progress = None,
 ) -> Result:
@@ -895,7 +896,7 @@ def basins(
         _real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         threads,
         _progress(progress),
-        _method(integrator, ("global", "local"), "integrator"),
+        _method(integrator, ("auto", "global", "local"), "integrator"),
     )
     return Result(d)
 
@@ -994,7 +995,7 @@ def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any, integrat
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
     _method(method, ("dop853", "dopri5", "rodas", "auto"))
-    _method(integrator, ("global", "local"), "integrator")
+    _method(integrator, ("auto", "global", "local"), "integrator")
 
 
 def _pounding_args(
@@ -1025,7 +1026,7 @@ def pounding(
     sample: float = 0.0025,
     rtol: float = 1e-8,
     method: str = "dop853",
-    integrator: str = "global",
+    integrator: str = "auto",
     free: bool = True,
 ) -> Result:
     """Pounding of two shear frames under one record (``vibroimpact
@@ -1059,7 +1060,7 @@ def pounding_history(
     sample: float = 0.01,
     rtol: float = 1e-8,
     method: str = "dop853",
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> Result:
     """The time history of a pounding pair with its contacts under one
     record (as :func:`pounding` takes them), sampled every ``sample``

@@ -58,32 +58,32 @@ def simulate(
 def periodic(
     model: Model, subharmonic: int, guess: Optional[F64], guess_periods: float, rtol: float,
     tol: float, krylov: bool, arnoldi: int, symmetric: bool, progress: Progress = None,
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> dict[str, Any]: ...
 def continue_branch(
     model: Model, parameter: str, from_: float, to: float, subharmonic: int,
     switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
-    progress: Progress = None, integrator: str = "global",
+    progress: Progress = None, integrator: str = "auto",
 ) -> dict[str, Any]: ...
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,
     rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], only: Optional[str] = None,
-    progress: Progress = None, lyapunov: Optional[int] = None, integrator: str = "global",
+    progress: Progress = None, lyapunov: Optional[int] = None, integrator: str = "auto",
 ) -> dict[str, Any]: ...
 
 def chart(
     model: Model, x: str, x_values: F64, y: str, y_values: F64, transient: int, record: int,
     starts: int, lyapunov: bool, rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> dict[str, Any]: ...
 
 def basins(
     model: Model, x: str, x_values: F64, y: str, y_values: F64, base: Optional[F64],
     transient: int, record: int, rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
-    integrator: str = "global",
+    integrator: str = "auto",
 ) -> dict[str, Any]: ...
 
 def parse_record(text: str, source: str, units: Optional[str] = None) -> dict[str, Any]: ...

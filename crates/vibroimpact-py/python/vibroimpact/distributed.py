@@ -198,7 +198,7 @@ def ida(
     sample: float = 0.0025,
     rtol: float = 1e-8,
     method: str = "dop853",
-    integrator: str = "global",
+    integrator: str = "auto",
     retries: int = 2,
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Result:

@@ -12,6 +12,7 @@ use super::{
 };
 use crate::model::Model;
 use crate::periodic::{shoot, shoot_krylov, ShootingOptions, MAX_DENSE_DIM, MIN_ARNOLDI};
+use crate::simulate::Integrator;
 
 /// One step of a [`Continuation`].
 #[derive(Clone, Debug)]
@@ -79,6 +80,13 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         validate(p0, p_end, opts)?;
         let model = model_at(&mut family, p0)?;
         validate_size(&model, opts)?;
+        let opts = &ContinuationOptions {
+            shooting: ShootingOptions {
+                integrator: branch_integrator(&mut family, &model, (p0, p_end), opts),
+                ..opts.shooting.clone()
+            },
+            ..opts.clone()
+        };
         let start = match opts.krylov {
             None => shoot(&model, x0, &opts.shooting)?,
             Some(m) => shoot_krylov(&model, x0, &opts.shooting, m)?,
@@ -392,6 +400,26 @@ impl<F: FnMut(f64) -> Result<Model, String>> Iterator for Continuation<F> {
         let step = self.advance();
         self.done = matches!(step, BranchStep::Stop(_));
         Some(step)
+    }
+}
+
+/// The integrator of a whole branch: [`Integrator::Auto`] resolved on the
+/// start's model, and global for a parameter beyond the forcing (the local
+/// maps carry a column of the forcing's parameters only).
+fn branch_integrator<F: FnMut(f64) -> Result<Model, String>>(
+    family: &mut F,
+    model: &Model,
+    (p0, p_end): (f64, f64),
+    opts: &ContinuationOptions,
+) -> Integrator {
+    let chosen = opts.shooting.integrator;
+    if chosen != Integrator::Auto || chosen.resolve(model) != Integrator::Local {
+        return chosen.resolve(model);
+    }
+    let near = p0 + 1e-6 * (p_end - p0);
+    match family(near) {
+        Ok(other) if model.differs_only_in_forcing(&other) => Integrator::Local,
+        _ => Integrator::Global,
     }
 }
 
