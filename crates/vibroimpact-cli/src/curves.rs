@@ -10,6 +10,7 @@ use vibroimpact::continuation::{
     continue_curve, grazing_margin, starts_grazing, Curve, CurveKind, CurveOptions, CurveStop,
     SpecialKind, SpecialPoint,
 };
+use vibroimpact::family::{Family2, ParameterizedModel2};
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ModelParameter;
 use vibroimpact::periodic::ShootingOptions;
@@ -225,10 +226,10 @@ pub fn curves(
     };
     let mut out: Vec<(String, Curve)> = Vec::new();
     let mut skipped = Vec::new();
-    let family = |pv: f64, qv: f64| {
-        let mut doc = document.clone();
-        doc.set(q, qv).map_err(|e| e.to_string())?;
-        Ok(doc.with_parameter(p, pv).map_err(|e| e.to_string())?.model)
+    let mut family = ParameterizedModel2 {
+        document: document.clone(),
+        p: p.clone(),
+        q: q.clone(),
     };
     for s in special {
         let Some(kind) = kind_of(s.kind, s.symmetry_breaking, &second.curves) else {
@@ -253,7 +254,7 @@ pub fn curves(
             continue;
         }
         if kind == CurveKind::Grazing {
-            let model = family(s.parameter, q0).map_err(CliError::new)?;
+            let model = family.model_at(s.parameter, q0)?;
             let margin = grazing_margin(&model, &s.state, &opts.shooting).map_err(CliError::new)?;
             if !starts_grazing(margin, &opts.shooting) {
                 skipped.push((
@@ -264,10 +265,16 @@ pub fn curves(
             }
         }
         for direction in [1.0, -1.0] {
-            let curve = continue_curve(family, kind, (&s.state, s.parameter, q0), direction, &opts)
-                .map_err(|e| {
-                    CliError::new(format!("the {} curve from {}: {e}", kind.name(), s.label))
-                })?;
+            let curve = continue_curve(
+                &mut family,
+                kind,
+                (&s.state, s.parameter, q0),
+                direction,
+                &opts,
+            )
+            .map_err(|e| {
+                CliError::new(format!("the {} curve from {}: {e}", kind.name(), s.label))
+            })?;
             let closed = curve.stop == CurveStop::Closed;
             out.push((s.label.clone(), curve));
             if closed {

@@ -42,6 +42,7 @@ from_display!(
     vibroimpact::impact::ImpactError,
     vibroimpact::identify::IdentifyError,
     vibroimpact::model::ModelError,
+    vibroimpact::family::FamilyError,
     vibroimpact::model_file::ModelFileError,
     vibroimpact::sweep::SweepError,
     serde_json::Error

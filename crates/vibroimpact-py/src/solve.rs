@@ -484,12 +484,10 @@ pub fn continue_branch<'py>(
             p.tick();
             !p.interrupt.requested()
         };
-        let fam = |x: f64| family.model_at(x).map_err(|e| e.to_string());
         let branch =
-            run_branch(fam, from_, &guess, to, &opts, on_point).map_err(|e| e.to_string())?;
+            run_branch(&family, from_, &guess, to, &opts, on_point).map_err(|e| e.to_string())?;
         let switched = switch_at.as_deref().map(|label| {
-            let fam = |x: f64| family.model_at(x).map_err(|e| e.to_string());
-            switch_branch(fam, &branch, label, (from_, to), &opts, on_point)
+            switch_branch(&family, &branch, label, (from_, to), &opts, on_point)
                 .map_err(|e| e.to_string())
         });
         Ok::<_, String>((branch, switched))

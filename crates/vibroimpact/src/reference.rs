@@ -110,7 +110,7 @@ pub fn r2(n: usize, clearance: f64, frequency: f64) -> Result<Model, ModelError>
 #[cfg(test)]
 pub(crate) fn r2_primary_orbit(n: usize, clearance: f64, frequency: f64) -> Vec<f64> {
     crate::continuation::amplitude_homotopy(
-        |a| r2_forced(n, clearance, frequency, a).map_err(|e| e.to_string()),
+        crate::family::of("amplitude", |a| r2_forced(n, clearance, frequency, a)),
         BASE_AMPLITUDE,
         &Default::default(),
     )

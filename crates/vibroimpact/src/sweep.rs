@@ -25,7 +25,7 @@ use serde::Serialize;
 
 use crate::integrate::{Interrupt, Method};
 use crate::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use crate::model::{BaseExcitation, HarmonicForce, Model};
+use crate::model::{BaseExcitation, HarmonicForce, Model, ModelError};
 use crate::model_file::LoadedModel;
 use crate::parameter::ParameterizedModel;
 use crate::simulate::{simulate, Integrator, Simulation, SimulationOptions};
@@ -293,7 +293,7 @@ pub fn parameter_values(from: f64, to: f64, k: usize) -> Vec<f64> {
 /// `model` started from `(u, v)` at the instant whose forcing phase is
 /// `phase`/[`FINE`] of a period: every harmonic excitation's phase is advanced
 /// by that fraction of 2π.
-fn start_model(model: &Model, start: &Start) -> Result<Model, String> {
+fn start_model(model: &Model, start: &Start) -> Result<Model, ModelError> {
     let shift = 2.0 * std::f64::consts::PI * (start.phase % FINE) as f64 / FINE as f64;
     let base = match model.base() {
         BaseExcitation::Harmonic {
@@ -324,7 +324,6 @@ fn start_model(model: &Model, start: &Start) -> Result<Model, String> {
         start.u.clone(),
         start.v.clone(),
     )
-    .map_err(|e| e.to_string())
 }
 
 /// Whether no contact overlaps at displacements `u`.

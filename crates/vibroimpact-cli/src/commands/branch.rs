@@ -300,8 +300,7 @@ fn homotopy_start(
     family: &ParameterizedModel,
     opts: &ContinuationOptions,
 ) -> Result<Vec<f64>, CliError> {
-    let model = |a: f64| family.model_at(a).map_err(|e| e.to_string());
-    Ok(amplitude_homotopy(model, family.initial(), opts)?)
+    Ok(amplitude_homotopy(family, family.initial(), opts)?)
 }
 
 /// Options of `vibroimpact continue`.
@@ -611,9 +610,8 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     };
     let mut progress = progress;
     let mut run = |guess: &[f64]| {
-        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
         continue_branch(
-            family,
+            &pm,
             args.range.from,
             guess,
             args.range.to,
@@ -635,9 +633,8 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;
     if let Some(label) = &args.switch_at {
-        let family = |p: f64| pm.model_at(p).map_err(|e| e.to_string());
         match switch_branch(
-            family,
+            &pm,
             &branches[0],
             label,
             (args.range.from, args.range.to),

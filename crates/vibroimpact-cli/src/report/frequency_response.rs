@@ -10,8 +10,9 @@ use rayon::prelude::*;
 use vibroimpact::continuation::{
     branch_switch_start, continue_branch, Branch, ContinuationOptions,
 };
+use vibroimpact::family::of;
 use vibroimpact::integrate::Interrupt;
-use vibroimpact::model::Model;
+use vibroimpact::model::{Model, ModelError};
 use vibroimpact::periodic::{guess_by_simulation_with, orbit_summary, ShootingOptions};
 use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
@@ -49,8 +50,8 @@ pub(super) struct RowResponse {
     pub sweep_down: Vec<(f64, f64)>,
 }
 
-fn row(n: usize, w: f64) -> Result<Model, String> {
-    reference::r2(n, reference::CLEARANCE, w).map_err(|e| e.to_string())
+fn row(n: usize, w: f64) -> Result<Model, ModelError> {
+    reference::r2(n, reference::CLEARANCE, w)
 }
 
 /// Runs every study of the section; `stop` interrupts them.
@@ -58,7 +59,7 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
     let w0 = reference::NATURAL_FREQUENCY;
     let mut rows = Vec::new();
     for n in [2usize, 3] {
-        let start = row(n, 1.5 * w0).map_err(CliError::new)?;
+        let start = row(n, 1.5 * w0)?;
         let guess =
             guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()), Integrator::Global)?;
         let defaults = ContinuationOptions::default();
@@ -71,7 +72,14 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
             ..defaults
         };
         let t0 = Instant::now();
-        let branch = continue_branch(|w| row(n, w), 1.5 * w0, &guess, 0.5 * w0, &opts, |_| true)?;
+        let branch = continue_branch(
+            of("frequency", |w| row(n, w)),
+            1.5 * w0,
+            &guess,
+            0.5 * w0,
+            &opts,
+            |_| true,
+        )?;
         eprintln!(
             "R2 N = {n}: branch of {} points in {:.1} s",
             branch.points.len(),
@@ -182,17 +190,29 @@ fn asymmetric_branches(
             ..opts.clone()
         };
         let t0 = Instant::now();
-        let switched =
-            branch_switch_start(|w| row(n, w), bp, (1.5 * w0, 0.5 * w0), &switch_opts, 0.02)
-                .and_then(|(p, x)| {
-                    let target = if p >= bp.parameter {
-                        1.5 * w0
-                    } else {
-                        0.5 * w0
-                    };
-                    continue_branch(|w| row(n, w), p, &x, target, &switch_opts, |_| true)
-                })
-                .map_err(|e| CliError::new(format!("R2 N = 2, switching at {label}: {e}")))?;
+        let switched = branch_switch_start(
+            of("frequency", |w| row(n, w)),
+            bp,
+            (1.5 * w0, 0.5 * w0),
+            &switch_opts,
+            0.02,
+        )
+        .and_then(|(p, x)| {
+            let target = if p >= bp.parameter {
+                1.5 * w0
+            } else {
+                0.5 * w0
+            };
+            continue_branch(
+                of("frequency", |w| row(n, w)),
+                p,
+                &x,
+                target,
+                &switch_opts,
+                |_| true,
+            )
+        })
+        .map_err(|e| CliError::new(format!("R2 N = 2, switching at {label}: {e}")))?;
         eprintln!(
             "R2 N = 2: asymmetric branch from {label}, {} points in {:.1} s ({})",
             switched.points.len(),

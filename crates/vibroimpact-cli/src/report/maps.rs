@@ -158,13 +158,9 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
 /// 0.5 ω0 (the homotopy in the amplitude from rest), and the curves of its folds, branch points, period
 /// doublings and Neimark–Sacker points in (frequency, amplitude).
 fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, Curves), CliError> {
-    let p = doc.parameter("frequency")?;
+    let family = ParameterizedModel::new(doc.clone(), "frequency")?;
+    let p = family.parameter.clone();
     let q = doc.parameter("amplitude")?;
-    let family = |w: f64| {
-        doc.with_parameter(&p, w)
-            .map(|m| m.model)
-            .map_err(|e| e.to_string())
-    };
     let defaults = ContinuationOptions::default();
     let opts = ContinuationOptions {
         shooting: ShootingOptions {
@@ -178,16 +174,11 @@ fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, C
     let mut at_start = doc.clone();
     at_start.set(&p, FREQUENCY.0)?;
     let guess = amplitude_homotopy(
-        |a| {
-            at_start
-                .with_parameter(&q, a)
-                .map(|m| m.model)
-                .map_err(|e| e.to_string())
-        },
+        ParameterizedModel::new(at_start, "amplitude")?,
         q.initial,
         &opts,
     )?;
-    let branch = continue_branch(family, FREQUENCY.0, &guess, FREQUENCY.1, &opts, |_| true)?;
+    let branch = continue_branch(&family, FREQUENCY.0, &guess, FREQUENCY.1, &opts, |_| true)?;
     let second = SecondParameter {
         parameter2: Some("amplitude".into()),
         from2: Some(AMPLITUDE.0),

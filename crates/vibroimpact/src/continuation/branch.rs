@@ -2,13 +2,14 @@
 //! step (predictor, corrector, step control, special points between the
 //! points), ending with the reason it stopped.
 
+use crate::family::Family;
 use nalgebra::Complex;
 
 use super::events::{BranchEvent, BUILT_IN};
 use super::problem::{period_image, Evaluated, Problem};
 use super::{
-    is_symmetric_orbit, model_at, BranchPoint, ContinuationError, ContinuationOptions,
-    SpecialPoint, StopReason,
+    is_symmetric_orbit, BranchPoint, ContinuationError, ContinuationOptions, SpecialPoint,
+    StopReason,
 };
 use crate::model::Model;
 use crate::periodic::{shoot, shoot_krylov, ShootingOptions, MAX_DENSE_DIM, MIN_ARNOLDI};
@@ -64,7 +65,7 @@ pub struct Continuation<F> {
     done: bool,
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
+impl<F: Family> Continuation<F> {
     /// Starts the branch of nT-periodic solutions at `(x0, p0)` toward
     /// `p_end`: validates the options, refines `x0` by shooting and
     /// corrects the start with the parameter held. `family(p)` builds the
@@ -78,7 +79,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
         opts: &ContinuationOptions,
     ) -> Result<Self, ContinuationError> {
         validate(p0, p_end, opts)?;
-        let model = model_at(&mut family, p0)?;
+        let model = family.model_at(p0)?;
         validate_size(&model, opts)?;
         let opts = &ContinuationOptions {
             shooting: ShootingOptions {
@@ -379,7 +380,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Continuation<F> {
     }
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Iterator for Continuation<F> {
+impl<F: Family> Iterator for Continuation<F> {
     type Item = BranchStep;
 
     fn next(&mut self) -> Option<BranchStep> {
@@ -406,7 +407,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Iterator for Continuation<F> {
 /// The integrator of a whole branch: [`Integrator::Auto`] resolved on the
 /// start's model, and global for a parameter beyond the forcing (the local
 /// maps carry a column of the forcing's parameters only).
-fn branch_integrator<F: FnMut(f64) -> Result<Model, String>>(
+fn branch_integrator<F: Family>(
     family: &mut F,
     model: &Model,
     (p0, p_end): (f64, f64),
@@ -417,7 +418,7 @@ fn branch_integrator<F: FnMut(f64) -> Result<Model, String>>(
         return chosen.resolve(model);
     }
     let near = p0 + 1e-6 * (p_end - p0);
-    match family(near) {
+    match family.model_at(near) {
         Ok(other) if model.differs_only_in_forcing(&other) => Integrator::Local,
         _ => Integrator::Global,
     }

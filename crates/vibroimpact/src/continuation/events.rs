@@ -5,11 +5,11 @@
 //! conditions on a point, [`UserEvent`]), and their location by bisection
 //! of the arclength.
 
+use crate::family::Family;
 use nalgebra::{Complex, DMatrix};
 
 use super::problem::{Evaluated, Problem};
 use super::{BranchPoint, SpecialKind};
-use crate::model::Model;
 
 /// The values of the built-in test functions at a point of a branch.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -255,7 +255,7 @@ impl Evaluated {
     }
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+impl<F: Family> Problem<F> {
     /// Location of the event that occurs between `a` and `b` on the
     /// arclength in (0, ds) from `a`: regula falsi (Illinois) on the event's
     /// scalar test function where it has one, bisection otherwise, until

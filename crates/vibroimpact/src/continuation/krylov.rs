@@ -4,10 +4,10 @@
 //! dominant Floquet multipliers by Arnoldi, so that nothing of size d² is
 //! ever formed: memory O(d · (Krylov dimension + recorded stages)).
 
+use crate::family::Family;
 use nalgebra::Complex;
 
 use super::problem::{unit_along, Linear, Problem};
-use crate::model::Model;
 use crate::periodic::{arnoldi_matrix, floquet_multipliers, gmres, MapTangent};
 
 /// Largest GMRES basis of a bordered solve.
@@ -80,7 +80,7 @@ impl Operators<'_> {
     }
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+impl<F: Family> Problem<F> {
     /// The matrix-free operators at the point of `linear` (None for a dense
     /// linearisation).
     pub(super) fn operators<'a>(&'a self, linear: &'a Linear) -> Option<Operators<'a>> {

@@ -67,7 +67,7 @@ pub use switching::{
 
 use nalgebra::Complex;
 
-use crate::model::Model;
+use crate::family::{Family, FamilyError};
 use crate::periodic::{PeriodicError, ShootingOptions};
 
 /// Kinds of special points.
@@ -379,13 +379,8 @@ pub struct Branch {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum ContinuationError {
     /// The family could not build a model at a parameter value.
-    #[error("model at parameter {parameter}: {message}")]
-    Model {
-        /// Parameter value.
-        parameter: f64,
-        /// The model error.
-        message: String,
-    },
+    #[error(transparent)]
+    Family(#[from] FamilyError),
     /// Shooting failed.
     #[error(transparent)]
     Periodic(#[from] PeriodicError),
@@ -398,17 +393,6 @@ pub enum ContinuationError {
     /// An integration failed.
     #[error("integration failed: {0}")]
     Integration(#[from] crate::integrate::IntegrationError),
-}
-
-/// The family's model at `p`, its error as a [`ContinuationError::Model`].
-fn model_at<F>(family: &mut F, p: f64) -> Result<Model, ContinuationError>
-where
-    F: FnMut(f64) -> Result<Model, String>,
-{
-    family(p).map_err(|message| ContinuationError::Model {
-        parameter: p,
-        message,
-    })
 }
 
 /// Continues the branch of nT-periodic solutions from `(x0, p0)` toward
@@ -426,7 +410,7 @@ pub fn continue_branch<F, C>(
     mut on_point: C,
 ) -> Result<Branch, ContinuationError>
 where
-    F: FnMut(f64) -> Result<Model, String>,
+    F: Family,
     C: FnMut(&BranchPoint) -> bool,
 {
     let mut steps = Continuation::new(family, p0, x0, p_end, opts)?;

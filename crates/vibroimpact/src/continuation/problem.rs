@@ -3,12 +3,13 @@
 //! tangent, and a converged point evaluated in full (orbit summary,
 //! multipliers, test values).
 
+use crate::family::Family;
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
 use super::events::TestValues;
-use super::{model_at, BranchPoint, ContinuationError, ContinuationOptions};
+use super::{BranchPoint, ContinuationError, ContinuationOptions};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
@@ -69,7 +70,7 @@ pub(super) struct Problem<F> {
     steps: u64,
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+impl<F: Family> Problem<F> {
     /// Scales: the displacement scale for u, × Ω of `model` for v,
     /// `p_scale` for p (the branch's, `branch::parameter_scale`).
     pub(super) fn new(family: F, opts: ContinuationOptions, model: &Model, p_scale: f64) -> Self {
@@ -88,7 +89,7 @@ impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
     }
 
     pub(super) fn model(&mut self, p: f64) -> Result<Model, ContinuationError> {
-        model_at(&mut self.family, p)
+        Ok(self.family.model_at(p)?)
     }
 
     pub(super) fn unscale(&self, z: &[f64]) -> (Vec<f64>, f64) {
@@ -319,7 +320,7 @@ impl Evaluated {
     }
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> Problem<F> {
+impl<F: Family> Problem<F> {
     /// The point `solved` in full detail: tangent (oriented along
     /// `previous_tangent`), orbit summary, multipliers and test values.
     pub(super) fn evaluate(
@@ -515,7 +516,7 @@ struct Corrector<'p, 'a, F> {
     krylov_norm: Option<f64>,
 }
 
-impl<F: FnMut(f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
+impl<F: Family> NewtonSystem for Corrector<'_, '_, F> {
     /// Ĝ(z) (with its linearisation unless a chord step follows) and the
     /// constraint residual.
     type Point = (Residual, f64);

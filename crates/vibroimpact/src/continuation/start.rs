@@ -9,8 +9,8 @@
 //! orbit of the primary branch at any N, where a guess by simulation may
 //! land on another attractor or none.
 
-use super::{continue_branch, model_at, ContinuationError, ContinuationOptions, StopReason};
-use crate::model::Model;
+use super::{continue_branch, ContinuationError, ContinuationOptions, StopReason};
+use crate::family::Family;
 
 /// Start of the homotopy, as a fraction of the target amplitude.
 const START_FRACTION: f64 = 1e-3;
@@ -26,7 +26,7 @@ pub fn amplitude_homotopy<F>(
     opts: &ContinuationOptions,
 ) -> Result<Vec<f64>, ContinuationError>
 where
-    F: FnMut(f64) -> Result<Model, String>,
+    F: Family,
 {
     if !(amplitude.is_finite() && amplitude != 0.0) {
         return Err(ContinuationError::Invalid(format!(
@@ -34,7 +34,7 @@ where
         )));
     }
     let a0 = START_FRACTION * amplitude;
-    let rest = model_at(&mut family, a0)?;
+    let rest = family.model_at(a0)?;
     // The caller's shooting and step control; its own point budget (the
     // caller's is for the branch that follows).
     let local = ContinuationOptions {
@@ -93,7 +93,7 @@ mod tests {
     fn homotopy_starts_r2_n4_where_a_simulated_guess_does_not() {
         let w = 1.5 * W0;
         let model = |a: f64| r2_n4_forced(w, a);
-        let family = |a: f64| model(a).map_err(|e| e.to_string());
+        let family = crate::family::of("amplitude", model);
         let opts = ContinuationOptions::default();
         let x = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap();
         let target = model(reference::BASE_AMPLITUDE).unwrap();
@@ -101,7 +101,9 @@ mod tests {
         assert!(sol.converged);
         assert!(sol.residual_history[0] < 1e-6, "{:?}", sol.residual_history);
         // The main continuation in the frequency starts from it.
-        let freq = |p: f64| reference::r2(4, reference::CLEARANCE, p).map_err(|e| e.to_string());
+        let freq = crate::family::of("frequency", |p: f64| {
+            reference::r2(4, reference::CLEARANCE, p)
+        });
         let start = Continuation::new(freq, w, &x, 0.5 * W0, &opts);
         assert!(start.is_ok(), "{:?}", start.err());
         assert!(matches!(
@@ -118,13 +120,13 @@ mod tests {
         let mut opts = ContinuationOptions::default();
         opts.shooting.interrupt = Some(interrupt.clone());
         let mut calls = 0;
-        let family = |a: f64| {
+        let family = crate::family::of("amplitude", |a: f64| {
             calls += 1;
             if calls == 30 {
                 interrupt.request();
             }
-            r2_n4_forced(0.9 * W0, a).map_err(|e| e.to_string())
-        };
+            r2_n4_forced(0.9 * W0, a)
+        });
         let err = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap_err();
         assert!(
             err.to_string()

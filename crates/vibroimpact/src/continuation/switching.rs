@@ -2,13 +2,14 @@
 //! symmetry-breaking pitchfork or a simple crossing) and the period-2n
 //! branch at a period doubling; [`switch_branch`] continues from them.
 
+use crate::family::Family;
 use nalgebra::DMatrix;
 
 use super::branch::parameter_scale;
 use super::problem::{period_image, Linear, Problem};
 use super::{
-    continue_branch, model_at, Branch, BranchPoint, ContinuationError, ContinuationOptions,
-    SpecialKind, SpecialPoint,
+    continue_branch, Branch, BranchPoint, ContinuationError, ContinuationOptions, SpecialKind,
+    SpecialPoint,
 };
 use crate::model::Model;
 use crate::periodic::{period_map, shoot, ShootingOptions};
@@ -42,9 +43,9 @@ pub fn period_doubled_start<F>(
     opts: &ContinuationOptions,
 ) -> Result<(f64, Vec<f64>), ContinuationError>
 where
-    F: FnMut(f64) -> Result<Model, String>,
+    F: Family,
 {
-    let model = model_at(&mut family, point.parameter)?;
+    let model = family.model_at(point.parameter)?;
     let map = period_map(&model, &point.state, &opts.shooting)?;
     let d = point.state.len();
     // Null vector of Φ + I.
@@ -54,7 +55,7 @@ where
     let scale = doubled.displacement_scale;
     for dp in [1e-3, -1e-3, 1e-2, -1e-2] {
         let p = point.parameter * (1.0 + dp);
-        let model = model_at(&mut family, p)?;
+        let model = family.model_at(p)?;
         for eps in [0.05, -0.05, 0.2, -0.2] {
             let guess: Vec<f64> = point
                 .state
@@ -124,9 +125,9 @@ pub fn branch_switch_start<F>(
     step: f64,
 ) -> Result<(f64, Vec<f64>), ContinuationError>
 where
-    F: FnMut(f64) -> Result<Model, String>,
+    F: Family,
 {
-    let model = model_at(&mut family, point.parameter)?;
+    let model = family.model_at(point.parameter)?;
     // The predictor off the branch is poorer than along it: a larger
     // corrector budget, in the full period map (the crossing branch of a
     // symmetry-breaking point is asymmetric).
@@ -178,7 +179,7 @@ where
 
 /// The direction off the branch at a branch point and the constraint for
 /// the corrector (see [`branch_switch_start`]), in scaled variables.
-fn switch_directions<F: FnMut(f64) -> Result<Model, String>>(
+fn switch_directions<F: Family>(
     problem: &mut Problem<F>,
     model: &Model,
     point: &SpecialPoint,
@@ -263,7 +264,7 @@ pub fn switch_branch<F, C>(
     progress: C,
 ) -> Result<Branch, SwitchError>
 where
-    F: FnMut(f64) -> Result<Model, String>,
+    F: Family,
     C: FnMut(&BranchPoint) -> bool,
 {
     let sp = branch

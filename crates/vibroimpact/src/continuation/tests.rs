@@ -1,13 +1,15 @@
 //! Tests of continuation: the linear limit, the R2 branches against
 //! AUTO-07p and brute force, branch switching.
 use super::*;
+use crate::family::of;
+use crate::model::{Model, ModelError};
 use crate::periodic::{orbit_summary, period_map, shoot};
 use crate::simulate::{simulate, SimulationOptions};
 
 use crate::reference::NATURAL_FREQUENCY as W0;
 
-fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, String> {
-    crate::reference::r2(n, clearance, omega).map_err(|e| e.to_string())
+fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, ModelError> {
+    crate::reference::r2(n, clearance, omega)
 }
 
 /// Tight tolerances for branches in the linear limit, compared with exact
@@ -25,15 +27,15 @@ fn tight_options() -> ContinuationOptions {
 }
 
 /// R2 N = 2 with this clearance, forced at `w` with the base amplitude `a`.
-fn r2_forced(clearance: f64, w: f64, a: f64) -> Result<Model, String> {
-    crate::reference::r2_forced(2, clearance, w, a).map_err(|e| e.to_string())
+fn r2_forced(clearance: f64, w: f64, a: f64) -> Result<Model, ModelError> {
+    crate::reference::r2_forced(2, clearance, w, a)
 }
 
 /// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,
 /// tight tolerances.
 fn linear_branch(n: usize) -> Branch {
     let opts = tight_options();
-    let family = |w: f64| r2(n, 1e3, w);
+    let family = of("frequency", |w: f64| r2(n, 1e3, w));
     continue_branch(family, 0.8 * W0, &vec![0.0; 2 * n], 1.2 * W0, &opts, |_| {
         true
     })
@@ -96,7 +98,9 @@ fn steps_do_not_shrink_with_the_row_length() {
 #[test]
 fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
     let w = 0.9 * W0;
-    let family = |a: f64| r2_forced(crate::reference::R3_CLEARANCE, w, a);
+    let family = of("amplitude", |a: f64| {
+        r2_forced(crate::reference::R3_CLEARANCE, w, a)
+    });
     let opts = tight_options();
     let a_ref = crate::reference::BASE_AMPLITUDE;
     let b = continue_branch(family, 0.0, &[0.0; 4], a_ref, &opts, |_| true).unwrap();
@@ -128,7 +132,9 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
 #[test]
 fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
     // The example row (R2 N = 2 at 0.95 ω0) in its forcing amplitude.
-    let family = |a: f64| r2_forced(crate::reference::CLEARANCE, 0.95 * W0, a);
+    let family = of("amplitude", |a: f64| {
+        r2_forced(crate::reference::CLEARANCE, 0.95 * W0, a)
+    });
     let opts = ContinuationOptions::default();
     let main = continue_branch(family, 0.0, &[0.0; 4], 0.05, &opts, |_| true).unwrap();
     assert_eq!(main.stop, StopReason::ReachedEnd);
@@ -163,7 +169,7 @@ fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
 fn iterator_steps_and_user_event() {
     let level = crate::reference::r3_steady_amplitude(0.9 * W0);
     let opts = tight_options();
-    let family = |w: f64| r2(2, 1e3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e3, w));
     let steps = Continuation::new(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts)
         .unwrap()
         .with_event(Box::new(UserEvent(move |p: &BranchPoint| {
@@ -174,7 +180,7 @@ fn iterator_steps_and_user_event() {
         (Some(BranchStep::Point { point, special }), Some(BranchStep::Stop(reason))) => {
             assert_eq!(point.parameter, 0.8 * W0);
             assert!(special.is_empty());
-            assert_eq!(*reason, StopReason::ReachedEnd);
+            assert_eq!(reason, &StopReason::ReachedEnd);
         }
         other => panic!("unexpected ends {other:?}"),
     }
@@ -229,7 +235,7 @@ fn start_orbit(n: usize, from: f64) -> Vec<f64> {
 }
 
 fn r2_branch(from: f64, to: f64) -> Branch {
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     let guess = start_orbit(2, from);
     let opts = ContinuationOptions::default();
     continue_branch(family, from * W0, &guess, to * W0, &opts, |_| true).unwrap()
@@ -242,7 +248,7 @@ fn r2_branch(from: f64, to: f64) -> Branch {
 #[test]
 fn a_branch_without_special_points_takes_the_same_steps() {
     let (from, to) = (0.56, 0.5);
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     let guess = start_orbit(2, from);
     let run = |special_points: bool| {
         let opts = ContinuationOptions {
@@ -408,7 +414,7 @@ fn assert_brute_force_agrees(p: &BranchPoint) {
 /// confirmed by the change of stability on either side.
 #[test]
 fn r2_asymmetric_branches_fold_and_period_doubling() {
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     let main = r2_branch(1.5, 0.9);
     let opts = ContinuationOptions {
         max_points: 45,
@@ -505,7 +511,7 @@ fn r2_asymmetric_branches_fold_and_period_doubling() {
 /// stops there as a closed loop instead of retracing the mirror.
 #[test]
 fn r2_asymmetric_branch_connects_bp2_to_bp3() {
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     let main = r2_branch(1.5, 0.9);
     let opts = ContinuationOptions {
         max_points: 3000,
@@ -597,7 +603,7 @@ fn spectral_distance_sees_moduli_near_the_circle() {
 /// multiplier at both ends (the same parameter) to 1e-6.
 #[test]
 fn krylov_branch_matches_dense() {
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     let guess = start_orbit(2, 1.5);
     let dense = r2_branch(1.5, 0.5);
     let opts = ContinuationOptions {
@@ -644,7 +650,7 @@ fn assert_same_results(krylov: &Branch, dense: &Branch) {
 /// 2e-9 ω0 and 1.6e-7; with 8 vectors 4e-6).
 #[test]
 fn krylov_branch_matches_dense_on_a_longer_row() {
-    let family = |w: f64| r2(16, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(16, 1e-3, w));
     let guess = start_orbit(16, 0.5);
     let run = |krylov| {
         let opts = ContinuationOptions {
@@ -667,7 +673,7 @@ fn krylov_branch_matches_dense_on_a_longer_row() {
 /// two threads: the same bytes on one thread and on two.
 #[test]
 fn krylov_branch_is_the_same_on_any_thread_count() {
-    let family = |w: f64| r2(8, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(8, 1e-3, w));
     let guess = start_orbit(8, 0.5);
     let opts = ContinuationOptions {
         krylov: Some(12),
@@ -702,13 +708,13 @@ fn a_stop_inside_a_correction_reads_as_interrupted() {
     let mut opts = ContinuationOptions::default();
     opts.shooting.interrupt = Some(interrupt.clone());
     let mut calls = 0;
-    let family = |w: f64| {
+    let family = of("frequency", |w: f64| {
         calls += 1;
         if calls == 40 {
             interrupt.request();
         }
         r2(2, 1e-3, w)
-    };
+    });
     let guess = start_orbit(2, 1.5);
     let b = continue_branch(family, 1.5 * W0, &guess, 0.5 * W0, &opts, |_| true).unwrap();
     assert_eq!(b.stop, StopReason::Interrupted);
@@ -718,7 +724,7 @@ fn a_stop_inside_a_correction_reads_as_interrupted() {
 /// Matrix-free options that cannot work are refused before anything runs.
 #[test]
 fn krylov_dimension_is_checked() {
-    let family = |w: f64| r2(2, 1e-3, w);
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
     for m in [1, 5] {
         let opts = ContinuationOptions {
             krylov: Some(m),

@@ -16,6 +16,7 @@
 
 use super::system::{Constraint, Observation};
 use super::{bound_crossed, CurveKind, CurveOptions, CurveSystem, Scales};
+use crate::family::Family2;
 use crate::model::Model;
 use crate::newton::NewtonSystem;
 use crate::periodic::{
@@ -43,7 +44,7 @@ pub(super) struct KrylovSystem<F> {
     arnoldi: usize,
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
+impl<F: Family2> KrylovSystem<F> {
     pub(super) fn new(
         family: F,
         kind: CurveKind,
@@ -112,7 +113,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
     fn residual(&mut self, z: &[f64]) -> Result<Vec<f64>, String> {
         let d = self.d();
         let (x, v, p, q) = self.split(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let (image, dgv) = self.map(&model, &x, v)?;
         let av: Vec<f64> = match (self.kind, self.opts.symmetric) {
             (CurveKind::Fold, _) => (0..d).map(|i| dgv[i] - v[i]).collect(),
@@ -165,7 +166,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> KrylovSystem<F> {
     }
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F> {
+impl<F: Family2> CurveSystem for KrylovSystem<F> {
     fn p_index(&self) -> usize {
         2 * self.d()
     }
@@ -174,7 +175,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
     /// (GMRES on A v = b), then the start corrected with q held.
     fn start(&mut self, state: &[f64], p: f64, q: f64) -> Result<Vec<f64>, String> {
         let d = self.d();
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let x: Vec<f64> = state.iter().zip(&self.scale).map(|(a, s)| a / s).collect();
         let mut v: Vec<f64> = (0..d)
             .map(|i| 1.0 + 0.1 * ((i * 7919) % 97) as f64 / 97.0)
@@ -246,7 +247,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for KrylovSystem<F
     fn observe(&mut self, z: &[f64]) -> Result<Observation, String> {
         let d = self.d();
         let (x, _, p, q) = self.split(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let noise = 1e3 * self.opts.rtol;
         let m = self.arnoldi.min(d);
         let tangent = self.tangent_at(&model, &x)?;
@@ -281,7 +282,7 @@ struct Corrector<'a, 's, F> {
     constraint: Constraint<'a>,
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
+impl<F: Family2> NewtonSystem for Corrector<'_, '_, F> {
     type Point = (Vec<f64>, f64);
     type Error = String;
 

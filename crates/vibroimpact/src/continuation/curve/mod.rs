@@ -26,6 +26,7 @@ mod codim2;
 mod krylov;
 mod system;
 
+use crate::family::Family2;
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -186,7 +187,7 @@ pub struct Curve {
 /// The curve through a special point: `family(p, q)` builds the model,
 /// `(state, p, q)` is the point (e.g. a fold of a one-parameter branch in p
 /// at q), followed in the direction of increasing q first (`direction` ±1).
-pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
+pub fn continue_curve<F: Family2>(
     mut family: F,
     kind: CurveKind,
     start: (&[f64], f64, f64),
@@ -194,7 +195,7 @@ pub fn continue_curve<F: FnMut(f64, f64) -> Result<Model, String>>(
     opts: &CurveOptions,
 ) -> Result<Curve, String> {
     let (state, p, q) = start;
-    let model = family(p, q)?;
+    let model = family.model_at(p, q).map_err(|e| e.to_string())?;
     let d = state.len();
     if d != 2 * model.bodies().len() {
         return Err(format!(

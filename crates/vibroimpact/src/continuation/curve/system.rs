@@ -2,6 +2,7 @@
 //! variables: the orbit residual, the test function(s) from a bordered
 //! system, their forward-difference Jacobian and the Newton corrector.
 
+use crate::family::Family2;
 use nalgebra::{Complex, DMatrix, DVector};
 
 use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};
@@ -105,7 +106,7 @@ impl Observation {
     }
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
+impl<F: Family2> Augmented<F> {
     pub(super) fn new(
         family: F,
         kind: CurveKind,
@@ -194,7 +195,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     /// DG² + I (flip on the half map), DG² − 2κ DG + I (Neimark–Sacker).
     fn test_matrix(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
         let (x, p, q, kappa) = self.unscale(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let map = period_map(&model, &x, &self.opts).map_err(|e| e.to_string())?;
         let d = x.len();
         let dg = DMatrix::from_fn(d, d, |r, c| {
@@ -221,7 +222,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     /// The impact margins of every contact over one period (scaled).
     fn margins(&mut self, z: &[f64]) -> Result<Vec<f64>, String> {
         let (x, p, q, _) = self.unscale(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let period = self.period(&model)?;
         let orbit =
             orbit_summary(&model, &x, period, 0, self.opts.rtol).map_err(|e| e.to_string())?;
@@ -236,7 +237,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     /// approach on the orbit from z.
     fn centre_window(&mut self, z: &[f64]) -> Result<(), String> {
         let (x, p, q, _) = self.unscale(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let period = self.period(&model)?;
         let orbit =
             orbit_summary(&model, &x, period, 400, self.opts.rtol).map_err(|e| e.to_string())?;
@@ -312,7 +313,7 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     fn residual_full(&mut self, z: &[f64]) -> Result<DVector<f64>, String> {
         if self.kind == CurveKind::Grazing {
             let (x, p, q, _) = self.unscale(z);
-            let model = (self.family)(p, q)?;
+            let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
             let image = period_image(&model, &x, &self.opts)
                 .ok_or("the period map failed at a grazing-curve iterate")?;
             let g = self.orbit_residual(&image, &x);
@@ -412,14 +413,14 @@ impl<F: FnMut(f64, f64) -> Result<Model, String>> Augmented<F> {
     /// eigenvalues.
     fn observe(&mut self, z: &[f64]) -> Result<Observation, String> {
         let (x, p, q, kappa) = self.unscale(z);
-        let model = (self.family)(p, q)?;
+        let model = self.family.model_at(p, q).map_err(|e| e.to_string())?;
         let map = period_map(&model, &x, &self.opts).map_err(|e| e.to_string())?;
         let eigenvalues = floquet_multipliers(&map.monodromy).map_err(|e| e.to_string())?;
         Observation::new(&model, x, (p, q), eigenvalues, kappa, &self.opts)
     }
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> CurveSystem for Augmented<F> {
+impl<F: Family2> CurveSystem for Augmented<F> {
     fn p_index(&self) -> usize {
         self.dim()
     }
@@ -500,7 +501,7 @@ struct Corrector<'a, 's, F> {
     chord: Option<(DMatrix<f64>, f64)>,
 }
 
-impl<F: FnMut(f64, f64) -> Result<Model, String>> NewtonSystem for Corrector<'_, '_, F> {
+impl<F: Family2> NewtonSystem for Corrector<'_, '_, F> {
     type Point = (DVector<f64>, DMatrix<f64>);
     type Error = String;
 

@@ -3,12 +3,14 @@
 
 use super::*;
 use crate::continuation::{continue_branch, ContinuationOptions, SpecialKind};
+use crate::family::{of, of2};
+use crate::model::ModelError;
 use crate::periodic::{map_multipliers, period_map};
 
 use crate::reference::NATURAL_FREQUENCY as W0;
 
-fn r2(n: usize, frequency: f64, amplitude: f64) -> Result<Model, String> {
-    crate::reference::r2_forced(n, 1e-3, frequency, amplitude).map_err(|e| e.to_string())
+fn r2(n: usize, frequency: f64, amplitude: f64) -> Result<Model, ModelError> {
+    crate::reference::r2_forced(n, 1e-3, frequency, amplitude)
 }
 
 /// R2 N = 1: the fold curve in (frequency, amplitude) from the fold LP1 of
@@ -18,7 +20,7 @@ fn r2(n: usize, frequency: f64, amplitude: f64) -> Result<Model, String> {
 /// a multiplier +1.
 #[test]
 fn fold_curve_joins_the_two_folds_through_a_cusp() {
-    let family = |w: f64| r2(1, w, 0.05);
+    let family = of("frequency", |w: f64| r2(1, w, 0.05));
     let start = r2(1, 0.5 * W0, 0.05).unwrap();
     let guess = crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap();
     let one = continue_branch(
@@ -53,7 +55,7 @@ fn fold_curve_joins_the_two_folds_through_a_cusp() {
         ..CurveOptions::default()
     };
     let curve = continue_curve(
-        r2_family,
+        of2(["frequency", "amplitude"], r2_family),
         CurveKind::Fold,
         (&lp1.state, lp1.parameter, 0.05),
         -1.0,
@@ -94,7 +96,7 @@ fn fold_curve_joins_the_two_folds_through_a_cusp() {
     let last = curve.points.last().unwrap();
     assert!((last.q - 0.0501).abs() < 1e-15, "{}", last.q);
     let back = continue_curve(
-        r2_family,
+        of2(["frequency", "amplitude"], r2_family),
         CurveKind::Fold,
         (&lp1.state, lp1.parameter, 0.05),
         -1.0,
@@ -132,13 +134,13 @@ fn fold_curve_joins_the_two_folds_through_a_cusp() {
     );
 }
 
-fn r2_family(p: f64, q: f64) -> Result<Model, String> {
+fn r2_family(p: f64, q: f64) -> Result<Model, ModelError> {
     r2(1, p, q)
 }
 
 /// A row of `n` seed pendulums (walls `(left, right)`) at base amplitude q
 /// and frequency p.
-fn row(n: usize, walls: (bool, bool), p: f64, q: f64) -> Result<Model, String> {
+fn row(n: usize, walls: (bool, bool), p: f64, q: f64) -> Result<Model, ModelError> {
     use crate::model::BaseExcitation;
     use crate::reference::{seed_law, DAMPING_RATIO, MASS};
     Model::row(
@@ -155,7 +157,6 @@ fn row(n: usize, walls: (bool, bool), p: f64, q: f64) -> Result<Model, String> {
             phase: 0.0,
         },
     )
-    .map_err(|e| e.to_string())
 }
 
 /// The branch 0.5 → 1.5 ω0 of the row at amplitude q, from a 200-period
@@ -173,13 +174,13 @@ fn branch_over(
     (from, to): (f64, f64),
 ) -> crate::continuation::Branch {
     let guess = crate::continuation::amplitude_homotopy(
-        |a| row(n, walls, from, a),
+        of("amplitude", |a| row(n, walls, from, a)),
         q,
         &ContinuationOptions::default(),
     )
     .unwrap();
     continue_branch(
-        |w: f64| row(n, walls, w, q),
+        of("frequency", |w: f64| row(n, walls, w, q)),
         from,
         &guess,
         to,
@@ -265,7 +266,7 @@ fn period_doubling_curve_keeps_a_multiplier_minus_one() {
     };
     for direction in [1.0, -1.0] {
         let curve = continue_curve(
-            |p, q| row(1, walls, p, q),
+            of2(["frequency", "amplitude"], |p, q| row(1, walls, p, q)),
             CurveKind::PeriodDoubling,
             (&pd.state, pd.parameter, 0.05),
             direction,
@@ -301,7 +302,7 @@ fn neimark_sacker_curve_keeps_a_pair_on_the_unit_circle() {
         ..CurveOptions::default()
     };
     let curve = continue_curve(
-        |p, q| row(2, walls, p, q),
+        of2(["frequency", "amplitude"], |p, q| row(2, walls, p, q)),
         CurveKind::NeimarkSacker,
         (&ns.state, ns.parameter, 0.02),
         1.0,
@@ -358,7 +359,7 @@ fn grazing_curve_keeps_a_contact_at_the_threshold() {
         ..CurveOptions::default()
     };
     let curve = continue_curve(
-        |p, q| row(2, walls, p, q),
+        of2(["frequency", "amplitude"], |p, q| row(2, walls, p, q)),
         CurveKind::Grazing,
         (&gr.state, gr.parameter, 0.05),
         1.0,
@@ -403,7 +404,7 @@ fn neimark_sacker_curve_ends_at_a_double_branch_point() {
     };
     let ns = special(&b, SpecialKind::NeimarkSacker, false);
     let curve = continue_curve(
-        |p, q| row(2, walls, p, q),
+        of2(["frequency", "amplitude"], |p, q| row(2, walls, p, q)),
         CurveKind::NeimarkSacker,
         (&ns.state, ns.parameter, 0.05),
         -1.0,
@@ -471,7 +472,7 @@ fn chart_cells_agree_with_the_curves() {
         ..CurveOptions::default()
     };
     let curve = continue_curve(
-        |p, q| row(1, walls, p, q),
+        of2(["frequency", "amplitude"], |p, q| row(1, walls, p, q)),
         CurveKind::PeriodDoubling,
         (&pd.state, pd.parameter, 0.05),
         1.0,
@@ -501,7 +502,7 @@ fn chart_cells_agree_with_the_curves() {
     let b = branch(1, walls, 0.05);
     let lp = special(&b, SpecialKind::Fold, true);
     let fold = continue_curve(
-        |p, q| row(1, walls, p, q),
+        of2(["frequency", "amplitude"], |p, q| row(1, walls, p, q)),
         CurveKind::Fold,
         (&lp.state, lp.parameter, 0.05),
         1.0,
@@ -575,7 +576,7 @@ fn krylov_curves_match_dense() {
         let mut ends = Vec::new();
         for opts in [&dense_opts, &krylov_opts] {
             let c = continue_curve(
-                |p, q| row(n, walls, p, q),
+                of2(["frequency", "amplitude"], |p, q| row(n, walls, p, q)),
                 kind,
                 (&sp.state, sp.parameter, 0.05),
                 1.0,
