@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
+use vibroimpact::continuation::{Linear, Start};
 use vibroimpact::integrate::Method;
 use vibroimpact::simulate::Integrator;
 
@@ -100,6 +101,17 @@ pub enum StartMethod {
     Homotopy,
 }
 
+impl StartMethod {
+    /// The library's start.
+    pub fn start(self) -> Start {
+        match self {
+            StartMethod::Auto => Start::Auto,
+            StartMethod::Simulate => Start::Simulate,
+            StartMethod::Homotopy => Start::Homotopy,
+        }
+    }
+}
+
 /// Dense or matrix-free linear algebra for periodic orbits and branches
 /// (`periodic`, `continue`).
 #[derive(Args, Debug)]
@@ -117,13 +129,21 @@ pub struct LinearAlgebra {
 }
 
 impl LinearAlgebra {
-    /// Rows at least this long are matrix-free unless `--dense`.
-    pub const AUTO_KRYLOV_BODIES: usize = 200;
+    /// The library's choice.
+    pub fn linear(&self) -> Linear {
+        if self.krylov {
+            Linear::MatrixFree
+        } else if self.dense {
+            Linear::Dense
+        } else {
+            Linear::Auto
+        }
+    }
 
     /// The Arnoldi dimension if matrix-free for a row of `bodies`, else
     /// None.
     pub fn krylov(&self, bodies: usize) -> Option<usize> {
-        (self.krylov || (!self.dense && bodies >= Self::AUTO_KRYLOV_BODIES)).then_some(self.arnoldi)
+        self.linear().krylov(bodies, self.arnoldi)
     }
 }
 

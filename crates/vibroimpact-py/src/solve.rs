@@ -8,8 +8,9 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use vibroimpact::contact::ContactLaw;
 use vibroimpact::continuation::{
-    continue_branch as run_branch, switch_branch, ContinuationOptions,
+    BranchStudy, ContinuationError, ContinuationOptions, Linear, Start, StudyError, StudyField,
 };
+use vibroimpact::family::Family;
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::{ImpactError, TwoBodies};
@@ -420,8 +421,10 @@ pub fn periodic<'py>(
 
 /// A branch of periodic solutions: the `continue` document (with
 /// `switched_branch` when `switch_at` is given); progress counts points.
+/// The library's [`BranchStudy`] does the checks, the start (`start`:
+/// auto, simulate or homotopy) and the switch, as for the CLI.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto"))]
+#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto", start = "auto", krylov = false, dense = false, arnoldi = 20))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_branch<'py>(
     py: Python<'py>,
@@ -436,67 +439,88 @@ pub fn continue_branch<'py>(
     guess_periods: f64,
     progress: Option<&Bound<'py, PyAny>>,
     integrator: &str,
+    start: &str,
+    krylov: bool,
+    dense: bool,
+    arnoldi: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
-    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
-    if !(from_.is_finite() && to.is_finite()) || from_ == to {
-        return Err(value_error(format!(
-            "from_ = {from_}, to = {to}: the range is empty or not finite"
-        )));
-    }
-    if family.parameter.integer {
-        return Err(value_error(format!(
-            "parameter `{parameter}` takes whole numbers: a branch needs a continuous parameter (sweep it instead)"
-        )));
-    }
-    if subharmonic == 0 {
-        return Err(value_error("subharmonic must be >= 1"));
-    }
-    let start = family.model_at(from_).map_err(value_error)?;
-    if start.forcing_frequency().is_none() {
-        return Err(value_error(
-            "the model has no periodic forcing with one frequency at from_: nothing to continue",
-        ));
-    }
-    let start_job = start.clone();
-    let out = monitor::run(py, progress, move |p: &Progress| {
-        p.set_total(max_points);
-        let opts = ContinuationOptions {
+    let mut family =
+        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
+    let start = match start {
+        "auto" => Start::Auto,
+        "simulate" => Start::Simulate,
+        "homotopy" => Start::Homotopy,
+        other => {
+            return Err(value_error(format!(
+                "start = {other:?}: must be auto, simulate or homotopy"
+            )))
+        }
+    };
+    let linear = match (krylov, dense) {
+        (true, true) => return Err(value_error("krylov = True, dense = True: choose one")),
+        (true, false) => Linear::MatrixFree,
+        (false, true) => Linear::Dense,
+        (false, false) => Linear::Auto,
+    };
+    let mut study = BranchStudy {
+        from: from_,
+        to,
+        start,
+        guess_periods,
+        switch_at,
+        linear,
+        arnoldi,
+        options: ContinuationOptions {
             max_points,
             ds_max,
             shooting: ShootingOptions {
                 subharmonic,
-                interrupt: Some(p.interrupt.clone()),
-                integrator,
+                integrator: integrator.parse().map_err(value_error)?,
                 ..ContinuationOptions::default().shooting
             },
             ..ContinuationOptions::default()
-        };
-        let guess = guess_by_simulation_with(
-            &start_job,
-            guess_periods,
-            1e-9,
-            Some(p.interrupt.clone()),
-            integrator,
-        )
-        .map_err(|e| format!("start guess: {e}"))?;
+        },
+    };
+    let spell = |e: StudyError| match e {
+        StudyError::Invalid { field, message } => value_error(format!(
+            "{}: {message}",
+            match field {
+                StudyField::Range => format!("from_ = {from_}, to = {to}"),
+                StudyField::From => format!("from_ = {from_}"),
+                StudyField::Subharmonic => format!("subharmonic = {subharmonic}"),
+                StudyField::Parameter => format!("parameter = {parameter:?}"),
+                StudyField::Start => format!("start = {:?}", start.name()),
+            }
+        )),
+        StudyError::Family(e) => value_error(e),
+        StudyError::Continuation(e @ ContinuationError::Invalid(_)) => value_error(e),
+        other => numerical_error(other),
+    };
+    let (start_model, _) = study.check(&mut family).map_err(spell)?;
+    let mut at_start = model.document.clone();
+    at_start
+        .set(&family.parameter, from_)
+        .map_err(value_error)?;
+    let amplitude = ParameterizedModel::new(at_start, "amplitude");
+    let out = monitor::run(py, progress, move |p: &Progress| {
+        p.set_total(max_points);
+        study.options.shooting.interrupt = Some(p.interrupt.clone());
+        let mut amplitude = amplitude;
+        let homotopy = amplitude.as_mut().ok().map(|a| {
+            let target = a.initial();
+            (a as &mut dyn Family, target)
+        });
         let on_point = |_: &vibroimpact::continuation::BranchPoint| {
             p.tick();
             !p.interrupt.requested()
         };
-        let branch =
-            run_branch(&family, from_, &guess, to, &opts, on_point).map_err(|e| e.to_string())?;
-        let switched = switch_at.as_deref().map(|label| {
-            switch_branch(&family, &branch, label, (from_, to), &opts, on_point)
-                .map_err(|e| e.to_string())
-        });
-        Ok::<_, String>((branch, switched))
+        study.run(&family, homotopy, on_point)
     })?;
-    let (branch, switched) = out.map_err(numerical_error)?;
-    let mut doc = branch_document(&branch, &start, parameter);
-    match switched {
-        Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start, parameter),
-        Some(Err(e)) => doc["switch_error"] = serde_json::Value::String(e),
+    let outcome = out.map_err(spell)?;
+    let mut doc = branch_document(&outcome.branch, &start_model, parameter);
+    match outcome.switched {
+        Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start_model, parameter),
+        Some(Err(e)) => doc["switch_error"] = serde_json::Value::String(e.to_string()),
         None => {}
     }
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)

@@ -142,6 +142,28 @@ def test_continue_local(cli):
     )
 
 
+def test_continue_falls_back_to_the_homotopy(cli):
+    # At 0.95 w0 the row's simulated guess does not converge: both faces
+    # start from the homotopy in the amplitude (the library's study) and
+    # give the same branch; `start` and the linear algebra are keywords.
+    m = EXAMPLES / "fujita-row.toml"
+    doc = cli("continue", m, "--parameter", "frequency", "--from", "7.0395", "--to", "7.5")
+    r = vi.continue_(m, "frequency", 7.0395, 7.5)
+    assert r.stop == doc["stop"] == "ReachedEnd"
+    close(r.column("parameter"), [p["parameter"] for p in doc["points"]])
+    close(r.points[-1].max_displacement, doc["points"][-1]["max_displacement"])
+    h = vi.continue_(m, "frequency", 7.0395, 7.5, start="homotopy", dense=True)
+    close(h.column("parameter"), r.column("parameter"))
+    with pytest.raises(vi.VibroimpactError, match="start"):
+        vi.continue_(m, "frequency", 7.0395, 7.5, start="simulate")
+    with pytest.raises(ValueError, match="start"):
+        vi.continue_(m, "frequency", 7.0395, 7.5, start="guess")
+    with pytest.raises(ValueError, match="krylov = True, dense = True"):
+        vi.continue_(m, "frequency", 7.0395, 7.5, krylov=True, dense=True)
+    with pytest.raises(ValueError, match="from_ = 7.5, to = 7.5: the range is empty"):
+        vi.continue_(m, "frequency", 7.5, 7.5)
+
+
 def test_periodic(cli):
     # The three-pendulum row's unstable symmetric orbit from the simulated
     # guess (the two-pendulum row's motion at 0.95 omega0 is irregular too:

@@ -64,6 +64,11 @@ pub trait Family {
     fn name(&self) -> &str;
     /// The model at parameter value `p`.
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError>;
+    /// Whether the parameter takes whole numbers only (a count): no
+    /// branch can follow it.
+    fn whole_numbers(&self) -> bool {
+        false
+    }
 }
 
 /// Models in two parameters (curves of special points: `p` along the
@@ -81,6 +86,9 @@ impl<T: Family + ?Sized> Family for &mut T {
     }
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
         (**self).model_at(p)
+    }
+    fn whole_numbers(&self) -> bool {
+        (**self).whole_numbers()
     }
 }
 
@@ -100,6 +108,9 @@ impl Family for ParameterizedModel {
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
         ParameterizedModel::model_at(self, p).map_err(|e| FamilyError::new(self.name(), p, e))
     }
+    fn whole_numbers(&self) -> bool {
+        self.parameter.integer
+    }
 }
 
 impl Family for &ParameterizedModel {
@@ -109,6 +120,9 @@ impl Family for &ParameterizedModel {
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
         ParameterizedModel::model_at(self, p)
             .map_err(|e| FamilyError::new(&self.parameter.name, p, e))
+    }
+    fn whole_numbers(&self) -> bool {
+        self.parameter.integer
     }
 }
 

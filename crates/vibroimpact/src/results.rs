@@ -282,7 +282,8 @@ pub fn branch_document(branch: &Branch, model: &Model, name: &str) -> Value {
         "parameter_name": name,
         "subharmonic": branch.subharmonic,
         "symmetric": branch.symmetric,
-        "stop": format!("{:?}", branch.stop),
+        "stop": branch.stop.name(),
+        "stop_detail": branch.stop.detail(),
         "contacts": (0..model.contacts().len()).map(|k| model.contact_name(k)).collect::<Vec<_>>(),
         "points": branch.points.iter().map(|p| json!({
             "parameter": p.parameter,

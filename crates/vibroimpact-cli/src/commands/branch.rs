@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::continuation::{
-    amplitude_homotopy, continue_branch, switch_branch, validate_size, Branch, ContinuationError,
-    ContinuationOptions,
+    amplitude_homotopy, Branch, BranchStudy, ContinuationOptions, StudyError, StudyField,
 };
+use vibroimpact::family::Family;
+use vibroimpact::integrate::Interrupt;
 use vibroimpact::model::Model;
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
@@ -410,35 +411,45 @@ fn write_branch(
     Ok(())
 }
 
-/// The family and the start model of `continue`, after checking the range,
-/// the subharmonic and that the parameter is continuous and the start
-/// forced periodically.
-fn continuation_family(args: &ContinueArgs) -> Result<(ParameterizedModel, Model), CliError> {
-    let pm = read_family(&args.range.model, &args.range.parameter)?;
-    if !(args.range.from.is_finite() && args.range.to.is_finite())
-        || args.range.from == args.range.to
-    {
-        return Err(CliError::new(format!(
-            "--from {} --to {}: the range is empty or not finite",
-            args.range.from, args.range.to
-        )));
+/// A study error in the command line's words: the option first.
+fn study_error(e: StudyError, args: &ContinueArgs) -> CliError {
+    match e {
+        StudyError::Invalid { field, message } => {
+            let option = match field {
+                StudyField::Range => format!("--from {} --to {}", args.range.from, args.range.to),
+                StudyField::From => format!("--from {}", args.range.from),
+                StudyField::Subharmonic => format!("--subharmonic {}", args.subharmonic),
+                StudyField::Parameter => format!("--parameter {}", args.range.parameter),
+                StudyField::Start => format!("--start {}", args.start.start().name()),
+            };
+            CliError::new(format!("{option}: {message}"))
+        }
+        other => CliError::new(other.to_string()),
     }
-    if args.subharmonic == 0 {
-        return Err(CliError::new("--subharmonic must be >= 1"));
+}
+
+/// The study `continue` runs.
+fn branch_study(args: &ContinueArgs, interrupt: &Interrupt) -> BranchStudy {
+    BranchStudy {
+        from: args.range.from,
+        to: args.range.to,
+        start: args.start.start(),
+        guess_periods: args.guess_periods,
+        switch_at: args.switch_at.clone(),
+        linear: args.linear.linear(),
+        arnoldi: args.linear.arnoldi,
+        options: ContinuationOptions {
+            max_points: args.max_points,
+            ds_max: args.ds_max,
+            shooting: ShootingOptions {
+                subharmonic: args.subharmonic,
+                interrupt: Some(interrupt.clone()),
+                integrator: args.integrator.integrator(),
+                ..ContinuationOptions::default().shooting
+            },
+            ..ContinuationOptions::default()
+        },
     }
-    if pm.parameter.integer {
-        return Err(CliError::new(format!(
-            "--parameter {}: takes whole numbers; a branch needs a continuous parameter (use sweep)",
-            args.range.parameter
-        )));
-    }
-    let start_model = pm.model_at(args.range.from)?;
-    if start_model.forcing_frequency().is_none() {
-        return Err(CliError::new(
-            "the model has no periodic forcing with one frequency at --from: nothing to continue",
-        ));
-    }
-    Ok((pm, start_model))
 }
 
 /// Prints the branches in the chosen format.
@@ -561,40 +572,23 @@ fn print_curves(c: &curves::Curves) {
 
 /// Runs `vibroimpact continue`.
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
-    let (pm, start_model) = continuation_family(args)?;
-    let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
+    let mut pm = read_family(&args.range.model, &args.range.parameter)?;
     let interrupt = crate::interrupt::on_ctrl_c();
+    let study = branch_study(args, &interrupt);
+    let (start_model, opts) = study.check(&mut pm).map_err(|e| study_error(e, args))?;
+    let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
     if let (Some(path), Some(q)) = (&args.second.special_points, &second) {
         return curves_from_file(args, &pm, q, path, &interrupt);
     }
-    let opts = ContinuationOptions {
-        max_points: args.max_points,
-        ds_max: args.ds_max,
-        krylov: args.linear.krylov(start_model.bodies().len()),
-        shooting: ShootingOptions {
-            subharmonic: args.subharmonic,
-            interrupt: Some(interrupt.clone()),
-            integrator: args.integrator.integrator(),
-            ..ContinuationOptions::default().shooting
-        },
-        ..ContinuationOptions::default()
-    };
-    validate_size(&start_model, &opts)?;
     let mut doc_at_start = pm.document.clone();
     doc_at_start.set(&pm.parameter, args.range.from)?;
-    let homotopy = || -> Result<Vec<f64>, CliError> {
-        homotopy_start(&homotopy_family(&doc_at_start)?, &opts)
-    };
-    let guess = match args.start {
-        StartMethod::Homotopy => homotopy()?,
-        StartMethod::Auto | StartMethod::Simulate => guess_by_simulation_with(
-            &start_model,
-            args.guess_periods,
-            1e-9,
-            Some(interrupt.clone()),
-            opts.shooting.integrator,
-        )
-        .map_err(|e| CliError::new(format!("start guess: {e}")))?,
+    let mut amplitude = homotopy_family(&doc_at_start);
+    let homotopy = match &mut amplitude {
+        Ok(family) => {
+            let target = family.initial();
+            Some((family as &mut dyn Family, target))
+        }
+        Err(_) => None,
     };
     let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
@@ -608,42 +602,26 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         ));
         !interrupt.requested()
     };
-    let mut progress = progress;
-    let mut run = |guess: &[f64]| {
-        continue_branch(
-            &pm,
-            args.range.from,
-            guess,
-            args.range.to,
-            &opts,
-            &mut progress,
-        )
-    };
-    // Auto: a simulated guess from which Newton does not converge falls
-    // back to the homotopy (the simulated guess, where it converges, is the
-    // attractor the user sees; the homotopy's orbit lies on the branch that
-    // grows from rest, which at a given frequency may be another one).
-    let branch = match run(&guess) {
-        Err(ContinuationError::StartNotConverged(_)) if args.start == StartMethod::Auto => {
-            run(&homotopy()?)?
-        }
-        other => other?,
-    };
-    let mut branches = vec![branch];
+    let outcome = study
+        .run(&pm, homotopy, progress)
+        .map_err(|e| match (e, &amplitude) {
+            // The homotopy was needed and the model has no amplitude to vary.
+            (
+                StudyError::Invalid {
+                    field: StudyField::Start,
+                    ..
+                },
+                Err(why),
+            ) => CliError::new(why.to_string()),
+            (e, _) => study_error(e, args),
+        })?;
+    let mut branches = vec![outcome.branch];
     // A failed switch keeps the main branch: it is written, then reported.
     let mut switch_error = None;
-    if let Some(label) = &args.switch_at {
-        match switch_branch(
-            &pm,
-            &branches[0],
-            label,
-            (args.range.from, args.range.to),
-            &opts,
-            progress,
-        ) {
-            Ok(b) => branches.push(b),
-            Err(e) => switch_error = Some(CliError::new(e.to_string())),
-        }
+    match outcome.switched {
+        Some(Ok(b)) => branches.push(b),
+        Some(Err(e)) => switch_error = Some(CliError::new(e.to_string())),
+        None => {}
     }
     bar.finish_and_clear();
     let curves = match &second {

@@ -543,6 +543,10 @@ def continue_(
     guess_periods: float = 200.0,
     progress: Progress = None,
     integrator: str = "auto",
+    start: str = "auto",
+    krylov: bool = False,
+    dense: bool = False,
+    arnoldi: int = 20,
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -553,9 +557,16 @@ def continue_(
     continued too (``switched_branch``). ``progress(points, max_points)``.
     ``integrator="local"``: the period maps by the exact motion between
     contacts, integrating only the bodies in touch (a parameter of the
-    forcing: "frequency", "amplitude").
+    forcing: "frequency", "amplitude"). ``start``: "auto" (a guess by
+    simulation over ``guess_periods``, then the homotopy in the forcing
+    amplitude if Newton does not converge from it), "simulate" or
+    "homotopy" (the primary branch from rest). ``krylov=True``:
+    matrix-free (Newton–Krylov, ``arnoldi`` dominant multipliers), the
+    default from 200 bodies; ``dense=True``: the dense monodromy at any
+    size.
 
-    Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop``,
+    Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
+    MaxPoints, Interrupted, CannotContinue or ClosedLoop) with ``stop_detail``,
     ``contacts``, ``points`` (each with ``parameter``, ``max_displacement``,
     ``max_velocity``, ``impacts_per_period``, ``stable``,
     ``spectral_radius``, ``floquet_multipliers``, ``initial_state``,
@@ -580,11 +591,17 @@ def continue_(
         _real(guess_periods, "guess_periods", positive=True),
         _progress(progress),
         _method(integrator, ("auto", "global", "local"), "integrator"),
+        _method(start, ("auto", "simulate", "homotopy"), "start"),
+        _flag(krylov, "krylov"),
+        _flag(dense, "dense"),
+        _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
     )
     r = Result(d)
     problem = None
-    if str(r.stop).startswith("CannotContinue"):
-        problem = f"the branch cannot continue: {r.stop} (the points computed so far are kept)"
+    if r.stop == "CannotContinue":
+        problem = (
+            f"the branch cannot continue: {r.stop_detail} (the points computed so far are kept)"
+        )
     elif "switch_error" in r:
         problem = r.switch_error
     if problem:

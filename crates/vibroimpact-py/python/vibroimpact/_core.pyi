@@ -63,7 +63,8 @@ def periodic(
 def continue_branch(
     model: Model, parameter: str, from_: float, to: float, subharmonic: int,
     switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
-    progress: Progress = None, integrator: str = "auto",
+    progress: Progress = None, integrator: str = "auto", start: str = "auto",
+    krylov: bool = False, dense: bool = False, arnoldi: int = 20,
 ) -> dict[str, Any]: ...
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,

@@ -42,7 +42,9 @@
 //! - `switching`: starts on crossing and period-doubled branches;
 //! - `curve`: two-parameter curves of folds, period doublings and
 //!   symmetry-breaking points ([`continue_curve`]);
-//! - [`continue_branch`]: the iterator collected into a [`Branch`].
+//! - [`continue_branch`]: the iterator collected into a [`Branch`];
+//! - [`BranchStudy`]: a whole `continue` (checks, start, branch, switch)
+//!   for every face.
 
 mod branch;
 mod curve;
@@ -50,6 +52,7 @@ mod events;
 mod krylov;
 mod problem;
 mod start;
+mod study;
 mod switching;
 #[cfg(test)]
 mod tests;
@@ -61,6 +64,9 @@ pub use curve::{
 };
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
+pub use study::{
+    BranchOutcome, BranchStudy, Linear, Start, StudyError, StudyField, AUTO_KRYLOV_BODIES,
+};
 pub use switching::{
     branch_switch_start, is_symmetric_orbit, period_doubled_start, switch_branch, SwitchError,
 };
@@ -342,6 +348,29 @@ pub enum StopReason {
     /// asymmetric branch between two symmetry-breaking points and its
     /// mirror image); it is not traversed again.
     ClosedLoop,
+}
+
+impl StopReason {
+    /// A stable name: `ReachedEnd`, `MaxPoints`, `Interrupted`,
+    /// `CannotContinue` or `ClosedLoop` (the documents' `stop`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::ReachedEnd => "ReachedEnd",
+            Self::MaxPoints => "MaxPoints",
+            Self::Interrupted => "Interrupted",
+            Self::CannotContinue(_) => "CannotContinue",
+            Self::ClosedLoop => "ClosedLoop",
+        }
+    }
+
+    /// Where and why a branch could not continue (the documents'
+    /// `stop_detail`); None for the other stops.
+    pub fn detail(&self) -> Option<&str> {
+        match self {
+            Self::CannotContinue(why) => Some(why),
+            _ => None,
+        }
+    }
 }
 
 impl std::fmt::Display for StopReason {
