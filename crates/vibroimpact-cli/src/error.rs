@@ -47,3 +47,9 @@ from_display!(
     vibroimpact::sweep::SweepError,
     serde_json::Error
 );
+
+/// A library option error in the command line's words: the option
+/// `--kebab-case`, then its value.
+pub fn option_error(e: &vibroimpact::field_error::FieldError) -> CliError {
+    CliError::new(e.spelled(&format!("--{}", e.field.replace('_', "-")), " "))
+}

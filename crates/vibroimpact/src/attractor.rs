@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::model::Model;
 use crate::model_file::LoadedModel;
-use crate::sweep::{run_value, Direction, Settings, Start, SweepOptions, SweepPoint};
+use crate::sweep::{run_value, Direction, Settings, Start, SweepError, SweepOptions, SweepPoint};
 
 /// Relative tolerance of the integrations of charts and basins unless the
 /// options or the model's `[simulation]` give one. The Poincaré samples of
@@ -28,7 +28,7 @@ pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
 /// The run settings of charts and basins: `options` for models like
 /// `base`, with [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`] where
 /// neither the options nor the model give a value.
-pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Settings, String> {
+pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Settings, SweepError> {
     let options = SweepOptions {
         rtol: options.rtol.or(base.simulation.rtol).or(Some(DEFAULT_RTOL)),
         cluster_tolerance: options
@@ -36,7 +36,7 @@ pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Set
             .or(Some(DEFAULT_CLUSTER_TOLERANCE)),
         ..options.clone()
     };
-    Settings::new(base, &options).map_err(|e| e.0)
+    Settings::new(base, &options)
 }
 
 /// Checks the values of a grid axis named `name`: at least one, all finite.

@@ -10,8 +10,9 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::attractor::{check_axis, identify, run_from, settings, Recorded, Run};
+use crate::field_error::FieldError;
 use crate::model_file::LoadedModel;
-use crate::sweep::{admissible, SweepOptions};
+use crate::sweep::{admissible, SweepError, SweepOptions};
 
 /// Largest number of initial states of one basin computation.
 pub const MAX_CELLS: usize = 50_000_000;
@@ -31,7 +32,7 @@ impl Component {
     /// body order).
     pub fn parse(text: &str, bodies: usize) -> Result<Self, BasinError> {
         let bad = || {
-            BasinError(format!(
+            BasinError::Input(format!(
                 "component `{text}`: give u or v and a body number from 1 to {bodies} (e.g. u1, v2)"
             ))
         };
@@ -121,8 +122,23 @@ pub struct Basins {
 /// Input errors of a basin computation (numerical failures are counted in
 /// the result).
 #[derive(Debug, Error)]
-#[error("{0}")]
-pub struct BasinError(pub String);
+pub enum BasinError {
+    /// An option refused by name.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// Any other input error.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl From<SweepError> for BasinError {
+    fn from(e: SweepError) -> Self {
+        match e {
+            SweepError::Field(f) => Self::Field(f),
+            SweepError::Input(m) => Self::Input(m),
+        }
+    }
+}
 
 /// The basins of `loaded`'s model over the plane `x` × `y` (component and
 /// values) through `base` (`[u.., v..]`; None: the model's initial state),
@@ -141,17 +157,17 @@ pub fn basins(
     let model = &loaded.model;
     let n = model.bodies().len();
     if x.0 == y.0 {
-        return Err(BasinError(format!(
+        return Err(BasinError::Input(format!(
             "the two components are both {}: give two different ones",
             x.0.name()
         )));
     }
     for (c, values) in [x, y] {
-        check_axis(&c.name(), values).map_err(BasinError)?;
+        check_axis(&c.name(), values).map_err(BasinError::Input)?;
     }
     let cells = x.1.len().saturating_mul(y.1.len());
     if cells > MAX_CELLS {
-        return Err(BasinError(format!(
+        return Err(BasinError::Input(format!(
             "{} × {} initial states: more than {MAX_CELLS}; use a coarser grid",
             x.1.len(),
             y.1.len()
@@ -159,14 +175,14 @@ pub fn basins(
     }
     let base_state = match base {
         Some(b) if b.len() != 2 * n => {
-            return Err(BasinError(format!(
-                "base state: needs {} values (u then v), got {}",
-                2 * n,
-                b.len()
-            )))
+            return Err(FieldError::about(
+                "base",
+                format!("needs {} values (u then v), got {}", 2 * n, b.len()),
+            )
+            .into())
         }
         Some(b) if b.iter().any(|v| !v.is_finite()) => {
-            return Err(BasinError("base state: the values must be finite".into()))
+            return Err(FieldError::about("base", "the values must be finite").into())
         }
         Some(b) => b.to_vec(),
         None => {
@@ -176,11 +192,11 @@ pub fn basins(
         }
     };
     let Some(omega) = model.forcing_frequency() else {
-        return Err(BasinError(
+        return Err(BasinError::Input(
             "the model has no periodic excitation with one frequency (attractors are recognised once per forcing period)".into(),
         ));
     };
-    let settings = settings(loaded, options).map_err(BasinError)?;
+    let settings = settings(loaded, options)?;
     let states: Vec<Vec<f64>> =
         y.1.iter()
             .flat_map(|&vy| {

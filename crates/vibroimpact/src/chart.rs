@@ -11,9 +11,10 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::attractor::{check_axis, count_attractors, run_from, settings, Recorded, Run};
+use crate::field_error::FieldError;
 use crate::model::Model;
 use crate::model_file::ModelDocument;
-use crate::sweep::{admissible, Settings, SweepOptions};
+use crate::sweep::{admissible, Settings, SweepError, SweepOptions};
 
 /// Largest number of runs (cells × starts) of one chart: the result keeps
 /// ~200 bytes a run.
@@ -86,8 +87,23 @@ pub struct Chart {
 /// Why a chart could not be computed (input errors; numerical failures are
 /// kept in the runs).
 #[derive(Debug, Error)]
-#[error("{0}")]
-pub struct ChartError(pub String);
+pub enum ChartError {
+    /// An option refused by name.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// Any other input error.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl From<SweepError> for ChartError {
+    fn from(e: SweepError) -> Self {
+        match e {
+            SweepError::Field(f) => Self::Field(f),
+            SweepError::Input(m) => Self::Input(m),
+        }
+    }
+}
 
 /// The chart of `document` over `x` (name, values) × `y` (name, values).
 /// Every model of the grid's first row and column is built before any
@@ -101,29 +117,27 @@ pub fn chart(
     options: &ChartOptions,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Chart, ChartError> {
-    let err = |e: crate::model_file::ModelFileError| ChartError(e.to_string());
+    let err = |e: crate::model_file::ModelFileError| ChartError::Input(e.to_string());
     let px = document.parameter(x.0).map_err(err)?;
     let py = document.parameter(y.0).map_err(err)?;
     if px.key == py.key {
-        return Err(ChartError(format!(
+        return Err(ChartError::Input(format!(
             "the two parameters `{}` and `{}` are the same key: give two different ones",
             x.0, y.0
         )));
     }
     for (name, values) in [x, y] {
-        check_axis(name, values).map_err(ChartError)?;
+        check_axis(name, values).map_err(ChartError::Input)?;
     }
     if options.starts == 0 {
-        return Err(ChartError(
-            "starts = 0: at least one initial state per cell".into(),
-        ));
+        return Err(FieldError::new("starts", 0, "at least one initial state per cell").into());
     }
     let runs =
         x.1.len()
             .saturating_mul(y.1.len())
             .saturating_mul(options.starts);
     if runs > MAX_RUNS {
-        return Err(ChartError(format!(
+        return Err(ChartError::Input(format!(
             "{} × {} cells × {} starts = {runs} runs: more than {MAX_RUNS}; use a coarser grid",
             x.1.len(),
             y.1.len(),
@@ -136,7 +150,7 @@ pub fn chart(
         Ok(doc.with_parameter(&px, vx).map_err(err)?.model)
     };
     let base = document.with_parameter(&px, x.1[0]).map_err(err)?;
-    let settings = settings(&base, &options.sweep).map_err(ChartError)?;
+    let settings = settings(&base, &options.sweep)?;
     let first = model_at(x.1[0], y.1[0])?;
     for (vx, vy) in
         x.1.iter()
@@ -145,13 +159,13 @@ pub fn chart(
     {
         let m = model_at(vx, vy)?;
         if m.forcing_frequency().is_none() {
-            return Err(ChartError(format!(
+            return Err(ChartError::Input(format!(
                 "{} = {vx}, {} = {vy}: the model has no periodic excitation with one frequency",
                 x.0, y.0
             )));
         }
         if m.bodies().len() != first.bodies().len() {
-            return Err(ChartError(format!(
+            return Err(ChartError::Input(format!(
                 "{} = {vx}, {} = {vy}: the number of bodies changes over the chart",
                 x.0, y.0
             )));
@@ -170,7 +184,7 @@ pub fn chart(
                     x: vx,
                     y: vy,
                     attractors: 0,
-                    runs: vec![Run::failed(Vec::new(), e.0)],
+                    runs: vec![Run::failed(Vec::new(), e.to_string())],
                 },
             };
             progress();

@@ -27,6 +27,7 @@
 //! - [`basins`]: basins of attraction in a plane of initial states;
 //! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
 //! - [`parameter`]: a numeric key of a model file made a parameter;
+//! - [`field_error`]: an option refused by name, spelled by each face;
 //! - [`family`]: a family of models in one or two parameters, the problem
 //!   every parameter study takes;
 //! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
@@ -50,6 +51,7 @@ pub mod continuation;
 pub mod dynamics;
 pub mod eigen;
 pub mod family;
+pub mod field_error;
 pub mod free_motion;
 pub mod identify;
 pub mod impact;

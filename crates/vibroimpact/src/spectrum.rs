@@ -12,6 +12,7 @@
 //! time step. Peaks are taken over the record's time steps, as
 //! Nigam–Jennings and `eqsig` do.
 
+use crate::field_error::FieldError;
 use nalgebra::{Matrix2, Matrix4, Vector2};
 
 use crate::record::Record;
@@ -59,15 +60,23 @@ pub fn response_spectrum(
     scale: f64,
     damping: f64,
     periods: &[f64],
-) -> Result<Vec<SpectralPoint>, String> {
+) -> Result<Vec<SpectralPoint>, FieldError> {
     if !(damping.is_finite() && (0.0..1.0).contains(&damping)) {
-        return Err(format!("damping {damping}: give a ratio in [0, 1)"));
+        return Err(FieldError::new(
+            "damping",
+            damping,
+            "give a ratio in [0, 1)",
+        ));
     }
     if !scale.is_finite() {
-        return Err(format!("scale {scale}: must be finite"));
+        return Err(FieldError::new("scale", scale, "must be finite"));
     }
     if let Some(t) = periods.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-        return Err(format!("period {t}: periods must be positive and finite"));
+        return Err(FieldError::new(
+            "periods",
+            t,
+            "periods must be positive and finite",
+        ));
     }
     let a: Vec<f64> = record.acceleration.iter().map(|v| v * scale).collect();
     let steps: Vec<f64> = record.times.windows(2).map(|w| w[1] - w[0]).collect();

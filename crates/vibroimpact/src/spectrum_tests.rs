@@ -100,12 +100,12 @@ fn piecewise_linear_input_matches_an_integration() {
 #[test]
 fn bad_input_is_refused() {
     let r = record(10, 0.01, |t| t);
-    assert!(response_spectrum(&r, 1.0, 1.5, &[1.0])
-        .unwrap_err()
-        .contains("damping"));
-    assert!(response_spectrum(&r, 1.0, 0.05, &[0.0])
-        .unwrap_err()
-        .contains("period"));
+    let e = response_spectrum(&r, 1.0, 1.5, &[1.0]).unwrap_err();
+    assert_eq!((e.field, e.value.as_deref()), ("damping", Some("1.5")));
+    assert_eq!(e.to_string(), "damping = 1.5: give a ratio in [0, 1)");
+    assert_eq!(e.spelled("--damping", " "), "--damping 1.5: give a ratio in [0, 1)");
+    let e = response_spectrum(&r, 1.0, 0.05, &[0.0]).unwrap_err();
+    assert_eq!(e.field, "periods");
     assert!(periods(1.0, 0.5, 10, true).unwrap_err().contains("periods"));
     let p = periods(0.05, 5.0, 100, true).unwrap();
     assert_eq!(p.len(), 100);

@@ -23,6 +23,7 @@
 
 use serde::Serialize;
 
+use crate::field_error::FieldError;
 use crate::integrate::{Interrupt, Method};
 use crate::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 use crate::model::{BaseExcitation, HarmonicForce, Model, ModelError};
@@ -37,8 +38,14 @@ const COARSE: usize = 16;
 
 /// A sweep that cannot start (bad options or parameter values).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct SweepError(pub String);
+pub enum SweepError {
+    /// An option refused by name.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// Any other input error (a model, a value).
+    #[error("{0}")]
+    Input(String),
+}
 
 /// Options of a sweep; `None` takes the model's `[simulation]` setting, else
 /// the default stated.
@@ -221,13 +228,12 @@ impl Settings {
     /// checked.
     pub(crate) fn new(base: &LoadedModel, options: &SweepOptions) -> Result<Self, SweepError> {
         if options.record < 1 {
-            return Err(SweepError("record 0: record at least one period".into()));
+            return Err(FieldError::new("record", 0, "record at least one period").into());
         }
         if options.transient > 1_000_000_000 {
-            return Err(SweepError(format!(
-                "transient = {}: at most 1e9 periods",
-                options.transient
-            )));
+            return Err(
+                FieldError::new("transient", options.transient, "at most 1e9 periods").into(),
+            );
         }
         let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
         let atol = options.atol.or(base.simulation.atol).unwrap_or(rtol * 1e-4);
@@ -240,23 +246,32 @@ impl Settings {
         let d = 2 * base.model.bodies().len();
         let window = (options.record as f64 * FINE as f64 + 1.0) * (d + 1) as f64;
         if window > crate::simulate::MAX_HISTORY_VALUES {
-            return Err(SweepError(format!(
-                "record = {}: the recorded window ({FINE} samples per period) would hold {window:.3e} values, more than {:e}",
+            return Err(FieldError::new(
+                "record",
                 options.record,
-                crate::simulate::MAX_HISTORY_VALUES
-            )));
+                format!(
+                    "the recorded window ({FINE} samples per period) would hold {window:.3e} values, more than {:e}",
+                    crate::simulate::MAX_HISTORY_VALUES
+                ),
+            )
+            .into());
         }
         if let Some(k) = options.lyapunov {
             if k == 0 || k > d {
-                return Err(SweepError(format!(
-                    "lyapunov = {k}: between 1 and the state dimension {d}"
-                )));
+                return Err(FieldError::new(
+                    "lyapunov",
+                    k,
+                    format!("between 1 and the state dimension {d}"),
+                )
+                .into());
             }
             if options.record < 2 {
-                return Err(SweepError(
-                    "record 1: Lyapunov exponents are averaged over at least 2 recorded periods"
-                        .into(),
-                ));
+                return Err(FieldError::new(
+                    "record",
+                    options.record,
+                    "Lyapunov exponents are averaged over at least 2 recorded periods",
+                )
+                .into());
             }
         }
         Ok(Self {
@@ -591,11 +606,11 @@ fn run_direction(
     out
 }
 
-fn finite_positive(what: &str, x: f64) -> Result<(), SweepError> {
+fn finite_positive(what: &'static str, x: f64) -> Result<(), SweepError> {
     if x > 0.0 && x.is_finite() {
         Ok(())
     } else {
-        Err(SweepError(format!("{what} = {x}: must be finite and > 0")))
+        Err(FieldError::new(what, x, "must be finite and > 0").into())
     }
 }
 
@@ -614,14 +629,14 @@ pub fn sweep(
 ) -> Result<SweepSummary, SweepError> {
     use rayon::prelude::*;
     if values.is_empty() {
-        return Err(SweepError("no parameter values to sweep".into()));
+        return Err(SweepError::Input("no parameter values to sweep".into()));
     }
     if let Some(x) = values.iter().find(|x| !x.is_finite()) {
-        return Err(SweepError(format!(
+        return Err(SweepError::Input(format!(
             "parameter value {x}: the values must be finite"
         )));
     }
-    let err = |e: crate::model_file::ModelFileError| SweepError(e.to_string());
+    let err = |e: crate::model_file::ModelFileError| SweepError::Input(e.to_string());
     let base = family.loaded_at(family.initial()).map_err(err)?;
     let settings = Settings::new(&base, options)?;
     let name = family.name();
@@ -630,13 +645,13 @@ pub fn sweep(
     for &p in values {
         let m = family.model_at(p).map_err(err)?;
         if m.forcing_frequency().is_none() {
-            return Err(SweepError(format!(
+            return Err(SweepError::Input(format!(
                 "{name} = {p}: the model has no periodic excitation with one frequency (a sweep samples once per forcing period)"
             )));
         }
         let names: Vec<&str> = m.bodies().iter().map(|b| b.name.as_str()).collect();
         if names != bodies.iter().map(String::as_str).collect::<Vec<_>>() {
-            return Err(SweepError(format!(
+            return Err(SweepError::Input(format!(
                 "{name} = {p}: the bodies change along the sweep ({} instead of {}); sweep a parameter that keeps them",
                 names.len(),
                 bodies.len()

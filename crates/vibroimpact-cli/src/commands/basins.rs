@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::basins::{basins, Basins, Component};
+use vibroimpact::basins::{basins, BasinError, Basins, Component};
 
 use crate::args::{AttractorRuns, GridAxes};
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::figures::{attractor_label, basins_figure};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_model;
@@ -115,12 +115,9 @@ pub fn run(args: &BasinsArgs) -> Result<(), CliError> {
         &options,
         &|| progress.inc(1),
     )
-    .map_err(|e| {
-        CliError::new(
-            e.to_string()
-                .replace("base state:", "--base:")
-                .replace("cluster_tolerance =", "--cluster-tolerance ="),
-        )
+    .map_err(|e| match e {
+        BasinError::Field(f) => option_error(&f),
+        other => CliError::new(other.to_string()),
     })?;
     progress.finish_and_clear();
     if interrupt.requested() {

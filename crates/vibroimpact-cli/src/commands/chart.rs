@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::chart::{chart, Chart, ChartOptions};
+use vibroimpact::chart::{chart, Chart, ChartError, ChartOptions};
 use vibroimpact::sweep::SweepOptions;
 
 use crate::args::{AttractorRuns, GridAxes};
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::figures::{chart_figure, class, curve_series, CLASSES};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_document;
@@ -209,13 +209,9 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         &options,
         &|| progress.inc(1),
     )
-    .map_err(|e| {
-        CliError::new(
-            e.to_string()
-                .replace("starts = ", "--starts ")
-                .replace("cluster_tolerance =", "--cluster-tolerance =")
-                .replace("lyapunov =", "--lyapunov"),
-        )
+    .map_err(|e| match e {
+        ChartError::Field(f) => option_error(&f),
+        other => CliError::new(other.to_string()),
     })?;
     progress.finish_and_clear();
     if interrupt.requested() {

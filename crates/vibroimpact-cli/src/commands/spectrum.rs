@@ -8,7 +8,7 @@ use clap::Args;
 use serde_json::json;
 use vibroimpact::spectrum::{periods, response_spectrum, SpectralPoint};
 
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
@@ -88,12 +88,8 @@ pub fn run(args: &SpectrumArgs) -> Result<(), CliError> {
     let units = records::units(args.units.as_deref())?;
     let periods = parse_periods(&args.periods)?;
     let record = records::read(&args.record, units)?;
-    let rows = response_spectrum(&record, args.scale, args.damping, &periods).map_err(|e| {
-        CliError::new(
-            e.replace("damping ", "--damping ")
-                .replace("scale ", "--scale "),
-        )
-    })?;
+    let rows = response_spectrum(&record, args.scale, args.damping, &periods)
+        .map_err(|e| option_error(&e))?;
     let doc = json!({
         "record": records::metadata(&record, args.scale),
         "damping": args.damping,

@@ -4,11 +4,13 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::sweep::{parameter_values, sweep, Direction, SweepOptions, SweepSummary};
+use vibroimpact::sweep::{
+    parameter_values, sweep, Direction, SweepError, SweepOptions, SweepSummary,
+};
 
 use crate::args::ParameterRange;
 use crate::args::{IntegratorName, MethodName};
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::figures::{diagram_figure, lyapunov_figure, parameter_label, sweep_directions};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_family;
@@ -274,12 +276,9 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     };
     let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
         .with_prefix("sweep");
-    let summary = sweep(&family, &values, &options, &|| progress.inc(1)).map_err(|e| {
-        CliError::new(
-            e.to_string()
-                .replace("cluster_tolerance =", "--cluster-tolerance =")
-                .replace("lyapunov =", "--lyapunov"),
-        )
+    let summary = sweep(&family, &values, &options, &|| progress.inc(1)).map_err(|e| match e {
+        SweepError::Field(f) => option_error(&f),
+        other => other.into(),
     })?;
     progress.finish_and_clear();
     if let Some(dir) = &args.out {
