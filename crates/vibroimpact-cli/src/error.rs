@@ -33,6 +33,8 @@ from_display!(
     std::string::FromUtf8Error,
     vibroimpact::continuation::ContinuationError,
     vibroimpact::continuation::SwitchError,
+    vibroimpact::continuation::StudyError,
+    vibroimpact::continuation::CurvesError,
     vibroimpact::integrate::IntegrationError,
     vibroimpact::periodic::PeriodicError,
     vibroimpact::simulate::OptionsError,

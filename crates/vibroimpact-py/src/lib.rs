@@ -14,6 +14,7 @@
 //! [`vibroimpact::integrate::Interrupt`].
 
 mod basins;
+mod branch;
 mod chart;
 mod convert;
 mod model;
@@ -40,7 +41,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::identify, m)?)?;
     m.add_function(wrap_pyfunction!(solve::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(solve::periodic, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::continue_branch, m)?)?;
+    m.add_function(wrap_pyfunction!(branch::continue_branch, m)?)?;
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;

@@ -7,10 +7,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use vibroimpact::contact::ContactLaw;
-use vibroimpact::continuation::{
-    BranchStudy, ContinuationError, ContinuationOptions, Linear, Start, StudyError, StudyField,
-};
-use vibroimpact::family::Family;
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::{ImpactError, TwoBodies};
@@ -21,8 +17,8 @@ use vibroimpact::periodic::{
     guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, ShootingOptions,
 };
 use vibroimpact::results::{
-    branch_document, impact_document, periodic_document, simulation_summary, ImpactMethod,
-    ImpactRelations, IMPACT_COLUMNS,
+    impact_document, periodic_document, simulation_summary, ImpactMethod, ImpactRelations,
+    IMPACT_COLUMNS,
 };
 use vibroimpact::simulate::SimulationOptions;
 use vibroimpact::sweep::{sweep as run_sweep, Direction, SweepOptions};
@@ -417,113 +413,6 @@ pub fn periodic<'py>(
     d.set_item("orbit_displacement", u)?;
     d.set_item("orbit_velocity", v)?;
     Ok(d)
-}
-
-/// A branch of periodic solutions: the `continue` document (with
-/// `switched_branch` when `switch_at` is given); progress counts points.
-/// The library's [`BranchStudy`] does the checks, the start (`start`:
-/// auto, simulate or homotopy) and the switch, as for the CLI.
-#[pyfunction]
-#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto", start = "auto", krylov = false, dense = false, arnoldi = 20))]
-#[allow(clippy::too_many_arguments)]
-pub fn continue_branch<'py>(
-    py: Python<'py>,
-    model: &PyModel,
-    parameter: &str,
-    from_: f64,
-    to: f64,
-    subharmonic: u32,
-    switch_at: Option<String>,
-    max_points: usize,
-    ds_max: f64,
-    guess_periods: f64,
-    progress: Option<&Bound<'py, PyAny>>,
-    integrator: &str,
-    start: &str,
-    krylov: bool,
-    dense: bool,
-    arnoldi: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let mut family =
-        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
-    let start = match start {
-        "auto" => Start::Auto,
-        "simulate" => Start::Simulate,
-        "homotopy" => Start::Homotopy,
-        other => {
-            return Err(value_error(format!(
-                "start = {other:?}: must be auto, simulate or homotopy"
-            )))
-        }
-    };
-    let linear = match (krylov, dense) {
-        (true, true) => return Err(value_error("krylov = True, dense = True: choose one")),
-        (true, false) => Linear::MatrixFree,
-        (false, true) => Linear::Dense,
-        (false, false) => Linear::Auto,
-    };
-    let mut study = BranchStudy {
-        from: from_,
-        to,
-        start,
-        guess_periods,
-        switch_at,
-        linear,
-        arnoldi,
-        options: ContinuationOptions {
-            max_points,
-            ds_max,
-            shooting: ShootingOptions {
-                subharmonic,
-                integrator: integrator.parse().map_err(value_error)?,
-                ..ContinuationOptions::default().shooting
-            },
-            ..ContinuationOptions::default()
-        },
-    };
-    let spell = |e: StudyError| match e {
-        StudyError::Invalid { field, message } => value_error(format!(
-            "{}: {message}",
-            match field {
-                StudyField::Range => format!("from_ = {from_}, to = {to}"),
-                StudyField::From => format!("from_ = {from_}"),
-                StudyField::Subharmonic => format!("subharmonic = {subharmonic}"),
-                StudyField::Parameter => format!("parameter = {parameter:?}"),
-                StudyField::Start => format!("start = {:?}", start.name()),
-            }
-        )),
-        StudyError::Family(e) => value_error(e),
-        StudyError::Continuation(e @ ContinuationError::Invalid(_)) => value_error(e),
-        other => numerical_error(other),
-    };
-    let (start_model, _) = study.check(&mut family).map_err(spell)?;
-    let mut at_start = model.document.clone();
-    at_start
-        .set(&family.parameter, from_)
-        .map_err(value_error)?;
-    let amplitude = ParameterizedModel::new(at_start, "amplitude");
-    let out = monitor::run(py, progress, move |p: &Progress| {
-        p.set_total(max_points);
-        study.options.shooting.interrupt = Some(p.interrupt.clone());
-        let mut amplitude = amplitude;
-        let homotopy = amplitude.as_mut().ok().map(|a| {
-            let target = a.initial();
-            (a as &mut dyn Family, target)
-        });
-        let on_point = |_: &vibroimpact::continuation::BranchPoint| {
-            p.tick();
-            !p.interrupt.requested()
-        };
-        study.run(&family, homotopy, on_point)
-    })?;
-    let outcome = out.map_err(spell)?;
-    let mut doc = branch_document(&outcome.branch, &start_model, parameter);
-    match outcome.switched {
-        Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start_model, parameter),
-        Some(Err(e)) => doc["switch_error"] = serde_json::Value::String(e.to_string()),
-        None => {}
-    }
-    Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
 }
 
 /// `k` values evenly spaced from `from_` to `to`, both ends exact (the

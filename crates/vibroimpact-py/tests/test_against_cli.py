@@ -164,6 +164,28 @@ def test_continue_falls_back_to_the_homotopy(cli):
         vi.continue_(m, "frequency", 7.5, 7.5)
 
 
+def test_continue_with_curves(cli, tmp_path):
+    # R2 N = 1: the fold curves in (frequency, amplitude) through the
+    # branch's folds, the same from both faces (the library's curve driver).
+    text = (EXAMPLES / "fujita-row-n2.toml").read_text().replace("count = 2", "count = 1")
+    m = tmp_path / "n1.toml"
+    m.write_text(text)
+    args = ("--parameter", "frequency", "--from", "3.705", "--to", "11.115")
+    doc = cli("continue", m, *args, "--parameter2", "amplitude", "--from2", "0.001",
+              "--to2", "0.1", "--curves", "fold")
+    r = vi.continue_(m, "frequency", 3.705, 11.115, parameter2="amplitude", from2=0.001,
+                     to2=0.1, curves=["fold"])
+    assert [c["kind"] for c in r.curves] == [c["kind"] for c in doc["curves"]] == ["fold"] * 4
+    for a, b in zip(r.curves, doc["curves"]):
+        assert a["stop"] == b["stop"]
+        close([p["amplitude"] for p in a["points"]], [p["amplitude"] for p in b["points"]])
+    assert len(r.curves_skipped) == len(doc["curves_skipped"]) == 0
+    with pytest.raises(ValueError, match="curves = torus: give any of fold, bp"):
+        vi.continue_(m, "frequency", 3.705, 11.115, parameter2="amplitude", curves=["torus"])
+    with pytest.raises(ValueError, match='parameter2 = "frequency": the same key'):
+        vi.continue_(m, "frequency", 3.705, 11.115, parameter2="frequency")
+
+
 def test_periodic(cli):
     # The three-pendulum row's unstable symmetric orbit from the simulated
     # guess (the two-pendulum row's motion at 0.95 omega0 is irregular too:

@@ -7,11 +7,13 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use crate::contact::{ContactLaw, LawKind};
-use crate::continuation::Branch;
+use crate::continuation::{Branch, Curves, SpecialKind, SpecialPoint};
 use crate::impact::closed_form::ExponentialImpact;
 use crate::impact::direct::{integrate_impact, DirectOptions};
 use crate::impact::{ImpactError, TwoBodies};
 use crate::model::Model;
+use crate::model_file::ModelDocument;
+use crate::parameter::ModelParameter;
 use crate::periodic::{OrbitSummary, PeriodicSolution};
 use crate::simulate::Simulation;
 
@@ -305,6 +307,127 @@ pub fn branch_document(branch: &Branch, model: &Model, name: &str) -> Value {
             "initial_state": s.state,
         })).collect::<Vec<_>>(),
     })
+}
+
+/// A branch document that cannot be read back (what is missing or wrong).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct BranchDocumentError(pub String);
+
+/// What the curves need of a branch document: its special points, whether
+/// the branch is on the half map, and its period multiple.
+#[derive(Clone, Debug)]
+pub struct BranchSpecialPoints {
+    /// The special points (their states and parameters).
+    pub special: Vec<SpecialPoint>,
+    /// On the half map.
+    pub symmetric: bool,
+    /// Its period multiple.
+    pub subharmonic: u32,
+}
+
+/// Reads back the special points of a [`branch_document`] of `document`
+/// (its `parameter_name` must be the key of `first`).
+pub fn branch_special_points(
+    doc: &Value,
+    document: &ModelDocument,
+    first: &ModelParameter,
+) -> Result<BranchSpecialPoints, BranchDocumentError> {
+    let at = |what: String| BranchDocumentError(what);
+    let name = doc["parameter_name"]
+        .as_str()
+        .ok_or_else(|| at("no `parameter_name`".into()))?;
+    let key = document.parameter(name).map(|p| p.key).ok();
+    if key.as_ref() != Some(&first.key) {
+        return Err(at(format!(
+            "a branch in `{name}`, not in the parameter {}",
+            first.name
+        )));
+    }
+    let symmetric = doc["symmetric"]
+        .as_bool()
+        .ok_or_else(|| at("no `symmetric`".into()))?;
+    let subharmonic = doc["subharmonic"]
+        .as_u64()
+        .and_then(|n| u32::try_from(n).ok())
+        .filter(|&n| n >= 1)
+        .ok_or_else(|| at("no `subharmonic` (a whole number ≥ 1)".into()))?;
+    let list = doc["special_points"]
+        .as_array()
+        .ok_or_else(|| at("no `special_points` list".into()))?;
+    let mut special = Vec::new();
+    for (k, s) in list.iter().enumerate() {
+        let field = |f: &str| at(format!("special_points[{k}]: no valid `{f}`"));
+        let kind = SpecialKind::ALL
+            .into_iter()
+            .find(|kind| s["kind"].as_str() == Some(kind.name()))
+            .ok_or_else(|| field("kind"))?;
+        let state: Vec<f64> = s["initial_state"]
+            .as_array()
+            .ok_or_else(|| field("initial_state"))?
+            .iter()
+            .map(|v| v.as_f64().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(|| field("initial_state"))?;
+        special.push(SpecialPoint {
+            kind,
+            label: s["label"]
+                .as_str()
+                .ok_or_else(|| field("label"))?
+                .to_string(),
+            parameter: s["parameter"]
+                .as_f64()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| field("parameter"))?,
+            state,
+            multipliers: Vec::new(),
+            tangent: Vec::new(),
+            after_point: 0,
+            symmetry_breaking: s["symmetry_breaking"]
+                .as_bool()
+                .ok_or_else(|| field("symmetry_breaking"))?,
+        });
+    }
+    Ok(BranchSpecialPoints {
+        special,
+        symmetric,
+        subharmonic,
+    })
+}
+
+/// The `curves` document: each curve with its kind, start label, stop,
+/// points (both parameters `p` and `q` by name, max |u| per body,
+/// multipliers) and its codimension-two points (kind, index in `points`,
+/// both parameters), and the special points skipped with the reason.
+pub fn curves_document(curves: &Curves, p: &str, q: &str) -> Value {
+    let list: Vec<Value> = curves
+        .followed
+        .iter()
+        .map(|(label, c)| {
+            json!({
+                "kind": c.kind.name(),
+                "from": label,
+                "stop": c.stop,
+                "special": c.special.iter().map(|sp| {
+                    let pt = &c.points[sp.point];
+                    json!({ "kind": sp.kind.name(), "point": sp.point, p: pt.p, q: pt.q })
+                }).collect::<Vec<_>>(),
+                "points": c.points.iter().map(|pt| json!({
+                    p: pt.p,
+                    q: pt.q,
+                    "max_displacement": pt.max_displacement,
+                    "floquet_multipliers": pt.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+                    "initial_state": pt.state,
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let skipped: Vec<Value> = curves
+        .skipped
+        .iter()
+        .map(|(label, why)| json!({ "from": label, "reason": why }))
+        .collect();
+    json!({ "parameter": p, "parameter2": q, "curves": list, "skipped": skipped })
 }
 
 /// The summary of a simulation (JSON).

@@ -103,7 +103,10 @@ fn bad_input_is_refused() {
     let e = response_spectrum(&r, 1.0, 1.5, &[1.0]).unwrap_err();
     assert_eq!((e.field, e.value.as_deref()), ("damping", Some("1.5")));
     assert_eq!(e.to_string(), "damping = 1.5: give a ratio in [0, 1)");
-    assert_eq!(e.spelled("--damping", " "), "--damping 1.5: give a ratio in [0, 1)");
+    assert_eq!(
+        e.spelled("--damping", " "),
+        "--damping 1.5: give a ratio in [0, 1)"
+    );
     let e = response_spectrum(&r, 1.0, 0.05, &[0.0]).unwrap_err();
     assert_eq!(e.field, "periods");
     assert!(periods(1.0, 0.5, 10, true).unwrap_err().contains("periods"));

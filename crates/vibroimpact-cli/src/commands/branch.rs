@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::continuation::{
-    amplitude_homotopy, Branch, BranchStudy, ContinuationOptions, StudyError, StudyField,
+    amplitude_homotopy, Branch, BranchOrigin, BranchStudy, ContinuationOptions, Curves, StudyError,
+    StudyField,
 };
 use vibroimpact::family::Family;
 use vibroimpact::integrate::Interrupt;
@@ -26,7 +27,7 @@ use crate::format::{history_csv, CsvText, Format, SummaryFormat};
 use crate::model_io::{read_document, read_family, read_model};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
-use vibroimpact::results::{branch_document, periodic_document};
+use vibroimpact::results::{branch_document, curves_document, periodic_document};
 
 /// Options of `vibroimpact periodic`.
 #[derive(Args, Debug)]
@@ -514,30 +515,29 @@ fn curves_from_file(
     path: &std::path::Path,
     interrupt: &vibroimpact::integrate::Interrupt,
 ) -> Result<(), CliError> {
-    let (special, symmetric, subharmonic) =
-        curves::read_special_points(path, &pm.document, &pm.parameter)?;
+    let read = curves::read_special_points(path, &pm.document, &pm.parameter)?;
     let shooting = ShootingOptions {
-        subharmonic,
+        subharmonic: read.subharmonic,
         interrupt: Some(interrupt.clone()),
         integrator: args.integrator.integrator(),
         ..ContinuationOptions::default().shooting
     };
     let bodies = pm.model_at(args.range.from)?.bodies().len();
-    let c = curves::curves(
-        &pm.document,
-        (&pm.parameter, q),
-        (&special, symmetric),
-        (args.range.from, args.range.to),
-        &args.second,
-        (&shooting, args.linear.krylov(bodies)),
-    )?;
+    let origin = BranchOrigin {
+        special: &read.special,
+        symmetric: read.symmetric,
+        range: (args.range.from, args.range.to),
+        q0: q.initial,
+    };
+    let linear = (&shooting, args.linear.krylov(bodies));
+    let c = curves::follow(pm, q, origin, &args.second, linear)?;
     if interrupt.requested() {
         return Err(CliError::new("interrupted (Ctrl-C): nothing written"));
     }
     if let Some(dir) = &args.out {
         curves::write_curves(dir, &c, &args.range.parameter, &q.name)?;
     }
-    let doc = curves::curves_document(&c, &args.range.parameter, &q.name);
+    let doc = curves_document(&c, &args.range.parameter, &q.name);
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
         _ => print_curves(&c),
@@ -546,7 +546,7 @@ fn curves_from_file(
 }
 
 /// The curves, one line each, with their codimension-two points.
-fn print_curves(c: &curves::Curves) {
+fn print_curves(c: &Curves) {
     for (label, curve) in &c.followed {
         let special: Vec<String> = curve
             .special
@@ -625,14 +625,16 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     }
     bar.finish_and_clear();
     let curves = match &second {
-        Some(q) => Some(curves::curves(
-            &pm.document,
-            (&pm.parameter, q),
-            (&branches[0].special, branches[0].symmetric),
-            (args.range.from, args.range.to),
-            &args.second,
-            (&opts.shooting, opts.krylov),
-        )?),
+        Some(q) => {
+            let origin = BranchOrigin {
+                special: &branches[0].special,
+                symmetric: branches[0].symmetric,
+                range: (args.range.from, args.range.to),
+                q0: q.initial,
+            };
+            let linear = (&opts.shooting, opts.krylov);
+            Some(curves::follow(&pm, q, origin, &args.second, linear)?)
+        }
         None => None,
     };
     if let (Some(dir), Some(c), Some(q)) = (&args.out, &curves, &second) {
@@ -654,7 +656,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let curves_doc = curves
         .as_ref()
         .zip(second.as_ref())
-        .map(|(c, q)| curves::curves_document(c, &args.range.parameter, &q.name));
+        .map(|(c, q)| curves_document(c, &args.range.parameter, &q.name));
     if let (Format::Table, Some(c)) = (args.format, &curves) {
         print_curves(c);
     }

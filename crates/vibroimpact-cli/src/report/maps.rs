@@ -10,8 +10,10 @@ use std::time::Instant;
 use vibroimpact::basins::{basins, Basins, Component};
 use vibroimpact::chart::{chart, Chart, ChartOptions};
 use vibroimpact::continuation::{
-    amplitude_homotopy, continue_branch, Branch, ContinuationOptions, Curve,
+    curves_of_branch, Branch, BranchOrigin, BranchStudy, ContinuationOptions, Curve, CurveKind,
+    CurveSelection, Curves, Linear, Start,
 };
+use vibroimpact::family::ParameterizedModel2;
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
@@ -20,7 +22,6 @@ use vibroimpact::reference::NATURAL_FREQUENCY as W0;
 use vibroimpact::sweep::{sweep, SweepOptions, SweepSummary};
 
 use super::{html_table, DataFile, Report};
-use crate::curves::{curves, Curves, SecondParameter};
 use crate::error::CliError;
 use crate::figures::{
     basins_figure, chart_figure, class, curve_series, diagram_figure, lyapunov_figure,
@@ -159,43 +160,53 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
 /// doublings and Neimark–Sacker points in (frequency, amplitude).
 fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, Curves), CliError> {
     let family = ParameterizedModel::new(doc.clone(), "frequency")?;
-    let p = family.parameter.clone();
     let q = doc.parameter("amplitude")?;
     let defaults = ContinuationOptions::default();
-    let opts = ContinuationOptions {
-        shooting: ShootingOptions {
-            interrupt: Some(stop.clone()),
-            ..defaults.shooting.clone()
-        },
-        ..defaults
-    };
     // The orbit at 0.5 ω0 on the branch that grows from rest (a simulated
     // guess there ends a chaotic transient wherever its last bits take it).
-    let mut at_start = doc.clone();
-    at_start.set(&p, FREQUENCY.0)?;
-    let guess = amplitude_homotopy(
-        ParameterizedModel::new(at_start, "amplitude")?,
-        q.initial,
-        &opts,
-    )?;
-    let branch = continue_branch(&family, FREQUENCY.0, &guess, FREQUENCY.1, &opts, |_| true)?;
-    let second = SecondParameter {
-        parameter2: Some("amplitude".into()),
-        from2: Some(AMPLITUDE.0),
-        to2: Some(AMPLITUDE.1),
-        curves: ["fold", "bp", "pd", "ns"].map(String::from).to_vec(),
-        curve_step: CURVE_STEP,
-        special_points: None,
+    let study = BranchStudy {
+        from: FREQUENCY.0,
+        to: FREQUENCY.1,
+        start: Start::Homotopy,
+        guess_periods: 200.0,
+        switch_at: None,
+        linear: Linear::Auto,
+        arnoldi: 20,
+        options: ContinuationOptions {
+            shooting: ShootingOptions {
+                interrupt: Some(stop.clone()),
+                ..defaults.shooting.clone()
+            },
+            ..defaults
+        },
     };
-    let curves = curves(
-        doc,
-        (&p, &q),
-        (&branch.special, branch.symmetric),
-        FREQUENCY,
-        &second,
-        (&opts.shooting, None),
-    )?;
-    Ok((branch, curves))
+    let mut at_start = doc.clone();
+    at_start.set(&family.parameter, FREQUENCY.0)?;
+    let mut amplitude = ParameterizedModel::new(at_start, "amplitude")?;
+    let outcome = study.run(&family, Some((&mut amplitude, q.initial)), |_| true)?;
+    let selection = CurveSelection {
+        kinds: vec![
+            CurveKind::Fold,
+            CurveKind::BranchPoint,
+            CurveKind::PeriodDoubling,
+            CurveKind::NeimarkSacker,
+        ],
+        bounds2: (Some(AMPLITUDE.0), Some(AMPLITUDE.1)),
+        step: CURVE_STEP,
+    };
+    let origin = BranchOrigin {
+        special: &outcome.branch.special,
+        symmetric: outcome.branch.symmetric,
+        range: FREQUENCY,
+        q0: q.initial,
+    };
+    let plane = ParameterizedModel2 {
+        document: doc.clone(),
+        p: family.parameter.clone(),
+        q,
+    };
+    let curves = curves_of_branch(plane, origin, &selection, (&outcome.options.shooting, None))?;
+    Ok((outcome.branch, curves))
 }
 
 /// The chart of one row with its curves and their codimension-two points.

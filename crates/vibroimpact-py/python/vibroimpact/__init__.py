@@ -530,6 +530,23 @@ def periodic(
     return r
 
 
+def _second_parameter(
+    parameter2: Any, from2: Any, to2: Any, curves: Any, curve_step: Any
+) -> tuple:
+    """The curves' settings of :func:`continue_`, checked."""
+    if parameter2 is not None and not isinstance(parameter2, str):
+        raise TypeError(f"parameter2: expected a name, got {type(parameter2).__name__}")
+    if isinstance(curves, str) or not all(isinstance(c, str) for c in curves):
+        raise TypeError("curves: expected a list of names such as ['fold', 'pd']")
+    return (
+        parameter2,
+        _real(from2, "from2", optional=True),
+        _real(to2, "to2", optional=True),
+        list(curves),
+        _real(curve_step, "curve_step", positive=True),
+    )
+
+
 def continue_(
     model: ModelLike,
     parameter: str,
@@ -547,6 +564,11 @@ def continue_(
     krylov: bool = False,
     dense: bool = False,
     arnoldi: int = 20,
+    parameter2: Optional[str] = None,
+    from2: Optional[float] = None,
+    to2: Optional[float] = None,
+    curves: Sequence[str] = ("fold", "bp", "pd", "ns", "grazing"),
+    curve_step: float = 0.05,
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -563,7 +585,13 @@ def continue_(
     "homotopy" (the primary branch from rest). ``krylov=True``:
     matrix-free (Newton–Krylov, ``arnoldi`` dominant multipliers), the
     default from 200 bodies; ``dense=True``: the dense monodromy at any
-    size.
+    size. ``parameter2``: a second parameter; every fold, branch point,
+    period doubling, Neimark–Sacker point and grazing of the branch (or
+    those named in ``curves``: "fold", "bp", "pd", "ns", "grazing") is
+    continued as a curve in both parameters within ``from2``–``to2``
+    (default 0 to twice its value), steps up to ``curve_step``, with the
+    codimension-two points on it: ``curves`` and ``curves_skipped`` in the
+    result, as ``continue --parameter2``.
 
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
     MaxPoints, Interrupted, CannotContinue or ClosedLoop) with ``stop_detail``,
@@ -595,6 +623,7 @@ def continue_(
         _flag(krylov, "krylov"),
         _flag(dense, "dense"),
         _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
+        _second_parameter(parameter2, from2, to2, curves, curve_step),
     )
     r = Result(d)
     problem = None

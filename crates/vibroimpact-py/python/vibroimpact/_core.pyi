@@ -65,6 +65,7 @@ def continue_branch(
     switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
     progress: Progress = None, integrator: str = "auto", start: str = "auto",
     krylov: bool = False, dense: bool = False, arnoldi: int = 20,
+    second: tuple[Optional[str], Optional[float], Optional[float], list[str], float] = ...,
 ) -> dict[str, Any]: ...
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,

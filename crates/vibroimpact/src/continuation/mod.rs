@@ -59,8 +59,9 @@ mod tests;
 
 pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
 pub use curve::{
-    continue_curve, grazing_margin, starts_grazing, Codim2Kind, Curve, CurveKind, CurveOptions,
-    CurvePoint, CurveSpecial, CurveStop,
+    continue_curve, curves_of_branch, grazing_margin, starts_grazing, BranchOrigin, Codim2Kind,
+    Curve, CurveKind, CurveOptions, CurvePoint, CurveSelection, CurveSpecial, CurveStop, Curves,
+    CurvesError, CURVE_NAMES,
 };
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
@@ -94,6 +95,16 @@ pub enum SpecialKind {
 }
 
 impl SpecialKind {
+    /// Every kind.
+    pub const ALL: [SpecialKind; 6] = [
+        SpecialKind::Fold,
+        SpecialKind::BranchPoint,
+        SpecialKind::PeriodDoubling,
+        SpecialKind::NeimarkSacker,
+        SpecialKind::Grazing,
+        SpecialKind::User,
+    ];
+
     /// Name used in files: `fold`, `branch-point`, `period-doubling`,
     /// `neimark-sacker`, `grazing`, `user`.
     pub fn name(self) -> &'static str {

@@ -23,6 +23,7 @@
 //! `codim2.rs`).
 
 mod codim2;
+mod from_branch;
 mod krylov;
 mod system;
 
@@ -34,6 +35,9 @@ use crate::model::Model;
 use crate::periodic::ShootingOptions;
 pub use codim2::Codim2Kind;
 use codim2::{changed, test_values, CIRCLE_TEST};
+pub use from_branch::{
+    curves_of_branch, BranchOrigin, CurveSelection, Curves, CurvesError, CURVE_NAMES,
+};
 use krylov::KrylovSystem;
 use system::{Augmented, Constraint, Observation};
 
@@ -76,6 +80,15 @@ pub enum CurveKind {
 }
 
 impl CurveKind {
+    /// Every kind.
+    pub const ALL: [CurveKind; 5] = [
+        CurveKind::Fold,
+        CurveKind::BranchPoint,
+        CurveKind::PeriodDoubling,
+        CurveKind::NeimarkSacker,
+        CurveKind::Grazing,
+    ];
+
     /// The name used in outputs.
     pub fn name(self) -> &'static str {
         match self {
