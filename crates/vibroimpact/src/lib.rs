@@ -13,7 +13,9 @@
 //!   (seed §3);
 //! - [`model`]: N bodies, springs, contact pairs and excitation (§4);
 //! - [`dynamics`]: the equations of motion with their banded Jacobian;
-//! - [`simulate`]: time histories with an impact log;
+//! - [`simulate`]: time histories with an impact log, by the global or
+//!   the local integrator;
+//! - [`free_motion`]: the exact motion of bodies between contacts;
 //! - [`variational`]: sensitivities and monodromy matrices (§5);
 //! - [`newton`]: the damped Newton method of every periodic solve;
 //! - [`periodic`]: periodic solutions by shooting, Floquet multipliers;
@@ -33,8 +35,11 @@
 //! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
 //! - [`results`]: the documents of results (the CLI's JSON, Python's
 //!   result objects);
-//! - [`integrate`]: the integrators (DOP853, RODAS) shared by every time
-//!   integration;
+//! - [`record`], [`spectrum`], [`pounding`]: earthquake records, their
+//!   response spectra, and pounding frames under them;
+//! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) shared by
+//!   every time integration;
+//! - [`eigen`]: eigenvalues of general real matrices;
 //! - [`numeric`]: scalar special functions and root finders.
 //!
 //! The library does no I/O: callers hand it numbers and text and get

@@ -183,7 +183,7 @@ pub struct ContinuationOptions {
     /// end: no built-in special points, and the points between the first
     /// and the last come without amplitudes (empty) and with 0 impacts per period
     /// unless an added event reads them (the amplitude homotopy of
-    /// [`amplitude_homotopy`](start::amplitude_homotopy), whose points
+    /// [`amplitude_homotopy`], whose points
     /// serve only to reach the model's own amplitude).
     pub special_points: bool,
 }
