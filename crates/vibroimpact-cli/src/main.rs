@@ -84,6 +84,48 @@ enum Command {
         #[arg(long, default_value = "vibroimpact-report")]
         out: PathBuf,
     },
+    /// Every subcommand's options as JSON (name, default, whether it takes
+    /// a value): what the parity test holds the Python functions to.
+    #[command(hide = true)]
+    Options,
+}
+
+/// The options of every subcommand, from clap's command tree: for each,
+/// `positional` names and `options` (`name` without the dashes,
+/// `default`, `flag`).
+fn options_document() -> serde_json::Value {
+    use clap::CommandFactory;
+    let cli = Cli::command();
+    let commands: serde_json::Map<String, serde_json::Value> = cli
+        .get_subcommands()
+        .filter(|c| !c.is_hide_set())
+        .map(|c| {
+            let positional: Vec<&str> = c.get_positionals().map(|a| a.get_id().as_str()).collect();
+            let options: Vec<serde_json::Value> = c
+                .get_arguments()
+                .filter(|a| !a.is_positional())
+                .filter_map(|a| {
+                    let name = a.get_long()?;
+                    let default: Vec<String> = a
+                        .get_default_values()
+                        .iter()
+                        .map(|v| v.to_string_lossy().into_owned())
+                        .collect();
+                    Some(serde_json::json!({
+                        "name": name,
+                        "default": (!default.is_empty()).then(|| default.join(",")),
+                        "flag": !a.get_action().takes_values(),
+                    }))
+                })
+                .filter(|o| o["name"] != "help" && o["name"] != "version")
+                .collect();
+            (
+                c.get_name().to_string(),
+                serde_json::json!({ "positional": positional, "options": options }),
+            )
+        })
+        .collect();
+    serde_json::Value::Object(commands)
 }
 
 fn main() -> ExitCode {
@@ -108,6 +150,10 @@ fn main() -> ExitCode {
         Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Pounding(args)) => pounding::run(args),
         Some(Command::Report { out }) => report::run(out),
+        Some(Command::Options) => {
+            println!("{:#}", options_document());
+            Ok(())
+        }
         None => report::run(&cli.out),
     };
     match result {

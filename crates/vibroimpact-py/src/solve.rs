@@ -7,6 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use vibroimpact::contact::ContactLaw;
+use vibroimpact::continuation::{amplitude_homotopy, ContinuationOptions, Linear};
 use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::{ImpactError, TwoBodies};
@@ -315,7 +316,7 @@ pub fn simulate<'py>(
 /// A periodic solution: the `periodic` document plus the orbit over one
 /// period (`orbit_t`, `orbit_displacement`, `orbit_velocity`).
 #[pyfunction]
-#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None, integrator = "auto"))]
+#[pyo3(signature = (model, subharmonic, guess, guess_periods, rtol, tol, krylov, arnoldi, symmetric, progress = None, integrator = "auto", dense = false, homotopy = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
@@ -330,8 +331,28 @@ pub fn periodic<'py>(
     symmetric: bool,
     progress: Option<&Bound<'py, PyAny>>,
     integrator: &str,
+    dense: bool,
+    homotopy: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.loaded.model;
+    let linear = match (krylov, dense) {
+        (true, true) => return Err(value_error("krylov = True, dense = True: choose one")),
+        (true, false) => Linear::MatrixFree,
+        (false, true) => Linear::Dense,
+        (false, false) => Linear::Auto,
+    };
+    let krylov = linear.krylov(m.bodies().len(), arnoldi).is_some();
+    let amplitude = if homotopy {
+        Some(
+            ParameterizedModel::new(model.document.clone(), "amplitude").map_err(|e| {
+                value_error(format!(
+                    "guess = 'homotopy' needs a forcing amplitude to vary: {e}"
+                ))
+            })?,
+        )
+    } else {
+        None
+    };
     if m.forcing_frequency().is_none() {
         return Err(value_error(format!(
             "{}: the model has no periodic forcing with one frequency, so it has no periodic solutions",
@@ -372,9 +393,21 @@ pub fn periodic<'py>(
     let out = monitor::run(py, progress, move |p: &Progress| {
         let m = &job.model;
         let interrupt = Some(p.interrupt.clone());
-        let x0 = match guess {
-            Some(g) => g,
-            None => guess_by_simulation_with(
+        let x0 = match (guess, amplitude) {
+            (Some(g), _) => g,
+            (None, Some(family)) => amplitude_homotopy(
+                &family,
+                family.initial(),
+                &ContinuationOptions {
+                    shooting: ShootingOptions {
+                        interrupt: interrupt.clone(),
+                        ..ContinuationOptions::default().shooting
+                    },
+                    ..ContinuationOptions::default()
+                },
+            )
+            .map_err(|e| format!("guess by homotopy: {e}"))?,
+            (None, None) => guess_by_simulation_with(
                 m,
                 guess_periods,
                 rtol.max(1e-9),

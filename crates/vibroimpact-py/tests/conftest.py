@@ -13,15 +13,22 @@ EXAMPLES = ROOT / "examples"
 
 
 @pytest.fixture(scope="session")
-def cli():
-    """Runs the `vibroimpact` CLI (built by `cargo test --workspace
-    --release`, or here if missing) and returns its parsed JSON output."""
+def cli_exe():
+    """The `vibroimpact` CLI binary (built by `cargo test --workspace
+    --release`, or here if missing)."""
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     exe = target / "release" / "vibroimpact"
     if not exe.exists():
         subprocess.run(
             ["cargo", "build", "--release", "-p", "vibroimpact-cli"], cwd=ROOT, check=True
         )
+    return str(exe)
+
+
+@pytest.fixture(scope="session")
+def cli(cli_exe):
+    """Runs the `vibroimpact` CLI and returns its parsed JSON output."""
+    exe = cli_exe
 
     def run(*args):
         out = subprocess.run(

@@ -466,7 +466,8 @@ def periodic(
     guess_periods: float = 200.0,
     rtol: float = 1e-10,
     tol: float = 1e-9,
-    krylov: Optional[bool] = None,
+    krylov: bool = False,
+    dense: bool = False,
     arnoldi: int = 20,
     symmetric: bool = False,
     progress: Progress = None,
@@ -476,9 +477,12 @@ def periodic(
     (``vibroimpact periodic``).
 
     ``guess``: "simulate" (the state after ``guess_periods`` forcing periods
-    from the model's initial state), a state array ``[u..., v...]`` or an
-    earlier result with ``initial_state``. ``krylov``: matrix-free
-    Newton-Krylov with Arnoldi multipliers (default from 200 bodies on).
+    from the model's initial state), "homotopy" (continued in the forcing
+    amplitude from the rest state: the primary orbit), a state array
+    ``[u..., v...]`` or an earlier result with ``initial_state``.
+    ``krylov=True``: matrix-free Newton-Krylov with Arnoldi multipliers
+    (the default from 200 bodies on); ``dense=True``: the dense monodromy
+    at any size.
     ``symmetric``: shoot on the half map of a mirror-symmetric row.
     ``integrator="local"``: the period map by the exact motion between
     contacts (its monodromy matrix, or with ``krylov`` the record that its
@@ -495,15 +499,15 @@ def periodic(
     """
     m = _model(model)
     if isinstance(guess, str):
-        if guess != "simulate":
-            raise ValueError(f"guess = {guess!r}: 'simulate', a state array or an earlier result")
+        if guess not in ("simulate", "homotopy"):
+            raise ValueError(
+                f"guess = {guess!r}: 'simulate', 'homotopy', a state array or an earlier result"
+            )
         g = None
     elif isinstance(guess, (Result, dict)):
         g = _floats(guess["initial_state"], "guess['initial_state']")
     else:
         g = _floats(guess, "guess")
-    if krylov is None:
-        krylov = len(m) >= 200
     r = Result(
         _core.periodic(
             m,
@@ -517,6 +521,8 @@ def periodic(
             _flag(symmetric, "symmetric"),
             _progress(progress),
             _method(integrator, ("auto", "global", "local"), "integrator"),
+            _flag(dense, "dense"),
+            isinstance(guess, str) and guess == "homotopy",
         )
     )
     if not r.converged:

@@ -58,7 +58,7 @@ def simulate(
 def periodic(
     model: Model, subharmonic: int, guess: Optional[F64], guess_periods: float, rtol: float,
     tol: float, krylov: bool, arnoldi: int, symmetric: bool, progress: Progress = None,
-    integrator: str = "auto",
+    integrator: str = "auto", dense: bool = False, homotopy: bool = False,
 ) -> dict[str, Any]: ...
 def continue_branch(
     model: Model, parameter: str, from_: float, to: float, subharmonic: int,
