@@ -70,8 +70,9 @@ def pair_with(law):
 
 
 def peaks_of_ours(result):
-    p = result["pounding"]
-    return float(p["peak_impact_force"]), [list(map(float, side)) for side in p["peak_drift"]]
+    p = result["runs"][0]["pounding"]
+    drift = p["peak_drift"]
+    return float(p["peak_impact_force"]), [list(map(float, drift[side])) for side in ("left", "right")]
 
 
 def error(force, drift, ref):
@@ -101,7 +102,7 @@ def study(name, law, record, quick):
     ref = peaks_of_ours(ref_result)
     print(f"\n== {name}: {law}")
     print(f"reference (vibroimpact rtol 1e-10, sample dt/32): peak force {ref[0]:.6e} N, "
-          f"{ref_result['pounding']['impacts']} impacts, drifts {ref[1]}")
+          f"{ref_result['runs'][0]['pounding']['impacts']} impacts, drifts {ref[1]}")
 
     convergence = []
     print("OpenSees time-step convergence (Newmark average acceleration, Newton, BandGeneral):")
@@ -169,7 +170,7 @@ def study(name, law, record, quick):
           f"{best_ours['seconds'] * 1e3:.2f} ms ({best_ours}): ratio {ratio:.1f} (target >= {TARGET_RATIO:g})")
     return {
         "law": law,
-        "reference": {"peak_impact_force": ref[0], "peak_drift": ref[1], "impacts": ref_result["pounding"]["impacts"]},
+        "reference": {"peak_impact_force": ref[0], "peak_drift": ref[1], "impacts": ref_result["runs"][0]["pounding"]["impacts"]},
         "opensees_convergence": convergence,
         "opensees_settings": settings,
         "vibroimpact_settings": ours,

@@ -11,14 +11,23 @@ use vibroimpact::continuation::{
 use vibroimpact::family::{Family, ParameterizedModel2};
 use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::ShootingOptions;
-use vibroimpact::results::{branch_document, curves_document};
+use vibroimpact::results::{branch_document, branch_special_points, curves_document};
 
 use crate::convert::{numerical_error, to_python, value_error};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
 
-/// The second parameter's curves: its name, bounds, kinds and step.
-type Second = (Option<String>, Option<f64>, Option<f64>, Vec<String>, f64);
+/// The second parameter's curves: its name, bounds, kinds, step, and the
+/// JSON text of an earlier branch document whose special points start them
+/// (then no branch is computed).
+type Second = (
+    Option<String>,
+    Option<f64>,
+    Option<f64>,
+    Vec<String>,
+    f64,
+    Option<String>,
+);
 
 /// A branch of periodic solutions: the `continue` document (with
 /// `switched_branch` when `switch_at` is given, `curves` and
@@ -26,7 +35,7 @@ type Second = (Option<String>, Option<f64>, Option<f64>, Vec<String>, f64);
 /// library's [`BranchStudy`] does the checks, the start (`start`: auto,
 /// simulate or homotopy) and the switch, as for the CLI.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto", start = "auto", krylov = false, dense = false, arnoldi = 20, second = (None, None, None, Vec::new(), 0.05)))]
+#[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto", start = "auto", krylov = false, dense = false, arnoldi = 20, second = (None, None, None, Vec::new(), 0.05, None)))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_branch<'py>(
     py: Python<'py>,
@@ -99,8 +108,8 @@ pub fn continue_branch<'py>(
         StudyError::Continuation(e @ ContinuationError::Invalid(_)) => value_error(e),
         other => numerical_error(other),
     };
-    let (start_model, _) = study.check(&mut family).map_err(spell)?;
-    let (parameter2, from2, to2, kinds, curve_step) = second;
+    let (start_model, checked) = study.check(&mut family).map_err(spell)?;
+    let (parameter2, from2, to2, kinds, curve_step, special_points) = second;
     let plane = match &parameter2 {
         None => None,
         Some(name) => {
@@ -124,6 +133,21 @@ pub fn continue_branch<'py>(
             Some((plane, selection))
         }
     };
+    if let Some(text) = special_points {
+        let Some((plane, selection)) = plane else {
+            return Err(value_error(
+                "special_points: give parameter2 too (the curves' second parameter)",
+            ));
+        };
+        return curves_from_document(
+            py,
+            progress,
+            &text,
+            (plane, selection),
+            (from_, to),
+            checked,
+        );
+    }
     let mut at_start = model.document.clone();
     at_start
         .set(&family.parameter, from_)
@@ -177,6 +201,43 @@ pub fn continue_branch<'py>(
         doc["curves"] = c["curves"].clone();
         doc["curves_skipped"] = c["skipped"].clone();
     }
+    Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
+}
+
+/// The curves through the special points of an earlier branch document
+/// (`text`, its JSON) in the plane's parameters: the `curves` document.
+fn curves_from_document<'py>(
+    py: Python<'py>,
+    progress: Option<&Bound<'py, PyAny>>,
+    text: &str,
+    (plane, selection): (ParameterizedModel2, CurveSelection),
+    range: (f64, f64),
+    options: ContinuationOptions,
+) -> PyResult<Bound<'py, PyDict>> {
+    let doc: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| value_error(format!("special_points: not a branch document: {e}")))?;
+    let read = branch_special_points(&doc, &plane.document, &plane.p)
+        .map_err(|e| value_error(format!("special_points: {e}")))?;
+    let out = monitor::run(py, progress, move |p: &Progress| {
+        let shooting = ShootingOptions {
+            subharmonic: read.subharmonic,
+            interrupt: Some(p.interrupt.clone()),
+            ..options.shooting
+        };
+        let origin = BranchOrigin {
+            special: &read.special,
+            symmetric: read.symmetric,
+            range,
+            q0: plane.q.initial,
+        };
+        let names = (plane.p.name.clone(), plane.q.name.clone());
+        curves_of_branch(plane, origin, &selection, (&shooting, options.krylov))
+            .map(|c| curves_document(&c, &names.0, &names.1))
+    })?;
+    let doc = out.map_err(|e| match e {
+        CurvesError::Field(f) => value_error(f),
+        other => numerical_error(other),
+    })?;
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
 }
 

@@ -49,6 +49,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(records::response_spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding_history, m)?)?;
+    m.add_function(wrap_pyfunction!(records::value_range, m)?)?;
     m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
     Ok(())
 }

@@ -5,11 +5,11 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::pounding::{PoundingPair, RunSettings};
+use vibroimpact::pounding::{documents, pounding_spectrum, PoundingPair, RunSettings};
 use vibroimpact::record::{parse_record as parse, Record, Units};
 use vibroimpact::spectrum::response_spectrum as spectrum;
 
-use crate::convert::{array1, floats, value_error};
+use crate::convert::{array1, floats, to_python, value_error};
 
 /// A record from the text of a file (`source` names it): `source`,
 /// `header`, `units` (of the file), `dt` (None if not uniform), `times`
@@ -93,73 +93,92 @@ fn inputs(
     Ok((pair, record, run))
 }
 
-/// One record's pounding study of the pair in `pair_text` (TOML, named by
-/// `source`): `left_period`, `right_period`, `pounding` and `free` (each
-/// with `peak_drift`, `peak_floor_acceleration`, `peak_displacement` as
-/// [left, right] lists, `peak_impact_force`, `impacts`, `closing`),
-/// `required_gap` and `code_gaps`; with `free` false, the pounding run
-/// alone (`pounding` and the periods).
+/// A record handed over from Python: its source, header lines, units of
+/// the file, times (s) and accelerations (m/s²).
+type RecordInput<'py> = (
+    String,
+    Vec<String>,
+    String,
+    PyReadonlyArray1<'py, f64>,
+    PyReadonlyArray1<'py, f64>,
+);
+
+/// The pounding study of the pair in `pair_text` (TOML, named by
+/// `source`) under `records` × `scale`: the `vibroimpact pounding`
+/// document (`pair`, and `runs`, each with `record`, `pounding`, `free`,
+/// `amplification`, `required_gap` and `code_gaps`; with `free` false the
+/// pounding response alone); with `gaps` and `ratios` the pounding
+/// spectrum (`pair`, `records`, `cells`).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, integrator, free))]
+#[pyo3(signature = (pair_text, source, records, scale, sample, rtol, method, integrator, free, gaps = None, ratios = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding<'py>(
     py: Python<'py>,
     pair_text: &str,
     source: &str,
-    times: PyReadonlyArray1<'py, f64>,
-    acceleration: PyReadonlyArray1<'py, f64>,
+    records: Vec<RecordInput<'py>>,
     scale: f64,
     sample: f64,
     rtol: f64,
     method: &str,
     integrator: &str,
     free: bool,
+    gaps: Option<Vec<f64>>,
+    ratios: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (pair, record, run) = inputs(
-        pair_text,
-        source,
-        (&times, &acceleration),
-        (sample, rtol, method, integrator),
-    )?;
-    let response = |r: &vibroimpact::pounding::Response| -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("peak_drift", [r.drift[0].clone(), r.drift[1].clone()])?;
-        d.set_item(
-            "peak_floor_acceleration",
-            [r.acceleration[0].clone(), r.acceleration[1].clone()],
-        )?;
-        d.set_item(
-            "peak_displacement",
-            [r.displacement[0].clone(), r.displacement[1].clone()],
-        )?;
-        d.set_item("peak_impact_force", r.peak_impact_force)?;
-        d.set_item("impacts", r.impacts)?;
-        d.set_item("closing", r.closing.clone())?;
-        Ok(d)
+    let run = RunSettings {
+        sample,
+        rtol,
+        method: crate::solve::method(method)?,
+        integrator: integrator.parse().map_err(value_error)?,
     };
-    let d = PyDict::new(py);
-    d.set_item("left_period", pair.left.period())?;
-    d.set_item("right_period", pair.right.period())?;
-    if !free {
-        let r = py
-            .detach(|| pair.respond(&record, scale, true, &run))
-            .map_err(value_error)?;
-        d.set_item("pounding", response(&r)?)?;
-        return Ok(d);
+    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let mut runs = Vec::with_capacity(records.len());
+    for (name, header, units, times, acceleration) in &records {
+        let t = floats(times, "times")?;
+        let a = floats(acceleration, "acceleration")?;
+        let mut record = Record::from_samples(name, t, &a).map_err(value_error)?;
+        record.header.clone_from(header);
+        record.units = Units::parse(units).map_err(|e| value_error(format!("units: {e}")))?;
+        runs.push((record, scale));
     }
-    let res = py
-        .detach(|| pair.analyse(&record, scale, &run))
+    let doc = py
+        .detach(|| match (&gaps, &ratios) {
+            (Some(g), Some(r)) => pounding_spectrum(&pair, &runs, g, r, &run)
+                .map(|cells| documents::study_document(&pair, &runs, None, Some(&cells))),
+            _ => runs
+                .iter()
+                .map(|(r, s)| {
+                    if free {
+                        pair.analyse(r, *s, &run)
+                            .map(|res| documents::run_document(r, *s, &res))
+                    } else {
+                        pair.respond(r, *s, true, &run)
+                            .map(|res| documents::pounding_only_document(r, *s, &res))
+                    }
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map(|list| documents::study_document(&pair, &runs, Some(list), None)),
+        })
         .map_err(value_error)?;
-    d.set_item("pounding", response(&res.pounding)?)?;
-    d.set_item("free", response(&res.free)?)?;
-    d.set_item("required_gap", res.required_gap)?;
-    let g = PyDict::new(py);
-    g.set_item("absolute_sum", res.code_gaps.absolute_sum)?;
-    g.set_item("srss", res.code_gaps.srss)?;
-    g.set_item("double_difference", res.code_gaps.double_difference)?;
-    g.set_item("correlation", res.code_gaps.correlation)?;
-    d.set_item("code_gaps", g)?;
-    Ok(d)
+    Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
+}
+
+/// `FROM:TO:N` as N evenly spaced values (the CLI's form of `--gaps` and
+/// `--ratios`); `field` names the keyword in errors.
+#[pyfunction]
+pub fn value_range<'py>(
+    py: Python<'py>,
+    field: &str,
+    text: &str,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let field = match field {
+        "gaps" => "gaps",
+        "ratios" => "ratios",
+        other => return Err(value_error(format!("no range keyword {other:?}"))),
+    };
+    let values = vibroimpact::pounding::value_range(field, text).map_err(value_error)?;
+    Ok(array1(py, values))
 }
 
 /// The time history of the pair (TOML `pair_text`) with its contacts under

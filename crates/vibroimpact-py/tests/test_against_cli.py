@@ -1,6 +1,8 @@
 """The Python API against the CLI on the same inputs: same numbers to 1e-12
 (both are the same library; the tolerance only allows for the JSON text)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -180,10 +182,53 @@ def test_continue_with_curves(cli, tmp_path):
         assert a["stop"] == b["stop"]
         close([p["amplitude"] for p in a["points"]], [p["amplitude"] for p in b["points"]])
     assert len(r.curves_skipped) == len(doc["curves_skipped"]) == 0
+    # The same curves from the branch's special points, without the branch
+    # (the CLI's --special-points).
+    again = vi.continue_(m, "frequency", 3.705, 11.115, parameter2="amplitude", from2=0.001,
+                         to2=0.1, curves=["fold"], special_points=r)
+    assert [c["kind"] for c in again.curves] == ["fold"] * 4
+    close(again.curves[0]["points"][-1]["amplitude"], r.curves[0]["points"][-1]["amplitude"])
     with pytest.raises(ValueError, match="curves = torus: give any of fold, bp"):
         vi.continue_(m, "frequency", 3.705, 11.115, parameter2="amplitude", curves=["torus"])
     with pytest.raises(ValueError, match='parameter2 = "frequency": the same key'):
         vi.continue_(m, "frequency", 3.705, 11.115, parameter2="frequency")
+
+
+def _same_document(a, b, path="doc"):
+    """The same fields and nesting, numbers within REL."""
+    if isinstance(b, dict):
+        assert sorted(a) == sorted(b), f"{path}: {sorted(a)} against {sorted(b)}"
+        for k in b:
+            _same_document(a[k], b[k], f"{path}.{k}")
+    elif isinstance(b, list) and b and not all(isinstance(x, (int, float)) for x in b):
+        assert len(a) == len(b), path
+        for k, (x, y) in enumerate(zip(a, b)):
+            _same_document(x, y, f"{path}[{k}]")
+    elif isinstance(b, list) or isinstance(b, float):
+        close(a, b)
+    else:
+        assert a == b, f"{path}: {a!r} against {b!r}"
+
+
+def test_pounding_documents_have_one_shape(cli):
+    # Several records, units, the free response, the pounding spectrum
+    # over gaps x ratios: Python returns the CLI's document.
+    pair = EXAMPLES / "pounding-frames.toml"
+    quake = EXAMPLES / "synthetic-quake.csv"
+    doc = cli("pounding", pair, quake, quake, "--units", "m/s2", "--scale", "0.8")
+    r = vi.pounding(pair, [quake, quake], units="m/s2", scale=0.8)
+    _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    assert doc["runs"][0]["pounding"]["peak_drift"]["left"]
+    spectrum = ("--gaps", "0.01:0.03:2", "--ratios", "1:1.5:2")
+    doc = cli("pounding", pair, quake, "--units", "m/s2", *spectrum)
+    r = vi.pounding(pair, quake, units="m/s2", gaps="0.01:0.03:2", ratios=[1.0, 1.5])
+    _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    alone = cli("pounding", pair, quake, "--units", "m/s2", "--free", "false")
+    assert sorted(alone["runs"][0]) == ["pounding", "record"]
+    with pytest.raises(OSError, match="pair: no-such-pair.toml: cannot read"):
+        vi.pounding("no-such-pair.toml", quake, units="m/s2")
+    with pytest.raises(ValueError, match="gaps = 0.01:0.03: give FROM:TO:N"):
+        vi.pounding(pair, quake, units="m/s2", gaps="0.01:0.03", ratios="1:2:2")
 
 
 def test_periodic(cli):

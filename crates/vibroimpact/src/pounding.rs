@@ -16,6 +16,7 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::contact::ContactLaw;
 use crate::dynamics::ChainDynamics;
+use crate::field_error::FieldError;
 use crate::integrate::{Method, OdeSystem};
 use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
 use crate::record::Record;
@@ -519,6 +520,31 @@ pub fn pounding_spectrum(
         .collect()
 }
 
+/// `FROM:TO:N` as N evenly spaced values (N = 1: FROM), the form of the
+/// spectrum's gaps and period ratios; `field` names the option.
+pub fn value_range(field: &'static str, text: &str) -> Result<Vec<f64>, FieldError> {
+    let bad = || FieldError::new(field, text, "give FROM:TO:N, e.g. 0.01:0.1:10");
+    let parts: Vec<&str> = text.split(':').collect();
+    let [a, b, n] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let a: f64 = a.trim().parse().map_err(|_| bad())?;
+    let b: f64 = b.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 || !a.is_finite() || !b.is_finite() || (n > 1 && a == b) {
+        return Err(bad());
+    }
+    Ok((0..n)
+        .map(|i| {
+            if n == 1 {
+                a
+            } else {
+                a + (b - a) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect())
+}
+
 /// The empirical q-quantile (0 ≤ q ≤ 1) of `values` with linear
 /// interpolation between order statistics (NaN for none).
 pub fn quantile(values: &[f64], q: f64) -> f64 {
@@ -585,6 +611,9 @@ pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, String> {
     pair.check().map_err(|e| format!("{source}: {e}"))?;
     Ok(pair)
 }
+
+#[path = "pounding_documents.rs"]
+pub mod documents;
 
 #[cfg(test)]
 #[path = "pounding_tests.rs"]

@@ -7,14 +7,15 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use serde_json::{json, Value};
+use serde_json::Value;
 use vibroimpact::pounding::{
-    parse_pair, pounding_spectrum, quantile, PoundingPair, Response, RunSettings, SpectrumCell,
+    documents, parse_pair, pounding_spectrum, quantile, value_range, PoundingPair, RunSettings,
+    SpectrumCell,
 };
 
 use crate::args::{IntegratorName, MethodName};
 
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
@@ -50,6 +51,11 @@ pub struct PoundingArgs {
     /// record sample.
     #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
+    /// Also the frames apart (`free`), the gap that avoids contact and the
+    /// code rules' gaps; `false`: the pair with its contacts only (half the
+    /// work).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    free: bool,
     /// Pounding spectrum: gaps FROM:TO:N (m), with --ratios.
     #[arg(long, requires = "ratios")]
     gaps: Option<String>,
@@ -64,65 +70,6 @@ pub struct PoundingArgs {
     /// Format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-}
-
-/// `FROM:TO:N` as N evenly spaced values (N = 1: FROM).
-fn range(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
-    let bad = || CliError::new(format!("--{flag} {text}: give FROM:TO:N, e.g. 0.01:0.1:10"));
-    let parts: Vec<&str> = text.split(':').collect();
-    let [a, b, n] = parts.as_slice() else {
-        return Err(bad());
-    };
-    let a: f64 = a.parse().map_err(|_| bad())?;
-    let b: f64 = b.parse().map_err(|_| bad())?;
-    let n: usize = n.parse().map_err(|_| bad())?;
-    if n == 0 || !a.is_finite() || !b.is_finite() || (n > 1 && a == b) {
-        return Err(bad());
-    }
-    Ok((0..n)
-        .map(|i| {
-            if n == 1 {
-                a
-            } else {
-                a + (b - a) * i as f64 / (n - 1) as f64
-            }
-        })
-        .collect())
-}
-
-fn response_json(r: &Response) -> Value {
-    json!({
-        "peak_drift": { "left": r.drift[0], "right": r.drift[1] },
-        "peak_floor_acceleration": { "left": r.acceleration[0], "right": r.acceleration[1] },
-        "peak_displacement": { "left": r.displacement[0], "right": r.displacement[1] },
-        "peak_impact_force": r.peak_impact_force,
-        "impacts": r.impacts,
-        "closing": r.closing,
-    })
-}
-
-fn ratio(a: &[f64], b: &[f64]) -> Vec<f64> {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| if *y > 0.0 { x / y } else { 1.0 })
-        .collect()
-}
-
-/// Median and 16/84 % quantiles of a list.
-fn stats(v: &[f64]) -> Value {
-    json!({ "median": quantile(v, 0.5), "p16": quantile(v, 0.16), "p84": quantile(v, 0.84), "values": v })
-}
-
-fn cell_json(c: &SpectrumCell) -> Value {
-    let impacts: Vec<f64> = c.impacts.iter().map(|&i| i as f64).collect();
-    json!({
-        "gap": c.gap,
-        "period_ratio": c.period_ratio,
-        "peak_impact_force": stats(&c.impact_force),
-        "impacts": stats(&impacts),
-        "drift_amplification": stats(&c.drift_amplification),
-        "required_gap": stats(&c.required_gap),
-    })
 }
 
 /// The pounding spectrum's figure: the median peak impact force against
@@ -199,52 +146,34 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         .iter()
         .map(|path| Ok((records::read(path, units)?, args.scale)))
         .collect::<Result<Vec<_>, CliError>>()?;
-    let frames = json!({
-        "left_period": pair.left.period(),
-        "right_period": pair.right.period(),
-        "gap": pair.gap,
-        "floors": pair.floors,
-    });
     let (doc, csv) = match (&args.gaps, &args.ratios) {
         (Some(g), Some(r)) => {
+            let range = |field, text| value_range(field, text).map_err(|e| option_error(&e));
             let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
             let cells =
                 pounding_spectrum(&pair, &runs, &gaps, &ratios, &run).map_err(CliError::new)?;
-            let doc = json!({
-                "pair": frames,
-                "records": runs.iter().map(|(r, s)| records::metadata(r, *s)).collect::<Vec<_>>(),
-                "cells": cells.iter().map(cell_json).collect::<Vec<_>>(),
-            });
             if let Some(dir) = &args.out {
                 ensure_dir(dir)?;
                 render(&spectrum_figure(&cells), &dir.join("spectrum"))?;
             }
+            let doc = documents::study_document(&pair, &runs, None, Some(&cells));
             (doc, Some(spectrum_csv(&cells)?))
         }
         _ => {
             let mut list = Vec::new();
             for (r, s) in &runs {
-                let res = pair.analyse(r, *s, &run).map_err(CliError::new)?;
-                list.push(json!({
-                    "record": records::metadata(r, *s),
-                    "pounding": response_json(&res.pounding),
-                    "free": response_json(&res.free),
-                    "amplification": {
-                        "drift": { "left": ratio(&res.pounding.drift[0], &res.free.drift[0]),
-                                   "right": ratio(&res.pounding.drift[1], &res.free.drift[1]) },
-                        "floor_acceleration": { "left": ratio(&res.pounding.acceleration[0], &res.free.acceleration[0]),
-                                                "right": ratio(&res.pounding.acceleration[1], &res.free.acceleration[1]) },
-                    },
-                    "required_gap": res.required_gap,
-                    "code_gaps": {
-                        "absolute_sum": res.code_gaps.absolute_sum,
-                        "srss": res.code_gaps.srss,
-                        "double_difference": res.code_gaps.double_difference,
-                        "correlation": res.code_gaps.correlation,
-                    },
-                }));
+                list.push(if args.free {
+                    let res = pair.analyse(r, *s, &run).map_err(CliError::new)?;
+                    documents::run_document(r, *s, &res)
+                } else {
+                    let res = pair.respond(r, *s, true, &run).map_err(CliError::new)?;
+                    documents::pounding_only_document(r, *s, &res)
+                });
             }
-            (json!({ "pair": frames, "runs": list }), None)
+            (
+                documents::study_document(&pair, &runs, Some(list), None),
+                None,
+            )
         }
     };
     if let Some(dir) = &args.out {

@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from collections.abc import Mapping
 from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
@@ -537,9 +538,21 @@ def periodic(
 
 
 def _second_parameter(
-    parameter2: Any, from2: Any, to2: Any, curves: Any, curve_step: Any
+    parameter2: Any, from2: Any, to2: Any, curves: Any, curve_step: Any, special_points: Any
 ) -> tuple:
-    """The curves' settings of :func:`continue_`, checked."""
+    """The curves' settings of :func:`continue_`, checked (an earlier
+    branch as the JSON text of its document)."""
+    if special_points is None:
+        earlier = None
+    elif isinstance(special_points, (str, os.PathLike)):
+        with open(special_points, encoding="utf-8") as f:
+            earlier = f.read()
+    elif isinstance(special_points, Mapping):
+        earlier = json.dumps(
+            special_points.to_dict() if isinstance(special_points, Result) else special_points
+        )
+    else:
+        raise TypeError("special_points: expected a continue_ result or a branch.json file")
     if parameter2 is not None and not isinstance(parameter2, str):
         raise TypeError(f"parameter2: expected a name, got {type(parameter2).__name__}")
     if isinstance(curves, str) or not all(isinstance(c, str) for c in curves):
@@ -550,6 +563,7 @@ def _second_parameter(
         _real(to2, "to2", optional=True),
         list(curves),
         _real(curve_step, "curve_step", positive=True),
+        earlier,
     )
 
 
@@ -575,6 +589,7 @@ def continue_(
     to2: Optional[float] = None,
     curves: Sequence[str] = ("fold", "bp", "pd", "ns", "grazing"),
     curve_step: float = 0.05,
+    special_points: Any = None,
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -597,7 +612,11 @@ def continue_(
     continued as a curve in both parameters within ``from2``–``to2``
     (default 0 to twice its value), steps up to ``curve_step``, with the
     codimension-two points on it: ``curves`` and ``curves_skipped`` in the
-    result, as ``continue --parameter2``.
+    result, as ``continue --parameter2``. ``special_points``: an earlier
+    result of ``continue_`` (or its ``branch.json``) whose special points
+    start the curves instead of a new branch; the result is then the
+    curves' document (``parameter``, ``parameter2``, ``curves``,
+    ``skipped``).
 
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
     MaxPoints, Interrupted, CannotContinue or ClosedLoop) with ``stop_detail``,
@@ -629,9 +648,11 @@ def continue_(
         _flag(krylov, "krylov"),
         _flag(dense, "dense"),
         _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
-        _second_parameter(parameter2, from2, to2, curves, curve_step),
+        _second_parameter(parameter2, from2, to2, curves, curve_step, special_points),
     )
     r = Result(d)
+    if special_points is not None:
+        return r
     problem = None
     if r.stop == "CannotContinue":
         problem = (
@@ -984,17 +1005,19 @@ def response_spectrum(
     damping: float = 0.05,
     scale: float = 1.0,
     acceleration: Optional[ArrayLike] = None,
+    units: Optional[str] = None,
 ) -> Result:
     """Elastic response spectra of a record, exact for its piecewise-linear
     ground acceleration (Nigam–Jennings; ``vibroimpact spectrum``).
-    ``record``: a result of :func:`read_record`, a file name, or the sample
-    times (s) with ``acceleration`` (m/s²). ``periods`` (s): default 100
+    ``record``: a result of :func:`read_record`, a file name (read with
+    ``units`` when its header does not state them), or the sample times (s)
+    with ``acceleration`` (m/s²). ``periods`` (s): default 100
     log-spaced from 0.05 to 5. Peaks over the record's time steps.
 
     Returns ``period``, ``pseudo_acceleration`` (m/s²), ``pseudo_velocity``
     (m/s), ``displacement`` (m)."""
     if isinstance(record, (str, os.PathLike)):
-        record = read_record(record)
+        record = read_record(record, units=units)
     if acceleration is None:
         try:
             times, acc = record["times"], record["acceleration"]
@@ -1021,13 +1044,17 @@ def response_spectrum(
 
 
 def _pair_text(pair: Any):
-    """(source, TOML text) of a pounding pair given as a file name or text."""
-    if isinstance(pair, os.PathLike) or (isinstance(pair, str) and "\n" not in pair and os.path.exists(pair)):
-        source = os.fspath(pair)
-        with open(source, encoding="utf-8") as f:
-            return source, f.read()
-    if isinstance(pair, str):
+    """(source, TOML text) of a pounding pair given as a file name or text
+    (text holds a line break or an `=`; anything else is a file name)."""
+    if isinstance(pair, str) and ("\n" in pair or "=" in pair):
         return "<pair>", pair
+    if isinstance(pair, (str, os.PathLike)):
+        source = os.fspath(pair)
+        try:
+            with open(source, encoding="utf-8") as f:
+                return source, f.read()
+        except OSError as e:
+            raise OSError(f"pair: {source}: cannot read: {e.strerror}") from None
     raise TypeError("pair: expected a pair file name or its TOML text")
 
 
@@ -1038,6 +1065,44 @@ def _record_arrays(record: Any):
         return record["times"], record["acceleration"]
     except (KeyError, TypeError, IndexError):
         raise TypeError("record: expected a read_record result or a file name") from None
+
+
+def _record_inputs(records: Any, units: Optional[str]) -> list:
+    """The binding's records: (source, header, units, times, acceleration)
+    of one record or a list of them (file names or :func:`read_record`
+    results)."""
+    one = isinstance(records, (str, os.PathLike, Mapping))
+    out = []
+    for k, r in enumerate([records] if one else list(records)):
+        if isinstance(r, (str, os.PathLike)):
+            r = read_record(r, units=units)
+        try:
+            times, acc = r["times"], r["acceleration"]
+        except (KeyError, TypeError, IndexError):
+            raise TypeError(
+                f"records[{k}]: expected a read_record result or a file name"
+            ) from None
+        out.append(
+            (
+                str(r.get("source", f"record {k}")),
+                [str(h) for h in r.get("header", [])],
+                str(r.get("units", "m/s2")),
+                _floats(times, "times", allow_scalar=False),
+                _floats(acc, "acceleration", allow_scalar=False),
+            )
+        )
+    if not out:
+        raise ValueError("records: give at least one record")
+    return out
+
+
+def _value_range(values: Any, name: str) -> Optional[np.ndarray]:
+    """`FROM:TO:N` (the CLI's form) or a list of values."""
+    if values is None:
+        return None
+    if isinstance(values, str):
+        return _core.value_range(name, values)
+    return _floats(values, name, allow_scalar=False)
 
 
 def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any, integrator: Any) -> None:
@@ -1072,36 +1137,63 @@ def _pounding_args(
 
 def pounding(
     pair: Union[str, "os.PathLike[str]"],
-    record: Any,
+    records: Any,
     *,
+    units: Optional[str] = None,
     scale: float = 1.0,
     sample: float = 0.0025,
     rtol: float = 1e-8,
     method: str = "dop853",
     integrator: str = "auto",
     free: bool = True,
+    gaps: Any = None,
+    ratios: Any = None,
 ) -> Result:
-    """Pounding of two shear frames under one record (``vibroimpact
-    pounding``): ``pair`` is a pair file (TOML, docs/earthquakes.md) or its
-    text, ``record`` a :func:`read_record` result or a file name, scaled by
-    ``scale``. ``sample`` (s): the sampling of drifts and floor
-    accelerations. ``method``: "dop853", or "dopri5", the faster at
-    ``rtol`` 1e-3 to 1e-5 (the record's samples limit the step; peaks
-    within 1 % there, docs/earthquakes.md). ``integrator="local"``: each
-    frame moves exactly between poundings, per record sample, and only the
-    pounding pair is integrated. ``free=False`` runs the pair
-    with its contacts only (half the work; no ``free``, ``required_gap``
-    or ``code_gaps``).
+    """Pounding of two shear frames under recorded ground motions
+    (``vibroimpact pounding``): ``pair`` is a pair file (TOML,
+    docs/earthquakes.md) or its text; ``records`` one record or a list, each
+    a :func:`read_record` result or a file name (read with ``units`` when
+    its header does not state them), scaled by ``scale``. ``sample`` (s):
+    the sampling of drifts and floor accelerations. ``method``: "dop853",
+    or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the record's samples
+    limit the step; peaks within 1 % there, docs/earthquakes.md).
+    ``integrator="local"``: each frame moves exactly between poundings, per
+    record sample. ``free=False`` runs the pair with its contacts only
+    (half the work; no ``free``, ``amplification``, ``required_gap`` or
+    ``code_gaps``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
+    values): the pounding spectrum over gaps (m) × period ratios
+    T_left/T_right instead of the runs.
 
-    Returns ``left_period``, ``right_period``, ``pounding`` and ``free``
-    (``peak_drift``, ``peak_floor_acceleration``, ``peak_displacement`` as
-    [left, right] lists per floor, ``peak_impact_force``, ``impacts``,
-    ``closing``), ``required_gap`` and ``code_gaps`` (``absolute_sum``,
-    ``srss``, ``double_difference``, ``correlation``)."""
-    args = _pounding_args(pair, record, scale, sample, rtol, method, integrator)
+    Returns the CLI's document: ``pair`` (``left_period``,
+    ``right_period``, ``gap``, ``floors``) and ``runs``, one per record,
+    each with ``record``, ``pounding`` and ``free`` (``peak_drift``,
+    ``peak_floor_acceleration``, ``peak_displacement`` per floor of the
+    ``left`` and ``right`` frames, ``peak_impact_force``, ``impacts``,
+    ``closing``), ``amplification``, ``required_gap`` and ``code_gaps``
+    (``absolute_sum``, ``srss``, ``double_difference``, ``correlation``);
+    with ``gaps`` and ``ratios``, ``pair``, ``records`` and ``cells`` (per
+    gap and ratio the median, 16 and 84 % quantiles over the records)."""
+    source, text = _pair_text(pair)
+    _pounding_settings(scale, sample, rtol, method, integrator)
     if not isinstance(free, bool):
         raise TypeError(f"free: expected True or False, got {free!r}")
-    return Result(_core.pounding(*args, free))
+    if (gaps is None) != (ratios is None):
+        raise ValueError("gaps, ratios: give both (the pounding spectrum) or neither")
+    return Result(
+        _core.pounding(
+            text,
+            source,
+            _record_inputs(records, units),
+            float(scale),
+            float(sample),
+            float(rtol),
+            method,
+            integrator,
+            free,
+            _value_range(gaps, "gaps"),
+            _value_range(ratios, "ratios"),
+        )
+    )
 
 
 def pounding_history(

@@ -65,7 +65,9 @@ def continue_branch(
     switch_at: Optional[str], max_points: int, ds_max: float, guess_periods: float,
     progress: Progress = None, integrator: str = "auto", start: str = "auto",
     krylov: bool = False, dense: bool = False, arnoldi: int = 20,
-    second: tuple[Optional[str], Optional[float], Optional[float], list[str], float] = ...,
+    second: tuple[
+        Optional[str], Optional[float], Optional[float], list[str], float, Optional[str]
+    ] = ...,
 ) -> dict[str, Any]: ...
 def sweep(
     model: Model, parameter: str, values: F64, transient: int, record: int, up_down: bool,
@@ -93,9 +95,11 @@ def response_spectrum(
     times: F64, acceleration: F64, periods: F64, damping: float, scale: float,
 ) -> dict[str, Any]: ...
 def pounding(
-    pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
-    rtol: float, method: str, integrator: str, free: bool,
+    pair_text: str, source: str, records: list[tuple[str, list[str], str, F64, F64]],
+    scale: float, sample: float, rtol: float, method: str, integrator: str, free: bool,
+    gaps: Optional[F64] = None, ratios: Optional[F64] = None,
 ) -> dict[str, Any]: ...
+def value_range(field: str, text: str) -> F64: ...
 def pounding_history(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
     rtol: float, method: str, integrator: str,

@@ -177,15 +177,20 @@ def ensemble(
 
 
 def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
+    """One record × scale: the pair's periods and the record's run
+    (``vibroimpact pounding``'s ``pair`` and ``runs[0]``)."""
     from . import _core, _floats
 
-    times, acc = record
+    name, header, units, times, acc = record
     # Arrays unpickled on a worker need not be aligned: copied as the
     # binding reads them.
     t = _floats(times, "times", allow_scalar=False)
     a = _floats(acc, "acceleration", allow_scalar=False)
     sample, rtol, method, integrator = run
-    return dict(_core.pounding(text, source, t, a, scale, sample, rtol, method, integrator, True))
+    doc = _core.pounding(
+        text, source, [(name, header, units, t, a)], scale, sample, rtol, method, integrator, True
+    )
+    return {"pair": dict(doc["pair"]), **dict(doc["runs"][0])}
 
 
 def ida(
@@ -229,7 +234,7 @@ def ida(
     if not recs:
         raise ValueError("records: give at least one record")
     jobs = [(i, float(s)) for i in range(len(recs)) for s in scales]
-    arrays = [(np.asarray(r["times"]), np.asarray(r["acceleration"])) for r in recs]
+    arrays = vi._record_inputs(recs, None)
     if client is None:
         results = []
         for k, (i, s) in enumerate(jobs):
@@ -244,14 +249,14 @@ def ida(
             for i, s in jobs
         ]
         results = _gather(futures, progress, len(futures))
-    period = float(results[0]["left_period"])
+    period = float(results[0]["pair"]["left_period"])
     sa_unit = [
         float(vi.response_spectrum(r, [period], damping=damping)["pseudo_acceleration"][0])
         for r in recs
     ]
 
     def drifts(res, key):
-        return [d for side in res[key]["peak_drift"] for d in side]
+        return [d for side in ("left", "right") for d in res[key]["peak_drift"][side]]
 
     max_drift = [max(drifts(r, "pounding")) for r in results]
     amplification = [
