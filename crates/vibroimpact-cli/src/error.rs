@@ -45,6 +45,7 @@ from_display!(
     vibroimpact::identify::IdentifyError,
     vibroimpact::model::ModelError,
     vibroimpact::family::FamilyError,
+    vibroimpact::measured::TableError,
     vibroimpact::model_file::ModelFileError,
     vibroimpact::sweep::SweepError,
     serde_json::Error

@@ -194,7 +194,9 @@ pub fn continue_branch<'py>(
     let mut doc = branch_document(&outcome.branch, &start_model, parameter);
     match outcome.switched {
         Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start_model, parameter),
-        Some(Err(e)) => doc["switch_error"] = serde_json::Value::String(e.to_string()),
+        Some(Err(e)) => {
+            doc["switch_error"] = format!("switch_at = {:?}: {}", e.label, e.message).into()
+        }
         None => {}
     }
     if let Some(c) = curves {

@@ -38,6 +38,20 @@ pub fn parse_record<'py>(
     Ok(d)
 }
 
+/// The named columns of measured data in CSV text (`source` names the file
+/// in errors, with the line), as arrays.
+#[pyfunction]
+pub fn parse_measured<'py>(
+    py: Python<'py>,
+    text: &str,
+    source: &str,
+    wanted: Vec<String>,
+) -> PyResult<Vec<Bound<'py, numpy::PyArray1<f64>>>> {
+    let names: Vec<&str> = wanted.iter().map(String::as_str).collect();
+    let table = vibroimpact::measured::parse_csv(text, source, &names).map_err(value_error)?;
+    Ok(table.columns.into_iter().map(|c| array1(py, c)).collect())
+}
+
 /// The response spectrum of the piecewise-linear record (`times` s,
 /// `acceleration` m/s²) × `scale` at `damping` for `periods` (s): arrays
 /// `period`, `pseudo_acceleration` (m/s²), `pseudo_velocity` (m/s),
@@ -72,14 +86,13 @@ pub fn response_spectrum<'py>(
     Ok(d)
 }
 
-/// A pounding run's pair (TOML `pair_text` named by `source`), record and
-/// settings.
-fn inputs(
+/// The pair (TOML `pair_text` named by `source`) and the run settings
+/// `(sample, rtol, method, integrator)` of a pounding study.
+fn pair_and_run(
     pair_text: &str,
     source: &str,
-    (times, acceleration): (&PyReadonlyArray1<'_, f64>, &PyReadonlyArray1<'_, f64>),
     (sample, rtol, method, integrator): (f64, f64, &str, &str),
-) -> PyResult<(PoundingPair, Record, RunSettings)> {
+) -> PyResult<(PoundingPair, RunSettings)> {
     let run = RunSettings {
         sample,
         rtol,
@@ -87,6 +100,18 @@ fn inputs(
         integrator: integrator.parse().map_err(value_error)?,
     };
     let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    Ok((pair, run))
+}
+
+/// A pounding run's pair (TOML `pair_text` named by `source`), record and
+/// settings.
+fn inputs(
+    pair_text: &str,
+    source: &str,
+    (times, acceleration): (&PyReadonlyArray1<'_, f64>, &PyReadonlyArray1<'_, f64>),
+    settings: (f64, f64, &str, &str),
+) -> PyResult<(PoundingPair, Record, RunSettings)> {
+    let (pair, run) = pair_and_run(pair_text, source, settings)?;
     let t = floats(times, "times")?;
     let a = floats(acceleration, "acceleration")?;
     let record = Record::from_samples("record", t, &a).map_err(value_error)?;
@@ -126,13 +151,7 @@ pub fn pounding<'py>(
     gaps: Option<Vec<f64>>,
     ratios: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let run = RunSettings {
-        sample,
-        rtol,
-        method: crate::solve::method(method)?,
-        integrator: integrator.parse().map_err(value_error)?,
-    };
-    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let (pair, run) = pair_and_run(pair_text, source, (sample, rtol, method, integrator))?;
     let mut runs = Vec::with_capacity(records.len());
     for (name, header, units, times, acceleration) in &records {
         let t = floats(times, "times")?;

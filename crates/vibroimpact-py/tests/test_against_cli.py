@@ -66,6 +66,19 @@ def test_identify(cli):
             close(r[key].value, doc[key]["value"])
             close(r[key].std_error, doc[key]["std_error"])
         close(r.acceleration_fit.alpha.value, doc["acceleration_fit"]["alpha"]["value"])
+        # The CLI's files as they are.
+        f = vi.identify(
+            restitution=EXAMPLES / "seed-impacts/restitution.csv",
+            acceleration=str(EXAMPLES / "seed-impacts/acceleration.csv"),
+            joint=joint,
+        )
+        assert f.a_over_b.value == r.a_over_b.value and f.alpha.value == r.alpha.value
+    with pytest.raises(ValueError, match=r"acceleration.csv:\d+: wrong header: expected a column named `restitution`"):
+        vi.identify(restitution=EXAMPLES / "seed-impacts/acceleration.csv")
+    with pytest.raises(OSError, match="restitution: no-such.csv: cannot read"):
+        vi.identify(restitution="no-such.csv")
+    with pytest.raises(ValueError, match="restitution = 1.5: must be above 0 and below 1.5"):
+        vi.identify(restitution=([0.1, 0.2], [0.9, 1.5]))
 
 
 def test_simulate(cli):
@@ -241,6 +254,21 @@ def test_periodic(cli):
         close(r[key], doc[key])
     assert r.stable == doc["stable"] and r.symmetric_orbit == doc["symmetric_orbit"]
     assert r.orbit_displacement.shape == (r.orbit_t.size, 3)
+
+
+def test_periodic_guesses(cli, tmp_path):
+    # The homotopy and a guess file, as the CLI takes them.
+    m = EXAMPLES / "fujita-row-n2.toml"
+    doc = cli("periodic", m, "--guess", "homotopy")
+    h = vi.periodic(m, guess="homotopy")
+    assert list(h.initial_state) == doc["initial_state"]
+    saved = tmp_path / "summary.json"
+    saved.write_text(json.dumps(doc))
+    again = cli("periodic", m, "--guess", saved)
+    f = vi.periodic(m, guess=saved)
+    close(f.initial_state, again["initial_state"])
+    with pytest.raises(OSError, match="cannot read it"):
+        vi.periodic(m, guess="no-such.json")
 
 
 @pytest.mark.parametrize("parameter,from_,to", [

@@ -258,6 +258,12 @@ def test_from_dict_takes_numpy_and_names_bad_keys():
     d["excitation"]["acceleration"][3] = 0.0
     with pytest.raises(ValueError, match="`time` has"):
         vi.Model.from_dict(d)
+    # A value of the wrong type names its key, not a line of TOML the user
+    # never wrote alone.
+    row = vi.Model.load(EXAMPLES / "fujita-row.toml").to_dict()
+    row["row"]["mass"] = "0.2"
+    with pytest.raises(ValueError, match=r"key `row.mass`: invalid type: string"):
+        vi.Model.from_dict(row)
 
 
 def test_a_panic_is_an_exception_not_a_crash():

@@ -6,6 +6,7 @@
 
 use serde::Serialize;
 
+use crate::field_error::FieldError;
 use crate::model::Model;
 use crate::model_file::LoadedModel;
 use crate::sweep::{run_value, Direction, Settings, Start, SweepError, SweepOptions, SweepPoint};
@@ -24,6 +25,27 @@ pub const DEFAULT_RTOL: f64 = 1e-7;
 /// a free oscillation of the lightly damped bodies (ζ = 0.013 in R2) of
 /// up to ~4e-3 of its initial size at 1.5 ω0.
 pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
+
+/// Input errors of charts and basins (numerical failures are kept in the
+/// runs).
+#[derive(Debug, thiserror::Error)]
+pub enum MapError {
+    /// An option refused by name.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// Any other input error.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl From<SweepError> for MapError {
+    fn from(e: SweepError) -> Self {
+        match e {
+            SweepError::Field(f) => Self::Field(f),
+            SweepError::Input(m) => Self::Input(m),
+        }
+    }
+}
 
 /// The run settings of charts and basins: `options` for models like
 /// `base`, with [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`] where

@@ -7,12 +7,11 @@
 
 use rayon::prelude::*;
 use serde::Serialize;
-use thiserror::Error;
 
-use crate::attractor::{check_axis, identify, run_from, settings, Recorded, Run};
+use crate::attractor::{check_axis, identify, run_from, settings, MapError, Recorded, Run};
 use crate::field_error::FieldError;
 use crate::model_file::LoadedModel;
-use crate::sweep::{admissible, SweepError, SweepOptions};
+use crate::sweep::{admissible, SweepOptions};
 
 /// Largest number of initial states of one basin computation.
 pub const MAX_CELLS: usize = 50_000_000;
@@ -121,24 +120,7 @@ pub struct Basins {
 
 /// Input errors of a basin computation (numerical failures are counted in
 /// the result).
-#[derive(Debug, Error)]
-pub enum BasinError {
-    /// An option refused by name.
-    #[error(transparent)]
-    Field(#[from] FieldError),
-    /// Any other input error.
-    #[error("{0}")]
-    Input(String),
-}
-
-impl From<SweepError> for BasinError {
-    fn from(e: SweepError) -> Self {
-        match e {
-            SweepError::Field(f) => Self::Field(f),
-            SweepError::Input(m) => Self::Input(m),
-        }
-    }
-}
+pub type BasinError = MapError;
 
 /// The basins of `loaded`'s model over the plane `x` × `y` (component and
 /// values) through `base` (`[u.., v..]`; None: the model's initial state),

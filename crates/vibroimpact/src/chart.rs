@@ -8,13 +8,12 @@
 
 use rayon::prelude::*;
 use serde::Serialize;
-use thiserror::Error;
 
-use crate::attractor::{check_axis, count_attractors, run_from, settings, Recorded, Run};
+use crate::attractor::{check_axis, count_attractors, run_from, settings, MapError, Recorded, Run};
 use crate::field_error::FieldError;
 use crate::model::Model;
 use crate::model_file::ModelDocument;
-use crate::sweep::{admissible, Settings, SweepError, SweepOptions};
+use crate::sweep::{admissible, Settings, SweepOptions};
 
 /// Largest number of runs (cells × starts) of one chart: the result keeps
 /// ~200 bytes a run.
@@ -86,24 +85,7 @@ pub struct Chart {
 
 /// Why a chart could not be computed (input errors; numerical failures are
 /// kept in the runs).
-#[derive(Debug, Error)]
-pub enum ChartError {
-    /// An option refused by name.
-    #[error(transparent)]
-    Field(#[from] FieldError),
-    /// Any other input error.
-    #[error("{0}")]
-    Input(String),
-}
-
-impl From<SweepError> for ChartError {
-    fn from(e: SweepError) -> Self {
-        match e {
-            SweepError::Field(f) => Self::Field(f),
-            SweepError::Input(m) => Self::Input(m),
-        }
-    }
-}
+pub type ChartError = MapError;
 
 /// The chart of `document` over `x` (name, values) × `y` (name, values).
 /// Every model of the grid's first row and column is built before any

@@ -157,7 +157,7 @@ fn validate_restitution(samples: &[RestitutionSample]) -> Result<(), IdentifyErr
         // values of 1.5 or more cannot come from a passive impact.
         if !(s.restitution > 0.0 && s.restitution < 1.5) {
             return bad(format!(
-                "restitution = {} must be in (0, 1.5)",
+                "restitution = {}: must be above 0 and below 1.5 (a passive impact; values a little above 1 are kept as measurement noise)",
                 s.restitution
             ));
         }

@@ -10,7 +10,7 @@
 //! - [`impact`]: two-body impact relations, closed form (seed eqs. 8–18)
 //!   and by direct integration;
 //! - [`identify`]: identification of a/b and α from measured impacts
-//!   (seed §3);
+//!   (seed §3); [`measured`]: tables of measured data (CSV text);
 //! - [`model`]: N bodies, springs, contact pairs and excitation (§4);
 //! - [`dynamics`]: the equations of motion with their banded Jacobian;
 //! - [`simulate`]: time histories with an impact log, by the global or
@@ -62,6 +62,7 @@ pub mod identify;
 pub mod impact;
 pub mod integrate;
 pub mod lyapunov;
+pub mod measured;
 pub mod model;
 pub mod model_file;
 pub mod newton;

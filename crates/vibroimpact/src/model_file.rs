@@ -465,7 +465,31 @@ impl ModelDocument {
         let file: ModelFile = toml::from_str(text).map_err(|e| {
             let msg = e.message().trim().replace('\n', " ");
             match e.span() {
-                Some(span) => cx.err_at(span, msg),
+                // The line as written names the key (the TOML text of a
+                // Python dict has no lines of the user's own).
+                Some(span) => {
+                    let start = text[..span.start.min(text.len())]
+                        .rfind('\n')
+                        .map_or(0, |i| i + 1);
+                    let line = text[start..].lines().next().unwrap_or("").trim();
+                    // The table the line sits in: the nearest header above.
+                    let table = text[..start]
+                        .lines()
+                        .rev()
+                        .map(str::trim)
+                        .find(|l| l.starts_with('['))
+                        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim());
+                    match line.split_once('=') {
+                        Some((key, _)) if !key.trim().is_empty() && !key.contains('[') => {
+                            let key = match table {
+                                Some(t) => format!("{t}.{}", key.trim()),
+                                None => key.trim().to_string(),
+                            };
+                            cx.err_at(span, format!("key `{key}`: {msg}"))
+                        }
+                        _ => cx.err_at(span, msg),
+                    }
+                }
                 None => cx.plain(msg),
             }
         })?;

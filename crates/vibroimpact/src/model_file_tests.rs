@@ -77,6 +77,13 @@ fn err(text: &str) -> String {
 fn errors_name_line_and_key() {
     let e = err(&ROW.replace("mass = 0.227", "mass = 0.227\nmasss = 1"));
     assert!(e.starts_with("m.toml:") && e.contains("masss"), "{e}");
+    // A value of the wrong type names its table and key (a Python dict's
+    // TOML text has no lines the user wrote).
+    let e = err(&ROW.replace("mass = 0.227", "mass = \"0.2\""));
+    assert!(
+        e.starts_with("m.toml:4: key `row.mass`: invalid type: string \"0.2\""),
+        "{e}"
+    );
     let e = err(&ROW.replace("clearance = 0.001\n", ""));
     assert!(e.contains("clearance"), "{e}");
     let e = err(&ROW.replace("mass = 0.227", "mass = -1"));

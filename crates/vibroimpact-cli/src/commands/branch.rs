@@ -620,7 +620,12 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let mut switch_error = None;
     match outcome.switched {
         Some(Ok(b)) => branches.push(b),
-        Some(Err(e)) => switch_error = Some(CliError::new(e.to_string())),
+        Some(Err(e)) => {
+            switch_error = Some(CliError::new(format!(
+                "--switch-at {}: {}",
+                e.label, e.message
+            )))
+        }
         None => {}
     }
     bar.finish_and_clear();

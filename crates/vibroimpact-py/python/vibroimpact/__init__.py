@@ -335,6 +335,17 @@ def contact_force(
 def _pairs(data: Any, name: str, second: str) -> tuple:
     if data is None:
         return np.empty(0), np.empty(0)
+    if isinstance(data, (str, os.PathLike)):
+        # A CSV file with the columns `impact_velocity` and `second`, as
+        # `vibroimpact identify` reads it.
+        path = os.fspath(data)
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                text = f.read()
+        except OSError as e:
+            raise OSError(f"{name}: {path}: cannot read: {e.strerror}") from None
+        u, y = _core.parse_measured(text, path, ["impact_velocity", second])
+        return u, y
     if isinstance(data, tuple) and len(data) == 2:
         u, y = data
         u, y = _floats(u, f"{name}[0] (impact_velocity)"), _floats(y, f"{name}[1] ({second})")
@@ -364,8 +375,9 @@ def identify(
 
     ``restitution``: (impact velocity, restitution) measurements and
     ``acceleration``: (impact velocity, peak acceleration of body 1 =
-    F_max/m1) measurements, each as a pair of arrays or an (n, 2) array;
-    either may be omitted. ``a_over_b`` fixes a/b; ``joint`` fits both at
+    F_max/m1) measurements, each as a pair of arrays, an (n, 2) array or a
+    CSV file with the columns ``impact_velocity`` and ``restitution`` (or
+    ``peak_acceleration``), as the CLI reads it; either may be omitted. ``a_over_b`` fixes a/b; ``joint`` fits both at
     once. Returns ``method``, ``a_over_b`` and ``alpha`` (each with
     ``value`` and ``std_error``), ``restitution_fit`` and
     ``acceleration_fit`` (with residuals).
@@ -480,7 +492,8 @@ def periodic(
     ``guess``: "simulate" (the state after ``guess_periods`` forcing periods
     from the model's initial state), "homotopy" (continued in the forcing
     amplitude from the rest state: the primary orbit), a state array
-    ``[u..., v...]`` or an earlier result with ``initial_state``.
+    ``[u..., v...]``, an earlier result with ``initial_state`` or a JSON file
+    holding one (``summary.json`` of ``periodic --out``).
     ``krylov=True``: matrix-free Newton-Krylov with Arnoldi multipliers
     (the default from 200 bodies on); ``dense=True``: the dense monodromy
     at any size.
@@ -499,11 +512,25 @@ def periodic(
     ``.result``).
     """
     m = _model(model)
-    if isinstance(guess, str):
-        if guess not in ("simulate", "homotopy"):
-            raise ValueError(
-                f"guess = {guess!r}: 'simulate', 'homotopy', a state array or an earlier result"
-            )
+    if isinstance(guess, os.PathLike) or (
+        isinstance(guess, str) and guess not in ("simulate", "homotopy")
+    ):
+        # A JSON file with `initial_state` (an earlier output), as the CLI.
+        path = os.fspath(guess)
+        try:
+            with open(path, encoding="utf-8") as f:
+                earlier = json.load(f)
+        except OSError as e:
+            raise OSError(
+                f"guess = {path!r}: 'simulate', 'homotopy', a state array, an earlier "
+                f"result or a JSON file with initial_state; cannot read it: {e.strerror}"
+            ) from None
+        except ValueError as e:
+            raise ValueError(f"guess: {path}: not JSON: {e}") from None
+        if not isinstance(earlier, dict) or "initial_state" not in earlier:
+            raise ValueError(f"guess: {path}: no `initial_state` array")
+        g = _floats(earlier["initial_state"], "guess['initial_state']")
+    elif isinstance(guess, str):
         g = None
     elif isinstance(guess, (Result, dict)):
         g = _floats(guess["initial_state"], "guess['initial_state']")
@@ -685,6 +712,12 @@ def _sweep_values(values, from_, to, points) -> np.ndarray:
         v = _floats(values, "values")
         if v.size < 2:
             raise ValueError(f"values: a sweep needs at least 2 values, got {v.size}")
+        steps = np.diff(v)
+        if not (np.all(steps > 0) or np.all(steps < 0)):
+            raise ValueError(
+                "values: give them in increasing or decreasing order (the points come back "
+                "sorted by the parameter, and an up-down sweep follows the order)"
+            )
         return v
     if from_ is None or to is None or points is None:
         raise ValueError("give values= or all of from_=, to=, points=")

@@ -43,8 +43,9 @@ class Model:
 
 def impact(
     velocity: F64, law_spec: str, mass1: float, mass2: float, method: str,
-    rtol: float, duration_level: Optional[float],
+    rtol: float, duration_level: Optional[float], progress: Progress = None,
 ) -> dict[str, Any]: ...
+def parse_measured(text: str, source: str, wanted: list[str]) -> list[F64]: ...
 def contact_force(law_spec: str, s: F64, sdot: F64, impact_velocity: F64) -> dict[str, F64]: ...
 def identify(
     restitution_velocity: F64, restitution: F64, acceleration_velocity: F64,

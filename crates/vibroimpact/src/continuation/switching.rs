@@ -245,10 +245,17 @@ fn switch_directions<F: Family>(
         .ok_or_else(|| ContinuationError::Invalid("no second direction at the branch point".into()))
 }
 
-/// Why a branch switch could not start.
+/// Why a branch switch could not start: the special point's label and
+/// why (each face spells the option before it: `--switch-at BP9: …`,
+/// `switch_at = 'BP9': …`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct SwitchError(pub String);
+#[error("switch at {label}: {message}")]
+pub struct SwitchError {
+    /// The label asked for.
+    pub label: String,
+    /// Why the switch could not start.
+    pub message: String,
+}
 
 /// The branch through special point `label` of `branch` (a branch point's
 /// crossing branch or a period doubling's period-2n branch), continued
@@ -271,21 +278,21 @@ where
         .special
         .iter()
         .find(|s| s.label == label)
-        .ok_or_else(|| {
-            SwitchError(format!(
-                "--switch-at {label}: no such special point on the branch (found: {})",
+        .ok_or_else(|| SwitchError {
+            label: label.to_string(),
+            message: format!(
+                "no such special point on the branch (found: {})",
                 branch
                     .special
                     .iter()
                     .map(|s| s.label.as_str())
                     .collect::<Vec<_>>()
                     .join(", ")
-            ))
+            ),
         })?;
-    let fail = |e: ContinuationError| {
-        SwitchError(format!(
-            "--switch-at {label}: {e} (the main branch is kept)"
-        ))
+    let fail = |e: ContinuationError| SwitchError {
+        label: label.to_string(),
+        message: format!("{e} (the main branch is kept)"),
     };
     let sub = opts.shooting.subharmonic;
     let (p1, x1, sub) = match sp.kind {
@@ -298,10 +305,10 @@ where
             (p, x, sub)
         }
         other => {
-            return Err(SwitchError(format!(
-                "--switch-at {label}: cannot switch at a {} point (only BP and PD)",
-                other.name()
-            )))
+            return Err(SwitchError {
+                label: label.to_string(),
+                message: format!("cannot switch at a {} point (only BP and PD)", other.name()),
+            })
         }
     };
     let switched_opts = ContinuationOptions {

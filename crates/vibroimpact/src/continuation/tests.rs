@@ -142,6 +142,16 @@ fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
     let switched = switch_branch(family, &main, "BP1", (0.0, 0.05), &opts, |_| true)
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(switched.stop, StopReason::ReachedEnd);
+    // A label the branch lacks, or a point that starts no branch: the
+    // label and why, for each face to spell.
+    let e = switch_branch(family, &main, "BP9", (0.0, 0.05), &opts, |_| true).unwrap_err();
+    assert_eq!(e.label, "BP9");
+    assert!(
+        e.message
+            .starts_with("no such special point on the branch (found: "),
+        "{e}"
+    );
+    assert!(e.message.contains("BP1"), "{e}");
     // A start next to the branch point (a step of 0.02 in the scale 0.025)
     // on the crossing branch, whose two bodies move differently (the main
     // branch is symmetric: equal amplitudes).
