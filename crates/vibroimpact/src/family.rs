@@ -8,8 +8,8 @@
 use std::fmt;
 
 use crate::model::{Model, ModelError};
-use crate::model_file::ModelDocument;
 use crate::model_file::ModelFileError;
+use crate::model_file::{ModelDocument, SimulationSpec};
 use crate::parameter::{ModelParameter, ParameterizedModel};
 
 /// Why a family has no model at a value.
@@ -69,6 +69,11 @@ pub trait Family {
     fn whole_numbers(&self) -> bool {
         false
     }
+    /// The `[simulation]` settings the models come with (tolerances,
+    /// impact threshold); none for a model built in code.
+    fn simulation(&self) -> SimulationSpec {
+        SimulationSpec::default()
+    }
 }
 
 /// Models in two parameters (curves of special points: `p` along the
@@ -89,6 +94,9 @@ impl<T: Family + ?Sized> Family for &mut T {
     }
     fn whole_numbers(&self) -> bool {
         (**self).whole_numbers()
+    }
+    fn simulation(&self) -> SimulationSpec {
+        (**self).simulation()
     }
 }
 
@@ -111,6 +119,9 @@ impl Family for ParameterizedModel {
     fn whole_numbers(&self) -> bool {
         self.parameter.integer
     }
+    fn simulation(&self) -> SimulationSpec {
+        self.document.simulation()
+    }
 }
 
 impl Family for &ParameterizedModel {
@@ -123,6 +134,9 @@ impl Family for &ParameterizedModel {
     }
     fn whole_numbers(&self) -> bool {
         self.parameter.integer
+    }
+    fn simulation(&self) -> SimulationSpec {
+        self.document.simulation()
     }
 }
 

@@ -577,6 +577,11 @@ impl ModelDocument {
         &self.source
     }
 
+    /// Its `[simulation]` settings (as written; checked when built).
+    pub fn simulation(&self) -> SimulationSpec {
+        self.file.simulation.clone().unwrap_or_default()
+    }
+
     /// Builds the model.
     pub fn build(&self) -> Result<LoadedModel, ModelFileError> {
         self.build_labelled(&self.source)

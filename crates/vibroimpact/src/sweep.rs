@@ -23,12 +23,12 @@
 
 use serde::Serialize;
 
+use crate::family::{Family, FamilyError};
 use crate::field_error::FieldError;
 use crate::integrate::{Interrupt, Method};
 use crate::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 use crate::model::{BaseExcitation, HarmonicForce, Model, ModelError};
 use crate::model_file::LoadedModel;
-use crate::parameter::ParameterizedModel;
 use crate::simulate::{simulate, Integrator, Simulation, SimulationOptions};
 
 /// Samples per forcing period of the recorded window (for max |u|).
@@ -621,8 +621,8 @@ fn finite_positive(what: &'static str, x: f64) -> Result<(), SweepError> {
 /// `progress` is called after every value, from any thread. The values run
 /// in parallel on rayon's current pool (up and down in parallel with
 /// `up_down`); the result does not depend on the number of threads.
-pub fn sweep(
-    family: &ParameterizedModel,
+pub fn sweep<F: Family>(
+    mut family: F,
     values: &[f64],
     options: &SweepOptions,
     progress: &(dyn Fn() + Sync),
@@ -636,10 +636,14 @@ pub fn sweep(
             "parameter value {x}: the values must be finite"
         )));
     }
-    let err = |e: crate::model_file::ModelFileError| SweepError::Input(e.to_string());
-    let base = family.loaded_at(family.initial()).map_err(err)?;
+    let err = |e: FamilyError| SweepError::Input(e.to_string());
+    let base = LoadedModel {
+        model: family.model_at(values[0]).map_err(err)?,
+        simulation: family.simulation(),
+        record: None,
+    };
     let settings = Settings::new(&base, options)?;
-    let name = family.name();
+    let name = family.name().to_string();
     let bodies: Vec<String> = base.model.bodies().iter().map(|b| b.name.clone()).collect();
     let mut models: Vec<(f64, Model)> = Vec::with_capacity(values.len());
     for &p in values {

@@ -1,6 +1,7 @@
 //! Tests of sweep.rs.
 
 use super::*;
+use crate::parameter::ParameterizedModel;
 
 #[test]
 fn values_are_even_with_exact_ends() {

@@ -6,16 +6,16 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use vibroimpact::continuation::{
     branch_switch_start, continue_branch, Branch, ContinuationOptions,
 };
 use vibroimpact::family::of;
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model::{Model, ModelError};
-use vibroimpact::periodic::{guess_by_simulation_with, orbit_summary, ShootingOptions};
+use vibroimpact::periodic::{guess_by_simulation_with, ShootingOptions};
 use vibroimpact::reference;
-use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
+use vibroimpact::simulate::Integrator;
+use vibroimpact::sweep::{sweep, Direction, SweepOptions, SweepSummary};
 
 use super::{html_escape, html_table, DataFile, Report};
 use crate::error::CliError;
@@ -85,8 +85,7 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
             branch.points.len(),
             t0.elapsed().as_secs_f64()
         );
-        let (sweep, sweep_down) =
-            rayon::join(|| sweep_from_rest(n, stop), || sweep_downward(n, stop));
+        let (sweep, sweep_down) = sweeps(n, stop)?;
         let asymmetric = if n == 2 {
             asymmetric_branches(n, &branch, &opts)?
         } else {
@@ -103,73 +102,42 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
     Ok(rows)
 }
 
-/// max |u1| (mm) over 10 periods after the run `opts` from the model at Ω
-/// (from where the run ended, also if it stopped early).
-fn settled_amplitude(model: &Model, w: f64, opts: &SimulationOptions) -> Option<f64> {
-    let end = simulate(model, opts).ok()?.final_state();
-    let t = 2.0 * std::f64::consts::PI / w;
-    let orbit = orbit_summary(model, &end, 10.0 * t, 2560, 1e-9).ok()?;
-    Some(1e3 * orbit.max_displacement[0])
-}
-
-fn sweep_options(
-    w: f64,
-    periods: f64,
-    start: Option<Vec<f64>>,
-    stop: &Interrupt,
-) -> SimulationOptions {
-    SimulationOptions {
-        t_end: periods * (2.0 * std::f64::consts::PI / w),
-        rtol: 1e-9,
-        atol: 1e-13,
-        start,
+/// The brute-force sweeps of R2 N = `n` over 0.5–1.5 ω0 by the library's
+/// sweep: from rest at every frequency (150 transient periods), and
+/// downward from 1.5 ω0, each frequency from the state the previous one
+/// reached (100 periods): (Ω/ω0, max |u1| in mm over 10 recorded periods),
+/// the values that completed.
+type Sweeps = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+fn sweeps(n: usize, stop: &Interrupt) -> Result<Sweeps, CliError> {
+    let w0 = reference::NATURAL_FREQUENCY;
+    let values: Vec<f64> = (0..SWEEP_POINTS)
+        .map(|k| (0.5 + k as f64 / 60.0) * w0)
+        .collect();
+    let options = |transient, only: Option<Direction>| SweepOptions {
+        transient,
+        record: 10,
+        up_down: only.is_some(),
+        only,
+        rtol: Some(1e-9),
+        atol: Some(1e-13),
         interrupt: Some(stop.clone()),
-        ..SimulationOptions::default()
-    }
-}
-
-/// Brute force from rest (150 periods) at every frequency, in parallel.
-fn sweep_from_rest(n: usize, stop: &Interrupt) -> Vec<(f64, f64)> {
-    let w0 = reference::NATURAL_FREQUENCY;
-    (0..SWEEP_POINTS)
-        .into_par_iter()
-        .map(|k| {
-            let w = (0.5 + k as f64 / 60.0) * w0;
-            let model = row(n, w).ok()?;
-            let amplitude = settled_amplitude(&model, w, &sweep_options(w, 150.0, None, stop))?;
-            Some((w / w0, amplitude))
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .collect()
-}
-
-/// Brute force downward from 1.5 ω0 (100 periods each), every frequency
-/// starting from the state the previous one reached: it follows an
-/// attractor while it exists.
-fn sweep_downward(n: usize, stop: &Interrupt) -> Vec<(f64, f64)> {
-    let w0 = reference::NATURAL_FREQUENCY;
-    let mut state: Option<Vec<f64>> = None;
-    let mut out = Vec::new();
-    for k in (0..SWEEP_POINTS).rev() {
-        let w = (0.5 + k as f64 / 60.0) * w0;
-        let Ok(model) = row(n, w) else { continue };
-        let opts = sweep_options(w, 100.0, state.clone(), stop);
-        let Ok(sim) = simulate(&model, &opts) else {
-            continue;
-        };
-        if sim.error.is_some() {
-            continue;
-        }
-        let end = sim.final_state();
-        let t = 2.0 * std::f64::consts::PI / w;
-        if let Ok(orbit) = orbit_summary(&model, &end, 10.0 * t, 2560, 1e-9) {
-            out.push((w / w0, 1e3 * orbit.max_displacement[0]));
-        }
-        state = Some(end);
-    }
-    out
+        ..SweepOptions::default()
+    };
+    let run = |transient, only| {
+        let family = of("frequency", |w| row(n, w));
+        sweep(family, &values, &options(transient, only), &|| {})
+    };
+    let amplitudes = |s: SweepSummary| -> Vec<(f64, f64)> {
+        s.points
+            .iter()
+            .filter(|p| p.error.is_none())
+            .map(|p| (p.parameter / w0, 1e3 * p.max_displacement[0]))
+            .collect()
+    };
+    let rest = amplitudes(run(150, None)?);
+    let mut down = amplitudes(run(100, Some(Direction::Down))?);
+    down.reverse();
+    Ok((rest, down))
 }
 
 /// The asymmetric branches born at the first two pitchforks (N = 2).
