@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::events::TestValues;
+use super::events::{BranchEvent, Observed, TestValues};
 use super::{BranchPoint, ContinuationError, ContinuationOptions};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
@@ -595,5 +595,79 @@ impl<F: Family> NewtonSystem for Corrector<'_, '_, F> {
         delta[..d]
             .iter()
             .fold(delta[d].abs(), |m, v| m.max(unit * v.abs()))
+    }
+}
+
+impl Evaluated {
+    /// The point as an event sees it.
+    pub(super) fn observed(&self) -> Observed<'_> {
+        Observed {
+            tests: &self.tests,
+            point: &self.point,
+        }
+    }
+}
+
+impl<F: Family> Problem<F> {
+    /// Location of the event that occurs between `a` and `b` on the
+    /// arclength in (0, ds) from `a`: regula falsi (Illinois) on the event's
+    /// scalar test function where it has one, bisection otherwise, until
+    /// the parameter is bracketed to `locate_tol`; returns the located
+    /// point.
+    pub(super) fn locate(
+        &mut self,
+        event: &dyn BranchEvent,
+        a: &Evaluated,
+        b: &Evaluated,
+        ds: f64,
+    ) -> Option<Evaluated> {
+        let (mut lo, mut hi) = (0.0, ds);
+        let (mut p_lo, mut p_hi) = (a.point.parameter, b.point.parameter);
+        let scalar = event.scalar(a.observed(), b.observed());
+        let (mut g_lo, mut g_hi) =
+            scalar.map_or((f64::NAN, f64::NAN), |f| (f(&a.tests), f(&b.tests)));
+        // Which end moved last (Illinois: the end kept twice has its value
+        // halved, so that the secant does not stall).
+        let mut moved_hi: Option<bool> = None;
+        let mut best: Option<Evaluated> = None;
+        let mut lo_point: Option<Evaluated> = None;
+        for _ in 0..80 {
+            if (p_hi - p_lo).abs() <= self.opts.locate_tol && best.is_some() {
+                break;
+            }
+            let width = hi - lo;
+            let secant = lo - g_lo * width / (g_hi - g_lo);
+            let mid = if secant.is_finite() && g_lo * g_hi < 0.0 {
+                secant.clamp(lo + 0.02 * width, hi - 0.02 * width)
+            } else {
+                0.5 * (lo + hi)
+            };
+            let (solved, _) = self.correct(&a.predict(mid), &a.tangent, Some(&a.solved.linear))?;
+            let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
+            let g = scalar.map_or(f64::NAN, |f| f(&e.tests));
+            if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {
+                hi = mid;
+                p_hi = e.point.parameter;
+                g_hi = g;
+                if moved_hi == Some(true) {
+                    g_lo *= 0.5;
+                }
+                moved_hi = Some(true);
+            } else {
+                lo = mid;
+                p_lo = e.point.parameter;
+                g_lo = g;
+                lo_point = Some(e.clone());
+                if moved_hi == Some(false) {
+                    g_hi *= 0.5;
+                }
+                moved_hi = Some(false);
+            }
+            best = Some(e);
+            if hi - lo < 1e-14 {
+                break;
+            }
+        }
+        best
     }
 }
