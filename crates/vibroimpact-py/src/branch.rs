@@ -58,22 +58,8 @@ pub fn continue_branch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut family =
         ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
-    let start = match start {
-        "auto" => Start::Auto,
-        "simulate" => Start::Simulate,
-        "homotopy" => Start::Homotopy,
-        other => {
-            return Err(value_error(format!(
-                "start = {other:?}: must be auto, simulate or homotopy"
-            )))
-        }
-    };
-    let linear = match (krylov, dense) {
-        (true, true) => return Err(value_error("krylov = True, dense = True: choose one")),
-        (true, false) => Linear::MatrixFree,
-        (false, true) => Linear::Dense,
-        (false, false) => Linear::Auto,
-    };
+    let start: Start = start.parse().map_err(value_error)?;
+    let linear = Linear::from_switches(krylov, dense).map_err(value_error)?;
     let mut study = BranchStudy {
         from: from_,
         to,

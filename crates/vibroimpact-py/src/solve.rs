@@ -335,12 +335,7 @@ pub fn periodic<'py>(
     homotopy: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.loaded.model;
-    let linear = match (krylov, dense) {
-        (true, true) => return Err(value_error("krylov = True, dense = True: choose one")),
-        (true, false) => Linear::MatrixFree,
-        (false, true) => Linear::Dense,
-        (false, false) => Linear::Auto,
-    };
+    let linear = Linear::from_switches(krylov, dense).map_err(value_error)?;
     let krylov = linear.krylov(m.bodies().len(), arnoldi).is_some();
     let amplitude = if homotopy {
         Some(

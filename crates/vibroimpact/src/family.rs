@@ -109,21 +109,6 @@ impl<T: Family2 + ?Sized> Family2 for &mut T {
     }
 }
 
-impl Family for ParameterizedModel {
-    fn name(&self) -> &str {
-        &self.parameter.name
-    }
-    fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
-        ParameterizedModel::model_at(self, p).map_err(|e| FamilyError::new(self.name(), p, e))
-    }
-    fn whole_numbers(&self) -> bool {
-        self.parameter.integer
-    }
-    fn simulation(&self) -> SimulationSpec {
-        self.document.simulation()
-    }
-}
-
 impl Family for &ParameterizedModel {
     fn name(&self) -> &str {
         &self.parameter.name
@@ -137,6 +122,22 @@ impl Family for &ParameterizedModel {
     }
     fn simulation(&self) -> SimulationSpec {
         self.document.simulation()
+    }
+}
+
+/// The owned family is the borrowed one.
+impl Family for ParameterizedModel {
+    fn name(&self) -> &str {
+        &self.parameter.name
+    }
+    fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
+        Family::model_at(&mut &*self, p)
+    }
+    fn whole_numbers(&self) -> bool {
+        (&self).whole_numbers()
+    }
+    fn simulation(&self) -> SimulationSpec {
+        (&self).simulation()
     }
 }
 

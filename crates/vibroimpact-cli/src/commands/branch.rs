@@ -513,24 +513,20 @@ fn curves_from_file(
     pm: &ParameterizedModel,
     q: &vibroimpact::parameter::ModelParameter,
     path: &std::path::Path,
-    interrupt: &vibroimpact::integrate::Interrupt,
+    (interrupt, opts): (&Interrupt, &ContinuationOptions),
 ) -> Result<(), CliError> {
     let read = curves::read_special_points(path, &pm.document, &pm.parameter)?;
     let shooting = ShootingOptions {
         subharmonic: read.subharmonic,
-        interrupt: Some(interrupt.clone()),
-        integrator: args.integrator.integrator(),
-        ..ContinuationOptions::default().shooting
+        ..opts.shooting.clone()
     };
-    let bodies = pm.model_at(args.range.from)?.bodies().len();
     let origin = BranchOrigin {
         special: &read.special,
         symmetric: read.symmetric,
         range: (args.range.from, args.range.to),
         q0: q.initial,
     };
-    let linear = (&shooting, args.linear.krylov(bodies));
-    let c = curves::follow(pm, q, origin, &args.second, linear)?;
+    let c = curves::follow(pm, q, origin, &args.second, (&shooting, opts.krylov))?;
     if interrupt.requested() {
         return Err(CliError::new("interrupted (Ctrl-C): nothing written"));
     }
@@ -578,7 +574,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let (start_model, opts) = study.check(&mut pm).map_err(|e| study_error(e, args))?;
     let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
     if let (Some(path), Some(q)) = (&args.second.special_points, &second) {
-        return curves_from_file(args, &pm, q, path, &interrupt);
+        return curves_from_file(args, &pm, q, path, (&interrupt, &opts));
     }
     let mut doc_at_start = pm.document.clone();
     doc_at_start.set(&pm.parameter, args.range.from)?;

@@ -134,8 +134,9 @@ fn sweeps(n: usize, stop: &Interrupt) -> Result<Sweeps, CliError> {
             .map(|p| (p.parameter / w0, 1e3 * p.max_displacement[0]))
             .collect()
     };
-    let rest = amplitudes(run(150, None)?);
-    let mut down = amplitudes(run(100, Some(Direction::Down))?);
+    // The downward sweep goes one value after the other: beside the other.
+    let (rest, down) = rayon::join(|| run(150, None), || run(100, Some(Direction::Down)));
+    let (rest, mut down) = (amplitudes(rest?), amplitudes(down?));
     down.reverse();
     Ok((rest, down))
 }

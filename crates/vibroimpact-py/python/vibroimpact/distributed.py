@@ -231,8 +231,6 @@ def ida(
     scales = np.asarray(scales, dtype=np.float64)
     if scales.ndim != 1 or scales.size == 0 or not np.all(np.isfinite(scales)):
         raise ValueError("scales: expected a non-empty list of finite factors")
-    if not recs:
-        raise ValueError("records: give at least one record")
     jobs = [(i, float(s)) for i in range(len(recs)) for s in scales]
     arrays = vi._record_inputs(recs, None)
     if client is None:

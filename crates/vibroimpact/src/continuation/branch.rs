@@ -414,8 +414,9 @@ fn branch_integrator<F: Family>(
     opts: &ContinuationOptions,
 ) -> Integrator {
     let chosen = opts.shooting.integrator;
-    if chosen != Integrator::Auto || chosen.resolve(model) != Integrator::Local {
-        return chosen.resolve(model);
+    let resolved = chosen.resolve(model);
+    if chosen != Integrator::Auto || resolved != Integrator::Local {
+        return resolved;
     }
     let near = p0 + 1e-6 * (p_end - p0);
     match family.model_at(near) {

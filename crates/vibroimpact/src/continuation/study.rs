@@ -38,6 +38,20 @@ impl Start {
     }
 }
 
+impl std::str::FromStr for Start {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Start::Auto),
+            "simulate" => Ok(Start::Simulate),
+            "homotopy" => Ok(Start::Homotopy),
+            other => Err(format!(
+                "start = {other:?}: must be auto, simulate or homotopy"
+            )),
+        }
+    }
+}
+
 /// Dense or matrix-free linear algebra for periodic orbits and branches.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Linear {
@@ -55,6 +69,17 @@ pub enum Linear {
 pub const AUTO_KRYLOV_BODIES: usize = 200;
 
 impl Linear {
+    /// The choice of the two switches `krylov` and `dense` (both: an
+    /// error).
+    pub fn from_switches(krylov: bool, dense: bool) -> Result<Self, String> {
+        match (krylov, dense) {
+            (true, true) => Err("krylov = True, dense = True: choose one".into()),
+            (true, false) => Ok(Linear::MatrixFree),
+            (false, true) => Ok(Linear::Dense),
+            (false, false) => Ok(Linear::Auto),
+        }
+    }
+
     /// The Arnoldi dimension `arnoldi` if matrix-free for `bodies`, else
     /// None (dense).
     pub fn krylov(self, bodies: usize, arnoldi: usize) -> Option<usize> {
