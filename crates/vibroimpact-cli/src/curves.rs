@@ -5,14 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::continuation::{
-    curves_of_branch, BranchOrigin, CurveKind, CurveSelection, Curves, CurvesError,
-};
-use vibroimpact::family::ParameterizedModel2;
+use vibroimpact::continuation::{CurveKind, CurveSelection, Curves};
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ModelParameter;
-use vibroimpact::parameter::ParameterizedModel;
-use vibroimpact::periodic::ShootingOptions;
 use vibroimpact::results::{branch_special_points, curves_document, BranchSpecialPoints};
 
 use crate::error::{option_error, CliError};
@@ -48,7 +43,7 @@ pub struct SecondParameter {
     /// Start the curves from the special points of an earlier run's
     /// `branch.json` (`continue --out`: its `special_points`, `symmetric`
     /// and `subharmonic`) instead of computing the branch again.
-    #[arg(long)]
+    #[arg(long, requires = "parameter2")]
     pub special_points: Option<PathBuf>,
 }
 
@@ -77,51 +72,6 @@ impl SecondParameter {
         selection.check().map_err(|e| option_error(&e))?;
         Ok(selection)
     }
-}
-
-/// Checks --curves and --parameter2 against the first parameter.
-pub fn validate(
-    second: &SecondParameter,
-    document: &ModelDocument,
-    first: &ModelParameter,
-) -> Result<Option<ModelParameter>, CliError> {
-    second.selection()?;
-    let Some(name) = &second.parameter2 else {
-        if second.special_points.is_some() {
-            return Err(CliError::new(
-                "--special-points: give --parameter2 too (the curves' second parameter)",
-            ));
-        }
-        return Ok(None);
-    };
-    let q = document.parameter(name)?;
-    if q.key == first.key {
-        return Err(CliError::new(format!(
-            "--parameter2 {name}: the same key as --parameter {}; give another",
-            first.name
-        )));
-    }
-    Ok(Some(q))
-}
-
-/// The curves in (`family`'s parameter, `q`) through the special points
-/// of `origin`, selected by the options, in the command line's words.
-pub fn follow(
-    family: &ParameterizedModel,
-    q: &ModelParameter,
-    origin: BranchOrigin<'_>,
-    second: &SecondParameter,
-    linear: (&ShootingOptions, Option<usize>),
-) -> Result<Curves, CliError> {
-    let plane = ParameterizedModel2 {
-        document: family.document.clone(),
-        p: family.parameter.clone(),
-        q: q.clone(),
-    };
-    curves_of_branch(plane, origin, &second.selection()?, linear).map_err(|e| match e {
-        CurvesError::Field(f) => option_error(&f),
-        other => CliError::new(other.to_string()),
-    })
 }
 
 /// Writes curves.json and the figure of the curves in the parameter plane.

@@ -1097,7 +1097,7 @@ fn continue_two_parameter_curves() {
         ),
         (
             &["--special-points", &model][..],
-            "--special-points: give --parameter2 too",
+            "--parameter2 <PARAMETER2>",
         ),
         (
             &["--parameter2", "amplitude", "--special-points", &model][..],

@@ -5,13 +5,11 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibroimpact::continuation::{
-    curves_of_branch, BranchOrigin, BranchStudy, ContinuationError, ContinuationOptions,
-    CurveSelection, CurvesError, Linear, Start, StudyError, StudyField,
+    BranchStudy, CheckedContinue, ContinuationError, ContinuationOptions, ContinueStudy,
+    CurveSelection, CurvesRequest, Linear, StudyError, StudyField,
 };
-use vibroimpact::family::{Family, ParameterizedModel2};
-use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::ShootingOptions;
-use vibroimpact::results::{branch_document, branch_special_points, curves_document};
+use vibroimpact::results::{branch_special_points, continue_document, curves_document};
 
 use crate::convert::{numerical_error, to_python, value_error};
 use crate::model::PyModel;
@@ -29,11 +27,94 @@ type Second = (
     Option<String>,
 );
 
+/// The settings of [`continue_branch`] besides the model, as Python gives
+/// them: range, period multiple, switch, points, step, guess periods,
+/// integrator, start, linear algebra (krylov, dense, arnoldi).
+type Settings<'a> = (
+    &'a str,
+    (f64, f64),
+    u32,
+    Option<String>,
+    (usize, f64, f64),
+    &'a str,
+    &'a str,
+    (bool, bool, usize),
+);
+
+/// The library's study of `continue_`'s arguments.
+fn study(settings: Settings<'_>, second: &Second) -> PyResult<ContinueStudy> {
+    let (parameter, (from, to), subharmonic, switch_at, budget, integrator, start, linear) =
+        settings;
+    let (max_points, ds_max, guess_periods) = budget;
+    let (parameter2, from2, to2, kinds, step, _) = second;
+    let defaults = ContinuationOptions::default();
+    Ok(ContinueStudy {
+        parameter: parameter.to_string(),
+        branch: BranchStudy {
+            from,
+            to,
+            start: start.parse().map_err(value_error)?,
+            guess_periods,
+            switch_at,
+            linear: Linear::from_switches(linear.0, linear.1).map_err(value_error)?,
+            arnoldi: linear.2,
+            options: ContinuationOptions {
+                max_points,
+                ds_max,
+                shooting: ShootingOptions {
+                    subharmonic,
+                    integrator: integrator.parse().map_err(value_error)?,
+                    ..defaults.shooting.clone()
+                },
+                ..defaults
+            },
+        },
+        curves: match parameter2 {
+            None => None,
+            Some(parameter2) => Some(CurvesRequest {
+                parameter2: parameter2.clone(),
+                selection: CurveSelection {
+                    kinds: CurveSelection::kinds_named(kinds).map_err(value_error)?,
+                    bounds2: (*from2, *to2),
+                    step: *step,
+                },
+            }),
+        },
+    })
+}
+
+/// A study error in Python's words: the keyword and its value first.
+fn spell(e: StudyError, study: &ContinueStudy) -> PyErr {
+    let branch = &study.branch;
+    let field = |f: StudyField| match f {
+        StudyField::Range => format!("from_ = {}, to = {}", branch.from, branch.to),
+        StudyField::From => format!("from_ = {}", branch.from),
+        StudyField::Subharmonic => {
+            format!("subharmonic = {}", branch.options.shooting.subharmonic)
+        }
+        StudyField::Parameter => format!("parameter = {:?}", study.parameter),
+        StudyField::Start => format!("start = {:?}", branch.start.name()),
+        StudyField::Parameter2 => format!(
+            "parameter2 = {:?}",
+            study.curves.as_ref().map_or("", |c| c.parameter2.as_str())
+        ),
+        StudyField::SpecialPoints => "special_points".to_string(),
+    };
+    match e {
+        StudyError::Invalid { field: f, message } => {
+            value_error(format!("{}: {message}", field(f)))
+        }
+        e @ (StudyError::Field(_) | StudyError::File(_) | StudyError::Family(_)) => value_error(e),
+        StudyError::Continuation(e @ ContinuationError::Invalid(_)) => value_error(e),
+        other => numerical_error(other),
+    }
+}
+
 /// A branch of periodic solutions: the `continue` document (with
 /// `switched_branch` when `switch_at` is given, `curves` and
 /// `curves_skipped` with `parameter2`); progress counts points. The
-/// library's [`BranchStudy`] does the checks, the start (`start`: auto,
-/// simulate or homotopy) and the switch, as for the CLI.
+/// library's [`ContinueStudy`] does the checks, the start (`start`: auto,
+/// simulate or homotopy), the switch and the curves, as for the CLI.
 #[pyfunction]
 #[pyo3(signature = (model, parameter, from_, to, subharmonic, switch_at, max_points, ds_max, guess_periods, progress = None, integrator = "auto", start = "auto", krylov = false, dense = false, arnoldi = 20, second = (None, None, None, Vec::new(), 0.05, None)))]
 #[allow(clippy::too_many_arguments)]
@@ -56,181 +137,68 @@ pub fn continue_branch<'py>(
     arnoldi: usize,
     second: Second,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut family =
-        ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
-    let start: Start = start.parse().map_err(value_error)?;
-    let linear = Linear::from_switches(krylov, dense).map_err(value_error)?;
-    let mut study = BranchStudy {
-        from: from_,
-        to,
-        start,
-        guess_periods,
+    let budget = (max_points, ds_max, guess_periods);
+    let linear = (krylov, dense, arnoldi);
+    let settings = (
+        parameter,
+        (from_, to),
+        subharmonic,
         switch_at,
+        budget,
+        integrator,
+        start,
         linear,
-        arnoldi,
-        options: ContinuationOptions {
-            max_points,
-            ds_max,
-            shooting: ShootingOptions {
-                subharmonic,
-                integrator: integrator.parse().map_err(value_error)?,
-                ..ContinuationOptions::default().shooting
-            },
-            ..ContinuationOptions::default()
-        },
-    };
-    let spell = |e: StudyError| match e {
-        StudyError::Invalid { field, message } => value_error(format!(
-            "{}: {message}",
-            match field {
-                StudyField::Range => format!("from_ = {from_}, to = {to}"),
-                StudyField::From => format!("from_ = {from_}"),
-                StudyField::Subharmonic => format!("subharmonic = {subharmonic}"),
-                StudyField::Parameter => format!("parameter = {parameter:?}"),
-                StudyField::Start => format!("start = {:?}", start.name()),
-            }
-        )),
-        StudyError::Family(e) => value_error(e),
-        StudyError::Continuation(e @ ContinuationError::Invalid(_)) => value_error(e),
-        other => numerical_error(other),
-    };
-    let (start_model, checked) = study.check(&mut family).map_err(spell)?;
-    let (parameter2, from2, to2, kinds, curve_step, special_points) = second;
-    let plane = match &parameter2 {
-        None => None,
-        Some(name) => {
-            let q = model.document.parameter(name).map_err(value_error)?;
-            if q.key == family.parameter.key {
-                return Err(value_error(format!(
-                    "parameter2 = {name:?}: the same key as parameter = {parameter:?}; give another"
-                )));
-            }
-            let selection = CurveSelection {
-                kinds: CurveSelection::kinds_named(&kinds).map_err(value_error)?,
-                bounds2: (from2, to2),
-                step: curve_step,
-            };
-            selection.check().map_err(value_error)?;
-            let plane = ParameterizedModel2 {
-                document: model.document.clone(),
-                p: family.parameter.clone(),
-                q,
-            };
-            Some((plane, selection))
-        }
-    };
-    if let Some(text) = special_points {
-        let Some((plane, selection)) = plane else {
-            return Err(value_error(
-                "special_points: give parameter2 too (the curves' second parameter)",
-            ));
-        };
-        return curves_from_document(
-            py,
-            progress,
-            &text,
-            (plane, selection),
-            (from_, to),
-            checked,
-        );
+    );
+    let study = study(settings, &second)?;
+    let mut checked = study
+        .clone()
+        .check(model.document.clone())
+        .map_err(|e| spell(e, &study))?;
+    if let Some(text) = &second.5 {
+        return curves_from_document(py, progress, text, checked, &study);
     }
-    let mut at_start = model.document.clone();
-    at_start
-        .set(&family.parameter, from_)
-        .map_err(value_error)?;
-    let amplitude = ParameterizedModel::new(at_start, "amplitude");
     let out = monitor::run(py, progress, move |p: &Progress| {
         p.set_total(max_points);
-        study.options.shooting.interrupt = Some(p.interrupt.clone());
-        let mut amplitude = amplitude;
-        let homotopy = amplitude.as_mut().ok().map(|a| {
-            let target = a.initial();
-            (a as &mut dyn Family, target)
-        });
-        let on_point = |_: &vibroimpact::continuation::BranchPoint| {
+        checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());
+        checked.run(|_| {
             p.tick();
             !p.interrupt.requested()
-        };
-        let outcome = study
-            .run(&family, homotopy, on_point)
-            .map_err(Failure::Study)?;
-        let curves = match plane {
-            Some((plane, selection)) => {
-                let origin = BranchOrigin {
-                    special: &outcome.branch.special,
-                    symmetric: outcome.branch.symmetric,
-                    range: (from_, to),
-                    q0: plane.q.initial,
-                };
-                let linear = (&outcome.options.shooting, outcome.options.krylov);
-                let names = (plane.p.name.clone(), plane.q.name.clone());
-                let c =
-                    curves_of_branch(plane, origin, &selection, linear).map_err(Failure::Curves)?;
-                Some(curves_document(&c, &names.0, &names.1))
-            }
-            None => None,
-        };
-        Ok::<_, Failure>((outcome, curves))
+        })
     })?;
-    let (outcome, curves) = out.map_err(|e| match e {
-        Failure::Study(e) => spell(e),
-        Failure::Curves(CurvesError::Field(f)) => value_error(f),
-        Failure::Curves(e) => numerical_error(e),
-    })?;
-    let mut doc = branch_document(&outcome.branch, &start_model, parameter);
-    match outcome.switched {
-        Some(Ok(b)) => doc["switched_branch"] = branch_document(&b, &start_model, parameter),
-        Some(Err(e)) => {
-            doc["switch_error"] = format!("switch_at = {:?}: {}", e.label, e.message).into()
-        }
-        None => {}
-    }
-    if let Some(c) = curves {
-        doc["curves"] = c["curves"].clone();
-        doc["curves_skipped"] = c["skipped"].clone();
+    let outcome = out.map_err(|e| spell(e, &study))?;
+    let mut doc = continue_document(&outcome);
+    if let Some(Err(e)) = &outcome.branch.switched {
+        doc["switch_error"] = format!("switch_at = {:?}: {}", e.label, e.message).into();
     }
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
 }
 
 /// The curves through the special points of an earlier branch document
-/// (`text`, its JSON) in the plane's parameters: the `curves` document.
+/// (`text`, its JSON): the `curves` document.
 fn curves_from_document<'py>(
     py: Python<'py>,
     progress: Option<&Bound<'py, PyAny>>,
     text: &str,
-    (plane, selection): (ParameterizedModel2, CurveSelection),
-    range: (f64, f64),
-    options: ContinuationOptions,
+    mut checked: CheckedContinue,
+    study: &ContinueStudy,
 ) -> PyResult<Bound<'py, PyDict>> {
     let doc: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| value_error(format!("special_points: not a branch document: {e}")))?;
-    let read = branch_special_points(&doc, &plane.document, &plane.p)
+    let family = &checked.branch.family;
+    let read = branch_special_points(&doc, &family.document, &family.parameter)
         .map_err(|e| value_error(format!("special_points: {e}")))?;
+    let names = (
+        family.parameter.name.clone(),
+        checked
+            .plane
+            .as_ref()
+            .map(|(plane, _)| plane.q.name.clone()),
+    );
     let out = monitor::run(py, progress, move |p: &Progress| {
-        let shooting = ShootingOptions {
-            subharmonic: read.subharmonic,
-            interrupt: Some(p.interrupt.clone()),
-            ..options.shooting
-        };
-        let origin = BranchOrigin {
-            special: &read.special,
-            symmetric: read.symmetric,
-            range,
-            q0: plane.q.initial,
-        };
-        let names = (plane.p.name.clone(), plane.q.name.clone());
-        curves_of_branch(plane, origin, &selection, (&shooting, options.krylov))
-            .map(|c| curves_document(&c, &names.0, &names.1))
+        checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());
+        checked.curves_from(&read)
     })?;
-    let doc = out.map_err(|e| match e {
-        CurvesError::Field(f) => value_error(f),
-        other => numerical_error(other),
-    })?;
+    let curves = out.map_err(|e| spell(e, study))?;
+    let doc = curves_document(&curves, &names.0, &names.1.unwrap_or_default());
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
-}
-
-/// How the work of [`continue_branch`] failed.
-enum Failure {
-    Study(StudyError),
-    Curves(CurvesError),
 }

@@ -74,6 +74,17 @@ pub trait Family {
     fn simulation(&self) -> SimulationSpec {
         SimulationSpec::default()
     }
+    /// The homotopy start's family: the model at parameter value `p` as a
+    /// family in its forcing amplitude (everything else fixed), with the
+    /// amplitude to reach. None for a family that cannot vary the
+    /// amplitude alone (a model built in code); an error when its model
+    /// has no forcing amplitude.
+    fn amplitude_family(
+        &self,
+        _p: f64,
+    ) -> Option<Result<(ParameterizedModel, f64), ModelFileError>> {
+        None
+    }
 }
 
 /// Models in two parameters (curves of special points: `p` along the
@@ -97,6 +108,12 @@ impl<T: Family + ?Sized> Family for &mut T {
     }
     fn simulation(&self) -> SimulationSpec {
         (**self).simulation()
+    }
+    fn amplitude_family(
+        &self,
+        p: f64,
+    ) -> Option<Result<(ParameterizedModel, f64), ModelFileError>> {
+        (**self).amplitude_family(p)
     }
 }
 
@@ -123,6 +140,17 @@ impl Family for &ParameterizedModel {
     fn simulation(&self) -> SimulationSpec {
         self.document.simulation()
     }
+    fn amplitude_family(
+        &self,
+        p: f64,
+    ) -> Option<Result<(ParameterizedModel, f64), ModelFileError>> {
+        let mut document = self.document.clone();
+        Some(
+            document
+                .set(&self.parameter, p)
+                .and_then(|()| ParameterizedModel::in_amplitude(document)),
+        )
+    }
 }
 
 /// The owned family is the borrowed one.
@@ -138,6 +166,12 @@ impl Family for ParameterizedModel {
     }
     fn simulation(&self) -> SimulationSpec {
         (&self).simulation()
+    }
+    fn amplitude_family(
+        &self,
+        p: f64,
+    ) -> Option<Result<(ParameterizedModel, f64), ModelFileError>> {
+        (&self).amplitude_family(p)
     }
 }
 

@@ -364,6 +364,14 @@ impl ParameterizedModel {
         })
     }
 
+    /// `document` as a family in its forcing amplitude, with its own
+    /// amplitude (the homotopy start's family and the value to reach).
+    pub fn in_amplitude(document: ModelDocument) -> Result<(Self, f64), ModelFileError> {
+        let family = Self::new(document, "amplitude")?;
+        let target = family.initial();
+        Ok((family, target))
+    }
+
     /// The parameter's name as given.
     pub fn name(&self) -> &str {
         &self.parameter.name

@@ -7,7 +7,7 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use crate::contact::{ContactLaw, LawKind};
-use crate::continuation::{Branch, Curves, SpecialKind, SpecialPoint};
+use crate::continuation::{Branch, ContinueOutcome, Curves, SpecialKind, SpecialPoint};
 use crate::impact::closed_form::ExponentialImpact;
 use crate::impact::direct::{integrate_impact, DirectOptions};
 use crate::impact::{ImpactError, TwoBodies};
@@ -393,6 +393,23 @@ pub fn branch_special_points(
         symmetric,
         subharmonic,
     })
+}
+
+/// The `continue` document: the branch's ([`branch_document`]) with
+/// `switched_branch` when the switch succeeded and, with curves, their
+/// `curves` and `curves_skipped` ([`curves_document`]).
+pub fn continue_document(outcome: &ContinueOutcome) -> Value {
+    let (model, name) = (&outcome.branch.start_model, &outcome.parameter);
+    let mut doc = branch_document(&outcome.branch.branch, model, name);
+    if let Some(Ok(b)) = &outcome.branch.switched {
+        doc["switched_branch"] = branch_document(b, model, name);
+    }
+    if let Some((c, q)) = &outcome.curves {
+        let c = curves_document(c, name, q);
+        doc["curves"] = c["curves"].clone();
+        doc["curves_skipped"] = c["skipped"].clone();
+    }
+    doc
 }
 
 /// The `curves` document: each curve with its kind, start label, stop,

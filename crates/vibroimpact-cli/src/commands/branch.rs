@@ -6,14 +6,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::continuation::{
-    amplitude_homotopy, Branch, BranchOrigin, BranchStudy, ContinuationOptions, Curves, StudyError,
-    StudyField,
+    primary_orbit, Branch, BranchStudy, CheckedContinue, ContinuationOptions, ContinueOutcome,
+    ContinueStudy, Curves, CurvesRequest, StudyError, StudyField,
 };
-use vibroimpact::family::Family;
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model::Model;
-use vibroimpact::model_file::ModelDocument;
-use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::periodic::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov,
     OrbitSummary, PeriodicSolution, ShootingOptions,
@@ -21,13 +18,15 @@ use vibroimpact::periodic::{
 
 use crate::args::{IntegratorName, LinearAlgebra, ParameterRange, StartMethod};
 use crate::curves::{self, SecondParameter};
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 use crate::figures::branch_figure;
 use crate::format::{history_csv, CsvText, Format, SummaryFormat};
-use crate::model_io::{read_document, read_family, read_model};
+use crate::model_io::{read_document, read_model};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
-use vibroimpact::results::{branch_document, curves_document, periodic_document};
+use vibroimpact::results::{
+    branch_document, continue_document, curves_document, periodic_document,
+};
 
 /// Options of `vibroimpact periodic`.
 #[derive(Args, Debug)]
@@ -130,8 +129,19 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         )
         .map_err(|e| stopped(&format!("guess by simulation: {e}")))?,
         "homotopy" => {
-            let family = homotopy_family(&read_document(&args.model)?)?;
-            homotopy_start(&family, &ContinuationOptions::default()).map_err(|e| stopped(&e))?
+            let opts = ContinuationOptions {
+                shooting: ShootingOptions {
+                    interrupt: Some(interrupt.clone()),
+                    ..ShootingOptions::default()
+                },
+                ..ContinuationOptions::default()
+            };
+            primary_orbit(&read_document(&args.model)?, &opts).map_err(|e| match e {
+                StudyError::Invalid { message, .. } => {
+                    CliError::new(format!("--guess homotopy: {message}"))
+                }
+                e => stopped(&e),
+            })?
         }
         _ => read_guess(&args.guess, &model, args.guess_periods, args.rtol)?,
     };
@@ -286,25 +296,6 @@ fn orbit_text(model: &Model, sol: &PeriodicSolution, orbit: &OrbitSummary) -> St
     t
 }
 
-/// The model at its own forcing amplitude as a family in the amplitude
-/// (`doc` with everything else fixed).
-fn homotopy_family(doc: &ModelDocument) -> Result<ParameterizedModel, CliError> {
-    ParameterizedModel::new(doc.clone(), "amplitude").map_err(|e| {
-        CliError::new(format!(
-            "the homotopy start needs a forcing amplitude to vary: {e}"
-        ))
-    })
-}
-
-/// The primary periodic orbit at the document's amplitude, by the
-/// homotopy in the amplitude from the rest state.
-fn homotopy_start(
-    family: &ParameterizedModel,
-    opts: &ContinuationOptions,
-) -> Result<Vec<f64>, CliError> {
-    Ok(amplitude_homotopy(family, family.initial(), opts)?)
-}
-
 /// Options of `vibroimpact continue`.
 #[derive(Args, Debug)]
 pub struct ContinueArgs {
@@ -422,67 +413,77 @@ fn study_error(e: StudyError, args: &ContinueArgs) -> CliError {
                 StudyField::Subharmonic => format!("--subharmonic {}", args.subharmonic),
                 StudyField::Parameter => format!("--parameter {}", args.range.parameter),
                 StudyField::Start => format!("--start {}", args.start.start().name()),
+                StudyField::Parameter2 => {
+                    format!(
+                        "--parameter2 {}",
+                        args.second.parameter2.as_deref().unwrap_or("")
+                    )
+                }
+                StudyField::SpecialPoints => "--special-points".to_string(),
             };
             CliError::new(format!("{option}: {message}"))
         }
+        StudyError::Field(f) => option_error(&f),
         other => CliError::new(other.to_string()),
     }
 }
 
 /// The study `continue` runs.
-fn branch_study(args: &ContinueArgs, interrupt: &Interrupt) -> BranchStudy {
-    BranchStudy {
-        from: args.range.from,
-        to: args.range.to,
-        start: args.start.start(),
-        guess_periods: args.guess_periods,
-        switch_at: args.switch_at.clone(),
-        linear: args.linear.linear(),
-        arnoldi: args.linear.arnoldi,
-        options: ContinuationOptions {
-            max_points: args.max_points,
-            ds_max: args.ds_max,
-            shooting: ShootingOptions {
-                subharmonic: args.subharmonic,
-                interrupt: Some(interrupt.clone()),
-                integrator: args.integrator.integrator(),
-                ..ContinuationOptions::default().shooting
+fn continue_study(args: &ContinueArgs, interrupt: &Interrupt) -> Result<ContinueStudy, CliError> {
+    let selection = args.second.selection()?;
+    Ok(ContinueStudy {
+        parameter: args.range.parameter.clone(),
+        branch: BranchStudy {
+            from: args.range.from,
+            to: args.range.to,
+            start: args.start.start(),
+            guess_periods: args.guess_periods,
+            switch_at: args.switch_at.clone(),
+            linear: args.linear.linear(),
+            arnoldi: args.linear.arnoldi,
+            options: ContinuationOptions {
+                max_points: args.max_points,
+                ds_max: args.ds_max,
+                shooting: ShootingOptions {
+                    subharmonic: args.subharmonic,
+                    interrupt: Some(interrupt.clone()),
+                    integrator: args.integrator.integrator(),
+                    ..ContinuationOptions::default().shooting
+                },
+                ..ContinuationOptions::default()
             },
-            ..ContinuationOptions::default()
         },
-    }
+        curves: args
+            .second
+            .parameter2
+            .clone()
+            .map(|parameter2| CurvesRequest {
+                parameter2,
+                selection,
+            }),
+    })
 }
 
-/// Prints the branches in the chosen format.
-fn print_branches(
-    args: &ContinueArgs,
-    branches: &[Branch],
-    start_model: &Model,
-    curves: Option<serde_json::Value>,
-) -> Result<(), CliError> {
-    let docs: Vec<serde_json::Value> = branches
-        .iter()
-        .map(|b| branch_document(b, start_model, &args.range.parameter))
-        .collect();
+/// Prints the branches (and curves) in the chosen format.
+fn print_outcome(args: &ContinueArgs, outcome: &ContinueOutcome) -> Result<(), CliError> {
+    let model = &outcome.branch.start_model;
+    let mut branches = vec![&outcome.branch.branch];
+    branches.extend(outcome.branch.switched.iter().flatten());
     match args.format {
-        Format::Json => {
-            let mut doc = docs[0].clone();
-            if docs.len() > 1 {
-                doc["switched_branch"] = docs[1].clone();
-            }
-            if let Some(c) = curves {
-                doc["curves"] = c["curves"].clone();
-                doc["curves_skipped"] = c["skipped"].clone();
-            }
-            println!("{}", serde_json::to_string_pretty(&doc)?);
-        }
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&continue_document(outcome))?
+        ),
         Format::Csv => {
             for b in branches {
-                print!("{}", branch_csv(b, start_model)?);
+                print!("{}", branch_csv(b, model)?);
             }
         }
         Format::Table => {
-            for (i, b) in branches.iter().enumerate() {
+            if let Some((c, _)) = &outcome.curves {
+                print_curves(c);
+            }
+            for (i, b) in branches.into_iter().enumerate() {
                 println!(
                     "{}: {} points from {} to {} ({:?})",
                     if i == 0 { "branch" } else { "switched branch" },
@@ -506,36 +507,55 @@ fn print_branches(
     Ok(())
 }
 
+/// Writes the branches (and curves) into the output folder.
+fn write_outcome(
+    dir: &Path,
+    args: &ContinueArgs,
+    outcome: &ContinueOutcome,
+) -> Result<(), CliError> {
+    let name = &args.range.parameter;
+    if let Some((c, q)) = &outcome.curves {
+        curves::write_curves(dir, c, name, q)?;
+    }
+    let mut branches = vec![(&outcome.branch.branch, "branch")];
+    if let Some(Ok(b)) = &outcome.branch.switched {
+        branches.push((b, "switched_branch"));
+    }
+    for (b, stem) in branches {
+        write_branch(dir, &outcome.branch.start_model, b, name, stem, 1.0, name)?;
+    }
+    Ok(())
+}
+
 /// `continue --parameter2 … --special-points branch.json`: the curves of
 /// an earlier branch's special points, without the branch.
 fn curves_from_file(
     args: &ContinueArgs,
-    pm: &ParameterizedModel,
-    q: &vibroimpact::parameter::ModelParameter,
-    path: &std::path::Path,
-    (interrupt, opts): (&Interrupt, &ContinuationOptions),
+    checked: CheckedContinue,
+    path: &Path,
+    interrupt: &Interrupt,
 ) -> Result<(), CliError> {
-    let read = curves::read_special_points(path, &pm.document, &pm.parameter)?;
-    let shooting = ShootingOptions {
-        subharmonic: read.subharmonic,
-        ..opts.shooting.clone()
-    };
-    let origin = BranchOrigin {
-        special: &read.special,
-        symmetric: read.symmetric,
-        range: (args.range.from, args.range.to),
-        q0: q.initial,
-    };
-    let c = curves::follow(pm, q, origin, &args.second, (&shooting, opts.krylov))?;
+    let family = &checked.branch.family;
+    let read = curves::read_special_points(path, &family.document, &family.parameter)?;
+    let q = checked
+        .plane
+        .as_ref()
+        .map(|(plane, _)| plane.q.name.clone());
+    let c = checked
+        .curves_from(&read)
+        .map_err(|e| study_error(e, args))?;
     if interrupt.requested() {
         return Err(CliError::new("interrupted (Ctrl-C): nothing written"));
     }
+    let (p, q) = (&args.range.parameter, q.unwrap_or_default());
     if let Some(dir) = &args.out {
-        curves::write_curves(dir, &c, &args.range.parameter, &q.name)?;
+        curves::write_curves(dir, &c, p, &q)?;
     }
-    let doc = curves_document(&c, &args.range.parameter, &q.name);
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&curves_document(&c, p, &q))?
+        ),
         _ => print_curves(&c),
     }
     Ok(())
@@ -568,24 +588,13 @@ fn print_curves(c: &Curves) {
 
 /// Runs `vibroimpact continue`.
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
-    let mut pm = read_family(&args.range.model, &args.range.parameter)?;
     let interrupt = crate::interrupt::on_ctrl_c();
-    let study = branch_study(args, &interrupt);
-    let (start_model, opts) = study.check(&mut pm).map_err(|e| study_error(e, args))?;
-    let second = curves::validate(&args.second, &pm.document, &pm.parameter)?;
-    if let (Some(path), Some(q)) = (&args.second.special_points, &second) {
-        return curves_from_file(args, &pm, q, path, (&interrupt, &opts));
+    let checked = continue_study(args, &interrupt)?
+        .check(read_document(&args.range.model)?)
+        .map_err(|e| study_error(e, args))?;
+    if let Some(path) = &args.second.special_points {
+        return curves_from_file(args, checked, path, &interrupt);
     }
-    let mut doc_at_start = pm.document.clone();
-    doc_at_start.set(&pm.parameter, args.range.from)?;
-    let mut amplitude = homotopy_family(&doc_at_start);
-    let homotopy = match &mut amplitude {
-        Ok(family) => {
-            let target = family.initial();
-            Some((family as &mut dyn Family, target))
-        }
-        Err(_) => None,
-    };
     let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
         bar.inc(1);
@@ -598,79 +607,25 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
         ));
         !interrupt.requested()
     };
-    let outcome = study
-        .run(&pm, homotopy, progress)
-        .map_err(|e| match (e, &amplitude) {
-            // The homotopy was needed and the model has no amplitude to vary.
-            (
-                StudyError::Invalid {
-                    field: StudyField::Start,
-                    ..
-                },
-                Err(why),
-            ) => CliError::new(why.to_string()),
-            (e, _) => study_error(e, args),
-        })?;
-    let mut branches = vec![outcome.branch];
-    // A failed switch keeps the main branch: it is written, then reported.
-    let mut switch_error = None;
-    match outcome.switched {
-        Some(Ok(b)) => branches.push(b),
-        Some(Err(e)) => {
-            switch_error = Some(CliError::new(format!(
-                "--switch-at {}: {}",
-                e.label, e.message
-            )))
-        }
-        None => {}
-    }
+    let outcome = checked.run(progress).map_err(|e| study_error(e, args))?;
     bar.finish_and_clear();
-    let curves = match &second {
-        Some(q) => {
-            let origin = BranchOrigin {
-                special: &branches[0].special,
-                symmetric: branches[0].symmetric,
-                range: (args.range.from, args.range.to),
-                q0: q.initial,
-            };
-            let linear = (&opts.shooting, opts.krylov);
-            Some(curves::follow(&pm, q, origin, &args.second, linear)?)
-        }
-        None => None,
-    };
-    if let (Some(dir), Some(c), Some(q)) = (&args.out, &curves, &second) {
-        curves::write_curves(dir, c, &args.range.parameter, &q.name)?;
-    }
     if let Some(dir) = &args.out {
-        for (b, stem) in branches.iter().zip(["branch", "switched_branch"]) {
-            write_branch(
-                dir,
-                &start_model,
-                b,
-                &args.range.parameter,
-                stem,
-                1.0,
-                &args.range.parameter,
-            )?;
-        }
+        write_outcome(dir, args, &outcome)?;
     }
-    let curves_doc = curves
-        .as_ref()
-        .zip(second.as_ref())
-        .map(|(c, q)| curves_document(c, &args.range.parameter, &q.name));
-    if let (Format::Table, Some(c)) = (args.format, &curves) {
-        print_curves(c);
-    }
-    print_branches(args, &branches, &start_model, curves_doc)?;
-    if let Some(e) = switch_error {
-        return Err(e);
+    print_outcome(args, &outcome)?;
+    // A failed switch keeps the main branch: it is written, then reported.
+    if let Some(Err(e)) = &outcome.branch.switched {
+        return Err(CliError::new(format!(
+            "--switch-at {}: {}",
+            e.label, e.message
+        )));
     }
     if interrupt.requested() {
         return Err(CliError::new(
             "interrupted (Ctrl-C): the points computed so far are kept",
         ));
     }
-    match &branches[0].stop {
+    match &outcome.branch.branch.stop {
         vibroimpact::continuation::StopReason::CannotContinue(why) => Err(CliError::new(format!(
             "the branch cannot continue: {why} (the points computed so far are kept)"
         ))),

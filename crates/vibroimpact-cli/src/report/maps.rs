@@ -10,10 +10,9 @@ use std::time::Instant;
 use vibroimpact::basins::{basins, Basins, Component};
 use vibroimpact::chart::{chart, Chart, ChartOptions};
 use vibroimpact::continuation::{
-    curves_of_branch, Branch, BranchOrigin, BranchStudy, ContinuationOptions, Curve, CurveKind,
-    CurveSelection, Curves, Linear, Start,
+    Branch, BranchStudy, ContinuationOptions, ContinueStudy, Curve, CurveKind, CurveSelection,
+    Curves, CurvesRequest, Linear, Start,
 };
-use vibroimpact::family::ParameterizedModel2;
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model_file::ModelDocument;
 use vibroimpact::parameter::ParameterizedModel;
@@ -159,54 +158,44 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
 /// 0.5 ω0 (the homotopy in the amplitude from rest), and the curves of its folds, branch points, period
 /// doublings and Neimark–Sacker points in (frequency, amplitude).
 fn branch_and_curves(doc: &ModelDocument, stop: &Interrupt) -> Result<(Branch, Curves), CliError> {
-    let family = ParameterizedModel::new(doc.clone(), "frequency")?;
-    let q = doc.parameter("amplitude")?;
     let defaults = ContinuationOptions::default();
     // The orbit at 0.5 ω0 on the branch that grows from rest (a simulated
     // guess there ends a chaotic transient wherever its last bits take it).
-    let study = BranchStudy {
-        from: FREQUENCY.0,
-        to: FREQUENCY.1,
-        start: Start::Homotopy,
-        guess_periods: 200.0,
-        switch_at: None,
-        linear: Linear::Auto,
-        arnoldi: 20,
-        options: ContinuationOptions {
-            shooting: ShootingOptions {
-                interrupt: Some(stop.clone()),
-                ..defaults.shooting.clone()
+    let study = ContinueStudy {
+        parameter: "frequency".into(),
+        branch: BranchStudy {
+            from: FREQUENCY.0,
+            to: FREQUENCY.1,
+            start: Start::Homotopy,
+            guess_periods: 200.0,
+            switch_at: None,
+            linear: Linear::Auto,
+            arnoldi: 20,
+            options: ContinuationOptions {
+                shooting: ShootingOptions {
+                    interrupt: Some(stop.clone()),
+                    ..defaults.shooting.clone()
+                },
+                ..defaults
             },
-            ..defaults
         },
+        curves: Some(CurvesRequest {
+            parameter2: "amplitude".into(),
+            selection: CurveSelection {
+                kinds: vec![
+                    CurveKind::Fold,
+                    CurveKind::BranchPoint,
+                    CurveKind::PeriodDoubling,
+                    CurveKind::NeimarkSacker,
+                ],
+                bounds2: (Some(AMPLITUDE.0), Some(AMPLITUDE.1)),
+                step: CURVE_STEP,
+            },
+        }),
     };
-    let mut at_start = doc.clone();
-    at_start.set(&family.parameter, FREQUENCY.0)?;
-    let mut amplitude = ParameterizedModel::new(at_start, "amplitude")?;
-    let outcome = study.run(&family, Some((&mut amplitude, q.initial)), |_| true)?;
-    let selection = CurveSelection {
-        kinds: vec![
-            CurveKind::Fold,
-            CurveKind::BranchPoint,
-            CurveKind::PeriodDoubling,
-            CurveKind::NeimarkSacker,
-        ],
-        bounds2: (Some(AMPLITUDE.0), Some(AMPLITUDE.1)),
-        step: CURVE_STEP,
-    };
-    let origin = BranchOrigin {
-        special: &outcome.branch.special,
-        symmetric: outcome.branch.symmetric,
-        range: FREQUENCY,
-        q0: q.initial,
-    };
-    let plane = ParameterizedModel2 {
-        document: doc.clone(),
-        p: family.parameter.clone(),
-        q,
-    };
-    let curves = curves_of_branch(plane, origin, &selection, (&outcome.options.shooting, None))?;
-    Ok((outcome.branch, curves))
+    let outcome = study.check(doc.clone())?.run(|_| true)?;
+    let curves = outcome.curves.map(|(c, _)| c).unwrap_or_default();
+    Ok((outcome.branch.branch, curves))
 }
 
 /// The chart of one row with its curves and their codimension-two points.

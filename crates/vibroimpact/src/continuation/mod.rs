@@ -47,6 +47,7 @@
 //!   for every face.
 
 mod branch;
+mod continue_study;
 mod curve;
 mod events;
 mod krylov;
@@ -58,6 +59,7 @@ mod switching;
 mod tests;
 
 pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
+pub use continue_study::{CheckedContinue, ContinueOutcome, ContinueStudy, CurvesRequest};
 pub use curve::{
     continue_curve, curves_of_branch, grazing_margin, starts_grazing, BranchOrigin, Codim2Kind,
     Curve, CurveKind, CurveOptions, CurvePoint, CurveSelection, CurveSpecial, CurveStop, Curves,
@@ -66,7 +68,8 @@ pub use curve::{
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use start::amplitude_homotopy;
 pub use study::{
-    BranchOutcome, BranchStudy, Linear, Start, StudyError, StudyField, AUTO_KRYLOV_BODIES,
+    primary_orbit, BranchOutcome, BranchStudy, CheckedBranch, Linear, Start, StudyError,
+    StudyField, AUTO_KRYLOV_BODIES,
 };
 pub use switching::{
     branch_switch_start, is_symmetric_orbit, period_doubled_start, switch_branch, SwitchError,

@@ -6,9 +6,12 @@
 //! and switches at a special point if asked.
 
 use super::{continue_branch, switch_branch, validate_size, Branch, BranchPoint};
-use super::{ContinuationError, ContinuationOptions, SwitchError};
+use super::{ContinuationError, ContinuationOptions, CurvesError, SwitchError};
 use crate::family::{Family, FamilyError};
+use crate::field_error::FieldError;
 use crate::model::Model;
+use crate::model_file::{ModelDocument, ModelFileError};
+use crate::parameter::ParameterizedModel;
 use crate::periodic::{guess_by_simulation_with, PeriodicError};
 
 /// How a branch study finds its first periodic orbit.
@@ -106,11 +109,15 @@ pub enum StudyField {
     Parameter,
     /// The start method.
     Start,
+    /// The curves' second parameter.
+    Parameter2,
+    /// An earlier branch document whose special points start the curves.
+    SpecialPoints,
 }
 
 impl StudyField {
     /// The library's spelling: `range`, `from`, `subharmonic`,
-    /// `parameter` or `start`.
+    /// `parameter`, `start`, `parameter2` or `special_points`.
     pub fn name(self) -> &'static str {
         match self {
             StudyField::Range => "range",
@@ -118,6 +125,8 @@ impl StudyField {
             StudyField::Subharmonic => "subharmonic",
             StudyField::Parameter => "parameter",
             StudyField::Start => "start",
+            StudyField::Parameter2 => "parameter2",
+            StudyField::SpecialPoints => "special_points",
         }
     }
 }
@@ -134,6 +143,12 @@ pub enum StudyError {
         /// What is wrong with it.
         message: String,
     },
+    /// A curve option the study refuses, by its field.
+    #[error(transparent)]
+    Field(FieldError),
+    /// The model file has no such parameter.
+    #[error(transparent)]
+    File(#[from] ModelFileError),
     /// The family has no model at the start.
     #[error(transparent)]
     Family(#[from] FamilyError),
@@ -143,6 +158,18 @@ pub enum StudyError {
     /// The continuation (or the homotopy) failed.
     #[error(transparent)]
     Continuation(#[from] ContinuationError),
+    /// A curve of special points failed.
+    #[error(transparent)]
+    Curves(CurvesError),
+}
+
+impl From<CurvesError> for StudyError {
+    fn from(e: CurvesError) -> Self {
+        match e {
+            CurvesError::Field(f) => StudyError::Field(f),
+            other => StudyError::Curves(other),
+        }
+    }
 }
 
 /// A branch of nT-periodic orbits from `from` to `to`.
@@ -183,101 +210,156 @@ pub struct BranchOutcome {
 }
 
 impl BranchStudy {
-    /// The model at the start and the options for its size after the
-    /// study's checks: a finite, nonempty
-    /// range, a period multiple ≥ 1, a continuous parameter and a periodic
-    /// forcing at the start.
-    pub fn check<F: Family>(
-        &self,
-        family: &mut F,
-    ) -> Result<(Model, ContinuationOptions), StudyError> {
-        let invalid = |field, message: String| StudyError::Invalid { field, message };
+    /// The study on `family` after its checks: a finite, nonempty range,
+    /// a period multiple ≥ 1, a continuous parameter and a periodic
+    /// forcing at the start; the model there and the options for its
+    /// size.
+    pub fn check<F: Family>(self, mut family: F) -> Result<CheckedBranch<F>, StudyError> {
+        let invalid = |field, message: &str| StudyError::Invalid {
+            field,
+            message: message.into(),
+        };
         if !(self.from.is_finite() && self.to.is_finite()) || self.from == self.to {
             return Err(invalid(
                 StudyField::Range,
-                "the range is empty or not finite".into(),
+                "the range is empty or not finite",
             ));
         }
         if self.options.shooting.subharmonic == 0 {
-            return Err(invalid(StudyField::Subharmonic, "must be >= 1".into()));
+            return Err(invalid(StudyField::Subharmonic, "must be >= 1"));
         }
         if family.whole_numbers() {
             return Err(invalid(
                 StudyField::Parameter,
-                "takes whole numbers: a branch needs a continuous parameter (sweep it instead)"
-                    .into(),
+                "takes whole numbers: a branch needs a continuous parameter (sweep it instead)",
             ));
         }
-        let model = family.model_at(self.from)?;
-        if model.forcing_frequency().is_none() {
+        let start_model = family.model_at(self.from)?;
+        if start_model.forcing_frequency().is_none() {
             return Err(invalid(
                 StudyField::From,
-                "the model has no periodic forcing with one frequency there: nothing to continue"
-                    .into(),
+                "the model has no periodic forcing with one frequency there: nothing to continue",
             ));
         }
         let options = ContinuationOptions {
-            krylov: self.linear.krylov(model.bodies().len(), self.arnoldi),
+            krylov: self.linear.krylov(start_model.bodies().len(), self.arnoldi),
             ..self.options.clone()
         };
-        validate_size(&model, &options)?;
-        Ok((model, options))
+        validate_size(&start_model, &options)?;
+        Ok(CheckedBranch {
+            study: self,
+            family,
+            start_model,
+            options,
+        })
     }
+}
 
-    /// Runs the study on `family`. `homotopy` is the family in the forcing
-    /// amplitude at the start (everything else fixed) with the amplitude
-    /// to reach, needed by the homotopy start. `on_point` sees every point
-    /// of both branches and returns false to stop.
-    pub fn run<F: Family>(
-        &self,
-        mut family: F,
-        mut homotopy: Option<(&mut dyn Family, f64)>,
+/// A branch study whose checks passed, ready to run.
+#[derive(Clone, Debug)]
+pub struct CheckedBranch<F> {
+    /// The study.
+    pub study: BranchStudy,
+    /// The family it runs on.
+    pub family: F,
+    /// The model at the start.
+    pub start_model: Model,
+    /// The options the branches run with (`krylov` set by the study's
+    /// `linear` for the start's size; a face sets its stop request in
+    /// `shooting.interrupt`).
+    pub options: ContinuationOptions,
+}
+
+impl<F: Family> CheckedBranch<F> {
+    /// Runs the study. `on_point` sees every point of both branches and
+    /// returns false to stop.
+    pub fn run(
+        mut self,
         mut on_point: impl FnMut(&BranchPoint) -> bool,
     ) -> Result<BranchOutcome, StudyError> {
-        let (start_model, options) = self.check(&mut family)?;
-        let opts = &options;
-        let mut by_homotopy = || match homotopy.as_mut() {
-            Some((h, amplitude)) => Ok(super::amplitude_homotopy(h, *amplitude, opts)?),
-            None => Err(StudyError::Invalid {
-                field: StudyField::Start,
-                message: "the homotopy start needs the family in the forcing amplitude".into(),
-            }),
-        };
-        let guess = match self.start {
-            Start::Homotopy => by_homotopy()?,
+        let study = &self.study;
+        let opts = &self.options;
+        let guess = match study.start {
+            Start::Homotopy => homotopy_guess(&self.family, study.from, opts)?,
             Start::Auto | Start::Simulate => guess_by_simulation_with(
-                &start_model,
-                self.guess_periods,
+                &self.start_model,
+                study.guess_periods,
                 1e-9,
                 opts.shooting.interrupt.clone(),
                 opts.shooting.integrator,
             )
             .map_err(StudyError::Guess)?,
         };
-        let mut run = |guess: &[f64], on_point: &mut dyn FnMut(&BranchPoint) -> bool| {
-            continue_branch(&mut family, self.from, guess, self.to, opts, on_point)
-        };
-        let branch = match run(&guess, &mut on_point) {
-            Err(ContinuationError::StartNotConverged(_)) if self.start == Start::Auto => {
-                run(&by_homotopy()?, &mut on_point)?
+        let family = &mut self.family;
+        let run =
+            |family: &mut F, guess: &[f64], on_point: &mut dyn FnMut(&BranchPoint) -> bool| {
+                continue_branch(family, study.from, guess, study.to, opts, on_point)
+            };
+        let branch = match run(family, &guess, &mut on_point) {
+            Err(ContinuationError::StartNotConverged(_)) if study.start == Start::Auto => {
+                let guess = homotopy_guess(&*family, study.from, opts)?;
+                run(family, &guess, &mut on_point)?
             }
             other => other?,
         };
-        let switched = self.switch_at.as_deref().map(|label| {
+        let switched = study.switch_at.as_deref().map(|label| {
             switch_branch(
-                &mut family,
+                &mut *family,
                 &branch,
                 label,
-                (self.from, self.to),
+                (study.from, study.to),
                 opts,
                 &mut on_point,
             )
         });
         Ok(BranchOutcome {
-            start_model,
+            start_model: self.start_model,
             branch,
             switched,
-            options,
+            options: self.options,
         })
     }
+}
+
+/// The orbit at `from` on the branch that grows from rest, by the
+/// homotopy in `family`'s forcing amplitude there.
+fn homotopy_guess<F: Family>(
+    family: &F,
+    from: f64,
+    opts: &ContinuationOptions,
+) -> Result<Vec<f64>, StudyError> {
+    let (amplitude, target) = match family.amplitude_family(from) {
+        Some(Ok(found)) => found,
+        Some(Err(why)) => return Err(no_amplitude(why)),
+        None => {
+            return Err(StudyError::Invalid {
+                field: StudyField::Start,
+                message: "a family built in code has no forcing amplitude to vary alone: \
+                          start by simulation"
+                    .into(),
+            })
+        }
+    };
+    Ok(super::amplitude_homotopy(amplitude, target, opts)?)
+}
+
+/// The homotopy start refused: the model has no forcing amplitude to vary.
+fn no_amplitude(why: ModelFileError) -> StudyError {
+    StudyError::Invalid {
+        field: StudyField::Start,
+        message: format!("the homotopy start needs a forcing amplitude to vary: {why}"),
+    }
+}
+
+/// The periodic state of `document`'s model on the branch that grows
+/// from rest, by the homotopy in its forcing amplitude from zero to its
+/// own (everything else fixed): a guess for `periodic` that does not
+/// depend on where a simulation's transient ends.
+pub fn primary_orbit(
+    document: &ModelDocument,
+    opts: &ContinuationOptions,
+) -> Result<Vec<f64>, StudyError> {
+    let (family, target) =
+        ParameterizedModel::in_amplitude(document.clone()).map_err(no_amplitude)?;
+    Ok(super::amplitude_homotopy(family, target, opts)?)
 }

@@ -109,7 +109,7 @@ impl CurveSelection {
 }
 
 /// The curves of a branch's special points.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct Curves {
     /// Each curve with the label of the special point it starts from.
     pub followed: Vec<(String, Curve)>,
