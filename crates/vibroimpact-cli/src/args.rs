@@ -139,12 +139,6 @@ impl LinearAlgebra {
             Linear::Auto
         }
     }
-
-    /// The Arnoldi dimension if matrix-free for a row of `bodies`, else
-    /// None.
-    pub fn krylov(&self, bodies: usize) -> Option<usize> {
-        self.linear().krylov(bodies, self.arnoldi)
-    }
 }
 
 /// The `points` values of a grid axis `--NAME-from`, `--NAME-to`,

@@ -27,7 +27,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{basins, branch, chart, identify, impact, pounding, simulate, spectrum, sweep};
+use commands::{
+    basins, branch, chart, identify, impact, periodic, pounding, simulate, spectrum, sweep,
+};
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
 #[derive(Parser, Debug)]
@@ -73,7 +75,7 @@ enum Command {
     Pounding(pounding::PoundingArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
-    Periodic(branch::PeriodicArgs),
+    Periodic(periodic::PeriodicArgs),
     /// Continue a branch of periodic solutions in a parameter (folds, branch
     /// points, period doublings, torus and grazing points).
     #[command(allow_negative_numbers = true)]
@@ -142,7 +144,7 @@ fn main() -> ExitCode {
         Some(Command::Impact(args)) => impact::run(args),
         Some(Command::Identify(args)) => identify::run(args),
         Some(Command::Simulate(args)) => simulate::run(args),
-        Some(Command::Periodic(args)) => branch::run_periodic(args),
+        Some(Command::Periodic(args)) => periodic::run_periodic(args),
         Some(Command::Continue(args)) => branch::run_continue(args),
         Some(Command::Sweep(args)) => sweep::run(args),
         Some(Command::Chart(args)) => chart::run(args),

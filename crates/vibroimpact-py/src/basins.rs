@@ -7,10 +7,10 @@ use pyo3::types::PyDict;
 use vibroimpact::basins::{basins as run_basins, Component};
 use vibroimpact::sweep::SweepOptions;
 
+use crate::convert::method;
 use crate::convert::{document, floats, thread_pool, value_error};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
-use crate::solve::method;
 
 /// Basins of attraction: the `basins` document of the CLI (`attractors`
 /// with their fractions, `cells` row by row). `x`, `y`: state components

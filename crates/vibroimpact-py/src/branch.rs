@@ -98,7 +98,7 @@ fn spell(e: StudyError, study: &ContinueStudy) -> PyErr {
             "parameter2 = {:?}",
             study.curves.as_ref().map_or("", |c| c.parameter2.as_str())
         ),
-        StudyField::SpecialPoints => "special_points".to_string(),
+        other => other.name().to_string(),
     };
     match e {
         StudyError::Invalid { field: f, message } => {

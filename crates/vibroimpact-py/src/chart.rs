@@ -7,10 +7,10 @@ use pyo3::types::PyDict;
 use vibroimpact::chart::{chart as run_chart, ChartOptions};
 use vibroimpact::sweep::SweepOptions;
 
+use crate::convert::method;
 use crate::convert::{document, floats, thread_pool, value_error};
 use crate::model::PyModel;
 use crate::monitor::{self, Progress};
-use crate::solve::method;
 
 /// A stability chart: the `chart` document of the CLI (`cells` row by row,
 /// each with its `runs`). `lyapunov`: each run's largest exponent;

@@ -7,6 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use pyo3::IntoPyObjectExt;
 use serde_json::Value;
+use vibroimpact::integrate::Method;
 
 use crate::VibroimpactError;
 
@@ -96,4 +97,33 @@ pub fn thread_pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(numerical_error)
+}
+
+/// The integration method named `name`.
+pub(crate) fn method(name: &str) -> PyResult<Method> {
+    match name {
+        "dop853" => Ok(Method::Dop853),
+        "dopri5" => Ok(Method::Dopri5),
+        "rodas" => Ok(Method::Rodas),
+        "auto" => Ok(Method::Auto),
+        other => Err(value_error(format!(
+            "method = {other:?}: give \"dop853\", \"dopri5\", \"rodas\" or \"auto\""
+        ))),
+    }
+}
+
+/// Sampled states (`rows` of `[u_1..u_N, v_1..v_N]`) as two `rows × N`
+/// arrays: displacements and velocities.
+pub(crate) fn split_states<'py>(
+    py: Python<'py>,
+    states: &[f64],
+    rows: usize,
+    n: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let (mut u, mut v) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * n));
+    for row in states.chunks_exact(2 * n).take(rows) {
+        u.extend_from_slice(&row[..n]);
+        v.extend_from_slice(&row[n..]);
+    }
+    Ok((array2(py, u, rows, n)?, array2(py, v, rows, n)?))
 }

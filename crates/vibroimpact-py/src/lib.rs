@@ -17,10 +17,13 @@ mod basins;
 mod branch;
 mod chart;
 mod convert;
+mod impact;
 mod model;
 mod monitor;
+mod periodic;
 mod records;
-mod solve;
+mod simulate;
+mod sweep;
 
 use pyo3::prelude::*;
 
@@ -36,13 +39,13 @@ pyo3::create_exception!(
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VibroimpactError", m.py().get_type::<VibroimpactError>())?;
     m.add_class::<model::PyModel>()?;
-    m.add_function(wrap_pyfunction!(solve::impact, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::contact_force, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::identify, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::simulate, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::periodic, m)?)?;
+    m.add_function(wrap_pyfunction!(impact::impact, m)?)?;
+    m.add_function(wrap_pyfunction!(impact::contact_force, m)?)?;
+    m.add_function(wrap_pyfunction!(impact::identify, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(periodic::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(branch::continue_branch, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
     m.add_function(wrap_pyfunction!(records::parse_record, m)?)?;
@@ -51,6 +54,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(records::pounding, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding_history, m)?)?;
     m.add_function(wrap_pyfunction!(records::value_range, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::parameter_values, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::parameter_values, m)?)?;
     Ok(())
 }

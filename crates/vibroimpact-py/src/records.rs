@@ -96,7 +96,7 @@ fn pair_and_run(
     let run = RunSettings {
         sample,
         rtol,
-        method: crate::solve::method(method)?,
+        method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
     };
     let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;

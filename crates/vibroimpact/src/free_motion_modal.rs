@@ -11,7 +11,7 @@
 //! record sample, where the matrix exponential costs an exponential of the
 //! augmented matrix per interval that does not start and end on samples.
 //! Eigenvectors by inverse iteration on the eigenvalues of
-//! [`crate::eigen`]; a group whose `V` is ill-conditioned (repeated or
+//! [`crate::linalg::eigen`]; a group whose `V` is ill-conditioned (repeated or
 //! nearly repeated eigenvalues: a critically damped body) has no modal
 //! form and keeps the matrix exponential.
 
@@ -69,7 +69,7 @@ impl Modal {
     /// they cannot be trusted.
     pub(super) fn new(a: &DMatrix<f64>, record_step: Option<f64>) -> Option<Self> {
         let d = a.nrows();
-        let lambda = crate::eigen::eigenvalues(a)?;
+        let lambda = crate::linalg::eigen::eigenvalues(a)?;
         let scale = a.amax().max(f64::MIN_POSITIVE);
         let ac = a.map(|x| C64::new(x, 0.0));
         let mut v = DMatrix::<C64>::zeros(d, d);

@@ -39,7 +39,8 @@
 //!   response spectra, and pounding frames under them;
 //! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) shared by
 //!   every time integration;
-//! - [`eigen`]: eigenvalues of general real matrices;
+//! - [`linalg`]: the band LU, GMRES and Arnoldi, eigenvalues of general
+//!   real matrices, the null vector;
 //! - [`numeric`]: scalar special functions and root finders.
 //!
 //! The library does no I/O: callers hand it numbers and text and get
@@ -54,13 +55,13 @@ pub mod chart;
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;
-pub mod eigen;
 pub mod family;
 pub mod field_error;
 pub mod free_motion;
 pub mod identify;
 pub mod impact;
 pub mod integrate;
+pub mod linalg;
 pub mod lyapunov;
 pub mod measured;
 pub mod model;

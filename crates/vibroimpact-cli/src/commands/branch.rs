@@ -1,300 +1,28 @@
-//! `vibroimpact periodic` (one periodic solution by shooting, with Floquet
-//! stability) and `vibroimpact continue` (a branch of them by
-//! pseudo-arclength continuation, with special points).
+//! `vibroimpact continue`: a branch of periodic solutions by
+//! pseudo-arclength continuation, with its special points, a switched
+//! branch and the curves of its special points in two parameters (the
+//! library's [`ContinueStudy`]).
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::continuation::{
-    primary_orbit, Branch, BranchStudy, CheckedContinue, ContinuationOptions, ContinueOutcome,
-    ContinueStudy, Curves, CurvesRequest, StudyError, StudyField,
+    Branch, BranchStudy, CheckedContinue, ContinuationOptions, ContinueOutcome, ContinueStudy,
+    Curves, CurvesRequest, StudyError, StudyField,
 };
 use vibroimpact::integrate::Interrupt;
 use vibroimpact::model::Model;
-use vibroimpact::periodic::{
-    guess_by_simulation, guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov,
-    OrbitSummary, PeriodicSolution, ShootingOptions,
-};
+use vibroimpact::periodic::ShootingOptions;
+use vibroimpact::results::{branch_document, continue_document, curves_document};
 
 use crate::args::{IntegratorName, LinearAlgebra, ParameterRange, StartMethod};
 use crate::curves::{self, SecondParameter};
 use crate::error::{option_error, CliError};
 use crate::figures::branch_figure;
-use crate::format::{history_csv, CsvText, Format, SummaryFormat};
-use crate::model_io::{read_document, read_model};
+use crate::format::{CsvText, Format};
+use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
-use crate::plot::{render, Figure, LegendPosition, Series};
-use vibroimpact::results::{
-    branch_document, continue_document, curves_document, periodic_document,
-};
-
-/// Options of `vibroimpact periodic`.
-#[derive(Args, Debug)]
-pub struct PeriodicArgs {
-    /// Model file (TOML).
-    model: PathBuf,
-    /// Period multiple n: look for a solution of period n T.
-    #[arg(long, default_value_t = 1)]
-    subharmonic: u32,
-    /// Start guess: `simulate` (the state after --guess-periods periods from
-    /// the model's initial state), `homotopy` (continued in the forcing
-    /// amplitude from the rest state: the primary orbit) or a JSON file
-    /// with `initial_state` (e.g. an earlier output).
-    #[arg(long, default_value = "simulate")]
-    guess: String,
-    /// Periods simulated for the guess.
-    #[arg(long, default_value_t = 200.0)]
-    guess_periods: f64,
-    /// Integration tolerance of the period map.
-    #[arg(long, default_value_t = 1e-10)]
-    rtol: f64,
-    /// Newton tolerance (scaled residual).
-    #[arg(long, default_value_t = 1e-9)]
-    tol: f64,
-    #[command(flatten)]
-    linear: LinearAlgebra,
-    /// Look for a mirror-symmetric orbit (u_i(t + nT/2) = -u_{N+1-i}(t)) with
-    /// the half map S P_{nT/2}: half the integration per Newton step; needs
-    /// a mirror-symmetric model and an odd --subharmonic.
-    #[arg(long)]
-    symmetric: bool,
-    /// Integrator of the period map: `local` carries the state (and the
-    /// monodromy matrix, or the record its products replay) by the exact
-    /// motion between contacts.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
-    integrator: IntegratorName,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
-    format: SummaryFormat,
-    /// Output folder: orbit.csv, summary.json, orbit figures.
-    #[arg(long)]
-    out: Option<PathBuf>,
-}
-
-fn read_guess(spec: &str, model: &Model, periods: f64, rtol: f64) -> Result<Vec<f64>, CliError> {
-    if spec == "simulate" {
-        return guess_by_simulation(model, periods, rtol.max(1e-9))
-            .map_err(|e| CliError::new(format!("guess by simulation: {e}")));
-    }
-    let text = crate::input::read_text(Path::new(spec))
-        .map_err(|e| CliError::new(format!("{spec}: cannot read the guess: {e}")))?;
-    let doc: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CliError::new(format!("{spec}: not JSON: {e}")))?;
-    let state: Vec<f64> = doc["initial_state"]
-        .as_array()
-        .ok_or_else(|| CliError::new(format!("{spec}: no `initial_state` array")))?
-        .iter()
-        .map(|v| {
-            v.as_f64()
-                .ok_or_else(|| CliError::new(format!("{spec}: `initial_state` must hold numbers")))
-        })
-        .collect::<Result<_, _>>()?;
-    let d = 2 * model.bodies().len();
-    if state.len() != d {
-        return Err(CliError::new(format!(
-            "{spec}: `initial_state` has {} values, the model needs {d} (u then v)",
-            state.len()
-        )));
-    }
-    Ok(state)
-}
-
-/// Runs `vibroimpact periodic`.
-pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
-    let model = read_model(&args.model)?.model;
-    if model.forcing_frequency().is_none() {
-        return Err(CliError::new(format!(
-            "{}: the model has no periodic forcing with one frequency, so it has no periodic solutions",
-            args.model.display()
-        )));
-    }
-    if args.subharmonic == 0 {
-        return Err(CliError::new("--subharmonic must be >= 1"));
-    }
-    let interrupt = crate::interrupt::on_ctrl_c();
-    let stopped = |e: &dyn std::fmt::Display| {
-        if interrupt.requested() {
-            CliError::new("interrupted (Ctrl-C): no periodic solution was written")
-        } else {
-            CliError::new(e.to_string())
-        }
-    };
-    let guess = match args.guess.as_str() {
-        "simulate" => guess_by_simulation_with(
-            &model,
-            args.guess_periods,
-            args.rtol.max(1e-9),
-            Some(interrupt.clone()),
-            args.integrator.integrator(),
-        )
-        .map_err(|e| stopped(&format!("guess by simulation: {e}")))?,
-        "homotopy" => {
-            let opts = ContinuationOptions {
-                shooting: ShootingOptions {
-                    interrupt: Some(interrupt.clone()),
-                    ..ShootingOptions::default()
-                },
-                ..ContinuationOptions::default()
-            };
-            primary_orbit(&read_document(&args.model)?, &opts).map_err(|e| match e {
-                StudyError::Invalid { message, .. } => {
-                    CliError::new(format!("--guess homotopy: {message}"))
-                }
-                e => stopped(&e),
-            })?
-        }
-        _ => read_guess(&args.guess, &model, args.guess_periods, args.rtol)?,
-    };
-    let opts = ShootingOptions {
-        subharmonic: args.subharmonic,
-        rtol: args.rtol,
-        tol: args.tol,
-        symmetric: args.symmetric,
-        interrupt: Some(interrupt.clone()),
-        integrator: args.integrator.integrator(),
-        ..ShootingOptions::default()
-    };
-    if args.symmetric && (!model.is_mirror_symmetric() || args.subharmonic % 2 == 0) {
-        return Err(CliError::new(format!(
-            "{}: --symmetric needs a mirror-symmetric model (mirrored bodies, contacts, walls and forcing) and an odd --subharmonic",
-            args.model.display()
-        )));
-    }
-    let arnoldi = args.linear.krylov(model.bodies().len());
-    let krylov = arnoldi.is_some();
-    let sol = if let Some(arnoldi) = arnoldi {
-        shoot_krylov(&model, &guess, &opts, arnoldi)
-    } else {
-        shoot(&model, &guess, &opts)
-    }
-    .map_err(|e| stopped(&e))?;
-    let orbit = orbit_summary_by(
-        &model,
-        &sol.initial_state,
-        (sol.period, 512),
-        args.rtol,
-        opts.integrator,
-    )?;
-    let symmetric_orbit = args.symmetric
-        || vibroimpact::continuation::is_symmetric_orbit(&model, &sol.initial_state, &opts);
-    let doc = periodic_document(
-        &model,
-        &sol,
-        &orbit,
-        args.subharmonic,
-        symmetric_orbit,
-        krylov,
-    );
-    if let Some(dir) = &args.out {
-        write_orbit(dir, &model, &orbit, &doc)?;
-    }
-    match args.format {
-        SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
-        SummaryFormat::Table => print!("{}", orbit_text(&model, &sol, &orbit)),
-    }
-    if sol.converged {
-        Ok(())
-    } else {
-        Err(CliError::new(format!(
-            "Newton did not converge: {} (residual history {:?})",
-            sol.stop.explanation(),
-            sol.residual_history
-                .iter()
-                .map(|r| format!("{r:.2e}"))
-                .collect::<Vec<_>>()
-        )))
-    }
-}
-
-/// Writes `orbit.csv`, `summary.json` and the orbit figures into `dir`.
-fn write_orbit(
-    dir: &Path,
-    model: &Model,
-    orbit: &OrbitSummary,
-    doc: &serde_json::Value,
-) -> Result<(), CliError> {
-    ensure_dir(dir)?;
-    let n = model.bodies().len();
-    write_atomic(
-        &dir.join("orbit.csv"),
-        history_csv(model, &orbit.times, &orbit.states)?.as_bytes(),
-    )?;
-    write_atomic(
-        &dir.join("summary.json"),
-        serde_json::to_string_pretty(doc)?.as_bytes(),
-    )?;
-    let mut fig = Figure::new(
-        "Periodic orbit",
-        "time over one period  [s]",
-        "displacement u  [mm]",
-    )
-    .legend_at(LegendPosition::Best);
-    let mut phase = Figure::new(
-        "Periodic orbit in the phase plane",
-        "displacement u  [mm]",
-        "velocity v  [m/s]",
-    )
-    .legend_at(LegendPosition::Best);
-    for i in 0..n.min(8) {
-        let name = &model.bodies()[i].name;
-        fig.push(Series::line(
-            format!("u_{name}"),
-            orbit
-                .times
-                .iter()
-                .enumerate()
-                .map(|(j, &t)| (t, 1e3 * orbit.states[j * 2 * n + i])),
-        ));
-        phase.push(Series::line(
-            name.clone(),
-            (0..orbit.times.len()).map(|j| {
-                (
-                    1e3 * orbit.states[j * 2 * n + i],
-                    orbit.states[j * 2 * n + n + i],
-                )
-            }),
-        ));
-    }
-    render(&fig, &dir.join("orbit"))?;
-    render(&phase, &dir.join("orbit_phase"))?;
-    Ok(())
-}
-
-/// The text summary of a shooting result.
-fn orbit_text(model: &Model, sol: &PeriodicSolution, orbit: &OrbitSummary) -> String {
-    let mut t = format!(
-        "{}: period {:.6} s, residual {:.2e} after {} iterations\n",
-        if sol.converged {
-            "converged"
-        } else {
-            "NOT CONVERGED"
-        },
-        sol.period,
-        sol.residual_history.last().copied().unwrap_or(f64::NAN),
-        sol.residual_history.len() - 1
-    );
-    t += &format!(
-        "{} (largest |multiplier| {:.6})\n",
-        if sol.stable() { "stable" } else { "unstable" },
-        sol.spectral_radius()
-    );
-    for m in &sol.multipliers {
-        t += &format!(
-            "  multiplier {:+.6} {:+.6}i  |{:.6}|\n",
-            m.re,
-            m.im,
-            m.norm()
-        );
-    }
-    for (i, b) in model.bodies().iter().enumerate() {
-        t += &format!(
-            "  {}: max|u| {:.6e} m, max|v| {:.6e} m/s\n",
-            b.name, orbit.max_displacement[i], orbit.max_velocity[i]
-        );
-    }
-    t += &format!("  impacts per period: {}\n", orbit.impacts_per_period());
-    t
-}
+use crate::plot::render;
 
 /// Options of `vibroimpact continue`.
 #[derive(Args, Debug)]
@@ -419,7 +147,7 @@ fn study_error(e: StudyError, args: &ContinueArgs) -> CliError {
                         args.second.parameter2.as_deref().unwrap_or("")
                     )
                 }
-                StudyField::SpecialPoints => "--special-points".to_string(),
+                other => format!("--{}", other.name().replace('_', "-")),
             };
             CliError::new(format!("{option}: {message}"))
         }

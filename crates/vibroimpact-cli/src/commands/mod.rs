@@ -6,6 +6,7 @@ pub mod branch;
 pub mod chart;
 pub mod identify;
 pub mod impact;
+pub mod periodic;
 pub mod pounding;
 pub mod simulate;
 pub mod spectrum;

@@ -8,7 +8,8 @@ use crate::family::Family;
 use nalgebra::Complex;
 
 use super::problem::{unit_along, Linear, Problem};
-use crate::periodic::{arnoldi_matrix, floquet_multipliers, gmres, MapTangent};
+use crate::linalg::{arnoldi_matrix, gmres};
+use crate::periodic::{floquet_multipliers, MapTangent};
 
 /// Largest GMRES basis of a bordered solve.
 const MAX_GMRES: usize = 400;

@@ -51,6 +51,7 @@ mod continue_study;
 mod curve;
 mod events;
 mod krylov;
+mod orbit_study;
 mod problem;
 mod start;
 mod study;
@@ -66,6 +67,7 @@ pub use curve::{
     CurvesError, CURVE_NAMES,
 };
 pub use events::{BranchEvent, Observed, TestValues, UserEvent};
+pub use orbit_study::{CheckedOrbit, Guess, OrbitOutcome, OrbitStudy};
 pub use start::amplitude_homotopy;
 pub use study::{
     primary_orbit, BranchOutcome, BranchStudy, CheckedBranch, Linear, Start, StudyError,

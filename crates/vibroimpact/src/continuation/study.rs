@@ -113,11 +113,18 @@ pub enum StudyField {
     Parameter2,
     /// An earlier branch document whose special points start the curves.
     SpecialPoints,
+    /// The symmetric half map.
+    Symmetric,
+    /// The Arnoldi dimension.
+    Arnoldi,
+    /// The start guess.
+    Guess,
 }
 
 impl StudyField {
     /// The library's spelling: `range`, `from`, `subharmonic`,
-    /// `parameter`, `start`, `parameter2` or `special_points`.
+    /// `parameter`, `start`, `parameter2`, `special_points`, `symmetric`,
+    /// `arnoldi` or `guess`.
     pub fn name(self) -> &'static str {
         match self {
             StudyField::Range => "range",
@@ -127,6 +134,9 @@ impl StudyField {
             StudyField::Start => "start",
             StudyField::Parameter2 => "parameter2",
             StudyField::SpecialPoints => "special_points",
+            StudyField::Symmetric => "symmetric",
+            StudyField::Arnoldi => "arnoldi",
+            StudyField::Guess => "guess",
         }
     }
 }
@@ -143,6 +153,9 @@ pub enum StudyError {
         /// What is wrong with it.
         message: String,
     },
+    /// The model does not admit the study (the message names its file).
+    #[error("{0}")]
+    Model(String),
     /// A curve option the study refuses, by its field.
     #[error(transparent)]
     Field(FieldError),
@@ -155,6 +168,9 @@ pub enum StudyError {
     /// The guess by simulation failed.
     #[error("start guess: {0}")]
     Guess(PeriodicError),
+    /// Shooting (or the orbit's summary) failed.
+    #[error(transparent)]
+    Shooting(PeriodicError),
     /// The continuation (or the homotopy) failed.
     #[error(transparent)]
     Continuation(#[from] ContinuationError),

@@ -89,21 +89,9 @@ where
     )))
 }
 
-/// Unit right null vector of a square matrix (the right singular vector of
-/// its smallest singular value).
+/// Unit right null vector of a square matrix ([`crate::linalg::null_vector`]).
 fn null_vector(m: DMatrix<f64>) -> Result<Vec<f64>, ContinuationError> {
-    let d = m.ncols();
-    let svd = m.svd(false, true);
-    let v_t = svd
-        .v_t
-        .ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))?;
-    let imin = svd
-        .singular_values
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.total_cmp(b.1))
-        .map_or(0, |(i, _)| i);
-    Ok((0..d).map(|j| v_t[(imin, j)]).collect())
+    crate::linalg::null_vector(m).ok_or_else(|| ContinuationError::Invalid("SVD failed".into()))
 }
 
 /// A start on the other branch through a branch point. At a

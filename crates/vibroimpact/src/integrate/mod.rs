@@ -14,7 +14,7 @@
 //!   II*, Sec. IV.7 and VI.3, code `rodas.f`), for stiff phases such as bodies pressed together by a
 //!   very stiff contact force; it needs the Jacobian `∂f/∂y` (analytic via
 //!   [`OdeSystem::jacobian`], else by banded finite differences) and solves
-//!   linear systems with the band LU of [`linalg`].
+//!   linear systems with the band LU of [`crate::linalg::band`].
 //!
 //! * [`OdeSystem`] is the interface a model implements (right-hand side, an
 //!   optional admissibility test of candidate states, optional Jacobian and
@@ -41,7 +41,6 @@ mod dopri5;
 mod driver;
 pub mod events;
 mod explicit;
-pub mod linalg;
 pub mod rosenbrock;
 mod stepper;
 pub mod tangent;
@@ -51,10 +50,10 @@ mod conformance_tests;
 #[cfg(test)]
 mod test_systems;
 
+pub use crate::linalg::{BandMatrix, Singular};
 pub use dop853::{Dop853, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Method};
 pub use driver::{Attempt, Driver, Point, StepMethod, Trial};
-pub use linalg::{BandMatrix, Singular};
 pub use rosenbrock::{Rodas, RodasMethod};
 pub use stepper::{Method, Stepper};
 pub use tangent::{integrate_recorded, RecordedJacobian, Recorder, TangentTape};

@@ -69,8 +69,8 @@
 use super::driver::{
     all_finite, Attempt, Driver, Point, StepMethod, Trial, NON_FINITE, SHRINK_HARD,
 };
-use super::linalg::BandMatrix;
 use super::{IntegrationError, IntegratorOptions, OdeSystem, RejectReason, Stats};
+use crate::linalg::BandMatrix;
 
 /// Diagonal `γ` of the method.
 const GAMMA: f64 = 0.25;

@@ -17,11 +17,11 @@
 use super::system::{Constraint, Observation};
 use super::{bound_crossed, CurveKind, CurveOptions, CurveSystem, Scales};
 use crate::family::Family2;
+use crate::linalg::{arnoldi_matrix, gmres};
 use crate::model::Model;
 use crate::newton::NewtonSystem;
 use crate::periodic::{
-    arnoldi_matrix, floquet_multipliers, gmres, map_and_product, period_map_with, MapTangent,
-    ShootingOptions, MAX_STEPS,
+    floquet_multipliers, map_and_product, period_map_with, MapTangent, ShootingOptions, MAX_STEPS,
 };
 
 /// Residual tolerance of the corrector (scaled max-norm).

@@ -383,3 +383,36 @@ pub(super) fn forced_map(
         }),
     })
 }
+
+/// `(G(x), DG v)` (the map and a product with its Jacobian) by one
+/// integration of the state with one tangent column (by the options'
+/// integrator), body order.
+pub(crate) fn map_and_product(
+    model: &Model,
+    x: &[f64],
+    v: &[f64],
+    opts: &ShootingOptions,
+) -> Result<(Vec<f64>, Vec<f64>), IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+    let (y, w) = if opts.integrator.resolve(model) == Integrator::Local {
+        let sim_opts = local_options(opts, t, MAX_STEPS);
+        let column = to_interleaved(v);
+        let flow = local_flow(model, &sim_opts, &to_interleaved(x), (&column, 1), false)
+            .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
+        (flow.y, flow.columns)
+    } else {
+        let mut var = Variational::new(ChainDynamics::new(model, false), 1);
+        let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);
+        let int_opts = opts.integrator_options(MAX_STEPS, Some(d));
+        let (mut z, _) = integrate_to(&mut var, 0.0, &z0, t, &int_opts)?;
+        let w = z.split_off(d);
+        (z, w)
+    };
+    let (image, product) = (from_interleaved(&y, n), from_interleaved(&w, n));
+    if opts.symmetric {
+        return Ok((mirror(&image), mirror(&product)));
+    }
+    Ok((image, product))
+}

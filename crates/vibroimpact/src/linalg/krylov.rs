@@ -1,7 +1,7 @@
 //! Matrix-free linear algebra of Newton–Krylov shooting and continuation:
 //! GMRES and the Arnoldi matrix of products with a Jacobian.
 
-use super::*;
+use nalgebra::{DMatrix, DVector};
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()

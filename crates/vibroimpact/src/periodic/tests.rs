@@ -1,4 +1,4 @@
-//! Tests of periodic.rs.
+//! Tests of the periodic module: maps, shooting, Floquet multipliers, orbits.
 use super::*;
 use crate::model::BaseExcitation;
 use crate::simulate::Integrator;

@@ -1,0 +1,89 @@
+//! `simulate`: a time history with its summary and impact log.
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact::results::simulation_summary;
+use vibroimpact::simulate::SimulationOptions;
+
+use crate::convert::{array1, document, method, split_states, value_error};
+use crate::model::PyModel;
+use crate::monitor::{self, Progress};
+
+/// A time history: the `simulate` summary plus `t`, `displacement`,
+/// `velocity` (rows per output time) and the impact log as arrays.
+#[pyfunction]
+#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, integrator, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    duration: f64,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    method_name: &str,
+    output_step: Option<f64>,
+    energy: bool,
+    impact_force_threshold: Option<f64>,
+    integrator: &str,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.loaded.model;
+    let settings = &model.loaded.simulation;
+    let method = method(method_name)?;
+    let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
+    // The CLI's defaults: the model's [simulation] settings, else these.
+    let rtol = rtol.or(settings.rtol).unwrap_or(1e-8);
+    let atol = atol.or(settings.atol).unwrap_or(rtol * 1e-4);
+    let impact_force_threshold = impact_force_threshold
+        .or(settings.impact_force_threshold)
+        .unwrap_or(1e-3);
+    let output_step = match output_step {
+        Some(0.0) => None,
+        Some(dt) => Some(dt),
+        None => Some(match m.forcing_frequency() {
+            Some(w) => 2.0 * std::f64::consts::PI / w / 100.0,
+            None => duration / 2000.0,
+        }),
+    };
+    let job = model.loaded.clone();
+    let result = monitor::run(py, progress, move |p: &Progress| {
+        p.track_time(duration);
+        let opts = SimulationOptions {
+            t_end: duration,
+            rtol,
+            atol,
+            output_step,
+            impact_force_threshold,
+            energy,
+            method,
+            integrator,
+            interrupt: Some(p.interrupt.clone()),
+            ..SimulationOptions::default()
+        };
+        vibroimpact::simulate::simulate(&job.model, &opts)
+    })?;
+    let sim = result.map_err(value_error)?;
+    let n = m.bodies().len();
+    let mut summary = simulation_summary(m, &sim);
+    summary.record = model.loaded.record.clone();
+    let d = document(py, &summary)?;
+    let (u, v) = split_states(py, &sim.states, sim.times.len(), n)?;
+    d.set_item("t", array1(py, sim.times))?;
+    d.set_item("displacement", u)?;
+    d.set_item("velocity", v)?;
+    let log = PyDict::new(py);
+    let col = |f: &dyn Fn(&vibroimpact::simulate::ImpactRecord) -> f64| {
+        sim.impacts.iter().map(f).collect::<Vec<f64>>()
+    };
+    let contact: Vec<i64> = sim.impacts.iter().map(|i| i.contact as i64).collect();
+    log.set_item("contact", numpy::PyArray1::from_vec(py, contact))?;
+    log.set_item("start_time", array1(py, col(&|i| i.start_time)))?;
+    log.set_item("end_time", array1(py, col(&|i| i.end_time)))?;
+    log.set_item("impact_velocity", array1(py, col(&|i| i.impact_velocity)))?;
+    log.set_item("rebound_velocity", array1(py, col(&|i| i.rebound_velocity)))?;
+    log.set_item("restitution", array1(py, col(&|i| i.restitution())))?;
+    log.set_item("peak_force", array1(py, col(&|i| i.peak_force)))?;
+    log.set_item("duration", array1(py, col(&|i| i.duration())))?;
+    d.set_item("impacts", log)?;
+    Ok(d)
+}
