@@ -361,42 +361,9 @@ pub fn simulate_streaming(
     opts: &SimulationOptions,
     mut sink: impl FnMut(f64, &[f64]) -> bool,
 ) -> Result<Simulation, OptionsError> {
-    check_options(opts)?;
-    if let Some(dt) = opts.output_step {
-        let samples = (opts.t_end - opts.output_from) / dt + 1.0;
-        if samples > MAX_SAMPLES {
-            return Err(OptionsError(format!(
-                "output step = {dt} s over {} s: {samples:.3e} samples, more than {MAX_SAMPLES:e}; take a larger output step or a shorter duration",
-                opts.t_end
-            )));
-        }
-    }
-    if let BaseExcitation::Record(r) = model.base() {
-        let end = r.times().last().copied().unwrap_or(0.0);
-        // A hair of slack for a duration typed from the record's own times.
-        if opts.t_end > end * (1.0 + 1e-12) {
-            return Err(OptionsError(format!(
-                "duration = {} s: the accelerogram ends at {end} s; give a duration up to the record's end (a record is not extended with zeros)",
-                opts.t_end
-            )));
-        }
-    }
+    check_run(model, opts)?;
     let mut sys = ChainDynamics::new(model, opts.energy);
-    let mut y0 = sys.initial_state(model);
-    if let Some(start) = &opts.start {
-        let n = model.bodies().len();
-        if start.len() != 2 * n || start.iter().any(|x| !x.is_finite()) {
-            return Err(OptionsError(format!(
-                "start state: needs {} finite values, got {}",
-                2 * n,
-                start.len()
-            )));
-        }
-        for i in 0..n {
-            y0[2 * i] = start[i];
-            y0[2 * i + 1] = start[n + i];
-        }
-    }
+    let y0 = start_state(model, opts, &sys)?;
     let n2 = sys.state_dim();
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,
@@ -424,23 +391,13 @@ pub fn simulate_streaming(
         impacts: Vec::new(),
         previous: Vec::new(),
     };
-    let mut buf = vec![0.0; y0.len()];
-    // One sample in body order [u.., v..].
-    let mut sample = vec![0.0; n2];
-    let mut record = |t: f64, y: &[f64]| {
-        for i in 0..n2 / 2 {
-            sample[i] = y[2 * i];
-            sample[n2 / 2 + i] = y[2 * i + 1];
-        }
-        sink(t, &sample)
-    };
-    let mut next_sample = 0usize;
+    let mut output = Output::new(opts, (y0.len(), n2), &mut sink);
     let mut sink_stopped = None;
     if opts.output_step.is_some() && opts.output_from == 0.0 {
-        if !record(0.0, &y0) {
+        if !output.record(0.0, &y0) {
             sink_stopped = Some(0.0);
         }
-        next_sample = 1;
+        output.next = 1;
     }
     let e0 = sys.mechanical_energy(&y0);
     let mut error: Option<IntegrationError> = st.reset(&mut sys, 0.0, &y0).err();
@@ -480,39 +437,10 @@ pub fn simulate_streaming(
         if let Some(h) = scan.entry_limit(st.h_next()) {
             st.limit_next_step(h);
         }
-        // An explicit method alone: stop early, with the reason, when
-        // stability limits its step so far that the rest of the run would
-        // exceed the step limit (a contact or body far stiffer than the
-        // motion).
-        if matches!(method, Method::Dop853 | Method::Dopri5) && st.stiffness_detected() {
-            let h = st.t() - st.t_prev();
-            let projected = (opts.t_end - st.t()) / h;
-            let limit = opts.max_steps;
-            if projected > limit.saturating_sub(st.stats().steps) as f64 {
-                error = Some(IntegrationError::Stiff {
-                    t: st.t(),
-                    h,
-                    projected,
-                    limit,
-                });
-                break;
-            }
-        }
-        // Any method: a run that crawls (a nonsensical parameter, e.g. a
-        // contact damping of 1e300) ends early with the reason instead of
-        // grinding to the step limit.
         steps += 1;
-        if steps % PROGRESS_CHECK == 0 {
-            let projected = steps as f64 * opts.t_end / st.t();
-            if projected > CRAWL_FACTOR * opts.max_steps as f64 {
-                error = Some(IntegrationError::NoProgress {
-                    t: st.t(),
-                    steps,
-                    projected,
-                    limit: opts.max_steps,
-                });
-                break;
-            }
+        error = early_end(&st, method, opts, steps);
+        if error.is_some() {
+            break;
         }
         // Automatic method: leave RODAS as soon as every contact is open
         // again and an explicit step of RODAS's size would be stable (the
@@ -530,24 +458,186 @@ pub fn simulate_streaming(
                 break;
             }
         }
-        if let Some(dt) = opts.output_step {
-            loop {
-                let ts = opts.output_from + next_sample as f64 * dt;
-                if ts > st.t() || ts > opts.t_end {
-                    break;
-                }
-                st.dense_output(&mut sys, ts, &mut buf);
-                next_sample += 1;
-                if !record(ts, &buf) {
-                    sink_stopped = Some(ts);
-                    break;
-                }
-            }
-        }
+        sink_stopped = output.samples(&mut st, &mut sys);
     }
     if let (None, Some(t)) = (&error, sink_stopped) {
         error = Some(IntegrationError::Interrupted { t });
     }
+    let extrema = extrema.map(|x| x.found);
+    Ok(global_result(
+        model,
+        opts,
+        (st, sys),
+        scan,
+        e0,
+        error,
+        extrema,
+    ))
+}
+
+/// The checks of a run beyond the options' own: the output samples within
+/// [`MAX_SAMPLES`], a record's duration within the record.
+fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
+    check_options(opts)?;
+    if let Some(dt) = opts.output_step {
+        let samples = (opts.t_end - opts.output_from) / dt + 1.0;
+        if samples > MAX_SAMPLES {
+            return Err(OptionsError(format!(
+                "output step = {dt} s over {} s: {samples:.3e} samples, more than {MAX_SAMPLES:e}; take a larger output step or a shorter duration",
+                opts.t_end
+            )));
+        }
+    }
+    if let BaseExcitation::Record(r) = model.base() {
+        let end = r.times().last().copied().unwrap_or(0.0);
+        // A hair of slack for a duration typed from the record's own times.
+        if opts.t_end > end * (1.0 + 1e-12) {
+            return Err(OptionsError(format!(
+                "duration = {} s: the accelerogram ends at {end} s; give a duration up to the record's end (a record is not extended with zeros)",
+                opts.t_end
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The interleaved start state: the model's, or the options' `start`
+/// (body order, checked).
+fn start_state(
+    model: &Model,
+    opts: &SimulationOptions,
+    sys: &ChainDynamics,
+) -> Result<Vec<f64>, OptionsError> {
+    let mut y0 = sys.initial_state(model);
+    if let Some(start) = &opts.start {
+        let n = model.bodies().len();
+        if start.len() != 2 * n || start.iter().any(|x| !x.is_finite()) {
+            return Err(OptionsError(format!(
+                "start state: needs {} finite values, got {}",
+                2 * n,
+                start.len()
+            )));
+        }
+        for i in 0..n {
+            y0[2 * i] = start[i];
+            y0[2 * i + 1] = start[n + i];
+        }
+    }
+    Ok(y0)
+}
+
+/// Why a run ends early after `steps` steps, if it does: an explicit
+/// method whose stability limits its step so far that the rest of the run
+/// would exceed the step limit (a contact or body far stiffer than the
+/// motion), or any method that crawls (a nonsensical parameter, e.g. a
+/// contact damping of 1e300) instead of grinding to the step limit.
+fn early_end(
+    st: &Stepper,
+    method: Method,
+    opts: &SimulationOptions,
+    steps: u64,
+) -> Option<IntegrationError> {
+    if matches!(method, Method::Dop853 | Method::Dopri5) && st.stiffness_detected() {
+        let h = st.t() - st.t_prev();
+        let projected = (opts.t_end - st.t()) / h;
+        let limit = opts.max_steps;
+        if projected > limit.saturating_sub(st.stats().steps) as f64 {
+            return Some(IntegrationError::Stiff {
+                t: st.t(),
+                h,
+                projected,
+                limit,
+            });
+        }
+    }
+    if steps % PROGRESS_CHECK == 0 {
+        let projected = steps as f64 * opts.t_end / st.t();
+        if projected > CRAWL_FACTOR * opts.max_steps as f64 {
+            return Some(IntegrationError::NoProgress {
+                t: st.t(),
+                steps,
+                projected,
+                limit: opts.max_steps,
+            });
+        }
+    }
+    None
+}
+
+/// The output samples of a run: every `output_step` from `output_from`,
+/// in body order, to the sink.
+struct Output<'a, S> {
+    step: Option<f64>,
+    from: f64,
+    t_end: f64,
+    /// Index of the next sample.
+    next: usize,
+    /// Dense output in the integrator's layout.
+    buf: Vec<f64>,
+    /// One sample in body order [u.., v..].
+    sample: Vec<f64>,
+    sink: &'a mut S,
+}
+
+impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
+    /// `dims`: the integrated state's length and the mechanical state's.
+    fn new(opts: &SimulationOptions, dims: (usize, usize), sink: &'a mut S) -> Self {
+        Self {
+            step: opts.output_step,
+            from: opts.output_from,
+            t_end: opts.t_end,
+            next: 0,
+            buf: vec![0.0; dims.0],
+            sample: vec![0.0; dims.1],
+            sink,
+        }
+    }
+
+    /// Hands the interleaved state `y` at `t` to the sink; false if it
+    /// asks to stop.
+    fn record(&mut self, t: f64, y: &[f64]) -> bool {
+        let n = self.sample.len() / 2;
+        for i in 0..n {
+            self.sample[i] = y[2 * i];
+            self.sample[n + i] = y[2 * i + 1];
+        }
+        (self.sink)(t, &self.sample)
+    }
+
+    /// The samples within the last step, by dense output; the time of the
+    /// sample at which the sink asked to stop, if it did.
+    fn samples(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) -> Option<f64> {
+        let dt = self.step?;
+        loop {
+            let ts = self.from + self.next as f64 * dt;
+            if ts > st.t() || ts > self.t_end {
+                return None;
+            }
+            st.dense_output(sys, ts, &mut self.buf);
+            self.next += 1;
+            let buf = std::mem::take(&mut self.buf);
+            let go_on = self.record(ts, &buf);
+            self.buf = buf;
+            if !go_on {
+                return Some(ts);
+            }
+        }
+    }
+}
+
+/// The result of a run by the global integrator: the final state, the
+/// impacts in order, the energy balance and the failure, if any, with the
+/// state it happened in.
+fn global_result(
+    model: &Model,
+    opts: &SimulationOptions,
+    (st, sys): (Stepper, ChainDynamics),
+    scan: StepScan,
+    e0: f64,
+    error: Option<IntegrationError>,
+    extrema: Option<Extrema>,
+) -> Simulation {
+    let n2 = sys.state_dim();
     let y = st.y().to_vec();
     let mut impacts = scan.impacts;
     by_start(&mut impacts);
@@ -566,7 +656,7 @@ pub fn simulate_streaming(
         let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
         failure(model, source, &state, &s_on)
     });
-    Ok(Simulation {
+    Simulation {
         times: Vec::new(),
         states: Vec::new(),
         final_time: st.t(),
@@ -577,9 +667,9 @@ pub fn simulate_streaming(
         contact_evaluations: sys.contact_evaluations(),
         energy,
         error,
-        extrema: extrema.map(|x| x.found),
+        extrema,
         local: None,
-    })
+    }
 }
 
 /// Impacts in order of start time, then contact.

@@ -26,7 +26,7 @@ from ._results import Result
 
 
 def _sweep_task(model, parameter, values, options, only=None):
-    from . import _sweep_local
+    from ._maps import _sweep_local
 
     return _sweep_local(model, parameter, values, options, threads=1, raw=True, only=only)
 
@@ -99,7 +99,7 @@ def sweep_on(
 
 
 def _chart_task(model, x, y, options):
-    from . import _chart_local
+    from ._maps import _chart_local
 
     return _chart_local(model, x, y, options, threads=1, raw=True)
 
@@ -152,14 +152,14 @@ def ensemble(
     returns the results in order. A numerical failure gives that model's
     result with ``error`` set (and what was computed); bad arguments raise
     at once."""
-    import vibroimpact
+    from ._checks import _model
 
     names = ("simulate", "periodic", "continue_", "sweep")
     if function not in names:
         raise ValueError(f"function = {function!r}: give one of {', '.join(names)}")
     if isinstance(models, (str, bytes)) or not hasattr(models, "__iter__"):
         raise TypeError("models: expected a list of models (or paths or dicts)")
-    models = [vibroimpact._model(m) for m in models]
+    models = [_model(m) for m in models]
     if not models:
         return []
     if client is None:
@@ -179,7 +179,8 @@ def ensemble(
 def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
     """One record × scale: the pair's periods and the record's run
     (``vibroimpact pounding``'s ``pair`` and ``runs[0]``)."""
-    from . import _core, _floats
+    from . import _core
+    from ._checks import _floats
 
     name, header, units, times, acc = record
     # Arrays unpickled on a worker need not be aligned: copied as the
@@ -222,17 +223,23 @@ def ida(
     ``required_gap`` (m); and ``period`` (T1, s) and ``sources``."""
     import os
 
-    import vibroimpact as vi
+    from ._earthquakes import (
+        _pair_text,
+        _pounding_settings,
+        _record_inputs,
+        read_record,
+        response_spectrum,
+    )
 
-    source, text = vi._pair_text(pair)
-    vi._pounding_settings(1.0, sample, rtol, method, integrator)
+    source, text = _pair_text(pair)
+    _pounding_settings(1.0, sample, rtol, method, integrator)
     run = (float(sample), float(rtol), method, integrator)
-    recs = [vi.read_record(r) if isinstance(r, (str, os.PathLike)) else r for r in records]
+    recs = [read_record(r) if isinstance(r, (str, os.PathLike)) else r for r in records]
     scales = np.asarray(scales, dtype=np.float64)
     if scales.ndim != 1 or scales.size == 0 or not np.all(np.isfinite(scales)):
         raise ValueError("scales: expected a non-empty list of finite factors")
     jobs = [(i, float(s)) for i in range(len(recs)) for s in scales]
-    arrays = vi._record_inputs(recs, None)
+    arrays = _record_inputs(recs, None)
     if client is None:
         results = []
         for k, (i, s) in enumerate(jobs):
@@ -249,7 +256,7 @@ def ida(
         results = _gather(futures, progress, len(futures))
     period = float(results[0]["pair"]["left_period"])
     sa_unit = [
-        float(vi.response_spectrum(r, [period], damping=damping)["pseudo_acceleration"][0])
+        float(response_spectrum(r, [period], damping=damping)["pseudo_acceleration"][0])
         for r in recs
     ]
 

@@ -17,7 +17,7 @@ import importlib.util
 import os
 from typing import Any, Dict, List
 
-from . import read_record
+from ._earthquakes import read_record
 from ._results import Result
 
 __all__ = ["fema_p695", "gmspy_files", "gmspy_record", "FEMA_P695_SETS"]

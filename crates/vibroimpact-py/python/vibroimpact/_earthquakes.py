@@ -1,0 +1,265 @@
+"""Earthquakes: :func:`read_record` (a ground-motion record file),
+:func:`response_spectrum` (``vibroimpact spectrum``), :func:`pounding`
+(``vibroimpact pounding``, two shear frames under recorded ground motions)
+and :func:`pounding_history`, with the checks of pair files, records and
+pounding settings that :mod:`vibroimpact.distributed` shares. Records that
+ship with other Python packages are in :mod:`vibroimpact.records`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from . import _core
+from ._checks import ArrayLike, _floats, _method
+from ._results import Result
+
+
+def read_record(path: Union[str, "os.PathLike[str]"], *, units: Optional[str] = None) -> Result:
+    """A ground-motion record: a PEER NGA ``.AT2`` file, two columns (time s,
+    acceleration; header lines skipped) or CSV. ``units`` (``"g"``,
+    ``"m/s2"``, ``"gal"``) is needed when the header does not state them.
+
+    Returns ``source``, ``header`` (the header lines), ``units`` (of the
+    file), ``dt`` (None if not uniform), ``times`` (s), ``acceleration``
+    (m/s², converted), ``pga`` (m/s²)."""
+    path = os.fspath(path)
+    if not isinstance(path, str):
+        raise TypeError("path: expected a file name")
+    if units is not None and not isinstance(units, str):
+        raise TypeError("units: expected 'g', 'm/s2' or 'gal'")
+    try:
+        size = os.stat(path).st_size
+    except OSError as e:
+        raise OSError(f"{path}: cannot read: {e.strerror}") from None
+    if size > 1 << 30:
+        raise ValueError(f"path: {path} has {size} bytes, more than the input limit of 1 GiB")
+    with open(path, encoding="utf-8", errors="replace") as f:
+        text = f.read()
+    return Result(_core.parse_record(text, path, units))
+
+
+def response_spectrum(
+    record: Any,
+    periods: Optional[ArrayLike] = None,
+    *,
+    damping: float = 0.05,
+    scale: float = 1.0,
+    acceleration: Optional[ArrayLike] = None,
+    units: Optional[str] = None,
+) -> Result:
+    """Elastic response spectra of a record, exact for its piecewise-linear
+    ground acceleration (Nigam–Jennings; ``vibroimpact spectrum``).
+    ``record``: a result of :func:`read_record`, a file name (read with
+    ``units`` when its header does not state them), or the sample times (s)
+    with ``acceleration`` (m/s²). ``periods`` (s): default 100
+    log-spaced from 0.05 to 5. Peaks over the record's time steps.
+
+    Returns ``period``, ``pseudo_acceleration`` (m/s²), ``pseudo_velocity``
+    (m/s), ``displacement`` (m)."""
+    if isinstance(record, (str, os.PathLike)):
+        record = read_record(record, units=units)
+    if acceleration is None:
+        try:
+            times, acc = record["times"], record["acceleration"]
+        except (KeyError, TypeError, IndexError):
+            raise TypeError(
+                "record: expected a read_record result, a file name, or times with acceleration="
+            ) from None
+    else:
+        times, acc = record, acceleration
+    if periods is None:
+        periods = np.geomspace(0.05, 5.0, 100)
+    for name, v in (("damping", damping), ("scale", scale)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    return Result(
+        _core.response_spectrum(
+            _floats(times, "times", allow_scalar=False),
+            _floats(acc, "acceleration", allow_scalar=False),
+            _floats(periods, "periods"),
+            float(damping),
+            float(scale),
+        )
+    )
+
+
+def _pair_text(pair: Any):
+    """(source, TOML text) of a pounding pair given as a file name or text
+    (text holds a line break or an `=`; anything else is a file name)."""
+    if isinstance(pair, str) and ("\n" in pair or "=" in pair):
+        return "<pair>", pair
+    if isinstance(pair, (str, os.PathLike)):
+        source = os.fspath(pair)
+        try:
+            with open(source, encoding="utf-8") as f:
+                return source, f.read()
+        except OSError as e:
+            raise OSError(f"pair: {source}: cannot read: {e.strerror}") from None
+    raise TypeError("pair: expected a pair file name or its TOML text")
+
+
+def _record_arrays(record: Any):
+    if isinstance(record, (str, os.PathLike)):
+        record = read_record(record)
+    try:
+        return record["times"], record["acceleration"]
+    except (KeyError, TypeError, IndexError):
+        raise TypeError("record: expected a read_record result or a file name") from None
+
+
+def _record_inputs(records: Any, units: Optional[str]) -> list:
+    """The binding's records: (source, header, units, times, acceleration)
+    of one record or a list of them (file names or :func:`read_record`
+    results)."""
+    one = isinstance(records, (str, os.PathLike, Mapping))
+    out = []
+    for k, r in enumerate([records] if one else list(records)):
+        if isinstance(r, (str, os.PathLike)):
+            r = read_record(r, units=units)
+        try:
+            times, acc = r["times"], r["acceleration"]
+        except (KeyError, TypeError, IndexError):
+            raise TypeError(
+                f"records[{k}]: expected a read_record result or a file name"
+            ) from None
+        out.append(
+            (
+                str(r.get("source", f"record {k}")),
+                [str(h) for h in r.get("header", [])],
+                str(r.get("units", "m/s2")),
+                _floats(times, "times", allow_scalar=False),
+                _floats(acc, "acceleration", allow_scalar=False),
+            )
+        )
+    if not out:
+        raise ValueError("records: give at least one record")
+    return out
+
+
+def _value_range(values: Any, name: str) -> Optional[np.ndarray]:
+    """`FROM:TO:N` (the CLI's form) or a list of values."""
+    if values is None:
+        return None
+    if isinstance(values, str):
+        return _core.value_range(name, values)
+    return _floats(values, name, allow_scalar=False)
+
+
+def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any, integrator: Any) -> None:
+    """Checks the settings of a pounding run (the binding checks their
+    ranges)."""
+    for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    _method(method, ("dop853", "dopri5", "rodas", "auto"))
+    _method(integrator, ("auto", "global", "local"), "integrator")
+
+
+def _pounding_args(
+    pair: Any, record: Any, scale: Any, sample: Any, rtol: Any, method: Any, integrator: Any
+) -> tuple:
+    """The binding's leading arguments of a pounding run, checked."""
+    source, text = _pair_text(pair)
+    _pounding_settings(scale, sample, rtol, method, integrator)
+    times, acc = _record_arrays(record)
+    return (
+        text,
+        source,
+        _floats(times, "times", allow_scalar=False),
+        _floats(acc, "acceleration", allow_scalar=False),
+        float(scale),
+        float(sample),
+        float(rtol),
+        method,
+        integrator,
+    )
+
+
+def pounding(
+    pair: Union[str, "os.PathLike[str]"],
+    records: Any,
+    *,
+    units: Optional[str] = None,
+    scale: float = 1.0,
+    sample: float = 0.0025,
+    rtol: float = 1e-8,
+    method: str = "dop853",
+    integrator: str = "auto",
+    free: bool = True,
+    gaps: Any = None,
+    ratios: Any = None,
+) -> Result:
+    """Pounding of two shear frames under recorded ground motions
+    (``vibroimpact pounding``): ``pair`` is a pair file (TOML,
+    docs/earthquakes.md) or its text; ``records`` one record or a list, each
+    a :func:`read_record` result or a file name (read with ``units`` when
+    its header does not state them), scaled by ``scale``. ``sample`` (s):
+    the sampling of drifts and floor accelerations. ``method``: "dop853",
+    or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the record's samples
+    limit the step; peaks within 1 % there, docs/earthquakes.md).
+    ``integrator="local"``: each frame moves exactly between poundings, per
+    record sample. ``free=False`` runs the pair with its contacts only
+    (half the work; no ``free``, ``amplification``, ``required_gap`` or
+    ``code_gaps``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
+    values): the pounding spectrum over gaps (m) × period ratios
+    T_left/T_right instead of the runs.
+
+    Returns the CLI's document: ``pair`` (``left_period``,
+    ``right_period``, ``gap``, ``floors``) and ``runs``, one per record,
+    each with ``record``, ``pounding`` and ``free`` (``peak_drift``,
+    ``peak_floor_acceleration``, ``peak_displacement`` per floor of the
+    ``left`` and ``right`` frames, ``peak_impact_force``, ``impacts``,
+    ``closing``), ``amplification``, ``required_gap`` and ``code_gaps``
+    (``absolute_sum``, ``srss``, ``double_difference``, ``correlation``);
+    with ``gaps`` and ``ratios``, ``pair``, ``records`` and ``cells`` (per
+    gap and ratio the median, 16 and 84 % quantiles over the records)."""
+    source, text = _pair_text(pair)
+    _pounding_settings(scale, sample, rtol, method, integrator)
+    if not isinstance(free, bool):
+        raise TypeError(f"free: expected True or False, got {free!r}")
+    if (gaps is None) != (ratios is None):
+        raise ValueError("gaps, ratios: give both (the pounding spectrum) or neither")
+    return Result(
+        _core.pounding(
+            text,
+            source,
+            _record_inputs(records, units),
+            float(scale),
+            float(sample),
+            float(rtol),
+            method,
+            integrator,
+            free,
+            _value_range(gaps, "gaps"),
+            _value_range(ratios, "ratios"),
+        )
+    )
+
+
+def pounding_history(
+    pair: Union[str, "os.PathLike[str]"],
+    record: Any,
+    *,
+    scale: float = 1.0,
+    sample: float = 0.01,
+    rtol: float = 1e-8,
+    method: str = "dop853",
+    integrator: str = "auto",
+) -> Result:
+    """The time history of a pounding pair with its contacts under one
+    record (as :func:`pounding` takes them), sampled every ``sample``
+    seconds: ``t`` (s), ``left`` and ``right`` (floor displacements relative
+    to the ground, floors × samples, m) and the impact log
+    ``impact_time`` (s), ``impact_floor`` (1-based), ``impact_peak_force``
+    (N)."""
+    d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method, integrator))
+    d["left"] = np.asarray(d["left"])
+    d["right"] = np.asarray(d["right"])
+    d["impact_floor"] = np.asarray(d["impact_floor"], dtype=np.int64)
+    return Result(d)
