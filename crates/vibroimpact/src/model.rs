@@ -230,171 +230,21 @@ impl Model {
                 "the model has no bodies",
             ));
         }
-        for (i, b) in bodies.iter().enumerate() {
-            let key = |what: &str| format!("body.{}.{what}", i + 1);
-            if !(b.mass > 0.0 && b.mass.is_finite()) {
-                return Err(ModelError::new(
-                    ModelErrorKind::InvalidValue,
-                    key("mass"),
-                    format!("body {}: mass = {}: must be finite and > 0", b.name, b.mass),
-                ));
-            }
-            nonneg(
-                || key("stiffness"),
-                || format!("body {}: stiffness", b.name),
-                b.stiffness,
-            )?;
-            nonneg(
-                || key("damping"),
-                || format!("body {}: damping", b.name),
-                b.damping,
-            )?;
-        }
-        for (k, c) in couplings.iter().enumerate() {
-            let key = |what: &str| format!("spring.{}.{what}", k + 1);
-            if c.a >= n || c.b >= n || c.a == c.b {
-                return Err(ModelError::new(
-                    ModelErrorKind::UnknownBody,
-                    key("between"),
-                    format!("spring {}: must join two different existing bodies", k + 1),
-                ));
-            }
-            nonneg(
-                || key("stiffness"),
-                || format!("spring {}: stiffness", k + 1),
-                c.stiffness,
-            )?;
-            nonneg(
-                || key("damping"),
-                || format!("spring {}: damping", k + 1),
-                c.damping,
-            )?;
-        }
-        let name = |i: usize| bodies[i].name.clone();
-        for (k, c) in contacts.iter().enumerate() {
-            let between = || format!("contact.{}.between", k + 1);
-            let unknown = || {
-                ModelError::new(
-                    ModelErrorKind::UnknownBody,
-                    between(),
-                    format!("contact {}: unknown body", k + 1),
-                )
-            };
-            match c.pair {
-                ContactPair::Bodies { left, right } => {
-                    if left >= n || right >= n {
-                        return Err(unknown());
-                    }
-                    if left >= right {
-                        return Err(ModelError::new(
-                            ModelErrorKind::Order,
-                            between(),
-                            format!(
-                                "contact {}: bodies must be given left first in their order along the line ({} is not left of {})",
-                                k + 1,
-                                name(left),
-                                name(right)
-                            ),
-                        ));
-                    }
-                }
-                ContactPair::LeftWall { body } | ContactPair::RightWall { body } => {
-                    if body >= n {
-                        return Err(unknown());
-                    }
-                }
-            }
-            nonneg(
-                || format!("contact.{}.clearance", k + 1),
-                || format!("contact {}: clearance", k + 1),
-                c.clearance,
-            )?;
-        }
-        for (k, f) in forces.iter().enumerate() {
-            let key = format!("force.{}", k + 1);
-            if f.body >= n {
-                return Err(ModelError::new(
-                    ModelErrorKind::UnknownBody,
-                    key,
-                    "harmonic force on an unknown body",
-                ));
-            }
-            if !(f.frequency > 0.0
-                && f.frequency.is_finite()
-                && f.amplitude.is_finite()
-                && f.phase.is_finite())
-            {
-                return Err(ModelError::new(
-                    ModelErrorKind::InvalidValue,
-                    key,
-                    format!(
-                        "harmonic force on {}: needs finite amplitude and phase and frequency > 0",
-                        name(f.body)
-                    ),
-                ));
-            }
-        }
-        if let BaseExcitation::Harmonic {
-            amplitude,
-            frequency,
-            phase,
-        } = base
-        {
-            if !(frequency > 0.0
-                && frequency.is_finite()
-                && amplitude.is_finite()
-                && phase.is_finite())
-            {
-                return Err(ModelError::new(
-                    ModelErrorKind::InvalidValue,
-                    "excitation",
-                    "harmonic base excitation: needs finite amplitude and phase and frequency > 0",
-                ));
-            }
-        }
-        let fill = |v: Vec<f64>, what: &str| -> Result<Vec<f64>, ModelError> {
-            let key = format!("initial.{what}");
-            if v.is_empty() {
-                Ok(vec![0.0; n])
-            } else if v.len() != n {
-                Err(ModelError::new(
-                    ModelErrorKind::Missing,
-                    key,
-                    format!("initial {what}: {} values for {n} bodies", v.len()),
-                ))
-            } else if v.iter().any(|x| !x.is_finite()) {
-                Err(ModelError::new(
-                    ModelErrorKind::InvalidValue,
-                    key,
-                    format!("initial {what}: values must be finite"),
-                ))
-            } else {
-                Ok(v)
-            }
-        };
+        check_bodies(&bodies)?;
+        check_couplings(&couplings, n)?;
+        check_contacts(&contacts, &bodies)?;
+        check_forces(&forces, &bodies)?;
+        check_base(&base)?;
         let model = Self {
-            initial_displacement: fill(initial_displacement, "displacement")?,
-            initial_velocity: fill(initial_velocity, "velocity")?,
+            initial_displacement: initial_values(initial_displacement, "displacement", n)?,
+            initial_velocity: initial_values(initial_velocity, "velocity", n)?,
             bodies,
             couplings,
             contacts,
             base,
             forces,
         };
-        for k in 0..model.contacts.len() {
-            let s = model.approach(k, &model.initial_displacement);
-            if s > 0.0 {
-                return Err(ModelError::new(
-                    ModelErrorKind::Overlap,
-                    format!("contact.{}", k + 1),
-                    format!(
-                        "contact {} ({}): the bodies overlap at the start by {s:e} m",
-                        k + 1,
-                        model.contact_name(k)
-                    ),
-                ));
-            }
-        }
+        check_overlaps(&model)?;
         Ok(model)
     }
 
@@ -696,6 +546,199 @@ impl Model {
 mod excitation;
 
 pub use excitation::{Accelerogram, BaseExcitation, HarmonicForce};
+
+/// Every body's mass finite and positive, its support's stiffness and
+/// damping finite and nonnegative.
+fn check_bodies(bodies: &[Body]) -> Result<(), ModelError> {
+    for (i, b) in bodies.iter().enumerate() {
+        let key = |what: &str| format!("body.{}.{what}", i + 1);
+        if !(b.mass > 0.0 && b.mass.is_finite()) {
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                key("mass"),
+                format!("body {}: mass = {}: must be finite and > 0", b.name, b.mass),
+            ));
+        }
+        nonneg(
+            || key("stiffness"),
+            || format!("body {}: stiffness", b.name),
+            b.stiffness,
+        )?;
+        nonneg(
+            || key("damping"),
+            || format!("body {}: damping", b.name),
+            b.damping,
+        )?;
+    }
+    Ok(())
+}
+
+/// Every spring joins two different existing bodies (of `n`), with finite,
+/// nonnegative stiffness and damping.
+fn check_couplings(couplings: &[Coupling], n: usize) -> Result<(), ModelError> {
+    for (k, c) in couplings.iter().enumerate() {
+        let key = |what: &str| format!("spring.{}.{what}", k + 1);
+        if c.a >= n || c.b >= n || c.a == c.b {
+            return Err(ModelError::new(
+                ModelErrorKind::UnknownBody,
+                key("between"),
+                format!("spring {}: must join two different existing bodies", k + 1),
+            ));
+        }
+        nonneg(
+            || key("stiffness"),
+            || format!("spring {}: stiffness", k + 1),
+            c.stiffness,
+        )?;
+        nonneg(
+            || key("damping"),
+            || format!("spring {}: damping", k + 1),
+            c.damping,
+        )?;
+    }
+    Ok(())
+}
+
+/// Every contact between existing bodies, the left one first, or a body
+/// and a wall, with a finite, nonnegative clearance.
+fn check_contacts(contacts: &[Contact], bodies: &[Body]) -> Result<(), ModelError> {
+    let n = bodies.len();
+    let name = |i: usize| bodies[i].name.clone();
+    for (k, c) in contacts.iter().enumerate() {
+        let between = || format!("contact.{}.between", k + 1);
+        let unknown = || {
+            ModelError::new(
+                ModelErrorKind::UnknownBody,
+                between(),
+                format!("contact {}: unknown body", k + 1),
+            )
+        };
+        match c.pair {
+            ContactPair::Bodies { left, right } => {
+                if left >= n || right >= n {
+                    return Err(unknown());
+                }
+                if left >= right {
+                    return Err(ModelError::new(
+                        ModelErrorKind::Order,
+                        between(),
+                        format!(
+                            "contact {}: bodies must be given left first in their order along the line ({} is not left of {})",
+                            k + 1,
+                            name(left),
+                            name(right)
+                        ),
+                    ));
+                }
+            }
+            ContactPair::LeftWall { body } | ContactPair::RightWall { body } => {
+                if body >= n {
+                    return Err(unknown());
+                }
+            }
+        }
+        nonneg(
+            || format!("contact.{}.clearance", k + 1),
+            || format!("contact {}: clearance", k + 1),
+            c.clearance,
+        )?;
+    }
+    Ok(())
+}
+
+/// Every harmonic force on an existing body, finite, with a positive
+/// frequency.
+fn check_forces(forces: &[HarmonicForce], bodies: &[Body]) -> Result<(), ModelError> {
+    let n = bodies.len();
+    let name = |i: usize| bodies[i].name.clone();
+    for (k, f) in forces.iter().enumerate() {
+        let key = format!("force.{}", k + 1);
+        if f.body >= n {
+            return Err(ModelError::new(
+                ModelErrorKind::UnknownBody,
+                key,
+                "harmonic force on an unknown body",
+            ));
+        }
+        if !(f.frequency > 0.0
+            && f.frequency.is_finite()
+            && f.amplitude.is_finite()
+            && f.phase.is_finite())
+        {
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                key,
+                format!(
+                    "harmonic force on {}: needs finite amplitude and phase and frequency > 0",
+                    name(f.body)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A harmonic base excitation finite, with a positive frequency.
+fn check_base(base: &BaseExcitation) -> Result<(), ModelError> {
+    if let BaseExcitation::Harmonic {
+        amplitude,
+        frequency,
+        phase,
+    } = *base
+    {
+        if !(frequency > 0.0 && frequency.is_finite() && amplitude.is_finite() && phase.is_finite())
+        {
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                "excitation",
+                "harmonic base excitation: needs finite amplitude and phase and frequency > 0",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Initial displacements or velocities (`what`) of `n` bodies: rest when
+/// empty, else `n` finite values.
+fn initial_values(v: Vec<f64>, what: &str, n: usize) -> Result<Vec<f64>, ModelError> {
+    let key = format!("initial.{what}");
+    if v.is_empty() {
+        Ok(vec![0.0; n])
+    } else if v.len() != n {
+        Err(ModelError::new(
+            ModelErrorKind::Missing,
+            key,
+            format!("initial {what}: {} values for {n} bodies", v.len()),
+        ))
+    } else if v.iter().any(|x| !x.is_finite()) {
+        Err(ModelError::new(
+            ModelErrorKind::InvalidValue,
+            key,
+            format!("initial {what}: values must be finite"),
+        ))
+    } else {
+        Ok(v)
+    }
+}
+
+/// No contact closed beyond contact at the initial displacements.
+fn check_overlaps(model: &Model) -> Result<(), ModelError> {
+    for k in 0..model.contacts.len() {
+        let s = model.approach(k, &model.initial_displacement);
+        if s > 0.0 {
+            return Err(ModelError::new(
+                ModelErrorKind::Overlap,
+                format!("contact.{}", k + 1),
+                format!(
+                    "contact {} ({}): the bodies overlap at the start by {s:e} m",
+                    k + 1,
+                    model.contact_name(k)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
 
 #[cfg(test)]
 #[path = "model_tests.rs"]

@@ -451,37 +451,9 @@ pub(crate) fn run_value(
     });
     // Transient: discarded, sampled coarsely for a hand-over state.
     if settings.transient > 0 {
-        let m = match start_model(model, &start) {
-            Ok(m) => m,
-            Err(e) => return fail(point, format!("cannot start: {e}")),
-        };
-        let dt = period / COARSE as f64;
-        let opts = SimulationOptions {
-            t_end: (settings.transient * COARSE) as f64 * dt,
-            output_step: Some(dt),
-            integrator: settings.integrator,
-            ..settings.opts.clone()
-        };
-        let sim = match simulate(&m, &opts) {
-            Ok(s) => s,
-            Err(e) => return fail(point, e.to_string()),
-        };
-        if let Some(e) = &sim.error {
-            return fail(
-                point,
-                format!(
-                    "integration failed {:.9} s into the transient: {e}",
-                    sim.final_time
-                ),
-            );
-        }
-        match handover(&m, &sim, start.phase, FINE / COARSE, start.phase) {
-            Some(s) => start = s,
-            None => return fail(
-                point,
-                "after the transient no sampled state is free of contact overlap to record from"
-                    .into(),
-            ),
+        match run_transient(model, &start, period, settings) {
+            Ok(s) => start = s,
+            Err(msg) => return fail(point, msg),
         }
     }
     // Recorded window: the first section instant, then `record` periods.
@@ -504,6 +476,81 @@ pub(crate) fn run_value(
         Ok(s) => s,
         Err(e) => return fail(point, e.to_string()),
     };
+    measure(&mut point, &sim, (period, w0), settings);
+    if let Some(e) = &sim.error {
+        let msg = format!(
+            "integration failed {:.9} s into the recorded run, after {} recorded periods: {e}",
+            sim.final_time, point.recorded_periods
+        );
+        return fail(point, msg);
+    }
+    if let Some(count) = settings.lyapunov {
+        let opts = LyapunovOptions {
+            count: Some(count),
+            transient: 0,
+            periods: settings.record,
+            rtol: settings.opts.rtol,
+            interrupt: settings.opts.interrupt.clone(),
+            integrator: settings.integrator,
+        };
+        match lyapunov_spectrum(&m, &sim.states[..2 * n], w0, &opts) {
+            Ok(ly) => {
+                point.lyapunov = Some(ly.exponents);
+                point.lyapunov_uncertainty = Some(ly.uncertainty);
+            }
+            Err(e) => return fail(point, format!("Lyapunov exponents: {e}")),
+        }
+    }
+    point.completed = true;
+    // Every sample is a section instant (phase 0).
+    let next = handover(&m, &sim, 0, FINE, start.phase + j_end);
+    (point, next)
+}
+
+/// The transient from `start`: simulated, sampled coarsely, and the
+/// state to record from (or why there is none).
+fn run_transient(
+    model: &Model,
+    start: &Start,
+    period: f64,
+    settings: &Settings,
+) -> Result<Start, String> {
+    let m = match start_model(model, &start) {
+        Ok(m) => m,
+        Err(e) => return Err(format!("cannot start: {e}")),
+    };
+    let dt = period / COARSE as f64;
+    let opts = SimulationOptions {
+        t_end: (settings.transient * COARSE) as f64 * dt,
+        output_step: Some(dt),
+        integrator: settings.integrator,
+        ..settings.opts.clone()
+    };
+    let sim = match simulate(&m, &opts) {
+        Ok(s) => s,
+        Err(e) => return Err(e.to_string()),
+    };
+    if let Some(e) = &sim.error {
+        return Err(format!(
+            "integration failed {:.9} s into the transient: {e}",
+            sim.final_time
+        ));
+    }
+    handover(&m, &sim, start.phase, FINE / COARSE, start.phase).ok_or_else(|| {
+        "after the transient no sampled state is free of contact overlap to record from".into()
+    })
+}
+
+/// The point's measures from the recorded run `sim` (its window from
+/// `w0`, `period` apart): Poincaré sections, exact extrema, impacts per
+/// period, spread and distinct section points.
+fn measure(
+    point: &mut SweepPoint,
+    sim: &Simulation,
+    (period, w0): (f64, f64),
+    settings: &Settings,
+) {
+    let n = point.max_displacement.len();
     let samples = sim.times.len();
     let row = |k: usize| &sim.states[k * 2 * n..(k + 1) * 2 * n];
     point.sections = (1..=settings.record)
@@ -537,34 +584,6 @@ pub(crate) fn run_value(
             settings.cluster_tolerance * max_v,
         );
     }
-    if let Some(e) = &sim.error {
-        let msg = format!(
-            "integration failed {:.9} s into the recorded run, after {} recorded periods: {e}",
-            sim.final_time, point.recorded_periods
-        );
-        return fail(point, msg);
-    }
-    if let Some(count) = settings.lyapunov {
-        let opts = LyapunovOptions {
-            count: Some(count),
-            transient: 0,
-            periods: settings.record,
-            rtol: settings.opts.rtol,
-            interrupt: settings.opts.interrupt.clone(),
-            integrator: settings.integrator,
-        };
-        match lyapunov_spectrum(&m, row(0), w0, &opts) {
-            Ok(ly) => {
-                point.lyapunov = Some(ly.exponents);
-                point.lyapunov_uncertainty = Some(ly.uncertainty);
-            }
-            Err(e) => return fail(point, format!("Lyapunov exponents: {e}")),
-        }
-    }
-    point.completed = true;
-    // Every sample is a section instant (phase 0).
-    let next = handover(&m, &sim, 0, FINE, start.phase + j_end);
-    (point, next)
 }
 
 /// The recorded window from section sample `j0` (of `FINE` a period) over

@@ -259,8 +259,19 @@ pub(super) fn render(report: &mut Report, maps: &Maps) -> Result<(), CliError> {
          attractor.</p>\n"
             .to_string(),
     );
-    let mut table = Vec::new();
+    summary_table(report, &maps.rows);
     for row in &maps.rows {
+        chart_figure_of(report, row)?;
+    }
+    sweep_figures(report, &maps.sweep)?;
+    basins_figure_of(report, &maps.basins)
+}
+
+/// The cells per class and the curves of each row: a table and the
+/// summary's counts.
+fn summary_table(report: &mut Report, rows: &[RowMap]) {
+    let mut table = Vec::new();
+    for row in rows {
         let counts = class_counts(&row.chart);
         let codim2: usize = row
             .curves
@@ -307,74 +318,80 @@ pub(super) fn render(report: &mut Report, maps: &Maps) -> Result<(), CliError> {
         "<p>Cells per class and curves continued:</p>\n{}",
         html_table(&header, &table)
     ));
-    for row in &maps.rows {
-        let chart = &row.chart;
-        let special: Vec<String> = row.branch.special.iter().map(|s| s.label.clone()).collect();
-        let caption = format!(
-            "R2 with N = {}: the attractor reached from the model's initial state in each of \
-             {} × {} cells ({} transient + {} recorded periods; light blue: not periodic \
-             or still settling, chaotic where such a run has λ1 > 0), and the curves of the special points {} of the branch at 0.05 m/s² \
-             (black: folds solid, branch points dashed; vermillion: period doublings dashed, \
-             Neimark–Sacker points solid; squares: codimension-two points on them).",
-            row.n,
-            chart.x_values.len(),
-            chart.y_values.len(),
-            chart.transient_periods,
-            chart.record_periods,
-            special.join(", ")
-        );
-        let cells = chart
-            .cells
-            .iter()
-            .map(|c| {
-                let run = c.runs.first();
-                vec![
-                    Some(c.x),
-                    Some(c.y),
-                    Some(class(c) as f64),
-                    run.and_then(|r| r.period.map(|p| p as f64)),
-                    run.map(|r| r.impacts_per_period),
-                    run.map(|r| r.max_displacement),
-                ]
-            })
-            .collect();
-        let curve_rows = row
-            .curves
-            .followed
-            .iter()
-            .enumerate()
-            .flat_map(|(k, (_, c))| {
-                c.points
-                    .iter()
-                    .map(move |p| vec![Some(k as f64), Some(p.p), Some(p.q)])
-            })
-            .collect();
-        report.figure(
-            &chart_with_curves(row),
-            &format!("fig_map_chart_n{}", row.n),
-            &caption,
+}
+
+/// One row's chart with its curves, and their data.
+fn chart_figure_of(report: &mut Report, row: &RowMap) -> Result<(), CliError> {
+    let chart = &row.chart;
+    let special: Vec<String> = row.branch.special.iter().map(|s| s.label.clone()).collect();
+    let caption = format!(
+        "R2 with N = {}: the attractor reached from the model's initial state in each of \
+         {} × {} cells ({} transient + {} recorded periods; light blue: not periodic \
+         or still settling, chaotic where such a run has λ1 > 0), and the curves of the special points {} of the branch at 0.05 m/s² \
+         (black: folds solid, branch points dashed; vermillion: period doublings dashed, \
+         Neimark–Sacker points solid; squares: codimension-two points on them).",
+        row.n,
+        chart.x_values.len(),
+        chart.y_values.len(),
+        chart.transient_periods,
+        chart.record_periods,
+        special.join(", ")
+    );
+    let cells = chart
+        .cells
+        .iter()
+        .map(|c| {
+            let run = c.runs.first();
             vec![
-                DataFile {
-                    name: format!("map_chart_n{}.csv", row.n),
-                    columns: vec![
-                        "frequency_rad_s",
-                        "amplitude_m_s2",
-                        "class",
-                        "period",
-                        "impacts_per_period",
-                        "max_displacement_m",
-                    ],
-                    rows: cells,
-                },
-                DataFile {
-                    name: format!("map_curves_n{}.csv", row.n),
-                    columns: vec!["curve", "frequency_rad_s", "amplitude_m_s2"],
-                    rows: curve_rows,
-                },
-            ],
-        )?;
-    }
-    let sweep = &maps.sweep;
+                Some(c.x),
+                Some(c.y),
+                Some(class(c) as f64),
+                run.and_then(|r| r.period.map(|p| p as f64)),
+                run.map(|r| r.impacts_per_period),
+                run.map(|r| r.max_displacement),
+            ]
+        })
+        .collect();
+    let curve_rows = row
+        .curves
+        .followed
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (_, c))| {
+            c.points
+                .iter()
+                .map(move |p| vec![Some(k as f64), Some(p.p), Some(p.q)])
+        })
+        .collect();
+    report.figure(
+        &chart_with_curves(row),
+        &format!("fig_map_chart_n{}", row.n),
+        &caption,
+        vec![
+            DataFile {
+                name: format!("map_chart_n{}.csv", row.n),
+                columns: vec![
+                    "frequency_rad_s",
+                    "amplitude_m_s2",
+                    "class",
+                    "period",
+                    "impacts_per_period",
+                    "max_displacement_m",
+                ],
+                rows: cells,
+            },
+            DataFile {
+                name: format!("map_curves_n{}.csv", row.n),
+                columns: vec!["curve", "frequency_rad_s", "amplitude_m_s2"],
+                rows: curve_rows,
+            },
+        ],
+    )?;
+    Ok(())
+}
+
+/// The N = 2 brute-force diagram and its largest Lyapunov exponent.
+fn sweep_figures(report: &mut Report, sweep: &SweepSummary) -> Result<(), CliError> {
     let lyapunov: Vec<(f64, f64)> = sweep
         .points
         .iter()
@@ -425,7 +442,11 @@ pub(super) fn render(report: &mut Report, maps: &Maps) -> Result<(), CliError> {
             lyapunov.iter().map(|&(w, l)| vec![w, l]).collect(),
         )],
     )?;
-    let b = &maps.basins;
+    Ok(())
+}
+
+/// The N = 2 basins at 1.1 ω0 and their fractions.
+fn basins_figure_of(report: &mut Report, b: &Basins) -> Result<(), CliError> {
     let nx = b.x_values.len();
     let fractions: Vec<String> = b
         .attractors
