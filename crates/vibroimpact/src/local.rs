@@ -95,6 +95,19 @@ impl Ord for Time {
     }
 }
 
+/// What a set that leaves hands to the next ([`Run::retire`]): its
+/// bodies (ascending), their state, its groups and contacts, the impacts
+/// logged so far and the step it had.
+#[derive(Default)]
+struct Retired {
+    bodies: Vec<usize>,
+    y: Vec<f64>,
+    groups: Vec<usize>,
+    contacts: Vec<usize>,
+    impacts: Vec<ImpactRecord>,
+    h_prev: Option<f64>,
+}
+
 /// The integrated bodies and their system.
 struct ActiveSet {
     /// Groups in the set, ascending.
@@ -428,37 +441,142 @@ impl Run<'_> {
                 self.deferred.retain(|(h, ..)| *h != g);
             }
         }
-        let mut h_prev = None;
-        // The old set's groups, bodies (ascending) and state.
-        let (mut old_bodies, mut old_y) = (Vec::new(), Vec::new());
-        let mut old_groups = Vec::new();
-        let mut old_contacts = Vec::new();
-        let mut impacts = std::mem::take(&mut self.impacts);
+        let old = self.retire(&groups, t);
+        self.local.set_changes += 1;
+        if groups.is_empty() {
+            self.impacts = old.impacts;
+            if let Some(tape) = self.tape.as_mut() {
+                tape.form(t, &[], &[], None, &[]);
+            }
+            return Ok(());
+        }
+        let (bodies, y) = self.enter(&groups, &old, t);
+        let (sub, ids, boundary) = self.sub_model(&groups, &bodies)?;
+        let energy = self.energy.is_some();
+        let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
+        let mut sys = Variational::new(chain, self.columns);
+        let trackers = ids
+            .iter()
+            .enumerate()
+            .map(|(kl, &k)| {
+                let mut tr =
+                    Tracker::new(&model.contacts()[k].law, self.opts.impact_force_threshold);
+                tr.active = self.onset[k].0;
+                sys.chain_mut().set_onset_velocity(kl, self.onset[k].1);
+                tr
+            })
+            .collect();
+        let int_opts = IntegratorOptions {
+            rtol: self.opts.rtol,
+            atol: self.opts.atol,
+            max_steps: self.opts.max_steps,
+            h_init: old.h_prev,
+            error_components: energy.then_some(2 * bodies.len()),
+            interrupt: self.opts.interrupt.clone(),
+            ..IntegratorOptions::default()
+        };
+        // The onset velocity of an impact that begins as the contact enters
+        // is the law's before the first evaluation.
+        for (kl, &k) in ids.iter().enumerate() {
+            let (s, sd) = sys.chain().approach(kl, &y);
+            let s_on = model.contacts()[k]
+                .law
+                .onset_approach(self.opts.impact_force_threshold);
+            if self.onset[k].0.is_none()
+                && s > s_on
+                && model.contacts()[k].law.needs_impact_velocity()
+            {
+                sys.chain_mut().set_onset_velocity(kl, sd);
+            }
+        }
+        let mut st = Stepper::new(self.method, y.len(), int_opts)?;
+        st.reset(&mut sys, t, &y)?;
+        if let Some(tape) = self.tape.as_mut() {
+            let rec = sys.system();
+            if rec.time(0) != Some(t) {
+                return Err(IntegrationError::InvalidOptions(
+                    "tangent tape: no record of the set's first point (internal error)".into(),
+                ));
+            }
+            tape.form(t, &groups, &bodies, Some(rec.system()), rec.evaluation(0));
+        }
+        let previous = (0..ids.len())
+            .map(|kl| contact_end(sys.chain(), kl, st.y(), st.dydt()))
+            .collect();
+        self.local.largest_set = self.local.largest_set.max(bodies.len());
+        let rate = groups
+            .iter()
+            .map(|&g| self.free.groups()[g].rate())
+            .fold(0.0f64, f64::max);
+        let mut scan = StepScan {
+            ids,
+            trackers,
+            impacts: old.impacts,
+            previous,
+        };
+        // A contact that enters past its impact threshold (the power laws'
+        // s_act lies past first touch, by a negligible force) begins its
+        // impact here.
+        for kl in 0..scan.ids.len() {
+            if scan.trackers[kl].active.is_none() && scan.previous[kl].0 > scan.trackers[kl].s_on {
+                scan.start(&mut st, &mut sys, kl, t);
+            }
+        }
+        if let Some(h) = scan.entry_limit(st.h_next()) {
+            st.limit_next_step(h);
+        }
+        self.limit_first_step(&mut st, &sys, &scan, &old.contacts);
+        let extrema = self
+            .extrema
+            .as_ref()
+            .map(|ex| ex.set_scan(&scan.ids, bodies.len(), &st, &sys));
+        self.set = Some(ActiveSet {
+            groups,
+            bodies,
+            boundary,
+            sys,
+            st,
+            scan,
+            saved: (t, y),
+            rate,
+            extrema,
+        });
+        Ok(())
+    }
+
+    /// Takes the current set apart at `t`: its results return to the run,
+    /// its groups that are not in `groups` move exactly from here, and
+    /// what the next set needs of it is returned.
+    fn retire(&mut self, groups: &[usize], t: f64) -> Retired {
+        let mut out = Retired {
+            impacts: std::mem::take(&mut self.impacts),
+            ..Retired::default()
+        };
         if let Some(mut old) = self.set.take() {
-            h_prev = Some(old.st.h_next());
+            out.h_prev = Some(old.st.h_next());
             self.absorb(&mut old);
             if let (Some(ex), Some(scan)) = (self.extrema.as_mut(), &old.extrema) {
                 ex.merge(&old, scan);
             }
             self.contact_evaluations += old.sys.chain().contact_evaluations();
-            old_y = old.st.y().to_vec();
+            let old_y = old.st.y().to_vec();
             self.energy_of_set(&old_y, old.bodies.len());
             for &i in &old.bodies {
                 self.slot[i] = None;
             }
-            old_bodies = old.bodies;
+            let old_bodies = old.bodies;
             for (kl, &k) in old.scan.ids.iter().enumerate() {
                 self.onset[k] = (
                     old.scan.trackers[kl].active,
                     old.sys.chain().onset_velocity(kl),
                 );
             }
-            impacts = old.scan.impacts;
+            out.impacts = old.scan.impacts;
             for &g in &old.groups {
                 self.in_set[g] = false;
             }
-            old_groups.clone_from(&old.groups);
-            old_contacts.clone_from(&old.scan.ids);
+            out.groups.clone_from(&old.groups);
+            out.contacts.clone_from(&old.scan.ids);
             // Groups leaving move exactly from here.
             for &g in &old.groups {
                 if !groups.contains(&g) {
@@ -488,15 +606,15 @@ impl Run<'_> {
                     self.tangents[g] = (t, w);
                 }
             }
+            (out.bodies, out.y) = (old_bodies, old_y);
         }
-        self.local.set_changes += 1;
-        if groups.is_empty() {
-            self.impacts = impacts;
-            if let Some(tape) = self.tape.as_mut() {
-                tape.form(t, &[], &[], None, &[]);
-            }
-            return Ok(());
-        }
+        out
+    }
+
+    /// The new set's bodies (ascending) and state at `t` for `groups`:
+    /// from the old set where it held them, else from the exact motion;
+    /// the audit's quadratures and the tangent columns after it.
+    fn enter(&mut self, groups: &[usize], old: &Retired, t: f64) -> (Vec<usize>, Vec<f64>) {
         let mut bodies: Vec<usize> = groups
             .iter()
             .flat_map(|&g| self.free.groups()[g].bodies().to_vec())
@@ -505,16 +623,16 @@ impl Run<'_> {
         for (j, &i) in bodies.iter().enumerate() {
             self.slot[i] = Some(j);
         }
-        for &g in &groups {
-            if !old_groups.contains(&g) {
+        for &g in groups {
+            if !old.groups.contains(&g) {
                 self.joined[g] = t;
             }
             self.in_set[g] = true;
         }
         let mut y = vec![0.0; 2 * bodies.len()];
         for (j, &i) in bodies.iter().enumerate() {
-            let (u, v) = match old_bodies.binary_search(&i) {
-                Ok(o) => (old_y[2 * o], old_y[2 * o + 1]),
+            let (u, v) = match old.bodies.binary_search(&i) {
+                Ok(o) => (old.y[2 * o], old.y[2 * o + 1]),
                 Err(_) => self.exact_body(i, t),
             };
             y[2 * j] = u;
@@ -528,17 +646,17 @@ impl Run<'_> {
         // Tangent columns after the state: rows from the old set, or
         // from the joining groups' exact homogeneous motion.
         if self.columns > 0 {
-            let (b2, o2) = (2 * bodies.len(), 2 * old_bodies.len());
-            for &g in &groups {
-                if !old_groups.contains(&g) {
+            let (b2, o2) = (2 * bodies.len(), 2 * old.bodies.len());
+            for &g in groups {
+                if !old.groups.contains(&g) {
                     self.tangents_to(g, t);
                 }
             }
             y.resize(b2 * (1 + self.columns), 0.0);
             for c in 0..self.columns {
                 for (j, &i) in bodies.iter().enumerate() {
-                    let (u, v) = match old_bodies.binary_search(&i) {
-                        Ok(o) => (old_y[o2 * (1 + c) + 2 * o], old_y[o2 * (1 + c) + 2 * o + 1]),
+                    let (u, v) = match old.bodies.binary_search(&i) {
+                        Ok(o) => (old.y[o2 * (1 + c) + 2 * o], old.y[o2 * (1 + c) + 2 * o + 1]),
                         Err(_) => {
                             let (g, jg) = self.free.place(i);
                             let m2 = 2 * self.free.groups()[g].bodies().len();
@@ -551,6 +669,18 @@ impl Run<'_> {
                 }
             }
         }
+        (bodies, y)
+    }
+
+    /// The set's own model: its bodies, the contacts within it (renumbered)
+    /// with their global ids, the springs and forces of its groups, and
+    /// the contacts on its boundary (to a body outside).
+    fn sub_model(
+        &self,
+        groups: &[usize],
+        bodies: &[usize],
+    ) -> Result<(Model, Vec<usize>, Vec<usize>), IntegrationError> {
+        let model = self.model;
         let local = |i: Option<usize>| i.map(|i| self.slot[i]);
         let mut ids = Vec::new();
         let mut contacts = Vec::new();
@@ -621,84 +751,22 @@ impl Run<'_> {
             Vec::new(),
         )
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        let energy = self.energy.is_some();
-        let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
-        let mut sys = Variational::new(chain, self.columns);
-        let trackers = ids
-            .iter()
-            .enumerate()
-            .map(|(kl, &k)| {
-                let mut tr =
-                    Tracker::new(&model.contacts()[k].law, self.opts.impact_force_threshold);
-                tr.active = self.onset[k].0;
-                sys.chain_mut().set_onset_velocity(kl, self.onset[k].1);
-                tr
-            })
-            .collect();
-        let int_opts = IntegratorOptions {
-            rtol: self.opts.rtol,
-            atol: self.opts.atol,
-            max_steps: self.opts.max_steps,
-            h_init: h_prev,
-            error_components: energy.then_some(2 * bodies.len()),
-            interrupt: self.opts.interrupt.clone(),
-            ..IntegratorOptions::default()
-        };
-        // The onset velocity of an impact that begins as the contact enters
-        // is the law's before the first evaluation.
-        for (kl, &k) in ids.iter().enumerate() {
-            let (s, sd) = sys.chain().approach(kl, &y);
-            let s_on = model.contacts()[k]
-                .law
-                .onset_approach(self.opts.impact_force_threshold);
-            if self.onset[k].0.is_none()
-                && s > s_on
-                && model.contacts()[k].law.needs_impact_velocity()
-            {
-                sys.chain_mut().set_onset_velocity(kl, sd);
-            }
-        }
-        let mut st = Stepper::new(self.method, y.len(), int_opts)?;
-        st.reset(&mut sys, t, &y)?;
-        if let Some(tape) = self.tape.as_mut() {
-            let rec = sys.system();
-            if rec.time(0) != Some(t) {
-                return Err(IntegrationError::InvalidOptions(
-                    "tangent tape: no record of the set's first point (internal error)".into(),
-                ));
-            }
-            tape.form(t, &groups, &bodies, Some(rec.system()), rec.evaluation(0));
-        }
-        let previous = (0..ids.len())
-            .map(|kl| contact_end(sys.chain(), kl, st.y(), st.dydt()))
-            .collect();
-        self.local.largest_set = self.local.largest_set.max(bodies.len());
-        let rate = groups
-            .iter()
-            .map(|&g| self.free.groups()[g].rate())
-            .fold(0.0f64, f64::max);
-        let mut scan = StepScan {
-            ids,
-            trackers,
-            impacts,
-            previous,
-        };
-        // A contact that enters past its impact threshold (the power laws'
-        // s_act lies past first touch, by a negligible force) begins its
-        // impact here.
-        for kl in 0..scan.ids.len() {
-            if scan.trackers[kl].active.is_none() && scan.previous[kl].0 > scan.trackers[kl].s_on {
-                scan.start(&mut st, &mut sys, kl, t);
-            }
-        }
-        if let Some(h) = scan.entry_limit(st.h_next()) {
-            st.limit_next_step(h);
-        }
-        // A fresh start knows nothing of the contacts' time scale, and a
-        // force that switches on (s^n at first touch, a damper's jump) is not
-        // smooth there: the first step is the one over which an entering
-        // contact's impulse stays below atol·μ. (Contacts already in the set
-        // keep the step the set had.)
+        Ok((sub, ids, boundary))
+    }
+
+    /// A fresh start knows nothing of the contacts' time scale, and a
+    /// force that switches on (s^n at first touch, a damper's jump) is not
+    /// smooth there: the first step is the one over which an entering
+    /// contact's impulse stays below atol·μ. (Contacts already in the set,
+    /// `old_contacts`, keep the step the set had.)
+    fn limit_first_step(
+        &self,
+        st: &mut Stepper,
+        sys: &SetSystem,
+        scan: &StepScan,
+        old_contacts: &[usize],
+    ) {
+        let model = self.model;
         for (kl, &k) in scan.ids.iter().enumerate() {
             if old_contacts.binary_search(&k).is_ok() {
                 continue;
@@ -715,22 +783,6 @@ impl Run<'_> {
                 st.limit_next_step(first_step(impulse, self.opts.atol * mu, h));
             }
         }
-        let extrema = self
-            .extrema
-            .as_ref()
-            .map(|ex| ex.set_scan(&scan.ids, bodies.len(), &st, &sys));
-        self.set = Some(ActiveSet {
-            groups,
-            bodies,
-            boundary,
-            sys,
-            st,
-            scan,
-            saved: (t, y),
-            rate,
-            extrema,
-        });
-        Ok(())
     }
 }
 

@@ -270,126 +270,9 @@ pub(in crate::simulate) fn run(
     tape: bool,
     record: &mut dyn FnMut(f64, &[f64]) -> bool,
 ) -> Result<LocalRun, OptionsError> {
-    if opts.energy && (tape || tangents.is_some_and(|w| w.columns > 0)) {
-        return Err(OptionsError(
-            "the energy audit carries no tangent columns or tape".into(),
-        ));
-    }
-    // (Period maps refuse such laws before a tape is asked for; the tape
-    // would miss the onset velocity's dependence on the state.)
-    if tape
-        && model
-            .contacts()
-            .iter()
-            .any(|c| c.law.needs_impact_velocity())
-    {
-        return Err(OptionsError(
-            "a tangent tape cannot follow a law that needs the impact's onset velocity".into(),
-        ));
-    }
-    if tape && method != Method::Dop853 {
-        return Err(OptionsError(format!(
-            "a tangent tape replays DOP853's stages; the method here is {method:?}"
-        )));
-    }
-    let free = FreeMotion::new(model).map_err(|e| OptionsError(e.to_string()))?;
-    let n = model.bodies().len();
-    let ng = free.groups().len();
-    let nc = model.contacts().len();
-    let mut group_contacts = vec![Vec::new(); ng];
-    for (k, c) in model.contacts().iter().enumerate() {
-        let sides = side_groups(&free, c);
-        for g in sides.iter().flatten() {
-            if group_contacts[*g].last() != Some(&k) {
-                group_contacts[*g].push(k);
-            }
-        }
-    }
-    let mut group_couplings = vec![Vec::new(); ng];
-    for (i, c) in model.couplings().iter().enumerate() {
-        group_couplings[free.place(c.a).0].push(i);
-    }
-    let mut group_forces = vec![Vec::new(); ng];
-    for (i, f) in model.forces().iter().enumerate() {
-        group_forces[free.place(f.body).0].push(i);
-    }
-    let exact = free
-        .groups()
-        .iter()
-        .map(|g| (0.0, rows_of(g.bodies(), y0)))
-        .collect();
-    let columns = tangents.map_or(0, |w| w.columns);
-    let tangent_refs = free
-        .groups()
-        .iter()
-        .map(|g| {
-            let w = tangents.map_or(Vec::new(), |tw| {
-                (0..columns)
-                    .flat_map(|c| rows_of(g.bodies(), &tw.values[c * 2 * n..(c + 1) * 2 * n]))
-                    .collect()
-            });
-            (0.0, w)
-        })
-        .collect();
-    let activation = (0..nc)
-        .map(|k| {
-            let s_on = model.contacts()[k]
-                .law
-                .onset_approach(opts.impact_force_threshold);
-            Activation::new(model, k, opts, s_on)
-        })
-        .collect();
-    let mut run = Run {
-        model,
-        opts,
-        method,
-        free,
-        exact,
-        in_set: vec![false; ng],
-        joined: vec![0.0; ng],
-        defer: false,
-        deferred: Vec::new(),
-        slot: vec![None; n],
-        activation,
-        group_contacts,
-        group_couplings,
-        group_forces,
-        generation: vec![0; nc],
-        queue: BinaryHeap::new(),
-        set: None,
-        impacts: Vec::new(),
-        onset: vec![(None, 0.0); nc],
-        stats: Stats::default(),
-        contact_evaluations: 0,
-        local: LocalStats {
-            body_evaluations: vec![0; n],
-            ..LocalStats::default()
-        },
-        checks_per_contact: vec![0; nc],
-        extrema: None,
-        columns,
-        tangents: tangent_refs,
-        breakpoints,
-        tape: tape.then(TapeRecord::default),
-        alike: Vec::new(),
-        energy: None,
-    };
-    if opts.energy {
-        run.energy = Some(LocalEnergy::new(model, &run.free));
-    }
-    run.alike = model
-        .contacts()
-        .iter()
-        .map(|c| alike(model, &run.free, c))
-        .collect();
-    if let Some(window) = opts.extrema_window {
-        let s_on = model
-            .contacts()
-            .iter()
-            .map(|c| c.law.onset_approach(opts.impact_force_threshold))
-            .collect();
-        run.extrema = Some(LocalExtrema::new(window, model, &run.free, s_on));
-    }
+    check_request(model, opts, method, tape, tangents)?;
+    let mut run = Run::new(model, opts, method, (y0, tangents), breakpoints, tape)?;
+    let (n, nc) = (model.bodies().len(), model.contacts().len());
     let mut out = LocalRun {
         t: 0.0,
         y: y0.to_vec(),
@@ -455,16 +338,8 @@ pub(in crate::simulate) fn run(
         let checks = run.local.contact_checks - initial_checks;
         if checks >= next_guard && t > 0.0 {
             next_guard = checks + PROGRESS_CHECK;
-            let projected = checks as f64 * opts.t_end / t;
-            if projected > CRAWL_FACTOR * (opts.max_steps as f64).max(nc as f64) {
-                out.error = Some(IntegrationError::ChecksCrawl {
-                    t,
-                    checks,
-                    projected,
-                    limit: opts.max_steps,
-                });
-                out.crawling = (0..nc)
-                    .max_by_key(|&k| (run.checks_per_contact[k] - checks_before[k], Reverse(k)));
+            if let Some((e, k)) = checks_crawl(&run, opts, (t, checks), &checks_before) {
+                (out.error, out.crawling) = (Some(e), k);
                 break;
             }
             checks_before.clone_from(&run.checks_per_contact);
@@ -531,40 +406,221 @@ pub(in crate::simulate) fn run(
             }
         }
     }
-    // The state at the end (or where it stopped).
-    let t_final = match &run.set {
-        Some(set) => set.st.t(),
-        None => t.min(opts.t_end),
+    Ok(run.finish(out, t))
+}
+
+/// The requests the local integrator refuses: the energy audit with
+/// tangents or a tape, a tape with a law that needs the onset velocity or
+/// with a method other than DOP853.
+fn check_request(
+    model: &Model,
+    opts: &SimulationOptions,
+    method: Method,
+    tape: bool,
+    tangents: Option<Tangents<'_>>,
+) -> Result<(), OptionsError> {
+    if opts.energy && (tape || tangents.is_some_and(|w| w.columns > 0)) {
+        return Err(OptionsError(
+            "the energy audit carries no tangent columns or tape".into(),
+        ));
+    }
+    // (Period maps refuse such laws before a tape is asked for; the tape
+    // would miss the onset velocity's dependence on the state.)
+    if tape
+        && model
+            .contacts()
+            .iter()
+            .any(|c| c.law.needs_impact_velocity())
+    {
+        return Err(OptionsError(
+            "a tangent tape cannot follow a law that needs the impact's onset velocity".into(),
+        ));
+    }
+    if tape && method != Method::Dop853 {
+        return Err(OptionsError(format!(
+            "a tangent tape replays DOP853's stages; the method here is {method:?}"
+        )));
+    }
+    Ok(())
+}
+
+/// Why the checks crawl, if they do at `t` after `checks`: the error and
+/// the contact checked most since the last look (`before`).
+fn checks_crawl(
+    run: &Run,
+    opts: &SimulationOptions,
+    (t, checks): (f64, u64),
+    before: &[u64],
+) -> Option<(IntegrationError, Option<usize>)> {
+    let nc = run.checks_per_contact.len();
+    let projected = checks as f64 * opts.t_end / t;
+    if projected <= CRAWL_FACTOR * (opts.max_steps as f64).max(nc as f64) {
+        return None;
+    }
+    let e = IntegrationError::ChecksCrawl {
+        t,
+        checks,
+        projected,
+        limit: opts.max_steps,
     };
-    let mut y = vec![0.0; 2 * n];
-    run.state_at(t_final, &mut y);
-    if columns > 0 {
-        out.tangents = Some(run.tangents_at(t_final));
-    }
-    // The exact motion since each group's last reference state: its
-    // extrema and its part of the energy audit.
-    for g in 0..run.exact.len() {
-        if !run.in_set[g] {
-            run.before_move(g, t_final);
+    let k = (0..nc).max_by_key(|&k| (run.checks_per_contact[k] - before[k], Reverse(k)));
+    Some((e, k))
+}
+
+impl<'a> Run<'a> {
+    /// The run's state at t = 0: the groups' exact motions from `y0` (and
+    /// their tangent columns), no set yet, every contact unscheduled.
+    fn new(
+        model: &'a Model,
+        opts: &'a SimulationOptions,
+        method: Method,
+        (y0, tangents): (&[f64], Option<Tangents<'_>>),
+        breakpoints: Vec<f64>,
+        tape: bool,
+    ) -> Result<Self, OptionsError> {
+        let free = FreeMotion::new(model).map_err(|e| OptionsError(e.to_string()))?;
+        let n = model.bodies().len();
+        let ng = free.groups().len();
+        let nc = model.contacts().len();
+        let mut group_contacts = vec![Vec::new(); ng];
+        for (k, c) in model.contacts().iter().enumerate() {
+            let sides = side_groups(&free, c);
+            for g in sides.iter().flatten() {
+                if group_contacts[*g].last() != Some(&k) {
+                    group_contacts[*g].push(k);
+                }
+            }
         }
-    }
-    if let Some(mut set) = run.set.take() {
-        run.energy_of_set(set.st.y(), set.bodies.len());
-        run.absorb(&mut set);
-        if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
-            ex.merge(&set, scan);
+        let mut group_couplings = vec![Vec::new(); ng];
+        for (i, c) in model.couplings().iter().enumerate() {
+            group_couplings[free.place(c.a).0].push(i);
         }
-        run.contact_evaluations += set.sys.chain().contact_evaluations();
-        run.impacts = set.scan.impacts;
+        let mut group_forces = vec![Vec::new(); ng];
+        for (i, f) in model.forces().iter().enumerate() {
+            group_forces[free.place(f.body).0].push(i);
+        }
+        let exact = free
+            .groups()
+            .iter()
+            .map(|g| (0.0, rows_of(g.bodies(), y0)))
+            .collect();
+        let columns = tangents.map_or(0, |w| w.columns);
+        let tangent_refs = free
+            .groups()
+            .iter()
+            .map(|g| {
+                let w = tangents.map_or(Vec::new(), |tw| {
+                    (0..columns)
+                        .flat_map(|c| rows_of(g.bodies(), &tw.values[c * 2 * n..(c + 1) * 2 * n]))
+                        .collect()
+                });
+                (0.0, w)
+            })
+            .collect();
+        let activation = (0..nc)
+            .map(|k| {
+                let s_on = model.contacts()[k]
+                    .law
+                    .onset_approach(opts.impact_force_threshold);
+                Activation::new(model, k, opts, s_on)
+            })
+            .collect();
+        let mut run = Self {
+            model,
+            opts,
+            method,
+            free,
+            exact,
+            in_set: vec![false; ng],
+            joined: vec![0.0; ng],
+            defer: false,
+            deferred: Vec::new(),
+            slot: vec![None; n],
+            activation,
+            group_contacts,
+            group_couplings,
+            group_forces,
+            generation: vec![0; nc],
+            queue: BinaryHeap::new(),
+            set: None,
+            impacts: Vec::new(),
+            onset: vec![(None, 0.0); nc],
+            stats: Stats::default(),
+            contact_evaluations: 0,
+            local: LocalStats {
+                body_evaluations: vec![0; n],
+                ..LocalStats::default()
+            },
+            checks_per_contact: vec![0; nc],
+            extrema: None,
+            columns,
+            tangents: tangent_refs,
+            breakpoints,
+            tape: tape.then(TapeRecord::default),
+            alike: Vec::new(),
+            energy: None,
+        };
+        if opts.energy {
+            run.energy = Some(LocalEnergy::new(model, &run.free));
+        }
+        run.alike = model
+            .contacts()
+            .iter()
+            .map(|c| alike(model, &run.free, c))
+            .collect();
+        if let Some(window) = opts.extrema_window {
+            let s_on = model
+                .contacts()
+                .iter()
+                .map(|c| c.law.onset_approach(opts.impact_force_threshold))
+                .collect();
+            run.extrema = Some(LocalExtrema::new(window, model, &run.free, s_on));
+        }
+        Ok(run)
     }
-    out.t = t_final;
-    out.y = y;
-    out.impacts = std::mem::take(&mut run.impacts);
-    out.stats = run.stats;
-    out.contact_evaluations = run.contact_evaluations;
-    out.local = run.local;
-    out.extrema = run.extrema.map(LocalExtrema::into_found);
-    out.energy = run.energy.map(|e| e.sums);
-    out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
-    Ok(out)
+
+    /// The run's result at its end `t` (where it stopped): the state, the
+    /// tangents, the exact motion's extrema and energy since each group's
+    /// last reference, and the set's results.
+    fn finish(self, mut out: LocalRun, t: f64) -> LocalRun {
+        let mut run = self;
+        let n = run.model.bodies().len();
+        let opts = run.opts;
+        // The state at the end (or where it stopped).
+        let t_final = match &run.set {
+            Some(set) => set.st.t(),
+            None => t.min(opts.t_end),
+        };
+        let mut y = vec![0.0; 2 * n];
+        run.state_at(t_final, &mut y);
+        if run.columns > 0 {
+            out.tangents = Some(run.tangents_at(t_final));
+        }
+        // The exact motion since each group's last reference state: its
+        // extrema and its part of the energy audit.
+        for g in 0..run.exact.len() {
+            if !run.in_set[g] {
+                run.before_move(g, t_final);
+            }
+        }
+        if let Some(mut set) = run.set.take() {
+            run.energy_of_set(set.st.y(), set.bodies.len());
+            run.absorb(&mut set);
+            if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
+                ex.merge(&set, scan);
+            }
+            run.contact_evaluations += set.sys.chain().contact_evaluations();
+            run.impacts = set.scan.impacts;
+        }
+        out.t = t_final;
+        out.y = y;
+        out.impacts = std::mem::take(&mut run.impacts);
+        out.stats = run.stats;
+        out.contact_evaluations = run.contact_evaluations;
+        out.local = run.local;
+        out.extrema = run.extrema.map(LocalExtrema::into_found);
+        out.energy = run.energy.map(|e| e.sums);
+        out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
+        out
+    }
 }
