@@ -29,3 +29,14 @@ pub fn status() -> ProgressBar {
         .unwrap_or_else(|_| ProgressStyle::default_spinner());
     ProgressBar::with_draw_target(None, target()).with_style(style)
 }
+
+/// Says up front, on standard error, that a run will take long (its
+/// estimated steps and time), if it will; the run goes on.
+pub fn announce_long(work: &vibroimpact::simulate::WorkEstimate) {
+    if work.is_long() {
+        eprintln!(
+            "note: {}; Ctrl-C stops it and keeps what is complete",
+            work.describe()
+        );
+    }
+}

@@ -260,3 +260,26 @@ fn pounding_example_with_each_method() {
         "{counts:?}"
     );
 }
+
+/// A legal run that will take long says so up front on standard error
+/// (estimated steps and time, and that the step limit or its pace ends
+/// it); a forcing at 4.3e9 rad/s then stops at once for want of progress.
+/// A run of ordinary length is silent.
+#[test]
+fn a_long_run_is_announced_up_front() {
+    let dir = temp_dir("long-run");
+    let row = repo_file("examples/fujita-row-n2.toml");
+    let text = std::fs::read_to_string(&row)
+        .unwrap()
+        .replace("frequency = 7.0395", "frequency = 4.3e9");
+    let fast = write_model(&dir, "fast.toml", &text);
+    let out = run(&["simulate", &fast, "--duration", "10"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.starts_with("note: a long run: about ") && err.contains("far beyond the step limit"),
+        "{err}"
+    );
+    let short = run(&["simulate", &row, "--periods", "20"]);
+    assert!(short.status.success() && short.stderr.is_empty());
+}

@@ -34,10 +34,18 @@ pyo3::create_exception!(
     "A numerical failure of vibroimpact (an integration that cannot go on, a Newton iteration that does not converge)."
 );
 
+pyo3::create_exception!(
+    _core,
+    LongRunWarning,
+    pyo3::exceptions::PyUserWarning,
+    "A run that will take long: its estimated steps and time, said before it starts (it still runs)."
+);
+
 /// The extension module.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VibroimpactError", m.py().get_type::<VibroimpactError>())?;
+    m.add("LongRunWarning", m.py().get_type::<LongRunWarning>())?;
     m.add_class::<model::PyModel>()?;
     m.add_function(wrap_pyfunction!(impact::impact, m)?)?;
     m.add_function(wrap_pyfunction!(impact::contact_force, m)?)?;

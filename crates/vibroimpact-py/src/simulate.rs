@@ -3,7 +3,7 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibroimpact::results::simulation_summary;
-use vibroimpact::simulate::SimulationOptions;
+use vibroimpact::simulate::{estimate_work, SimulationOptions, WorkEstimate};
 
 use crate::convert::{array1, document, method, split_states, value_error};
 use crate::model::PyModel;
@@ -45,20 +45,24 @@ pub fn simulate<'py>(
             None => duration / 2000.0,
         }),
     };
+    let opts = SimulationOptions {
+        t_end: duration,
+        rtol,
+        atol,
+        output_step,
+        impact_force_threshold,
+        energy,
+        method,
+        integrator,
+        ..SimulationOptions::default()
+    };
+    warn_if_long(py, &estimate_work(m, &opts))?;
     let job = model.loaded.clone();
     let result = monitor::run(py, progress, move |p: &Progress| {
         p.track_time(duration);
         let opts = SimulationOptions {
-            t_end: duration,
-            rtol,
-            atol,
-            output_step,
-            impact_force_threshold,
-            energy,
-            method,
-            integrator,
             interrupt: Some(p.interrupt.clone()),
-            ..SimulationOptions::default()
+            ..opts
         };
         vibroimpact::simulate::simulate(&job.model, &opts)
     })?;
@@ -86,4 +90,17 @@ pub fn simulate<'py>(
     log.set_item("duration", array1(py, col(&|i| i.duration())))?;
     d.set_item("impacts", log)?;
     Ok(d)
+}
+
+/// A `LongRunWarning` with the estimate, if the run will take long.
+pub(crate) fn warn_if_long(py: Python<'_>, work: &WorkEstimate) -> PyResult<()> {
+    if !work.is_long() {
+        return Ok(());
+    }
+    let text = format!(
+        "{}; Ctrl-C stops it and keeps what is complete",
+        work.describe()
+    );
+    let text = std::ffi::CString::new(text).map_err(crate::convert::value_error)?;
+    PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 1)
 }

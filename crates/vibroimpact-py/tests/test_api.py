@@ -6,6 +6,7 @@ import pickle
 import signal
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -198,7 +199,7 @@ def test_ctrl_c_interrupts_a_long_call():
         timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
         start = time.perf_counter()
         timer.start()
-        with pytest.raises(KeyboardInterrupt):
+        with pytest.raises(KeyboardInterrupt), pytest.warns(vi.LongRunWarning):
             vi.simulate(ROW, periods=1e6, output_step=0)
         assert time.perf_counter() - start < 5.0
         # Impacts by integration stop between chunks of velocities.
@@ -272,3 +273,19 @@ def test_a_panic_is_an_exception_not_a_crash():
     with pytest.raises(ValueError):
         vi.sweep(ROW, "frequency", values=[6.0, -1.0], transient=1, record=1)
     assert vi.impact([0.1]).restitution.size == 1
+
+
+def test_a_long_run_warns_before_it_starts():
+    """simulate over 1e7 periods (about 1.6e9 steps) warns up front with
+    the estimated steps, time and the step limit that ends it; as an error
+    the warning stops the call before any work. A short run is silent."""
+    m = vi.Model.load(EXAMPLES / "fujita-row-n2.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", vi.LongRunWarning)
+        vi.simulate(m, periods=20)
+        t0 = time.perf_counter()
+        with pytest.raises(vi.LongRunWarning, match=r"integration steps.*step limit") as e:
+            vi.simulate(m, periods=1e7, output_step=0)
+        assert time.perf_counter() - t0 < 5.0
+    steps = float(str(e.value).split("about ")[1].split(" ")[0])
+    assert 5e8 < steps < 5e9, str(e.value)

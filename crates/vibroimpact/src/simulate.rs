@@ -819,6 +819,8 @@ fn simulate_local(
     })
 }
 
+#[path = "simulate_estimate.rs"]
+mod estimate;
 #[path = "simulate_events.rs"]
 mod events;
 #[path = "simulate_extrema.rs"]
@@ -828,6 +830,7 @@ mod integrator;
 #[path = "local.rs"]
 pub mod local;
 
+pub use estimate::{estimate_work, WorkEstimate, LONG_RUN};
 use events::{contact_at, contact_end, StepScan, Tracker};
 pub use extrema::Extrema;
 use extrema::ExtremaScan;

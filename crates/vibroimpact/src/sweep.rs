@@ -515,7 +515,7 @@ fn run_transient(
     period: f64,
     settings: &Settings,
 ) -> Result<Start, String> {
-    let m = match start_model(model, &start) {
+    let m = match start_model(model, start) {
         Ok(m) => m,
         Err(e) => return Err(format!("cannot start: {e}")),
     };

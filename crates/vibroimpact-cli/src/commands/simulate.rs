@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use vibroimpact::model::Model;
-use vibroimpact::simulate::{simulate_streaming, Simulation, SimulationOptions};
+use vibroimpact::simulate::{estimate_work, simulate_streaming, Simulation, SimulationOptions};
 
 use crate::args::{IntegratorName, MethodName};
 use crate::error::CliError;
@@ -294,6 +294,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         interrupt: Some(interrupt.clone()),
         ..opts
     };
+    crate::progress::announce_long(&estimate_work(model, &opts));
     let mut history = match &args.out {
         Some(dir) => {
             ensure_dir(dir)?;

@@ -15,14 +15,16 @@ of the CLI's JSON output, with numpy arrays for numeric lists.
 Long calls release the GIL, stop on Ctrl-C (KeyboardInterrupt) and report
 progress to ``progress(done, total)`` if given. Bad input raises
 ``ValueError`` naming the argument or model key; a numerical failure raises
-:class:`VibroimpactError`.
+:class:`VibroimpactError`. A legal run that will take long (``simulate`` of
+1e7 periods, a forcing far faster than the bodies) still runs, but first
+warns with :class:`LongRunWarning`: its estimated steps and time.
 """
 
 from __future__ import annotations
 
 # The façade: the public names live in topic modules, by subject.
 from . import _checks
-from ._core import Model, VibroimpactError
+from ._core import LongRunWarning, Model, VibroimpactError
 from ._earthquakes import pounding, pounding_history, read_record, response_spectrum
 from ._impacts import contact_force, identify, impact
 from ._maps import basins, chart, parameter_values, sweep
@@ -37,6 +39,7 @@ __all__ = [
     "Model",
     "Result",
     "VibroimpactError",
+    "LongRunWarning",
     "basins",
     "chart",
     "contact_force",

@@ -15,6 +15,12 @@ class VibroimpactError(Exception):
     """A numerical failure (an integration that cannot go on, a Newton
     iteration that does not converge)."""
 
+class LongRunWarning(UserWarning):
+    """A run that will take long: its estimated steps and time, said
+    before it starts (it still runs)."""
+
+def parameter_values(from_: float, to: float, k: int) -> F64: ...
+
 class Model:
     """A model of bodies, springs, contacts and excitation (the model-file
     schema of docs/model.md). Immutable and picklable."""
