@@ -6,13 +6,13 @@ use std::path::Path;
 use serde_json::{json, Value};
 use vibroimpact::record::{parse_record, Record, Units};
 
-use crate::error::CliError;
+use crate::error::{option_error, CliError};
 
 /// `--units` parsed (None: the records' headers say).
 pub fn units(flag: Option<&str>) -> Result<Option<Units>, CliError> {
     flag.map(Units::parse)
         .transpose()
-        .map_err(|e| CliError::new(format!("--units: {e}")))
+        .map_err(|e| option_error(&e))
 }
 
 /// Reads a record file: AT2, two columns or CSV; errors name the file and
@@ -20,7 +20,7 @@ pub fn units(flag: Option<&str>) -> Result<Option<Units>, CliError> {
 pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
     let name = path.display().to_string();
     let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
-    parse_record(&text, &name, units).map_err(CliError::new)
+    parse_record(&text, &name, units).map_err(|e| CliError::new(e.to_string()))
 }
 
 /// The record's metadata carried into every output.

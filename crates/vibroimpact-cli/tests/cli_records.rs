@@ -95,7 +95,7 @@ fn bad_records_and_options_are_refused() {
     for (args, needle) in [
         (
             vec!["spectrum", &at2, "--units", "furlong"],
-            "--units: units `furlong`",
+            "--units furlong: give g, m/s2 or gal",
         ),
         (
             vec!["spectrum", &at2, "--periods", "2:1:10"],

@@ -5,11 +5,13 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::pounding::{documents, pounding_spectrum, PoundingPair, RunSettings};
+use vibroimpact::pounding::{
+    documents, pounding_spectrum, PoundingError, PoundingPair, RunSettings,
+};
 use vibroimpact::record::{parse_record as parse, Record, Units};
 use vibroimpact::spectrum::response_spectrum as spectrum;
 
-use crate::convert::{array1, floats, to_python, value_error};
+use crate::convert::{array1, floats, numerical_error, to_python, value_error};
 
 /// A record from the text of a file (`source` names it): `source`,
 /// `header`, `units` (of the file), `dt` (None if not uniform), `times`
@@ -22,10 +24,7 @@ pub fn parse_record<'py>(
     source: &str,
     units: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let units = units
-        .map(Units::parse)
-        .transpose()
-        .map_err(|e| value_error(format!("units: {e}")))?;
+    let units = units.map(Units::parse).transpose().map_err(value_error)?;
     let r = parse(text, source, units).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("source", &r.source)?;
@@ -88,6 +87,15 @@ pub fn response_spectrum<'py>(
 
 /// The pair (TOML `pair_text` named by `source`) and the run settings
 /// `(sample, rtol, method, integrator)` of a pounding study.
+/// A pounding error in Python's words: bad input is `ValueError` (a
+/// setting by its keyword), a failed run `VibroimpactError`.
+fn pounding_error(e: PoundingError) -> PyErr {
+    match e {
+        PoundingError::Run { .. } => numerical_error(e),
+        other => value_error(other),
+    }
+}
+
 fn pair_and_run(
     pair_text: &str,
     source: &str,
@@ -99,7 +107,7 @@ fn pair_and_run(
         method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
     };
-    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(value_error)?;
+    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(pounding_error)?;
     Ok((pair, run))
 }
 
@@ -158,7 +166,7 @@ pub fn pounding<'py>(
         let a = floats(acceleration, "acceleration")?;
         let mut record = Record::from_samples(name, t, &a).map_err(value_error)?;
         record.header.clone_from(header);
-        record.units = Units::parse(units).map_err(|e| value_error(format!("units: {e}")))?;
+        record.units = Units::parse(units).map_err(value_error)?;
         runs.push((record, scale));
     }
     let doc = py
@@ -179,7 +187,7 @@ pub fn pounding<'py>(
                 .collect::<Result<Vec<_>, _>>()
                 .map(|list| documents::study_document(&pair, &runs, Some(list), None)),
         })
-        .map_err(value_error)?;
+        .map_err(pounding_error)?;
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
 }
 
@@ -227,7 +235,7 @@ pub fn pounding_history<'py>(
     )?;
     let sim = py
         .detach(|| pair.history(&record, scale, &run))
-        .map_err(value_error)?;
+        .map_err(pounding_error)?;
     let (nl, n) = (pair.left.masses.len(), sim.final_displacement.len());
     let floors = |range: std::ops::Range<usize>| -> Vec<Vec<f64>> {
         range

@@ -646,7 +646,7 @@ pub fn load_accelerogram(
         .transpose()
         .map_err(|e| ModelFileError(format!("{source}: [excitation] {e}")))?;
     if units.is_some() || crate::record::is_at2(text, source) {
-        crate::record::parse_record(text, source, units).map_err(ModelFileError)
+        crate::record::parse_record(text, source, units).map_err(|e| ModelFileError(e.to_string()))
     } else {
         parse_accelerogram_csv(text, source)
     }
@@ -691,7 +691,7 @@ pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<Record, ModelF
             None => return err(format!("{source}:{line_no}: `{l}` is not two numbers")),
         }
     }
-    Record::from_samples(source, times, &values).map_err(ModelFileError)
+    Record::from_samples(source, times, &values).map_err(|e| ModelFileError(e.to_string()))
 }
 
 #[path = "model_file_build.rs"]

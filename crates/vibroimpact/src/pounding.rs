@@ -34,6 +34,81 @@ pub struct ShearFrame {
     pub damping_ratio: f64,
 }
 
+/// Why a pounding study cannot run or did not finish.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PoundingError {
+    /// The pair refused: the pair file where it came from one, the line
+    /// where known, the key at fault where known (`left`, `right`, `gap`,
+    /// `floors`, `law`), and what is wrong.
+    #[error("{}", pair_text(file.as_deref(), *line, message))]
+    Pair {
+        /// The pair file.
+        file: Option<String>,
+        /// The line in it.
+        line: Option<usize>,
+        /// The key at fault.
+        key: Option<&'static str>,
+        /// What is wrong (naming the frame and floor).
+        message: String,
+    },
+    /// A setting of the study refused, by its field (`sample`, `ratios`,
+    /// `gaps`, `records`).
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// A run under a record failed: the record and why.
+    #[error("{record}: {message}")]
+    Run {
+        /// The record's source.
+        record: String,
+        /// Why.
+        message: String,
+    },
+}
+
+/// `FILE:LINE: message`, `FILE: message` or the message.
+fn pair_text(file: Option<&str>, line: Option<usize>, message: &str) -> String {
+    match (file, line) {
+        (Some(f), Some(l)) => format!("{f}:{l}: {message}"),
+        (Some(f), None) => format!("{f}: {message}"),
+        _ => message.to_string(),
+    }
+}
+
+impl PoundingError {
+    /// The pair refused at `key`.
+    fn pair(key: &'static str, message: String) -> Self {
+        PoundingError::Pair {
+            file: None,
+            line: None,
+            key: Some(key),
+            message,
+        }
+    }
+
+    /// A run under `record` failed.
+    fn run(record: &Record, message: impl ToString) -> Self {
+        PoundingError::Run {
+            record: record.source.clone(),
+            message: message.to_string(),
+        }
+    }
+
+    /// The error with the pair file it came from.
+    fn in_file(self, source: &str) -> Self {
+        match self {
+            PoundingError::Pair {
+                line, key, message, ..
+            } => PoundingError::Pair {
+                file: Some(source.to_string()),
+                line,
+                key,
+                message,
+            },
+            other => other,
+        }
+    }
+}
+
 impl ShearFrame {
     /// Checks the frame: as many storeys as floors, masses and stiffnesses
     /// positive and finite, a damping ratio in [0, 1).
@@ -221,19 +296,29 @@ pub fn correlation(r: f64, zi: f64, zj: f64) -> f64 {
 
 impl PoundingPair {
     /// Checks the pair.
-    pub fn check(&self) -> Result<(), String> {
-        self.left.check("left frame")?;
-        self.right.check("right frame")?;
+    pub fn check(&self) -> Result<(), PoundingError> {
+        let pair = PoundingError::pair;
+        self.left.check("left frame").map_err(|m| pair("left", m))?;
+        self.right
+            .check("right frame")
+            .map_err(|m| pair("right", m))?;
         if !(self.gap.is_finite() && self.gap >= 0.0) {
-            return Err(format!("gap {}: give a finite gap >= 0", self.gap));
+            return Err(pair(
+                "gap",
+                format!("gap {}: give a finite gap >= 0", self.gap),
+            ));
         }
         let top = self.left.masses.len().min(self.right.masses.len());
         if self.floors.is_empty() {
-            return Err("floors: give at least one pounding floor".into());
+            return Err(pair(
+                "floors",
+                "floors: give at least one pounding floor".into(),
+            ));
         }
         if let Some(f) = self.floors.iter().find(|f| **f == 0 || **f > top) {
-            return Err(format!(
-                "floors: floor {f} is not a floor of both frames (1 to {top})"
+            return Err(pair(
+                "floors",
+                format!("floors: floor {f} is not a floor of both frames (1 to {top})"),
             ));
         }
         Ok(())
@@ -242,7 +327,12 @@ impl PoundingPair {
     /// The pair as a model under `record` × `scale`: the left frame's
     /// floors, then the right frame's, on one line; a contact per pounding
     /// floor if `contacts`.
-    pub fn model(&self, record: &Record, scale: f64, contacts: bool) -> Result<Model, String> {
+    pub fn model(
+        &self,
+        record: &Record,
+        scale: f64,
+        contacts: bool,
+    ) -> Result<Model, PoundingError> {
         self.check()?;
         let mut bodies = Vec::new();
         let mut couplings = Vec::new();
@@ -285,7 +375,7 @@ impl PoundingPair {
         };
         let base = BaseExcitation::Record(
             Accelerogram::new(record.times.clone(), record.acceleration.clone(), scale)
-                .map_err(|e| format!("{}: {e}", record.source))?,
+                .map_err(|e| PoundingError::run(record, e))?,
         );
         Model::new(
             bodies,
@@ -296,7 +386,12 @@ impl PoundingPair {
             Vec::new(),
             Vec::new(),
         )
-        .map_err(|e| e.to_string())
+        .map_err(|e| PoundingError::Pair {
+            file: None,
+            line: None,
+            key: None,
+            message: e.to_string(),
+        })
     }
 
     /// The peak response to `record` × `scale` over its duration, with the
@@ -309,7 +404,7 @@ impl PoundingPair {
         scale: f64,
         contacts: bool,
         run: &RunSettings,
-    ) -> Result<Response, String> {
+    ) -> Result<Response, PoundingError> {
         let model = self.model(record, scale, contacts)?;
         let opts = self.options(record, run)?;
         let nl = self.left.masses.len();
@@ -342,9 +437,9 @@ impl PoundingPair {
             }
             true
         })
-        .map_err(|e| e.0)?;
+        .map_err(|e| PoundingError::run(record, e.0))?;
         if let Some(e) = &sim.error {
-            return Err(format!("{}: {}", record.source, e));
+            return Err(PoundingError::run(record, e));
         }
         Ok(Response {
             drift,
@@ -365,19 +460,23 @@ impl PoundingPair {
         record: &Record,
         scale: f64,
         run: &RunSettings,
-    ) -> Result<crate::simulate::Simulation, String> {
+    ) -> Result<crate::simulate::Simulation, PoundingError> {
         let model = self.model(record, scale, true)?;
-        let sim =
-            crate::simulate::simulate(&model, &self.options(record, run)?).map_err(|e| e.0)?;
+        let sim = crate::simulate::simulate(&model, &self.options(record, run)?)
+            .map_err(|e| PoundingError::run(record, e.0))?;
         match &sim.error {
-            Some(e) => Err(format!("{}: {}", record.source, e)),
+            Some(e) => Err(PoundingError::run(record, e)),
             None => Ok(sim),
         }
     }
 
-    fn options(&self, record: &Record, run: &RunSettings) -> Result<SimulationOptions, String> {
+    fn options(
+        &self,
+        record: &Record,
+        run: &RunSettings,
+    ) -> Result<SimulationOptions, PoundingError> {
         if !(run.sample.is_finite() && run.sample > 0.0) {
-            return Err(format!("sample step {}: give a positive step", run.sample));
+            return Err(FieldError::new("sample", run.sample, "give a positive step").into());
         }
         Ok(SimulationOptions {
             t_end: record.times.last().copied().unwrap_or(0.0),
@@ -397,7 +496,7 @@ impl PoundingPair {
         record: &Record,
         scale: f64,
         run: &RunSettings,
-    ) -> Result<PoundingResult, String> {
+    ) -> Result<PoundingResult, PoundingError> {
         let pounding = self.respond(record, scale, true, run)?;
         let free = self.respond(record, scale, false, run)?;
         let required_gap = free.closing.iter().fold(0.0f64, |m, c| m.max(*c));
@@ -450,9 +549,9 @@ pub struct SpectrumCell {
 
 /// The pair with the right frame's stiffnesses scaled so that T_left /
 /// T_right = `ratio`.
-pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, String> {
+pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, PoundingError> {
     if !(ratio.is_finite() && ratio > 0.0) {
-        return Err(format!("period ratio {ratio}: give a positive ratio"));
+        return Err(FieldError::new("ratios", ratio, "give positive period ratios").into());
     }
     pair.check()?;
     let factor = (pair.right.period() * ratio / pair.left.period()).powi(2);
@@ -470,13 +569,17 @@ pub fn pounding_spectrum(
     gaps: &[f64],
     ratios: &[f64],
     run: &RunSettings,
-) -> Result<Vec<SpectrumCell>, String> {
+) -> Result<Vec<SpectrumCell>, PoundingError> {
     use rayon::prelude::*;
     if records.is_empty() || gaps.is_empty() || ratios.is_empty() {
-        return Err("a pounding spectrum needs records, gaps and period ratios".into());
+        return Err(FieldError::about(
+            "records",
+            "a pounding spectrum needs records, gaps and period ratios",
+        )
+        .into());
     }
     if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
-        return Err(format!("gap {g}: give finite gaps >= 0"));
+        return Err(FieldError::new("gaps", g, "give finite gaps >= 0").into());
     }
     let pairs: Vec<PoundingPair> = ratios
         .iter()
@@ -583,15 +686,14 @@ struct PairSpec {
 /// A pair from TOML text: `[left]` and `[right]` (`masses`, `stiffnesses`,
 /// `damping_ratio`), `gap`, `floors` and `law` (a contact law as in model
 /// files); messages name `source` and the line.
-pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, String> {
-    let spec: PairSpec = toml::from_str(text).map_err(|e| {
-        let line = e
+pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, PoundingError> {
+    let spec: PairSpec = toml::from_str(text).map_err(|e| PoundingError::Pair {
+        file: Some(source.to_string()),
+        line: e
             .span()
-            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-        match line {
-            Some(l) => format!("{source}:{l}: {}", e.message().trim()),
-            None => format!("{source}: {}", e.message().trim()),
-        }
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1),
+        key: None,
+        message: e.message().trim().to_string(),
     })?;
     let frame = |f: FrameSpec| ShearFrame {
         masses: f.masses,
@@ -606,9 +708,9 @@ pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, String> {
         law: spec
             .law
             .build()
-            .map_err(|e| format!("{source}: law: {e}"))?,
+            .map_err(|e| PoundingError::pair("law", format!("law: {e}")).in_file(source))?,
     };
-    pair.check().map_err(|e| format!("{source}: {e}"))?;
+    pair.check().map_err(|e| e.in_file(source))?;
     Ok(pair)
 }
 

@@ -252,7 +252,11 @@ fn bad_pairs_are_refused() {
     ];
     for (p, needle) in cases {
         let e = p.check().unwrap_err();
-        assert!(e.contains(needle), "{e}");
+        assert!(e.to_string().contains(needle), "{e}");
+        assert!(
+            matches!(e, PoundingError::Pair { key: Some(_), .. }),
+            "{e:?}"
+        );
     }
 }
 
@@ -319,11 +323,19 @@ fn pair_files_are_parsed_and_checked() {
         &text.replace("damping_ratio = 0.02", "dampingratio = 0.02"),
         "pair.toml",
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(
         e.starts_with("pair.toml:11:") && e.contains("dampingratio"),
         "{e}"
     );
     let e = parse_pair(&text.replace("floors = [1]", "floors = [2]"), "pair.toml").unwrap_err();
-    assert!(e.contains("floor 2 is not a floor of both"), "{e}");
+    assert!(
+        matches!(&e, PoundingError::Pair { file: Some(f), key: Some("floors"), .. } if f == "pair.toml"),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().contains("floor 2 is not a floor of both"),
+        "{e}"
+    );
 }

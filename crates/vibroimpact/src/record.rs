@@ -5,10 +5,57 @@
 //! samples (no resampling). The library parses text; the callers read the
 //! files.
 
+use std::fmt;
+
 use serde::Serialize;
+
+use crate::field_error::FieldError;
 
 /// Standard gravity (m/s²) for records in g.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// Why a record cannot be read: its file (the source it was read from),
+/// the line to blame where there is one, and what is wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RecordError {
+    /// The record's source (a file name).
+    pub file: String,
+    /// The line (1-based), where one line is to blame.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl RecordError {
+    /// An error at `line` of `file`.
+    pub fn at(file: &str, line: usize, message: impl Into<String>) -> Self {
+        Self {
+            file: file.to_string(),
+            line: Some(line),
+            message: message.into(),
+        }
+    }
+
+    /// An error of `file` as a whole.
+    pub fn whole(file: &str, message: impl Into<String>) -> Self {
+        Self {
+            file: file.to_string(),
+            line: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for RecordError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{line}: {}", self.file, self.message),
+            None => write!(f, "{}: {}", self.file, self.message),
+        }
+    }
+}
+
+impl std::error::Error for RecordError {}
 
 /// The units of a record's accelerations.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,12 +70,16 @@ pub enum Units {
 
 impl Units {
     /// Parses `g`, `m/s2` (`m/s^2`, `m/s²`) or `gal` (`cm/s2`).
-    pub fn parse(text: &str) -> Result<Units, String> {
+    pub fn parse(text: &str) -> Result<Units, FieldError> {
         match text.trim().to_ascii_lowercase().as_str() {
             "g" => Ok(Units::G),
             "m/s2" | "m/s^2" | "m/s²" | "mps2" => Ok(Units::MetersPerSecond2),
             "gal" | "cm/s2" | "cm/s^2" | "cm/s²" => Ok(Units::Gal),
-            other => Err(format!("units `{other}`: give g, m/s2 or gal (cm/s2)")),
+            other => Err(FieldError::new(
+                "units",
+                other,
+                "give g, m/s2 or gal (cm/s2)",
+            )),
         }
     }
 
@@ -124,24 +175,33 @@ impl Record {
         source: &str,
         times: Vec<f64>,
         acceleration: &[f64],
-    ) -> Result<Record, String> {
+    ) -> Result<Record, RecordError> {
         if times.len() != acceleration.len() {
-            return Err(format!(
-                "{source}: {} times and {} accelerations",
-                times.len(),
-                acceleration.len()
+            return Err(RecordError::whole(
+                source,
+                format!(
+                    "{} times and {} accelerations",
+                    times.len(),
+                    acceleration.len()
+                ),
             ));
         }
         if let Some(k) =
             (0..times.len()).find(|&k| !(times[k].is_finite() && acceleration[k].is_finite()))
         {
-            return Err(format!("{source}: sample {k} is not finite"));
+            return Err(RecordError::whole(
+                source,
+                format!("sample {k} is not finite"),
+            ));
         }
         if let Some(k) = (1..times.len()).find(|&k| times[k] <= times[k - 1]) {
-            return Err(format!(
-                "{source}: time {} of sample {k} is not after the previous {} (times must increase)",
-                times[k],
-                times[k - 1]
+            return Err(RecordError::whole(
+                source,
+                format!(
+                    "time {} of sample {k} is not after the previous {} (times must increase)",
+                    times[k],
+                    times[k - 1]
+                ),
             ));
         }
         Record::new(
@@ -159,11 +219,11 @@ impl Record {
         units: Units,
         times: Vec<f64>,
         values: &[f64],
-    ) -> Result<Record, String> {
+    ) -> Result<Record, RecordError> {
         if times.len() < 2 {
-            return Err(format!(
-                "{source}: {} samples; a record needs at least two",
-                times.len()
+            return Err(RecordError::whole(
+                source,
+                format!("{} samples; a record needs at least two", times.len()),
             ));
         }
         let steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
@@ -213,12 +273,15 @@ fn units_in(line: &str) -> Option<Units> {
 /// station, component; `ACCELERATION TIME SERIES IN UNITS OF G`; `NPTS=
 /// n, DT= dt SEC` or the older `n dt NPTS, DT`), then n values, any number
 /// per line. The first sample is at t = 0. `units` overrides the header's.
-pub fn parse_at2(text: &str, source: &str, units: Option<Units>) -> Result<Record, String> {
+pub fn parse_at2(text: &str, source: &str, units: Option<Units>) -> Result<Record, RecordError> {
     let lines: Vec<&str> = text.lines().collect();
     if lines.len() < 4 {
-        return Err(format!(
-            "{source}: an AT2 file has four header lines, this has {} lines",
-            lines.len()
+        return Err(RecordError::whole(
+            source,
+            format!(
+                "an AT2 file has four header lines, this has {} lines",
+                lines.len()
+            ),
         ));
     }
     let header: Vec<String> = lines[..4]
@@ -226,36 +289,55 @@ pub fn parse_at2(text: &str, source: &str, units: Option<Units>) -> Result<Recor
         .map(|l| l.trim_end().to_string())
         .collect();
     let units = units.or_else(|| units_in(lines[2])).ok_or_else(|| {
-        format!(
-            "{source}:3: no units in `{}`; state them (g, m/s2 or gal)",
-            lines[2].trim()
+        RecordError::at(
+            source,
+            3,
+            format!(
+                "no units in `{}`; state them (g, m/s2 or gal)",
+                lines[2].trim()
+            ),
         )
     })?;
     let (npts, dt) = npts_dt(lines[3]).ok_or_else(|| {
-        format!(
-            "{source}:4: expected `NPTS= n, DT= dt SEC`, found `{}`",
-            lines[3].trim()
+        RecordError::at(
+            source,
+            4,
+            format!(
+                "expected `NPTS= n, DT= dt SEC`, found `{}`",
+                lines[3].trim()
+            ),
         )
     })?;
     if !(dt.is_finite() && dt > 0.0) {
-        return Err(format!("{source}:4: DT = {dt}: give a positive time step"));
+        return Err(RecordError::at(
+            source,
+            4,
+            format!("DT = {dt}: give a positive time step"),
+        ));
     }
     let mut values = Vec::with_capacity(npts);
     for (i, line) in lines.iter().enumerate().skip(4) {
         for word in line.split_whitespace() {
             let v: f64 = word
                 .parse()
-                .map_err(|_| format!("{source}:{}: `{word}` is not a number", i + 1))?;
+                .map_err(|_| RecordError::at(source, i + 1, format!("`{word}` is not a number")))?;
             if !v.is_finite() {
-                return Err(format!("{source}:{}: `{word}` is not finite", i + 1));
+                return Err(RecordError::at(
+                    source,
+                    i + 1,
+                    format!("`{word}` is not finite"),
+                ));
             }
             values.push(v);
         }
     }
     if values.len() != npts {
-        return Err(format!(
-            "{source}: the header says NPTS = {npts}, the file has {} values",
-            values.len()
+        return Err(RecordError::whole(
+            source,
+            format!(
+                "the header says NPTS = {npts}, the file has {} values",
+                values.len()
+            ),
         ));
     }
     let times = (0..npts).map(|k| k as f64 * dt).collect();
@@ -285,7 +367,11 @@ fn npts_dt(line: &str) -> Option<(usize, f64)> {
 /// comma; the lines before the first pair of numbers are the header
 /// (skipped, kept), `#` lines are comments. Without `units` the header
 /// must state them (`g`, `m/s2`, `cm/s2`, `gal`).
-pub fn parse_columns(text: &str, source: &str, units: Option<Units>) -> Result<Record, String> {
+pub fn parse_columns(
+    text: &str,
+    source: &str,
+    units: Option<Units>,
+) -> Result<Record, RecordError> {
     let mut header = Vec::new();
     let mut times: Vec<f64> = Vec::new();
     let mut values = Vec::new();
@@ -312,19 +398,21 @@ pub fn parse_columns(text: &str, source: &str, units: Option<Units>) -> Result<R
                 header.push(l.to_string());
                 continue;
             }
-            return Err(format!(
-                "{source}:{}: expected two numbers (time, acceleration), found `{l}`",
-                i + 1
+            return Err(RecordError::at(
+                source,
+                i + 1,
+                format!("expected two numbers (time, acceleration), found `{l}`"),
             ));
         };
         if !(t.is_finite() && a.is_finite()) {
-            return Err(format!("{source}:{}: values must be finite", i + 1));
+            return Err(RecordError::at(source, i + 1, "values must be finite"));
         }
         if let Some(&last) = times.last() {
             if t <= last {
-                return Err(format!(
-                    "{source}:{}: time {t} is not after the previous {last} (times must increase)",
-                    i + 1
+                return Err(RecordError::at(
+                    source,
+                    i + 1,
+                    format!("time {t} is not after the previous {last} (times must increase)"),
                 ));
             }
         }
@@ -335,7 +423,10 @@ pub fn parse_columns(text: &str, source: &str, units: Option<Units>) -> Result<R
     let units = units
         .or_else(|| header.iter().find_map(|h| units_in(h)))
         .ok_or_else(|| {
-            format!("{source}: the header states no units; give them (g, m/s2 or gal)")
+            RecordError::whole(
+                source,
+                "the header states no units; give them (g, m/s2 or gal)",
+            )
         })?;
     check_gaps(&times, &lines, source)?;
     Record::new(source, header, units, times, &values)
@@ -343,7 +434,7 @@ pub fn parse_columns(text: &str, source: &str, units: Option<Units>) -> Result<R
 
 /// Refuses a step more than 10× the median step: samples are missing
 /// (a gap), and the linear interpolation across it would invent motion.
-fn check_gaps(times: &[f64], lines: &[usize], source: &str) -> Result<(), String> {
+fn check_gaps(times: &[f64], lines: &[usize], source: &str) -> Result<(), RecordError> {
     let steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
     if steps.len() < 3 {
         return Ok(());
@@ -352,11 +443,14 @@ fn check_gaps(times: &[f64], lines: &[usize], source: &str) -> Result<(), String
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
     if let Some(k) = steps.iter().position(|s| *s > 10.0 * median) {
-        return Err(format!(
-            "{source}:{}: a gap of {:.4e} s after t = {} (the median step is {median:.4e} s): samples are missing",
+        return Err(RecordError::at(
+            source,
             lines[k + 1],
-            steps[k],
-            times[k]
+            format!(
+                "a gap of {:.4e} s after t = {} (the median step is {median:.4e} s): samples are missing",
+                steps[k],
+                times[k]
+            ),
         ));
     }
     Ok(())
@@ -374,7 +468,7 @@ pub fn is_at2(text: &str, source: &str) -> bool {
 }
 
 /// A record from text: AT2 ([`is_at2`]), else two columns.
-pub fn parse_record(text: &str, source: &str, units: Option<Units>) -> Result<Record, String> {
+pub fn parse_record(text: &str, source: &str, units: Option<Units>) -> Result<Record, RecordError> {
     if is_at2(text, source) {
         parse_at2(text, source, units)
     } else {

@@ -111,9 +111,19 @@ fn bad_records_name_the_line() {
     ];
     for (text, needle) in cases {
         let e = parse_record(&text, "x", None).unwrap_err();
-        assert!(e.contains(needle), "{e}");
+        assert!(e.to_string().contains(needle), "{e}");
+        assert_eq!(e.file, "x");
     }
-    assert!(Units::parse("furlongs")
-        .unwrap_err()
-        .contains("g, m/s2 or gal"));
+    // The line is its own field where one line is to blame.
+    let e = parse_record("t a (g)\n0 1\n0.01 2\n0.01 3\n", "x", None).unwrap_err();
+    assert_eq!(
+        (e.line, e.message.starts_with("time 0.01")),
+        (Some(4), true)
+    );
+    let units = Units::parse("furlongs").unwrap_err();
+    assert_eq!(
+        (units.field, units.value.as_deref()),
+        ("units", Some("furlongs"))
+    );
+    assert!(units.message.contains("g, m/s2 or gal"));
 }

@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::pounding::{
-    documents, parse_pair, pounding_spectrum, quantile, value_range, PoundingPair, RunSettings,
-    SpectrumCell,
+    documents, parse_pair, pounding_spectrum, quantile, value_range, PoundingError, PoundingPair,
+    RunSettings, SpectrumCell,
 };
 
 use crate::args::{IntegratorName, MethodName};
@@ -122,6 +122,14 @@ fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
     w.finish()
 }
 
+/// A pounding error in the command line's words: a setting by its option.
+fn pounding_error(e: PoundingError) -> CliError {
+    match e {
+        PoundingError::Field(f) => option_error(&f),
+        other => CliError::new(other.to_string()),
+    }
+}
+
 /// Runs `vibroimpact pounding`.
 pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let units = records::units(args.units.as_deref())?;
@@ -140,7 +148,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let source = args.pair.display().to_string();
     let text =
         crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
-    let pair: PoundingPair = parse_pair(&text, &source).map_err(CliError::new)?;
+    let pair: PoundingPair = parse_pair(&text, &source).map_err(pounding_error)?;
     let runs = args
         .records
         .iter()
@@ -151,7 +159,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             let range = |field, text| value_range(field, text).map_err(|e| option_error(&e));
             let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
             let cells =
-                pounding_spectrum(&pair, &runs, &gaps, &ratios, &run).map_err(CliError::new)?;
+                pounding_spectrum(&pair, &runs, &gaps, &ratios, &run).map_err(pounding_error)?;
             if let Some(dir) = &args.out {
                 ensure_dir(dir)?;
                 render(&spectrum_figure(&cells), &dir.join("spectrum"))?;
@@ -163,10 +171,10 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             let mut list = Vec::new();
             for (r, s) in &runs {
                 list.push(if args.free {
-                    let res = pair.analyse(r, *s, &run).map_err(CliError::new)?;
+                    let res = pair.analyse(r, *s, &run).map_err(pounding_error)?;
                     documents::run_document(r, *s, &res)
                 } else {
-                    let res = pair.respond(r, *s, true, &run).map_err(CliError::new)?;
+                    let res = pair.respond(r, *s, true, &run).map_err(pounding_error)?;
                     documents::pounding_only_document(r, *s, &res)
                 });
             }
