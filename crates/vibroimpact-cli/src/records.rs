@@ -3,7 +3,6 @@
 
 use std::path::Path;
 
-use serde_json::{json, Value};
 use vibroimpact::record::{parse_record, Record, Units};
 
 use crate::error::{option_error, CliError};
@@ -21,9 +20,4 @@ pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
     let name = path.display().to_string();
     let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
     parse_record(&text, &name, units).map_err(|e| CliError::new(e.to_string()))
-}
-
-/// The record's metadata carried into every output.
-pub fn metadata(r: &Record, scale: f64) -> Value {
-    json!(r.metadata(scale))
 }

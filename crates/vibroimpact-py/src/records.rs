@@ -9,6 +9,7 @@ use vibroimpact::pounding::{
     documents, pounding_spectrum, PoundingError, PoundingPair, RunSettings,
 };
 use vibroimpact::record::{parse_record as parse, Record, Units};
+use vibroimpact::results::spectrum_document;
 use vibroimpact::spectrum::response_spectrum as spectrum;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};
@@ -51,11 +52,14 @@ pub fn parse_measured<'py>(
     Ok(table.columns.into_iter().map(|c| array1(py, c)).collect())
 }
 
-/// The response spectrum of the piecewise-linear record (`times` s,
-/// `acceleration` m/s²) × `scale` at `damping` for `periods` (s): arrays
-/// `period`, `pseudo_acceleration` (m/s²), `pseudo_velocity` (m/s),
-/// `displacement` (m); peaks over the record's time steps.
+/// The `spectrum` document of the record (`source`, `header` and file
+/// `units` as read; times s, `acceleration` m/s²) × `scale` at `damping`
+/// for `periods` (s), as the CLI writes it, with the columns of its rows
+/// as arrays: `period`, `pseudo_acceleration` (m/s²), `pseudo_velocity`
+/// (m/s), `displacement` (m).
 #[pyfunction]
+#[pyo3(signature = (times, acceleration, periods, damping, scale, source = "record", header = Vec::new(), units = "m/s2"))]
+#[allow(clippy::too_many_arguments)]
 pub fn response_spectrum<'py>(
     py: Python<'py>,
     times: PyReadonlyArray1<'py, f64>,
@@ -63,26 +67,33 @@ pub fn response_spectrum<'py>(
     periods: PyReadonlyArray1<'py, f64>,
     damping: f64,
     scale: f64,
+    source: &str,
+    header: Vec<String>,
+    units: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let t = floats(&times, "times")?;
     let a = floats(&acceleration, "acceleration")?;
     let p = floats(&periods, "periods")?;
-    let record = Record::from_samples("record", t, &a).map_err(value_error)?;
+    let mut record = Record::from_samples(source, t, &a).map_err(value_error)?;
+    record.header = header;
+    record.units = Units::parse(units).map_err(value_error)?;
     let rows = py
         .detach(|| spectrum(&record, scale, damping, &p))
         .map_err(value_error)?;
-    let d = PyDict::new(py);
+    let doc =
+        to_python(py, &spectrum_document(&record, scale, damping, &rows))?.cast_into::<PyDict>()?;
+    doc.del_item("rows")?;
     let col = |f: fn(&vibroimpact::spectrum::SpectralPoint) -> f64| {
         rows.iter().map(f).collect::<Vec<f64>>()
     };
-    d.set_item("period", array1(py, col(|r| r.period)))?;
-    d.set_item(
+    doc.set_item("period", array1(py, col(|r| r.period)))?;
+    doc.set_item(
         "pseudo_acceleration",
         array1(py, col(|r| r.pseudo_acceleration)),
     )?;
-    d.set_item("pseudo_velocity", array1(py, col(|r| r.pseudo_velocity)))?;
-    d.set_item("displacement", array1(py, col(|r| r.displacement)))?;
-    Ok(d)
+    doc.set_item("pseudo_velocity", array1(py, col(|r| r.pseudo_velocity)))?;
+    doc.set_item("displacement", array1(py, col(|r| r.displacement)))?;
+    Ok(doc)
 }
 
 /// The pair (TOML `pair_text` named by `source`) and the run settings

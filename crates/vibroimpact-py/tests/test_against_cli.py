@@ -385,3 +385,17 @@ def test_parameter_values_match_the_cli(cli):
               "--points", "13", "--transient", "0", "--record", "1")
     v = vi.parameter_values(1e-3, 2.3e-3, 13)
     assert v.tolist() == [p["parameter"] for p in doc["points"]]
+
+
+def test_spectrum_document_has_the_cli_shape(cli):
+    # The CLI's spectrum JSON is the schema: Python returns its fields (the
+    # record as read, damping, peaks, units) with the rows as columns.
+    quake = EXAMPLES / "synthetic-quake.csv"
+    doc = cli("spectrum", quake, "--units", "m/s2", "--scale", "0.8", "--damping", "0.03")
+    r = vi.response_spectrum(quake, units="m/s2", scale=0.8, damping=0.03)
+    rows = doc.pop("rows")
+    for key in ("period", "pseudo_acceleration", "pseudo_velocity", "displacement"):
+        close(r[key], [row[key] for row in rows])
+    got = {k: v for k, v in r.to_dict().items() if k in doc}
+    assert set(got) == set(doc)
+    _same_document(got, doc, "spectrum")

@@ -395,6 +395,28 @@ pub fn branch_special_points(
     })
 }
 
+/// The `spectrum` document: the record (scaled by `scale`), the damping,
+/// how the peaks are taken, the units and a row per period.
+pub fn spectrum_document(
+    record: &crate::record::Record,
+    scale: f64,
+    damping: f64,
+    rows: &[crate::spectrum::SpectralPoint],
+) -> Value {
+    json!({
+        "record": record.metadata(scale),
+        "damping": damping,
+        "peaks": "over the record's time steps",
+        "units": { "period": "s", "pseudo_acceleration": "m/s2", "pseudo_velocity": "m/s", "displacement": "m" },
+        "rows": rows.iter().map(|p| json!({
+            "period": p.period,
+            "pseudo_acceleration": p.pseudo_acceleration,
+            "pseudo_velocity": p.pseudo_velocity,
+            "displacement": p.displacement,
+        })).collect::<Vec<_>>(),
+    })
+}
+
 /// The `continue` document: the branch's ([`branch_document`]) with
 /// `switched_branch` when the switch succeeded and, with curves, their
 /// `curves` and `curves_skipped` ([`curves_document`]).

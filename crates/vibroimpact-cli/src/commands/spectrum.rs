@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use serde_json::json;
+use vibroimpact::results::spectrum_document;
 use vibroimpact::spectrum::{periods, response_spectrum, SpectralPoint};
 
 use crate::error::{option_error, CliError};
@@ -90,18 +90,7 @@ pub fn run(args: &SpectrumArgs) -> Result<(), CliError> {
     let record = records::read(&args.record, units)?;
     let rows = response_spectrum(&record, args.scale, args.damping, &periods)
         .map_err(|e| option_error(&e))?;
-    let doc = json!({
-        "record": records::metadata(&record, args.scale),
-        "damping": args.damping,
-        "peaks": "over the record's time steps",
-        "units": { "period": "s", "pseudo_acceleration": "m/s2", "pseudo_velocity": "m/s", "displacement": "m" },
-        "rows": rows.iter().map(|p| json!({
-            "period": p.period,
-            "pseudo_acceleration": p.pseudo_acceleration,
-            "pseudo_velocity": p.pseudo_velocity,
-            "displacement": p.displacement,
-        })).collect::<Vec<_>>(),
-    });
+    let doc = spectrum_document(&record, args.scale, args.damping, &rows);
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
         write_atomic(&dir.join("spectrum.csv"), csv(&rows)?.as_bytes())?;

@@ -100,6 +100,7 @@ def basins(
 def parse_record(text: str, source: str, units: Optional[str] = None) -> dict[str, Any]: ...
 def response_spectrum(
     times: F64, acceleration: F64, periods: F64, damping: float, scale: float,
+    source: str = "record", header: list[str] = ..., units: str = "m/s2",
 ) -> dict[str, Any]: ...
 def pounding(
     pair_text: str, source: str, records: list[tuple[str, list[str], str, F64, F64]],

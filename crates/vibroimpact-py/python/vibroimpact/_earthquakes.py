@@ -19,6 +19,9 @@ from . import _core
 from ._checks import ArrayLike, _floats, _method
 from ._results import Result
 
+# The numbers a setting takes: Python's and numpy's.
+_NUMBER = (int, float, np.integer, np.floating)
+
 
 def read_record(path: Union[str, "os.PathLike[str]"], *, units: Optional[str] = None) -> Result:
     """A ground-motion record: a PEER NGA ``.AT2`` file, two columns (time s,
@@ -28,7 +31,10 @@ def read_record(path: Union[str, "os.PathLike[str]"], *, units: Optional[str] = 
     Returns ``source``, ``header`` (the header lines), ``units`` (of the
     file), ``dt`` (None if not uniform), ``times`` (s), ``acceleration``
     (m/s², converted), ``pga`` (m/s²)."""
-    path = os.fspath(path)
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise TypeError(f"path: expected a file name, got {type(path).__name__}") from None
     if not isinstance(path, str):
         raise TypeError("path: expected a file name")
     if units is not None and not isinstance(units, str):
@@ -60,10 +66,13 @@ def response_spectrum(
     with ``acceleration`` (m/s²). ``periods`` (s): default 100
     log-spaced from 0.05 to 5. Peaks over the record's time steps.
 
-    Returns ``period``, ``pseudo_acceleration`` (m/s²), ``pseudo_velocity``
-    (m/s), ``displacement`` (m)."""
+    Returns the ``vibroimpact spectrum`` document: ``record`` (source,
+    header, units, dt, pga, scale, …), ``damping``, ``peaks``, ``units``, and
+    its rows as the arrays ``period``, ``pseudo_acceleration`` (m/s²),
+    ``pseudo_velocity`` (m/s), ``displacement`` (m)."""
     if isinstance(record, (str, os.PathLike)):
         record = read_record(record, units=units)
+    meta = {}
     if acceleration is None:
         try:
             times, acc = record["times"], record["acceleration"]
@@ -71,12 +80,18 @@ def response_spectrum(
             raise TypeError(
                 "record: expected a read_record result, a file name, or times with acceleration="
             ) from None
+        if isinstance(record, Mapping) and "source" in record:
+            meta = {
+                "source": str(record["source"]),
+                "header": [str(h) for h in record.get("header", [])],
+                "units": str(record.get("units", "m/s2")),
+            }
     else:
         times, acc = record, acceleration
     if periods is None:
         periods = np.geomspace(0.05, 5.0, 100)
     for name, v in (("damping", damping), ("scale", scale)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        if isinstance(v, bool) or not isinstance(v, _NUMBER) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
     return Result(
         _core.response_spectrum(
@@ -85,6 +100,7 @@ def response_spectrum(
             _floats(periods, "periods"),
             float(damping),
             float(scale),
+            **meta,
         )
     )
 
@@ -155,7 +171,7 @@ def _pounding_settings(scale: Any, sample: Any, rtol: Any, method: Any, integrat
     """Checks the settings of a pounding run (the binding checks their
     ranges)."""
     for name, v in (("scale", scale), ("sample", sample), ("rtol", rtol)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        if isinstance(v, bool) or not isinstance(v, _NUMBER) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
     _method(method, ("dop853", "dopri5", "rodas", "auto"))
     _method(integrator, ("auto", "global", "local"), "integrator")

@@ -120,8 +120,11 @@ def _second_parameter(
     if special_points is None:
         earlier = None
     elif isinstance(special_points, (str, os.PathLike)):
-        with open(special_points, encoding="utf-8") as f:
-            earlier = f.read()
+        try:
+            with open(special_points, encoding="utf-8") as f:
+                earlier = f.read()
+        except OSError as e:
+            raise OSError(f"special_points: {os.fspath(special_points)}: cannot read: {e.strerror}") from None
     elif isinstance(special_points, Mapping):
         earlier = json.dumps(
             special_points.to_dict() if isinstance(special_points, Result) else special_points
