@@ -289,71 +289,27 @@ fn sweep_bad_input_and_failures() {
         &[&["--parameter", "row.colour"][..], &range].concat(),
         "does not exist",
     );
-    check(
-        &[
-            "--parameter",
-            "frequency",
-            "--from",
-            "7",
-            "--to",
-            "8",
-            "--points",
-            "1",
-        ],
-        "at least 2",
-    );
-    check(
-        &[
-            "--parameter",
-            "frequency",
-            "--from",
-            "7",
-            "--to",
-            "7",
-            "--points",
-            "3",
-        ],
-        "give a range",
-    );
-    check(
-        &[
-            "--parameter",
-            "frequency",
-            "--from",
-            "nan",
-            "--to",
-            "7",
-            "--points",
-            "3",
-        ],
-        "finite",
-    );
-    check(
-        &[
-            "--parameter",
-            "frequency",
-            "--from",
-            "7",
-            "--to",
-            "inf",
-            "--points",
-            "3",
-        ],
-        "finite",
-    );
-    check(
-        &[
-            "--parameter",
-            "row.mass",
-            "--from",
-            "0.2",
-            "--to",
-            "-0.2",
-            "--points",
-            "3",
-        ],
-        "row.mass = 0:",
-    );
+    for (parameter, from, to, points, needle) in [
+        ("frequency", "7", "8", "1", "at least 2"),
+        ("frequency", "7", "7", "3", "give a range"),
+        ("frequency", "nan", "7", "3", "finite"),
+        ("frequency", "7", "inf", "3", "finite"),
+        ("row.mass", "0.2", "-0.2", "3", "row.mass = 0:"),
+    ] {
+        check(
+            &[
+                "--parameter",
+                parameter,
+                "--from",
+                from,
+                "--to",
+                to,
+                "--points",
+                points,
+            ],
+            needle,
+        );
+    }
     check(
         &[&["--parameter", "frequency", "--rtol", "0"][..], &range].concat(),
         "rtol",
@@ -387,9 +343,15 @@ fn sweep_bad_input_and_failures() {
         !out.status.success() && err.contains("periodic") && err.contains("row.mass = 1"),
         "{err}"
     );
-    // An integration failure at one value (an impossible tolerance once the
-    // bodies move): the other value is kept, the failed one is named.
-    let out_dir = dir.join("fail");
+}
+
+/// An integration failure at one value of a sweep (an impossible
+/// tolerance once the bodies move): the other value is kept, the failed
+/// one is named.
+#[test]
+fn sweep_failure_keeps_the_other_values() {
+    let model = repo_file("examples/fujita-row.toml");
+    let out_dir = temp_dir("sweep-fail").join("fail");
     let out = run(&[
         "sweep",
         &model,
@@ -932,8 +894,8 @@ fn basins_grid_outputs_and_bad_input() {
 /// curves start at the branch's folds at the model's amplitude, the two
 /// branch points lie on one closed curve (followed once); the change of
 /// the impact count at GR1 (an impact splitting in two, no contact
-/// grazing) is listed as skipped; curves.json and the figure are written;
-/// the same key twice and an unknown curve kind are refused.
+/// grazing) is listed as skipped; curves.json and the figure are written,
+/// and drawn over a chart of the same plane.
 #[test]
 fn continue_two_parameter_curves() {
     let dir = temp_dir("curves");
@@ -1072,6 +1034,18 @@ fn continue_two_parameter_curves() {
         &[&grid[..], &["--x", "amplitude", "--y", "frequency"]].concat(),
         "curves in (frequency, amplitude), the chart is in (amplitude, frequency)",
     );
+}
+
+/// `continue --parameter2` refuses the same key twice, an unknown curve
+/// kind, bounds that exclude the start, special points without a second
+/// parameter and a file that is not a branch document.
+#[test]
+fn continue_two_parameter_bad_input() {
+    let dir = temp_dir("curves-bad");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row-n2.toml"))
+        .unwrap()
+        .replace("count = 2", "count = 1");
+    let model = write_model(&dir, "n1.toml", &text);
     let base = [
         "continue",
         &model,
