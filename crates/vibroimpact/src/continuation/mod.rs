@@ -43,8 +43,10 @@
 //! - `curve`: two-parameter curves of folds, period doublings and
 //!   symmetry-breaking points ([`continue_curve`]);
 //! - [`continue_branch`]: the iterator collected into a [`Branch`];
-//! - [`BranchStudy`]: a whole `continue` (checks, start, branch, switch)
-//!   for every face.
+//! - the studies every face runs: [`BranchStudy`] (checks, start,
+//!   branch, switch) on any family, [`ContinueStudy`] (a branch of a model
+//!   file with the curves of its special points) and [`OrbitStudy`] (one
+//!   periodic orbit: guess, shooting, summary).
 
 mod branch;
 mod continue_study;
