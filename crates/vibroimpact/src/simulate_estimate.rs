@@ -3,10 +3,10 @@
 //! minutes or hours (the faces print or warn; the run still goes).
 //!
 //! A first bound comes from the model alone: the integrator takes at
-//! least [`STEPS_PER_CYCLE`] steps per cycle of the fastest time scale (the
+//! least `STEPS_PER_CYCLE` steps per cycle of the fastest time scale (the
 //! forcing, a body's natural frequency or damping rate, a record's
-//! samples). Where that bound already exceeds [`PROBE_FROM`] seconds, the
-//! first part of the run is simulated as a probe (about [`PROBE_SECONDS`]
+//! samples). Where that bound already exceeds `PROBE_FROM` seconds, the
+//! first part of the run is simulated as a probe (about `PROBE_SECONDS`
 //! of work by the bound, and at most the steps the bound prices at that)
 //! and its steps and time are scaled to the whole duration, which counts
 //! the impacts the bound cannot see.
@@ -130,7 +130,7 @@ fn fastest_rate(model: &Model) -> f64 {
 
 /// The work of simulating `model` with `opts`: the bound from its fastest
 /// time scale, or a probe of the run's first part where the bound exceeds
-/// [`PROBE_FROM`] seconds.
+/// `PROBE_FROM` seconds.
 pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> WorkEstimate {
     let cycles = opts.t_end * fastest_rate(model) / (2.0 * PI);
     let per_cycle = STEPS_PER_CYCLE * (1e-8 / opts.rtol.clamp(1e-14, 1e-2)).powf(0.125);

@@ -1,6 +1,6 @@
 //! The linear algebra the library writes itself, in one place: the band
 //! LU of the implicit integrator ([`band`]), GMRES and the Arnoldi matrix
-//! of matrix-free shooting and continuation ([`krylov`]), the EISPACK
+//! of matrix-free shooting and continuation (`krylov`), the EISPACK
 //! eigenvalue iteration where nalgebra's Schur iteration stalls
 //! ([`eigen`]) and the null vector of branch switching. Dense
 //! factorisations, SVD and Schur come from nalgebra (docs/decisions.md
