@@ -37,6 +37,8 @@
 //!   result objects);
 //! - [`record`], [`spectrum`], [`pounding`]: earthquake records, their
 //!   response spectra, and pounding frames under them;
+//! - [`hysteresis`]: the force–drift laws of inelastic storeys (bilinear,
+//!   Bouc–Wen);
 //! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) shared by
 //!   every time integration;
 //! - [`linalg`]: the band LU, GMRES and Arnoldi, eigenvalues of general
@@ -58,6 +60,7 @@ pub mod dynamics;
 pub mod family;
 pub mod field_error;
 pub mod free_motion;
+pub mod hysteresis;
 pub mod identify;
 pub mod impact;
 pub mod integrate;
