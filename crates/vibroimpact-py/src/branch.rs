@@ -27,25 +27,20 @@ type Second = (
     Option<String>,
 );
 
-/// The settings of [`continue_branch`] besides the model, as Python gives
-/// them: range, period multiple, switch, points, step, guess periods,
-/// integrator, start, linear algebra (krylov, dense, arnoldi).
-type Settings<'a> = (
-    &'a str,
-    (f64, f64),
-    u32,
-    Option<String>,
-    (usize, f64, f64),
-    &'a str,
-    &'a str,
-    (bool, bool, usize),
-);
+/// The branch's settings as Python gives them: parameter, range, period
+/// multiple, switch.
+type Branch<'a> = (&'a str, (f64, f64), u32, Option<String>);
+
+/// The run's settings: (points, step, guess periods), integrator, start.
+type Run<'a> = ((usize, f64, f64), &'a str, &'a str);
 
 /// The library's study of `continue_`'s arguments.
-fn study(settings: Settings<'_>, second: &Second) -> PyResult<ContinueStudy> {
-    let (parameter, (from, to), subharmonic, switch_at, budget, integrator, start, linear) =
-        settings;
-    let (max_points, ds_max, guess_periods) = budget;
+fn study(
+    (parameter, (from, to), subharmonic, switch_at): Branch<'_>,
+    ((max_points, ds_max, guess_periods), integrator, start): Run<'_>,
+    linear: (bool, bool, usize),
+    second: &Second,
+) -> PyResult<ContinueStudy> {
     let (parameter2, from2, to2, kinds, step, _) = second;
     let defaults = ContinuationOptions::default();
     Ok(ContinueStudy {
@@ -137,19 +132,12 @@ pub fn continue_branch<'py>(
     arnoldi: usize,
     second: Second,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let budget = (max_points, ds_max, guess_periods);
-    let linear = (krylov, dense, arnoldi);
-    let settings = (
-        parameter,
-        (from_, to),
-        subharmonic,
-        switch_at,
-        budget,
-        integrator,
-        start,
-        linear,
-    );
-    let study = study(settings, &second)?;
+    let study = study(
+        (parameter, (from_, to), subharmonic, switch_at),
+        ((max_points, ds_max, guess_periods), integrator, start),
+        (krylov, dense, arnoldi),
+        &second,
+    )?;
     let mut checked = study
         .clone()
         .check(model.document.clone())

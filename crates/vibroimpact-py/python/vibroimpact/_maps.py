@@ -1,8 +1,8 @@
 """Brute-force maps over parameters and initial states:
 :func:`parameter_values` (the values of ``sweep --from --to --points``),
 :func:`sweep` (the bifurcation diagram), :func:`chart` (the stability
-chart) and :func:`basins` (basins of attraction), with the local runs
-(``_sweep_local``, ``_chart_local``) that :mod:`vibroimpact.distributed`
+chart) and :func:`basins` (basins of attraction). Their runs on this
+machine are in :mod:`._map_runs`, which :mod:`vibroimpact.distributed`
 also runs as Dask tasks.
 """
 
@@ -25,7 +25,7 @@ from ._checks import (
     _progress,
     _real,
 )
-from ._core import Model
+from ._map_runs import _chart_local, _sweep_local
 from ._results import Result
 
 
@@ -140,41 +140,6 @@ def sweep(
     return _sweep_local(m, parameter, v, options, threads=threads, progress=progress)
 
 
-def _sweep_local(
-    model: Model,
-    parameter: str,
-    values: np.ndarray,
-    options: dict,
-    *,
-    threads: Optional[int] = None,
-    progress: Progress = None,
-    raw: bool = False,
-    only: Optional[str] = None,
-):
-    """One sweep on this machine (also one Dask task's work); ``raw``: the
-    plain document, for gathering."""
-    # Arrays unpickled on a Dask worker are often misaligned: copy those.
-    values = np.require(values, np.float64, ["C", "A"])
-    d = _core.sweep(
-        model,
-        parameter,
-        values,
-        options["transient"],
-        options["record"],
-        options["up_down"],
-        options["rtol"],
-        options["atol"],
-        options["method"],
-        options["cluster_tolerance"],
-        threads,
-        only,
-        _progress(progress),
-        options["lyapunov"],
-        options.get("integrator", "auto"),
-    )
-    return d if raw else Result(d)
-
-
 def chart(
     model: ModelLike,
     x: str,
@@ -252,32 +217,6 @@ def chart(
 
         return chart_on(client, m, (x, xs), (y, ys), options, tasks=tasks, progress=progress)
     return _chart_local(m, (x, xs), (y, ys), options, threads=threads, progress=progress)
-
-
-def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: Progress = None, raw: bool = False):
-    """One chart on this machine (also one Dask task's rows); ``raw``: the
-    plain document, for gathering."""
-    xs = np.require(x[1], np.float64, ["C", "A"])
-    ys = np.require(y[1], np.float64, ["C", "A"])
-    d = _core.chart(
-        model,
-        x[0],
-        xs,
-        y[0],
-        ys,
-        options["transient"],
-        options["record"],
-        options["starts"],
-        options["lyapunov"],
-        options["rtol"],
-        options["atol"],
-        options["method"],
-        options["cluster_tolerance"],
-        threads,
-        _progress(progress),
-        options.get("integrator", "auto"),
-    )
-    return d if raw else Result(d)
 
 
 def basins(

@@ -26,7 +26,7 @@ from ._results import Result
 
 
 def _sweep_task(model, parameter, values, options, only=None):
-    from ._maps import _sweep_local
+    from ._map_runs import _sweep_local
 
     return _sweep_local(model, parameter, values, options, threads=1, raw=True, only=only)
 
@@ -99,7 +99,7 @@ def sweep_on(
 
 
 def _chart_task(model, x, y, options):
-    from ._maps import _chart_local
+    from ._map_runs import _chart_local
 
     return _chart_local(model, x, y, options, threads=1, raw=True)
 

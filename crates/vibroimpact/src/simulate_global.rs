@@ -1,0 +1,329 @@
+//! A run streamed sample by sample (docs/theory.md §4): the checks of the
+//! run, its start state, the global integrator's steps with impact
+//! tracking, extrema, the automatic method's switch back to DOP853, the
+//! early ends (stiff, crawling) and the output sampler; the local
+//! integrator's run where it is chosen (§10).
+
+use super::*;
+
+/// Simulates `model` as [`simulate`] does, handing every output sample to
+/// `sink(t, [u.., v..])` instead of keeping it (the returned history is
+/// empty), so that a history of any length is written as it is computed in
+/// bounded memory. `sink` returns false to stop the simulation (e.g. when
+/// the disk is full); the result then ends there with
+/// [`IntegrationError::Interrupted`]. At most [`MAX_SAMPLES`] samples.
+pub fn simulate_streaming(
+    model: &Model,
+    opts: &SimulationOptions,
+    mut sink: impl FnMut(f64, &[f64]) -> bool,
+) -> Result<Simulation, OptionsError> {
+    check_run(model, opts)?;
+    let mut sys = ChainDynamics::new(model, opts.energy);
+    let y0 = start_state(model, opts, &sys)?;
+    let n2 = sys.state_dim();
+    let int_opts = IntegratorOptions {
+        rtol: opts.rtol,
+        atol: opts.atol,
+        max_steps: opts.max_steps,
+        error_components: opts.energy.then_some(n2),
+        interrupt: opts.interrupt.clone(),
+        ..IntegratorOptions::default()
+    };
+    let method = effective_method(model, opts)?;
+    let mut st =
+        Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
+    let breakpoints = breakpoints(model, opts.t_end);
+    if opts.integrator.resolve(model) == Integrator::Local {
+        return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
+    }
+    let mut next_break = 0;
+    let mut scan = StepScan {
+        ids: (0..model.contacts().len()).collect(),
+        trackers: model
+            .contacts()
+            .iter()
+            .map(|c| Tracker::new(&c.law, opts.impact_force_threshold))
+            .collect(),
+        impacts: Vec::new(),
+        previous: Vec::new(),
+    };
+    let mut output = Output::new(opts, (y0.len(), n2), &mut sink);
+    let mut sink_stopped = None;
+    if opts.output_step.is_some() && opts.output_from == 0.0 {
+        if !output.record(0.0, &y0) {
+            sink_stopped = Some(0.0);
+        }
+        output.next = 1;
+    }
+    let e0 = sys.mechanical_energy(&y0);
+    let mut error: Option<IntegrationError> = st.reset(&mut sys, 0.0, &y0).err();
+    scan.previous = (0..model.contacts().len())
+        .map(|k| contact_end(&sys, k, st.y(), st.dydt()))
+        .collect();
+    // Contacts already engaged at the start (s_on < s <= 0) begin an impact
+    // at t = 0.
+    if error.is_none() {
+        for k in 0..model.contacts().len() {
+            if scan.previous[k].0 > scan.trackers[k].s_on {
+                scan.start(&mut st, &mut sys, k, 0.0);
+            }
+        }
+    }
+    let mut extrema = match (opts.extrema_window, &error) {
+        (Some(window), None) => {
+            let s_on = scan.trackers.iter().map(|tr| tr.s_on).collect();
+            Some(ExtremaScan::new(window, n2 / 2, s_on, &st, &sys))
+        }
+        _ => None,
+    };
+    let mut steps: u64 = 0;
+    while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
+        while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
+            next_break += 1;
+        }
+        let bound = breakpoints.get(next_break).copied().unwrap_or(opts.t_end);
+        if let Err(e) = st.step(&mut sys, bound) {
+            error = Some(e);
+            break;
+        }
+        scan.scan(&mut st, &mut sys);
+        if let Some(x) = extrema.as_mut() {
+            x.step(&mut st, &mut sys);
+        }
+        if let Some(h) = scan.entry_limit(st.h_next()) {
+            st.limit_next_step(h);
+        }
+        steps += 1;
+        error = early_end(&st, method, opts, steps);
+        if error.is_some() {
+            break;
+        }
+        // Automatic method: leave RODAS as soon as every contact is open
+        // again and an explicit step of RODAS's size would be stable (the
+        // restart costs two evaluations).
+        if method == Method::Auto
+            && st.active() == Method::Rodas
+            && scan.trackers.iter().all(|t| t.active.is_none())
+            && st
+                .rodas_jacobian_bound()
+                .is_some_and(|b| st.h_next() * b < EXPLICIT_STABILITY)
+        {
+            let (t, y) = (st.t(), st.y().to_vec());
+            if let Err(e) = st.reset(&mut sys, t, &y) {
+                error = Some(e);
+                break;
+            }
+        }
+        sink_stopped = output.samples(&mut st, &mut sys);
+    }
+    if let (None, Some(t)) = (&error, sink_stopped) {
+        error = Some(IntegrationError::Interrupted { t });
+    }
+    let extrema = extrema.map(|x| x.found);
+    Ok(global_result(
+        model,
+        opts,
+        (st, sys),
+        scan,
+        e0,
+        error,
+        extrema,
+    ))
+}
+
+/// The checks of a run beyond the options' own: the output samples within
+/// [`MAX_SAMPLES`], a record's duration within the record.
+fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
+    check_options(opts)?;
+    if let Some(dt) = opts.output_step {
+        let samples = (opts.t_end - opts.output_from) / dt + 1.0;
+        if samples > MAX_SAMPLES {
+            return Err(OptionsError(format!(
+                "output step = {dt} s over {} s: {samples:.3e} samples, more than {MAX_SAMPLES:e}; take a larger output step or a shorter duration",
+                opts.t_end
+            )));
+        }
+    }
+    if let BaseExcitation::Record(r) = model.base() {
+        let end = r.times().last().copied().unwrap_or(0.0);
+        // A hair of slack for a duration typed from the record's own times.
+        if opts.t_end > end * (1.0 + 1e-12) {
+            return Err(OptionsError(format!(
+                "duration = {} s: the accelerogram ends at {end} s; give a duration up to the record's end (a record is not extended with zeros)",
+                opts.t_end
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The interleaved start state: the model's, or the options' `start`
+/// (body order, checked).
+fn start_state(
+    model: &Model,
+    opts: &SimulationOptions,
+    sys: &ChainDynamics,
+) -> Result<Vec<f64>, OptionsError> {
+    let mut y0 = sys.initial_state(model);
+    if let Some(start) = &opts.start {
+        let n = model.bodies().len();
+        if start.len() != 2 * n || start.iter().any(|x| !x.is_finite()) {
+            return Err(OptionsError(format!(
+                "start state: needs {} finite values, got {}",
+                2 * n,
+                start.len()
+            )));
+        }
+        for i in 0..n {
+            y0[2 * i] = start[i];
+            y0[2 * i + 1] = start[n + i];
+        }
+    }
+    Ok(y0)
+}
+
+/// Why a run ends early after `steps` steps, if it does: an explicit
+/// method whose stability limits its step so far that the rest of the run
+/// would exceed the step limit (a contact or body far stiffer than the
+/// motion), or any method that crawls (a nonsensical parameter, e.g. a
+/// contact damping of 1e300) instead of grinding to the step limit.
+fn early_end(
+    st: &Stepper,
+    method: Method,
+    opts: &SimulationOptions,
+    steps: u64,
+) -> Option<IntegrationError> {
+    if matches!(method, Method::Dop853 | Method::Dopri5) && st.stiffness_detected() {
+        let h = st.t() - st.t_prev();
+        let projected = (opts.t_end - st.t()) / h;
+        let limit = opts.max_steps;
+        if projected > limit.saturating_sub(st.stats().steps) as f64 {
+            return Some(IntegrationError::Stiff {
+                t: st.t(),
+                h,
+                projected,
+                limit,
+            });
+        }
+    }
+    if steps % PROGRESS_CHECK == 0 {
+        let projected = steps as f64 * opts.t_end / st.t();
+        if projected > CRAWL_FACTOR * opts.max_steps as f64 {
+            return Some(IntegrationError::NoProgress {
+                t: st.t(),
+                steps,
+                projected,
+                limit: opts.max_steps,
+            });
+        }
+    }
+    None
+}
+
+/// The output samples of a run: every `output_step` from `output_from`,
+/// in body order, to the sink.
+struct Output<'a, S> {
+    step: Option<f64>,
+    from: f64,
+    t_end: f64,
+    /// Index of the next sample.
+    next: usize,
+    /// Dense output in the integrator's layout.
+    buf: Vec<f64>,
+    /// One sample in body order [u.., v..].
+    sample: Vec<f64>,
+    sink: &'a mut S,
+}
+
+impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
+    /// `dims`: the integrated state's length and the mechanical state's.
+    fn new(opts: &SimulationOptions, dims: (usize, usize), sink: &'a mut S) -> Self {
+        Self {
+            step: opts.output_step,
+            from: opts.output_from,
+            t_end: opts.t_end,
+            next: 0,
+            buf: vec![0.0; dims.0],
+            sample: vec![0.0; dims.1],
+            sink,
+        }
+    }
+
+    /// Hands the interleaved state `y` at `t` to the sink; false if it
+    /// asks to stop.
+    fn record(&mut self, t: f64, y: &[f64]) -> bool {
+        let n = self.sample.len() / 2;
+        for i in 0..n {
+            self.sample[i] = y[2 * i];
+            self.sample[n + i] = y[2 * i + 1];
+        }
+        (self.sink)(t, &self.sample)
+    }
+
+    /// The samples within the last step, by dense output; the time of the
+    /// sample at which the sink asked to stop, if it did.
+    fn samples(&mut self, st: &mut Stepper, sys: &mut ChainDynamics) -> Option<f64> {
+        let dt = self.step?;
+        loop {
+            let ts = self.from + self.next as f64 * dt;
+            if ts > st.t() || ts > self.t_end {
+                return None;
+            }
+            st.dense_output(sys, ts, &mut self.buf);
+            self.next += 1;
+            let buf = std::mem::take(&mut self.buf);
+            let go_on = self.record(ts, &buf);
+            self.buf = buf;
+            if !go_on {
+                return Some(ts);
+            }
+        }
+    }
+}
+
+/// The result of a run by the global integrator: the final state, the
+/// impacts in order, the energy balance and the failure, if any, with the
+/// state it happened in.
+fn global_result(
+    model: &Model,
+    opts: &SimulationOptions,
+    (st, sys): (Stepper, ChainDynamics),
+    scan: StepScan,
+    e0: f64,
+    error: Option<IntegrationError>,
+    extrema: Option<Extrema>,
+) -> Simulation {
+    let n2 = sys.state_dim();
+    let y = st.y().to_vec();
+    let mut impacts = scan.impacts;
+    by_start(&mut impacts);
+    let energy = opts.energy.then(|| EnergyBalance {
+        initial: e0,
+        mechanical: sys.mechanical_energy(&y),
+        input_work: y[n2],
+        damping_dissipation: y[n2 + 1],
+        contact_dissipation: y[n2 + 2],
+    });
+    let error = error.map(|source| {
+        let state = match &source {
+            IntegrationError::StepSizeUnderflow { y, .. } => y.clone(),
+            _ => st.y().to_vec(),
+        };
+        let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
+        failure(model, source, &state, &s_on)
+    });
+    Simulation {
+        times: Vec::new(),
+        states: Vec::new(),
+        final_time: st.t(),
+        final_displacement: (0..n2 / 2).map(|i| y[2 * i]).collect(),
+        final_velocity: (0..n2 / 2).map(|i| y[2 * i + 1]).collect(),
+        impacts,
+        stats: st.stats(),
+        contact_evaluations: sys.contact_evaluations(),
+        energy,
+        error,
+        extrema,
+        local: None,
+    }
+}
