@@ -28,7 +28,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    basins, branch, chart, identify, impact, periodic, pounding, simulate, spectrum, sweep,
+    basins, branch, chart, hysteresis, identify, impact, periodic, pounding, simulate, spectrum,
+    sweep,
 };
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
@@ -68,6 +69,10 @@ enum Command {
     /// columns, CSV): pseudo-acceleration, pseudo-velocity, displacement.
     #[command(allow_negative_numbers = true)]
     Spectrum(spectrum::SpectrumArgs),
+    /// A storey law (elastic, bilinear, Bouc–Wen) under cyclic drift or a
+    /// drift history: its hysteresis loop and dissipated energy.
+    #[command(allow_negative_numbers = true)]
+    Hysteresis(hysteresis::HysteresisArgs),
     /// Pounding of two shear frames under recorded ground motions: response
     /// with and without pounding, the gap that avoids contact, code rules,
     /// and pounding spectra over gap × period ratio.
@@ -150,6 +155,7 @@ fn main() -> ExitCode {
         Some(Command::Chart(args)) => chart::run(args),
         Some(Command::Basins(args)) => basins::run(args),
         Some(Command::Spectrum(args)) => spectrum::run(args),
+        Some(Command::Hysteresis(args)) => hysteresis::run(args),
         Some(Command::Pounding(args)) => pounding::run(args),
         Some(Command::Report { out }) => report::run(out),
         Some(Command::Options) => {

@@ -217,3 +217,74 @@ fn pounding_of_two_frames() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+/// `hysteresis`: a bilinear storey's loop over a cyclic protocol (the
+/// dissipated energy of two cycles at 4 u_y is the parallelogram's area,
+/// plus the first excursion's), its files, and bad settings by option.
+#[test]
+fn hysteresis_loop_and_bad_input() {
+    let dir = temp_dir("hysteresis");
+    let out = dir.join("loop");
+    let doc = json(&[
+        "hysteresis",
+        "--stiffness",
+        "1e8",
+        "--yield-drift",
+        "0.01",
+        "--post-yield-ratio",
+        "0.1",
+        "--amplitudes",
+        "0.04",
+        "--cycles",
+        "2",
+        "--points",
+        "8",
+        "--format",
+        "json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // Plastic drift: 0 -> 4 uy: 3 uy; three swings of 8 uy: 6 uy each;
+    // the last quarter -4 uy -> 0: 2 uy. Each dissipates (1 - b) k uy per
+    // unit of plastic drift.
+    let kh_uy = 0.9 * 1e8 * 0.01;
+    let total = doc["total_dissipated"].as_f64().unwrap();
+    let expected = kh_uy * 0.01 * (3.0 + 6.0 * 3.0 + 2.0);
+    assert!(
+        (total - expected).abs() < 1e-9 * expected,
+        "{total} vs {expected}"
+    );
+    for f in [
+        "hysteresis.csv",
+        "hysteresis.json",
+        "hysteresis.svg",
+        "hysteresis.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let base = ["hysteresis", "--stiffness", "1e8", "--amplitudes", "0.02"];
+    for (extra, needle) in [
+        (
+            &["--yield-drift", "0.01", "--post-yield-ratio", "1"][..],
+            "--post-yield-ratio 1: must be in [0, 1)",
+        ),
+        (&[][..], "--yield-drift: give the yield drift"),
+        (
+            &[
+                "--law",
+                "bouc-wen",
+                "--yield-drift",
+                "0.01",
+                "--exponent",
+                "0",
+            ][..],
+            "--exponent 0:",
+        ),
+        (
+            &["--yield-drift", "0.01", "--points", "10"][..],
+            "--points 10: give a positive multiple of 4",
+        ),
+    ] {
+        assert_clean_error(&[&base[..], extra].concat(), needle);
+    }
+}

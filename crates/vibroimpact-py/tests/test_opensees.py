@@ -119,3 +119,41 @@ def test_the_local_integrator_agrees_with_converged_opensees(northridge, name):
     assert errors.max() < 0.01, errors
     with pytest.raises(ValueError, match="integrator"):
         vi.pounding(text, northridge, integrator="exact")
+
+
+def _opensees_loop(material, drifts):
+    """OpenSees' uniaxial material `material` (its arguments after the tag)
+    driven through `drifts` by testUniaxialMaterial: the forces."""
+    import openseespy.opensees as ops
+
+    ops.wipe()
+    ops.uniaxialMaterial(*material[:1], 1, *material[1:])
+    ops.testUniaxialMaterial(1)
+    forces = []
+    for d in drifts:
+        ops.setStrain(float(d))
+        forces.append(ops.getStress())
+    return np.array(forces)
+
+
+def test_storey_laws_match_opensees_materials():
+    # Bilinear = Steel01 without isotropic hardening (a1 = a3 = 0,
+    # a2 = a4 = 1): the same loop to 1e-12 of the yield force. Bouc-Wen =
+    # BoucWen with gamma_OS = gamma/uy^n, beta_OS = beta/uy^n: OpenSees
+    # takes one backward-Euler step per strain increment, so its loop
+    # converges to ours at first order in the increment.
+    k, uy, b = 1.2e8, 0.01, 0.05
+    r = vi.hysteresis(stiffness=k, yield_drift=uy, post_yield_ratio=b,
+                      amplitudes=[0.005, 0.02, 0.04], cycles=2, points=400)
+    steel = _opensees_loop(["Steel01", k * uy, k, b, 0.0, 1.0, 0.0, 1.0], r.drift)
+    assert np.max(np.abs(steel - r.force)) < 1e-12 * k * uy
+    errors = []
+    for points in (400, 4000):
+        w = vi.hysteresis(law="bouc-wen", stiffness=k, yield_drift=uy, post_yield_ratio=b,
+                          exponent=2.0, beta=0.55, gamma=0.45, amplitudes=[0.02, 0.04],
+                          cycles=2, points=points)
+        os_bw = _opensees_loop(
+            ["BoucWen", b, k, 2.0, 0.45 / uy**2, 0.55 / uy**2, 1.0, 0.0, 0.0, 0.0], w.drift
+        )
+        errors.append(np.max(np.abs(os_bw - w.force)) / (k * uy))
+    assert errors[1] < 2e-3 and 7 < errors[0] / errors[1] < 13, errors

@@ -20,6 +20,7 @@ FUNCTIONS = {
     "basins": vi.basins,
     "spectrum": vi.response_spectrum,
     "pounding": vi.pounding,
+    "hysteresis": vi.hysteresis,
 }
 # Subcommands without a function: the default study's report.
 NO_FUNCTION = {"report"}

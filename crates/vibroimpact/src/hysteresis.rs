@@ -19,6 +19,8 @@
 //! The dissipated (hysteretic) energy of a storey is the work of its
 //! hysteretic part less what it stores, (1 − b) k (∫ z dd − z²/2).
 
+use serde::{Deserialize, Serialize};
+
 use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, OdeSystem};
 
 /// A storey law's setting refused: its key and what is wrong (the caller
@@ -351,6 +353,124 @@ pub fn under_drift(
         d0 = d;
     }
     Ok(out)
+}
+
+/// A storey's law as written in a file or given by a face, without its
+/// stiffness (the frame's): `law = "elastic" | "bilinear" | "bouc-wen"`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "law", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum StoreySpec {
+    /// Linear.
+    Elastic,
+    /// Bilinear with kinematic hardening.
+    Bilinear {
+        /// Yield drift u_y (m).
+        yield_drift: f64,
+        /// b ∈ [0, 1).
+        post_yield_ratio: f64,
+    },
+    /// Bouc–Wen.
+    BoucWen {
+        /// Yield drift u_y (m).
+        yield_drift: f64,
+        /// α ∈ [0, 1).
+        post_yield_ratio: f64,
+        /// n ≥ 1, default 2.
+        exponent: Option<f64>,
+        /// β, default 0.5.
+        beta: Option<f64>,
+        /// γ, default 0.5.
+        gamma: Option<f64>,
+        /// δ_A (1/J), default 0.
+        degradation_a: Option<f64>,
+        /// δ_ν (1/J), default 0.
+        degradation_nu: Option<f64>,
+        /// δ_η (1/J), default 0.
+        degradation_eta: Option<f64>,
+    },
+}
+
+impl StoreySpec {
+    /// The law with the storey's elastic `stiffness`, checked.
+    pub fn law(&self, stiffness: f64) -> Result<StoreyLaw, LawError> {
+        let law = match *self {
+            StoreySpec::Elastic => StoreyLaw::Elastic { stiffness },
+            StoreySpec::Bilinear {
+                yield_drift,
+                post_yield_ratio,
+            } => StoreyLaw::Bilinear(Bilinear {
+                stiffness,
+                yield_drift,
+                post_yield_ratio,
+            }),
+            StoreySpec::BoucWen {
+                yield_drift,
+                post_yield_ratio,
+                exponent,
+                beta,
+                gamma,
+                degradation_a,
+                degradation_nu,
+                degradation_eta,
+            } => StoreyLaw::BoucWen(BoucWen {
+                stiffness,
+                yield_drift,
+                post_yield_ratio,
+                exponent: exponent.unwrap_or(2.0),
+                beta: beta.unwrap_or(0.5),
+                gamma: gamma.unwrap_or(0.5),
+                degradation: Degradation {
+                    a: degradation_a.unwrap_or(0.0),
+                    nu: degradation_nu.unwrap_or(0.0),
+                    eta: degradation_eta.unwrap_or(0.0),
+                },
+            }),
+        };
+        law.check()?;
+        Ok(law)
+    }
+}
+
+/// A cyclic drift protocol: `cycles` sine cycles at each amplitude of
+/// `amplitudes` (m) in turn, `points` samples a cycle (a multiple of 4, so
+/// that the turning points are samples), from rest.
+pub fn cyclic_protocol(
+    amplitudes: &[f64],
+    cycles: usize,
+    points: usize,
+) -> Result<Vec<f64>, LawError> {
+    let bad = |key, value: f64, message| LawError {
+        key,
+        value,
+        message,
+    };
+    if points == 0 || points % 4 != 0 {
+        return Err(bad(
+            "points",
+            points as f64,
+            "give a positive multiple of 4",
+        ));
+    }
+    if cycles == 0 {
+        return Err(bad("cycles", 0.0, "give at least one cycle"));
+    }
+    if let Some(&a) = amplitudes.iter().find(|a| !(a.is_finite() && **a > 0.0)) {
+        return Err(bad("amplitudes", a, "give finite amplitudes > 0"));
+    }
+    Ok(amplitudes
+        .iter()
+        .flat_map(|&a| {
+            (1..=cycles * points).map(move |i| {
+                // Exact zeros and turning points at the quarter cycles.
+                let k = i % points;
+                if k * 4 % points == 0 {
+                    [0.0, a, 0.0, -a][k * 4 / points]
+                } else {
+                    a * (2.0 * std::f64::consts::PI * k as f64 / points as f64).sin()
+                }
+            })
+        })
+        .collect())
 }
 
 #[cfg(test)]

@@ -395,6 +395,51 @@ pub fn branch_special_points(
     })
 }
 
+/// A storey law's name and parameters, defaults resolved.
+pub fn storey_law_document(law: &crate::hysteresis::StoreyLaw) -> Value {
+    use crate::hysteresis::StoreyLaw;
+    match law {
+        StoreyLaw::Elastic { stiffness } => json!({"law": "elastic", "stiffness": stiffness}),
+        StoreyLaw::Bilinear(b) => json!({
+            "law": "bilinear",
+            "stiffness": b.stiffness,
+            "yield_drift": b.yield_drift,
+            "post_yield_ratio": b.post_yield_ratio,
+        }),
+        StoreyLaw::BoucWen(w) => json!({
+            "law": "bouc-wen",
+            "stiffness": w.stiffness,
+            "yield_drift": w.yield_drift,
+            "post_yield_ratio": w.post_yield_ratio,
+            "exponent": w.exponent,
+            "beta": w.beta,
+            "gamma": w.gamma,
+            "degradation_a": w.degradation.a,
+            "degradation_nu": w.degradation.nu,
+            "degradation_eta": w.degradation.eta,
+        }),
+    }
+}
+
+/// The `hysteresis` document: the law, the units, a row per drift
+/// (force, dissipated energy), the peak force and the total dissipated
+/// energy.
+pub fn hysteresis_document(
+    law: &crate::hysteresis::StoreyLaw,
+    drifts: &[f64],
+    rows: &[(f64, f64)],
+) -> Value {
+    json!({
+        "law": storey_law_document(law),
+        "units": { "drift": "m", "force": "N", "dissipated": "J" },
+        "peak_force": rows.iter().fold(0.0f64, |m, r| m.max(r.0.abs())),
+        "total_dissipated": rows.last().map_or(0.0, |r| r.1),
+        "rows": drifts.iter().zip(rows).map(|(d, (f, e))| json!({
+            "drift": d, "force": f, "dissipated": e,
+        })).collect::<Vec<_>>(),
+    })
+}
+
 /// The `spectrum` document: the record (scaled by `scale`), the damping,
 /// how the peaks are taken, the units and a row per period.
 pub fn spectrum_document(

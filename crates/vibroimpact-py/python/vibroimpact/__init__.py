@@ -30,6 +30,7 @@ from ._impacts import contact_force, identify, impact
 from ._maps import basins, chart, parameter_values, sweep
 from ._motion import simulate
 from ._orbits import continue_, periodic
+from ._storeys import hysteresis
 from ._results import Result
 
 # The type aliases of the public signatures (not in __all__).
@@ -44,6 +45,7 @@ __all__ = [
     "chart",
     "contact_force",
     "continue_",
+    "hysteresis",
     "identify",
     "impact",
     "parameter_values",

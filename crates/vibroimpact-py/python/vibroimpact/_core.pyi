@@ -108,6 +108,10 @@ def pounding(
     gaps: Optional[F64] = None, ratios: Optional[F64] = None,
 ) -> dict[str, Any]: ...
 def value_range(field: str, text: str) -> F64: ...
+def hysteresis(
+    law: tuple[str, float, Optional[float], float, float, float, float, float, float, float],
+    amplitudes: list[float], cycles: int, points: int, drift: Optional[F64], rtol: float,
+) -> dict[str, Any]: ...
 def pounding_history(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
     rtol: float, method: str, integrator: str,

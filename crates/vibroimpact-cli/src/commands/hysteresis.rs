@@ -1,0 +1,222 @@
+//! `vibroimpact hysteresis`: a storey law ([`vibroimpact::hysteresis`])
+//! under a cyclic drift protocol or a drift history from a file: its loop
+//! (force and dissipated energy at every drift) as JSON, CSV or a table,
+//! with a figure of the loop.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use vibroimpact::hysteresis::{cyclic_protocol, under_drift, LawError, StoreySpec};
+use vibroimpact::results::hysteresis_document;
+
+use crate::error::CliError;
+use crate::format::{CsvText, Format};
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition, Series};
+
+/// The storey laws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LawName {
+    /// F = k d.
+    Elastic,
+    /// Bilinear with kinematic hardening (OpenSees Steel01 without
+    /// isotropic hardening).
+    Bilinear,
+    /// Bouc–Wen with optional degradation (OpenSees BoucWen).
+    BoucWen,
+}
+
+/// Options of `vibroimpact hysteresis`.
+#[derive(Args, Debug)]
+pub struct HysteresisArgs {
+    /// The law.
+    #[arg(long, value_enum, default_value_t = LawName::Bilinear)]
+    law: LawName,
+    /// Elastic stiffness k (N/m).
+    #[arg(long)]
+    stiffness: f64,
+    /// Yield drift u_y (m); bilinear and Bouc–Wen.
+    #[arg(long)]
+    yield_drift: Option<f64>,
+    /// Post-yield stiffness over the elastic one, in [0, 1).
+    #[arg(long, default_value_t = 0.05)]
+    post_yield_ratio: f64,
+    /// Bouc–Wen exponent n (≥ 1; large: sharp yield).
+    #[arg(long, default_value_t = 2.0)]
+    exponent: f64,
+    /// Bouc–Wen β.
+    #[arg(long, default_value_t = 0.5)]
+    beta: f64,
+    /// Bouc–Wen γ.
+    #[arg(long, default_value_t = 0.5)]
+    gamma: f64,
+    /// Bouc–Wen δ_A (1/J): A = 1 − δ_A e with e the hysteretic work.
+    #[arg(long, default_value_t = 0.0)]
+    degradation_a: f64,
+    /// Bouc–Wen δ_ν (1/J), strength degradation.
+    #[arg(long, default_value_t = 0.0)]
+    degradation_nu: f64,
+    /// Bouc–Wen δ_η (1/J), stiffness degradation.
+    #[arg(long, default_value_t = 0.0)]
+    degradation_eta: f64,
+    /// Drift amplitudes of the cyclic protocol (m), comma separated, each
+    /// held for --cycles sine cycles.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    amplitudes: Vec<f64>,
+    /// Cycles at each amplitude.
+    #[arg(long, default_value_t = 2)]
+    cycles: usize,
+    /// Samples a cycle (a multiple of 4).
+    #[arg(long, default_value_t = 200)]
+    points: usize,
+    /// A drift history instead of the protocol: a file of drifts (m), one a
+    /// line (a header line and `#` comments are skipped); linear between
+    /// them, from rest.
+    #[arg(long)]
+    drift: Option<PathBuf>,
+    /// Relative tolerance of Bouc–Wen's integration along the drift.
+    #[arg(long, default_value_t = 1e-10)]
+    rtol: f64,
+    /// Output folder: hysteresis.csv, hysteresis.json and the loop figure.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+impl HysteresisArgs {
+    /// The law's spec from the options.
+    fn spec(&self) -> Result<StoreySpec, CliError> {
+        let uy = || {
+            self.yield_drift
+                .ok_or_else(|| CliError::new("--yield-drift: give the yield drift (m)"))
+        };
+        Ok(match self.law {
+            LawName::Elastic => StoreySpec::Elastic,
+            LawName::Bilinear => StoreySpec::Bilinear {
+                yield_drift: uy()?,
+                post_yield_ratio: self.post_yield_ratio,
+            },
+            LawName::BoucWen => StoreySpec::BoucWen {
+                yield_drift: uy()?,
+                post_yield_ratio: self.post_yield_ratio,
+                exponent: Some(self.exponent),
+                beta: Some(self.beta),
+                gamma: Some(self.gamma),
+                degradation_a: Some(self.degradation_a),
+                degradation_nu: Some(self.degradation_nu),
+                degradation_eta: Some(self.degradation_eta),
+            },
+        })
+    }
+}
+
+/// A law error in the command line's words.
+fn law_error(e: LawError) -> CliError {
+    CliError::new(format!(
+        "--{} {}: {}",
+        e.key.replace(['_', '.'], "-"),
+        e.value,
+        e.message
+    ))
+}
+
+/// The drifts of a file: one number a line, a header line and `#`
+/// comments skipped; errors name the file and line.
+fn read_drifts(path: &Path) -> Result<Vec<f64>, CliError> {
+    let name = path.display();
+    let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
+    let mut drifts = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        match l.parse::<f64>() {
+            Ok(d) if d.is_finite() => drifts.push(d),
+            Ok(_) => {
+                return Err(CliError::new(format!(
+                    "{name}:{}: `{l}` is not finite",
+                    i + 1
+                )))
+            }
+            Err(_) if drifts.is_empty() => continue,
+            Err(_) => {
+                return Err(CliError::new(format!(
+                    "{name}:{}: `{l}` is not a drift",
+                    i + 1
+                )))
+            }
+        }
+    }
+    if drifts.is_empty() {
+        return Err(CliError::new(format!("{name}: no drifts")));
+    }
+    Ok(drifts)
+}
+
+/// Runs `vibroimpact hysteresis`.
+pub fn run(args: &HysteresisArgs) -> Result<(), CliError> {
+    let law = args.spec()?.law(args.stiffness).map_err(law_error)?;
+    if !(args.rtol.is_finite() && args.rtol > 0.0) {
+        return Err(CliError::new(format!(
+            "--rtol {}: must be finite and > 0",
+            args.rtol
+        )));
+    }
+    let drifts = match (&args.drift, args.amplitudes.is_empty()) {
+        (Some(path), true) => read_drifts(path)?,
+        (None, false) => {
+            cyclic_protocol(&args.amplitudes, args.cycles, args.points).map_err(law_error)?
+        }
+        (Some(_), false) => {
+            return Err(CliError::new(
+                "--drift: give --drift or --amplitudes, not both",
+            ))
+        }
+        (None, true) => {
+            return Err(CliError::new(
+                "--amplitudes: give the protocol's drift amplitudes (m), or --drift FILE",
+            ))
+        }
+    };
+    let rows = under_drift(&law, &drifts, args.rtol)?;
+    let doc = hysteresis_document(&law, &drifts, &rows);
+    if let Some(dir) = &args.out {
+        ensure_dir(dir)?;
+        write_atomic(&dir.join("hysteresis.csv"), csv(&drifts, &rows)?.as_bytes())?;
+        write_atomic(
+            &dir.join("hysteresis.json"),
+            serde_json::to_string_pretty(&doc)?.as_bytes(),
+        )?;
+        let mut fig = Figure::new("Hysteresis loop", "drift  [mm]", "force  [kN]")
+            .legend_at(LegendPosition::None);
+        fig.push(Series::line(
+            "",
+            drifts.iter().zip(&rows).map(|(d, r)| (1e3 * d, 1e-3 * r.0)),
+        ));
+        render(&fig, &dir.join("hysteresis"))?;
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        Format::Csv => print!("{}", csv(&drifts, &rows)?),
+        Format::Table => println!(
+            "{}: {} drifts, peak force {:.6e} N, dissipated {:.6e} J",
+            doc["law"]["law"].as_str().unwrap_or(""),
+            drifts.len(),
+            doc["peak_force"].as_f64().unwrap_or(f64::NAN),
+            doc["total_dissipated"].as_f64().unwrap_or(f64::NAN),
+        ),
+    }
+    Ok(())
+}
+
+fn csv(drifts: &[f64], rows: &[(f64, f64)]) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    w.row(["drift", "force", "dissipated"])?;
+    for (d, (f, e)) in drifts.iter().zip(rows) {
+        w.row([format!("{d:e}"), format!("{f:e}"), format!("{e:e}")])?;
+    }
+    w.finish()
+}

@@ -1,0 +1,108 @@
+"""Storeys that yield: :func:`hysteresis`, a storey law (elastic,
+bilinear, Bouc–Wen) under a cyclic drift protocol or a drift history
+(``vibroimpact hysteresis``).
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from . import _core
+from ._checks import _count, _floats, _method, _real
+from ._results import Result
+
+
+def _drift_history(drift: Any) -> Optional[np.ndarray]:
+    """The drifts of ``drift``: an array, or a file of one drift a line (a
+    header line and ``#`` comments skipped), as ``--drift FILE`` reads."""
+    if drift is None:
+        return None
+    if isinstance(drift, (str, os.PathLike)):
+        path = os.fspath(drift)
+        try:
+            with open(path, encoding="utf-8") as f:
+                lines = f.read().splitlines()
+        except OSError as e:
+            raise OSError(f"drift: {path}: cannot read: {e.strerror}") from None
+        values = []
+        for i, line in enumerate(lines):
+            text = line.strip()
+            if not text or text.startswith("#"):
+                continue
+            try:
+                values.append(float(text))
+            except ValueError:
+                if values:
+                    raise ValueError(f"drift: {path}:{i + 1}: `{text}` is not a drift") from None
+        drift = values
+    d = _floats(drift, "drift", allow_scalar=False)
+    if d.size == 0:
+        raise ValueError("drift: no drifts")
+    return d
+
+
+def hysteresis(
+    *,
+    stiffness: float,
+    law: str = "bilinear",
+    yield_drift: Optional[float] = None,
+    post_yield_ratio: float = 0.05,
+    exponent: float = 2.0,
+    beta: float = 0.5,
+    gamma: float = 0.5,
+    degradation_a: float = 0.0,
+    degradation_nu: float = 0.0,
+    degradation_eta: float = 0.0,
+    amplitudes: Optional[Sequence[float]] = None,
+    cycles: int = 2,
+    points: int = 200,
+    drift: Any = None,
+    rtol: float = 1e-10,
+) -> Result:
+    """A storey law under cyclic drift (``vibroimpact hysteresis``).
+
+    ``law``: ``"elastic"``, ``"bilinear"`` (kinematic hardening, OpenSees
+    Steel01 without isotropic terms) or ``"bouc-wen"`` (OpenSees BoucWen in
+    yield-drift form, docs/theory.md §11). ``stiffness`` (N/m),
+    ``yield_drift`` (m), ``post_yield_ratio`` in [0, 1); Bouc–Wen's
+    ``exponent``, ``beta``, ``gamma`` and degradation ``degradation_a``,
+    ``degradation_nu``, ``degradation_eta`` (1/J). The drift: the protocol
+    of ``amplitudes`` (m) held ``cycles`` sine cycles each, ``points``
+    samples a cycle (a multiple of 4), or ``drift``, an array or a file of
+    drifts (m, linear between them, from rest). Bouc–Wen is integrated
+    along the drift to ``rtol``.
+
+    Returns ``law`` (its parameters), ``units``, ``peak_force`` (N),
+    ``total_dissipated`` (J) and the arrays ``drift``, ``force`` and
+    ``dissipated`` (the energy dissipated up to each drift)."""
+    history = _drift_history(drift)
+    amps = [] if amplitudes is None else [float(a) for a in _floats(amplitudes, "amplitudes")]
+    if history is None and not amps:
+        raise ValueError("amplitudes: give the protocol's drift amplitudes (m), or drift=")
+    if history is not None and amps:
+        raise ValueError("drift: give drift= or amplitudes=, not both")
+    spec = (
+        _method(law, ("elastic", "bilinear", "bouc-wen"), "law"),
+        _real(stiffness, "stiffness"),
+        _real(yield_drift, "yield_drift", optional=True),
+        _real(post_yield_ratio, "post_yield_ratio"),
+        _real(exponent, "exponent"),
+        _real(beta, "beta"),
+        _real(gamma, "gamma"),
+        _real(degradation_a, "degradation_a"),
+        _real(degradation_nu, "degradation_nu"),
+        _real(degradation_eta, "degradation_eta"),
+    )
+    return Result(
+        _core.hysteresis(
+            spec,
+            amps,
+            _count(cycles, "cycles", minimum=1, maximum=10**6),
+            _count(points, "points", minimum=4, maximum=10**7),
+            history,
+            _real(rtol, "rtol", positive=True),
+        )
+    )

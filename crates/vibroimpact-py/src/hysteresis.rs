@@ -1,0 +1,78 @@
+//! `hysteresis`: a storey law under a cyclic drift protocol or a drift
+//! history (as `vibroimpact hysteresis`).
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact::hysteresis::{cyclic_protocol, under_drift, StoreySpec};
+use vibroimpact::results::hysteresis_document;
+
+use crate::convert::{array1, floats, numerical_error, to_python, value_error};
+
+/// The law's name and parameters as Python gives them: law, stiffness,
+/// yield drift, post-yield ratio, exponent, β, γ, δ_A, δ_ν, δ_η.
+type Law = (String, f64, Option<f64>, f64, f64, f64, f64, f64, f64, f64);
+
+/// The spec of the law named `name`.
+fn spec(
+    (name, _, yield_drift, post_yield_ratio, exponent, beta, gamma, a, nu, eta): &Law,
+) -> PyResult<StoreySpec> {
+    let uy = || yield_drift.ok_or_else(|| value_error("yield_drift: give the yield drift (m)"));
+    let post_yield_ratio = *post_yield_ratio;
+    let (exponent, beta, gamma) = (*exponent, *beta, *gamma);
+    let (a, nu, eta) = (*a, *nu, *eta);
+    Ok(match name.as_str() {
+        "elastic" => StoreySpec::Elastic,
+        "bilinear" => StoreySpec::Bilinear {
+            yield_drift: uy()?,
+            post_yield_ratio,
+        },
+        "bouc-wen" => StoreySpec::BoucWen {
+            yield_drift: uy()?,
+            post_yield_ratio,
+            exponent: Some(exponent),
+            beta: Some(beta),
+            gamma: Some(gamma),
+            degradation_a: Some(a),
+            degradation_nu: Some(nu),
+            degradation_eta: Some(eta),
+        },
+        other => {
+            return Err(value_error(format!(
+                "law = {other:?}: give \"elastic\", \"bilinear\" or \"bouc-wen\""
+            )))
+        }
+    })
+}
+
+/// The `hysteresis` document with the rows as the arrays `drift`,
+/// `force` and `dissipated`: the law under `drift` (m, linear between the
+/// values, from rest) or, without it, the cyclic protocol of `amplitudes`
+/// (m) × `cycles`, `points` samples a cycle.
+#[pyfunction]
+#[pyo3(signature = (law, amplitudes, cycles, points, drift, rtol))]
+pub fn hysteresis<'py>(
+    py: Python<'py>,
+    law: Law,
+    amplitudes: Vec<f64>,
+    cycles: usize,
+    points: usize,
+    drift: Option<PyReadonlyArray1<'py, f64>>,
+    rtol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let storey = spec(&law)?.law(law.1).map_err(value_error)?;
+    let drifts = match drift {
+        Some(d) => floats(&d, "drift")?,
+        None => cyclic_protocol(&amplitudes, cycles, points).map_err(value_error)?,
+    };
+    let rows = py
+        .detach(|| under_drift(&storey, &drifts, rtol))
+        .map_err(numerical_error)?;
+    let doc =
+        to_python(py, &hysteresis_document(&storey, &drifts, &rows))?.cast_into::<PyDict>()?;
+    doc.del_item("rows")?;
+    doc.set_item("force", array1(py, rows.iter().map(|r| r.0).collect()))?;
+    doc.set_item("dissipated", array1(py, rows.iter().map(|r| r.1).collect()))?;
+    doc.set_item("drift", array1(py, drifts))?;
+    Ok(doc)
+}
