@@ -32,8 +32,8 @@ pub fn status() -> ProgressBar {
 
 /// Says up front, on standard error, that a run will take long (its
 /// estimated steps and time), if it will; the run goes on.
-pub fn announce_long(work: &vibroimpact::simulate::WorkEstimate) {
-    if work.is_long() {
+pub fn announce_long(work: Option<vibroimpact::simulate::WorkEstimate>) {
+    if let Some(work) = work.filter(|w| w.is_long()) {
         eprintln!(
             "note: {}; Ctrl-C stops it and keeps what is complete",
             work.describe()

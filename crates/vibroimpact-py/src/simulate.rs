@@ -56,7 +56,8 @@ pub fn simulate<'py>(
         integrator,
         ..SimulationOptions::default()
     };
-    warn_if_long(py, &estimate_work(m, &opts))?;
+    let work = py.detach(|| estimate_work(m, &opts));
+    warn_if_long(py, work)?;
     let job = model.loaded.clone();
     let result = monitor::run(py, progress, move |p: &Progress| {
         p.track_time(duration);
@@ -93,14 +94,15 @@ pub fn simulate<'py>(
 }
 
 /// A `LongRunWarning` with the estimate, if the run will take long.
-pub(crate) fn warn_if_long(py: Python<'_>, work: &WorkEstimate) -> PyResult<()> {
-    if !work.is_long() {
+pub(crate) fn warn_if_long(py: Python<'_>, work: Option<WorkEstimate>) -> PyResult<()> {
+    let Some(work) = work.filter(|w| w.is_long()) else {
         return Ok(());
-    }
+    };
     let text = format!(
         "{}; Ctrl-C stops it and keeps what is complete",
         work.describe()
     );
     let text = std::ffi::CString::new(text).map_err(crate::convert::value_error)?;
-    PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 1)
+    // Level 2: the user's call of vi.simulate, not the package's.
+    PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 2)
 }

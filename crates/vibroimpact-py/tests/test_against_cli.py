@@ -269,6 +269,16 @@ def test_periodic_guesses(cli, tmp_path):
     close(f.initial_state, again["initial_state"])
     with pytest.raises(OSError, match="cannot read it"):
         vi.periodic(m, guess="no-such.json")
+    # Forced through a body, not the base: no amplitude for the homotopy,
+    # refused by the guess's own name in both faces.
+    forced = tmp_path / "forced.toml"
+    forced.write_text(
+        "[row]\ncount = 1\nmass = 1\nnatural_frequency = 5\ndamping_ratio = 0.02\n"
+        "clearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n"
+        "[[force]]\nbody = \"p1\"\namplitude = 1\nfrequency = 4\n"
+    )
+    with pytest.raises(ValueError, match="guess = 'homotopy': the homotopy needs a forcing amplitude"):
+        vi.periodic(forced, guess="homotopy")
 
 
 @pytest.mark.parametrize("parameter,from_,to", [

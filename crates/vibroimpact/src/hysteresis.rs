@@ -29,7 +29,8 @@ use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, OdeSys
 #[error("{key} = {value}: {message}")]
 pub struct LawError {
     /// The key (`stiffness`, `yield_drift`, `post_yield_ratio`, `exponent`,
-    /// `beta`, `gamma`, `degradation`).
+    /// `beta`, `gamma`, `degradation_a`, `degradation_nu`,
+    /// `degradation_eta`; of a protocol `amplitudes`, `cycles`, `points`).
     pub key: &'static str,
     /// Its value.
     pub value: f64,
@@ -172,9 +173,9 @@ impl Bilinear {
 impl BoucWen {
     /// Refuses a stiffness or yield drift ≤ 0, a post-yield ratio outside
     /// [0, 1), an exponent below 1 (|z|ⁿ then has an infinite slope at
-    /// z = 0), β + γ ≤ 0 (z unbounded under loading), γ − β > 1 (a
-    /// negative tangent on unloading from yield) and degradation
-    /// coefficients below 0.
+    /// z = 0), β + γ ≤ 0 (z unbounded under loading), β < 0 (the tangent on
+    /// unloading from saturation, 2β/(β + γ) of the elastic one, turns
+    /// negative) and degradation coefficients below 0.
     pub fn check(&self) -> Result<(), LawError> {
         check_common(self.stiffness, self.yield_drift, self.post_yield_ratio)?;
         need(
@@ -193,24 +194,24 @@ impl BoucWen {
         need(
             "beta",
             self.beta,
-            self.gamma - self.beta <= 1.0,
-            "give gamma - beta <= 1 (else the tangent turns negative on unloading)",
+            self.beta >= 0.0,
+            "give beta >= 0 (else the tangent turns negative on unloading)",
         )?;
         let dg = &self.degradation;
         need(
-            "degradation.a",
+            "degradation_a",
             dg.a,
             dg.a >= 0.0,
             "must be finite and >= 0",
         )?;
         need(
-            "degradation.nu",
+            "degradation_nu",
             dg.nu,
             dg.nu >= 0.0,
             "must be finite and >= 0",
         )?;
         need(
-            "degradation.eta",
+            "degradation_eta",
             dg.eta,
             dg.eta >= 0.0,
             "must be finite and >= 0",
@@ -251,16 +252,19 @@ impl BoucWen {
             law: *self,
             sign: (d1 - d0).signum(),
         };
-        // Integrate in the distance travelled, s ∈ [0, |d1 − d0|].
+        // In the distance travelled over u_y, with z over u_y and the work
+        // over k u_y²: one tolerance for both.
+        let (uy, scale) = (self.yield_drift, self.stiffness * self.yield_drift.powi(2));
         let opts = IntegratorOptions {
             rtol,
-            atol: rtol * self.yield_drift,
+            atol: rtol,
             ..IntegratorOptions::default()
         };
-        let (y, _) = integrate_to(&mut sys, 0.0, &[s.z, s.work], (d1 - d0).abs(), &opts)?;
+        let y0 = [s.z / uy, s.work / scale];
+        let (y, _) = integrate_to(&mut sys, 0.0, &y0, (d1 - d0).abs() / uy, &opts)?;
         Ok(Hysteretic {
-            z: y[0],
-            work: y[1],
+            z: y[0] * uy,
+            work: y[1] * scale,
         })
     }
 }
@@ -276,14 +280,16 @@ impl OdeSystem for AlongDrift {
     fn dim(&self) -> usize {
         2
     }
+    /// In the scaled variables of [`BoucWen::advance`].
     fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+        let (uy, k) = (self.law.yield_drift, self.law.stiffness);
         let s = Hysteretic {
-            z: y[0],
-            work: y[1],
+            z: y[0] * uy,
+            work: y[1] * k * uy * uy,
         };
         let (dz, dw) = self.law.slope(s, self.sign);
         dydt[0] = self.sign * dz;
-        dydt[1] = self.sign * dw;
+        dydt[1] = self.sign * dw / (k * uy);
     }
 }
 
@@ -431,6 +437,9 @@ impl StoreySpec {
     }
 }
 
+/// The most samples a cyclic protocol may have (800 MB of drifts).
+pub const MAX_PROTOCOL_SAMPLES: f64 = 1e8;
+
 /// A cyclic drift protocol: `cycles` sine cycles at each amplitude of
 /// `amplitudes` (m) in turn, `points` samples a cycle (a multiple of 4, so
 /// that the turning points are samples), from rest.
@@ -453,6 +462,14 @@ pub fn cyclic_protocol(
     }
     if cycles == 0 {
         return Err(bad("cycles", 0.0, "give at least one cycle"));
+    }
+    let total = (cycles as f64) * (points as f64) * amplitudes.len() as f64;
+    if total > MAX_PROTOCOL_SAMPLES {
+        return Err(bad(
+            "points",
+            points as f64,
+            "the protocol would have more than 1e8 samples (amplitudes x cycles x points)",
+        ));
     }
     if let Some(&a) = amplitudes.iter().find(|a| !(a.is_finite() && **a > 0.0)) {
         return Err(bad("amplitudes", a, "give finite amplitudes > 0"));

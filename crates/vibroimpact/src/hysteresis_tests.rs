@@ -156,7 +156,8 @@ fn bad_settings_name_the_key() {
         (StoreyLaw::BoucWen(bouc_wen(0.5)), "exponent"),
         (
             StoreyLaw::BoucWen(BoucWen {
-                beta: -0.5,
+                beta: -0.1,
+                gamma: 0.4,
                 ..bouc_wen(1.0)
             }),
             "beta",
@@ -169,7 +170,7 @@ fn bad_settings_name_the_key() {
                 },
                 ..bouc_wen(1.0)
             }),
-            "degradation.eta",
+            "degradation_eta",
         ),
     ];
     for (law, key) in cases {

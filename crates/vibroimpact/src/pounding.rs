@@ -571,12 +571,15 @@ pub fn pounding_spectrum(
     run: &RunSettings,
 ) -> Result<Vec<SpectrumCell>, PoundingError> {
     use rayon::prelude::*;
-    if records.is_empty() || gaps.is_empty() || ratios.is_empty() {
-        return Err(FieldError::about(
-            "records",
-            "a pounding spectrum needs records, gaps and period ratios",
-        )
-        .into());
+    for (field, empty) in [
+        ("records", records.is_empty()),
+        ("gaps", gaps.is_empty()),
+        ("ratios", ratios.is_empty()),
+    ] {
+        if empty {
+            let message = "a pounding spectrum needs records, gaps and period ratios";
+            return Err(FieldError::about(field, message).into());
+        }
     }
     if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
         return Err(FieldError::new("gaps", g, "give finite gaps >= 0").into());

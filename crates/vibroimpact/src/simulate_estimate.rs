@@ -14,7 +14,8 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use super::{simulate, SimulationOptions, CRAWL_FACTOR};
+use super::global::check_run;
+use super::{effective_method, simulate, SimulationOptions, CRAWL_FACTOR};
 use crate::model::{BaseExcitation, Model};
 
 /// DOP853's steps per cycle of the fastest scale at rtol 1e-8 (a damped
@@ -74,7 +75,7 @@ impl WorkEstimate {
         let how = if self.probed > 0.0 {
             format!("scaled from its first {:.3e} s", self.probed)
         } else {
-            "at least: the fastest time scale's steps".to_string()
+            "by the fastest time scale".to_string()
         };
         let mut text = format!(
             "a long run: about {:.2e} integration steps, about {} on one core ({how})",
@@ -130,8 +131,11 @@ fn fastest_rate(model: &Model) -> f64 {
 
 /// The work of simulating `model` with `opts`: the bound from its fastest
 /// time scale, or a probe of the run's first part where the bound exceeds
-/// `PROBE_FROM` seconds.
-pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> WorkEstimate {
+/// `PROBE_FROM` seconds. None for a run its checks refuse (the run itself
+/// says why).
+pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> Option<WorkEstimate> {
+    check_run(model, opts).ok()?;
+    effective_method(model, opts).ok()?;
     let cycles = opts.t_end * fastest_rate(model) / (2.0 * PI);
     let per_cycle = STEPS_PER_CYCLE * (1e-8 / opts.rtol.clamp(1e-14, 1e-2)).powf(0.125);
     let parts = (model.bodies().len() + model.contacts().len()) as f64;
@@ -143,7 +147,7 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> WorkEstimate {
         max_steps: opts.max_steps,
     };
     if bound.seconds.is_nan() || bound.seconds <= PROBE_FROM {
-        return bound;
+        return Some(bound);
     }
     // The probe runs to the bound's share of PROBE_SECONDS, or as many
     // steps as the bound prices at PROBE_SECONDS if impacts make it
@@ -158,8 +162,10 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> WorkEstimate {
         ..opts.clone()
     };
     let clock = Instant::now();
-    match simulate(model, &probe) {
-        Ok(sim) if sim.final_time > 0.0 && sim.stats.steps > 0 => {
+    // (The local integrator may take no step at all in free flight: the
+    // probe's time still scales.)
+    Some(match simulate(model, &probe) {
+        Ok(sim) if sim.final_time > 0.0 => {
             let scale = opts.t_end / sim.final_time;
             WorkEstimate {
                 steps: sim.stats.steps as f64 * scale,
@@ -169,7 +175,7 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> WorkEstimate {
             }
         }
         _ => bound,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -190,7 +196,7 @@ mod tests {
             t_end: periods * period,
             ..SimulationOptions::default()
         };
-        let short = estimate_work(&model, &opts(200.0));
+        let short = estimate_work(&model, &opts(200.0)).unwrap();
         let run = simulate(&model, &opts(200.0)).unwrap();
         assert_eq!(short.probed, 0.0);
         assert!(!short.is_long());
@@ -200,7 +206,7 @@ mod tests {
             short.steps,
             run.stats.steps
         );
-        let long = estimate_work(&model, &opts(1e7));
+        let long = estimate_work(&model, &opts(1e7)).unwrap();
         assert!(long.probed > 0.0 && long.probed < 1000.0 * period);
         let per_period = long.steps / 1e7;
         let measured = run.stats.steps as f64 / 200.0;

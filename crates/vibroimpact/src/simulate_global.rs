@@ -133,7 +133,7 @@ pub fn simulate_streaming(
 
 /// The checks of a run beyond the options' own: the output samples within
 /// [`MAX_SAMPLES`], a record's duration within the record.
-fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
+pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
     check_options(opts)?;
     if let Some(dt) = opts.output_step {
         let samples = (opts.t_end - opts.output_from) / dt + 1.0;

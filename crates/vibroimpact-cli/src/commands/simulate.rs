@@ -294,7 +294,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         interrupt: Some(interrupt.clone()),
         ..opts
     };
-    crate::progress::announce_long(&estimate_work(model, &opts));
+    crate::progress::announce_long(estimate_work(model, &opts));
     let mut history = match &args.out {
         Some(dir) => {
             ensure_dir(dir)?;

@@ -8,6 +8,7 @@ use super::study::{Linear, StudyError, StudyField};
 use super::{is_symmetric_orbit, primary_orbit, ContinuationOptions};
 use crate::model::Model;
 use crate::model_file::ModelDocument;
+use crate::parameter::ParameterizedModel;
 use crate::periodic::{
     guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, OrbitSummary,
     PeriodicSolution, ShootingOptions, MIN_ARNOLDI,
@@ -105,13 +106,22 @@ impl OrbitStudy {
                 format!("at least {need} Krylov vectors are needed for a stability verdict"),
             ));
         }
-        if let Guess::State(x) = &self.guess {
-            if x.len() != d {
+        match &self.guess {
+            Guess::State(x) if x.len() != d => {
                 return Err(invalid(
                     StudyField::Guess,
                     format!("has {} values, the model needs {d} (u then v)", x.len()),
                 ));
             }
+            Guess::Homotopy => {
+                if let Err(e) = ParameterizedModel::in_amplitude(document.clone()) {
+                    return Err(invalid(
+                        StudyField::Guess,
+                        format!("the homotopy needs a forcing amplitude to vary: {e}"),
+                    ));
+                }
+            }
+            _ => {}
         }
         Ok(CheckedOrbit {
             study: self,
@@ -144,7 +154,14 @@ impl CheckedOrbit {
                     },
                     ..ContinuationOptions::default()
                 };
-                primary_orbit(&self.document, &continuation)?
+                // The homotopy is the guess here, not a branch's start.
+                primary_orbit(&self.document, &continuation).map_err(|e| match e {
+                    StudyError::Invalid { message, .. } => StudyError::Invalid {
+                        field: StudyField::Guess,
+                        message,
+                    },
+                    other => other,
+                })?
             }
         };
         let solution = match self.krylov {
