@@ -28,6 +28,10 @@ use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian, Recorder};
 use crate::model::{BaseExcitation, Model};
 use crate::variational::Variational;
 
+#[path = "dynamics_storeys.rs"]
+mod storeys;
+pub use storeys::{Branch, StoreyTerms};
+
 /// Index in the interleaved state `[u_1, v_1, …]` of component k of a
 /// body-order state `[u_1..u_N, v_1..v_N]` of N bodies.
 #[inline]
@@ -122,6 +126,7 @@ pub struct ChainDynamics {
     contact_evaluations: u64,
     bandwidth: (usize, usize),
     screen: ScreenSoA,
+    storeys: StoreyTerms,
 }
 
 /// Contact screening in structure-of-arrays form (the hot loop of every
@@ -184,7 +189,9 @@ impl ChainDynamics {
                 }
             })
             .collect::<Vec<_>>();
-        let mut reach = 0;
+        let first_state = 2 * n + if energy { 3 } else { 0 };
+        let storeys = StoreyTerms::new(model.storeys(), first_state, model.initial_displacement());
+        let mut reach = storeys.reach();
         for c in model.couplings() {
             reach = reach.max(c.a.abs_diff(c.b));
         }
@@ -255,6 +262,7 @@ impl ChainDynamics {
             contact_evaluations: 0,
             bandwidth,
             screen,
+            storeys,
         }
     }
 
@@ -276,6 +284,16 @@ impl ChainDynamics {
     /// Contact law evaluations so far (skipped contacts not counted).
     pub fn contact_evaluations(&self) -> u64 {
         self.contact_evaluations
+    }
+
+    /// The hysteretic storeys.
+    pub fn storeys(&self) -> &StoreyTerms {
+        &self.storeys
+    }
+
+    /// The hysteretic storeys, to switch a bilinear storey's branch.
+    pub fn storeys_mut(&mut self) -> &mut StoreyTerms {
+        &mut self.storeys
     }
 
     /// The onset approach velocity of contact k's current impact.
@@ -476,7 +494,7 @@ impl Chain for SetSystem {
 
 impl OdeSystem for ChainDynamics {
     fn dim(&self) -> usize {
-        2 * self.n + if self.energy { 3 } else { 0 }
+        2 * self.n + if self.energy { 3 } else { 0 } + self.storeys.states()
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
@@ -508,6 +526,7 @@ impl OdeSystem for ChainDynamics {
             self.force[b] -= f;
             damper += c * dv * dv;
         }
+        self.storeys.apply(y, &mut self.force, dydt);
         let (sc, contacts, onset, force) = (
             &self.screen,
             &self.contacts,
@@ -596,14 +615,15 @@ impl OdeSystem for ChainDynamics {
     /// Banded for the mechanical state; dense with the energy quadratures
     /// (their rows depend on every velocity).
     fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
-        (!self.energy).then_some(self.bandwidth)
+        (!self.energy && !self.storeys.integrated()).then_some(self.bandwidth)
     }
 
     /// Analytic ∂f/∂y: springs, dampers, couplings and every contact not
     /// screened out, with the laws' analytic partial derivatives. The energy
     /// quadratures' rows are left to finite differences (returns false then).
     fn jacobian(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
-        if self.energy {
+        // The storeys' hysteretic terms are left to finite differences.
+        if self.energy || !self.storeys.is_empty() {
             return false;
         }
         for i in 0..self.n {

@@ -173,6 +173,7 @@ pub struct Model {
     forces: Vec<HarmonicForce>,
     initial_displacement: Vec<f64>,
     initial_velocity: Vec<f64>,
+    storeys: Vec<Storey>,
 }
 
 /// `v` must be finite and >= 0; `key` is its path, `what` names it (both
@@ -243,6 +244,7 @@ impl Model {
             contacts,
             base,
             forces,
+            storeys: Vec::new(),
         };
         check_overlaps(&model)?;
         Ok(model)
@@ -544,8 +546,11 @@ impl Model {
 
 #[path = "model_excitation.rs"]
 mod excitation;
+#[path = "model_storey.rs"]
+mod storey;
 
 pub use excitation::{Accelerogram, BaseExcitation, HarmonicForce};
+pub use storey::Storey;
 
 /// Every body's mass finite and positive, its support's stiffness and
 /// damping finite and nonnegative.

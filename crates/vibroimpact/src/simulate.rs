@@ -509,6 +509,8 @@ mod global;
 mod integrator;
 #[path = "local.rs"]
 pub mod local;
+#[path = "simulate_switches.rs"]
+mod switches;
 
 pub use estimate::{estimate_work, WorkEstimate, LONG_RUN};
 use events::{contact_at, contact_end, StepScan, Tracker};

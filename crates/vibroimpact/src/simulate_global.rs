@@ -4,6 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
+use super::switches::{Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -76,15 +77,31 @@ pub fn simulate_streaming(
         }
         _ => None,
     };
+    let mut switches = Switches::new(&sys, y0.len());
     let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
             next_break += 1;
         }
-        let bound = breakpoints.get(next_break).copied().unwrap_or(opts.t_end);
+        let mut bound = breakpoints.get(next_break).copied().unwrap_or(opts.t_end);
+        if let Some(sw) = switches.as_mut() {
+            bound = sw.before_step(&st, bound);
+        }
         if let Err(e) = st.step(&mut sys, bound) {
             error = Some(e);
             break;
+        }
+        let mut switch_here = None;
+        if let Some(sw) = switches.as_mut() {
+            match sw.after_step(&mut st, &mut sys) {
+                Err(e) => {
+                    error = Some(e);
+                    break;
+                }
+                Ok(Verdict::Retake) => continue,
+                Ok(Verdict::Switch(k)) => switch_here = Some(k),
+                Ok(Verdict::Clear) => {}
+            }
         }
         scan.scan(&mut st, &mut sys);
         if let Some(x) = extrema.as_mut() {
@@ -115,6 +132,16 @@ pub fn simulate_streaming(
             }
         }
         sink_stopped = output.samples(&mut st, &mut sys);
+        // A bilinear storey's branch switches where the step ended; the
+        // right-hand side changes there, so the stepper restarts.
+        if let Some(k) = switch_here {
+            let (t, y) = (st.t(), st.y().to_vec());
+            sys.storeys_mut().switch(k, &y);
+            if let Err(e) = st.reset(&mut sys, t, &y) {
+                error = Some(e);
+                break;
+            }
+        }
     }
     if let (None, Some(t)) = (&error, sink_stopped) {
         error = Some(IntegrationError::Interrupted { t });
@@ -135,6 +162,18 @@ pub fn simulate_streaming(
 /// [`MAX_SAMPLES`], a record's duration within the record.
 pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
     check_options(opts)?;
+    if !model.storeys().is_empty() {
+        if opts.integrator == Integrator::Local {
+            return Err(OptionsError(
+                "integrator = local: the local integrator does not carry hysteretic storeys yet (docs/decisions.md D26); use global or auto".into(),
+            ));
+        }
+        if opts.energy {
+            return Err(OptionsError(
+                "energy: the energy audit does not carry hysteretic storeys yet (docs/decisions.md D26)".into(),
+            ));
+        }
+    }
     if let Some(dt) = opts.output_step {
         let samples = (opts.t_end - opts.output_from) / dt + 1.0;
         if samples > MAX_SAMPLES {

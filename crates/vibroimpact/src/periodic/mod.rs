@@ -268,6 +268,11 @@ pub(crate) fn map_time(model: &Model, opts: &ShootingOptions) -> Result<f64, Per
 /// integrator's track it but their derivatives miss its dependence on the
 /// state (Newton stalls at 0.04); docs/decisions.md D24.
 pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
+    // Hysteretic storeys: their branches and states are not in the map's
+    // state (D26).
+    if !model.storeys().is_empty() {
+        return Err("hysteretic storeys: their history is not part of the period map's state: no shooting, continuation or Lyapunov exponents with them (simulations and pounding runs are fine)".into());
+    }
     match (0..model.contacts().len()).find(|&k| model.contacts()[k].law.needs_impact_velocity()) {
         Some(k) => Err(format!(
             "contact {}: its law needs the impact's onset velocity, whose dependence on the state the period map and its derivatives do not carry yet: no shooting, continuation or Lyapunov exponents with it (simulations, sweeps and pounding runs are fine)",

@@ -1,0 +1,193 @@
+//! The hysteretic storeys in the equations of motion (docs/theory.md §11).
+//!
+//! A Bouc–Wen storey integrates its hysteretic drift z and the work e of
+//! its hysteretic part with the state: (z, e) after the bodies' (u, v).
+//! A bilinear storey carries its branch as memory instead, as a contact
+//! carries its onset velocity: elastic through an anchor, z = z₀ + d − d₀,
+//! or plastic at z = ±u_y. Within a step its force is then linear in the
+//! drift; the run locates a switch (yield: |z| reaches u_y; unloading: ḋ
+//! turns against z) on the step's dense output, takes the step again up to
+//! it and switches the branch there ([`StoreyTerms::switch_value`],
+//! [`StoreyTerms::switch`]).
+
+use crate::hysteresis::{Hysteretic, StoreyLaw};
+use crate::model::Storey;
+
+/// How far past the yield drift (relative) the elastic branch may go
+/// before a switch counts: a switch just located (ḋ = 0 to the last bits)
+/// does not switch back at once.
+const YIELD_SLACK: f64 = 1e-10;
+
+/// A bilinear storey's branch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Branch {
+    /// z = z₀ + d − d₀.
+    Elastic {
+        /// The drift at the anchor.
+        d0: f64,
+        /// z there.
+        z0: f64,
+    },
+    /// z held at ±u_y while the drift goes on outwards.
+    Plastic {
+        /// ±u_y.
+        z: f64,
+    },
+}
+
+/// One storey's term.
+#[derive(Clone, Debug)]
+struct Term {
+    below: Option<usize>,
+    above: usize,
+    law: StoreyLaw,
+    /// The branch of a bilinear storey.
+    branch: Branch,
+    /// Where a Bouc–Wen storey's (z, e) sit in the state.
+    state: Option<usize>,
+}
+
+/// The hysteretic storeys of a model, as the equations of motion use them.
+#[derive(Clone, Debug, Default)]
+pub struct StoreyTerms {
+    terms: Vec<Term>,
+    states: usize,
+}
+
+impl StoreyTerms {
+    /// The terms of `storeys`; a Bouc–Wen storey's state from index
+    /// `first_state` on (two each); every bilinear storey elastic from
+    /// rest at the initial drifts of `u0` (displacements, body order).
+    pub fn new(storeys: &[Storey], first_state: usize, u0: &[f64]) -> Self {
+        let mut states = 0;
+        let terms = storeys
+            .iter()
+            .map(|s| {
+                let d0 = u0[s.above] - s.below.map_or(0.0, |b| u0[b]);
+                let state = matches!(s.law, StoreyLaw::BoucWen(_)).then(|| {
+                    states += 2;
+                    first_state + states - 2
+                });
+                Term {
+                    below: s.below,
+                    above: s.above,
+                    law: s.law,
+                    branch: Branch::Elastic { d0, z0: 0.0 },
+                    state,
+                }
+            })
+            .collect();
+        Self { terms, states }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.terms.is_empty()
+    }
+
+    /// How many states the Bouc–Wen storeys add.
+    pub fn states(&self) -> usize {
+        self.states
+    }
+
+    /// Whether any storey integrates a state (then the Jacobian is dense).
+    pub fn integrated(&self) -> bool {
+        self.states > 0
+    }
+
+    /// The farthest apart two bodies a storey joins (for the bandwidth).
+    pub fn reach(&self) -> usize {
+        self.terms
+            .iter()
+            .filter_map(|t| t.below.map(|b| b.abs_diff(t.above)))
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Storey k's drift and drift rate in the interleaved state `y`.
+    fn drift(&self, k: usize, y: &[f64]) -> (f64, f64) {
+        let t = &self.terms[k];
+        let (u, v) = (y[2 * t.above], y[2 * t.above + 1]);
+        match t.below {
+            Some(b) => (u - y[2 * b], v - y[2 * b + 1]),
+            None => (u, v),
+        }
+    }
+
+    /// Storey k's hysteretic state in `y`.
+    fn hysteretic(&self, k: usize, d: f64, y: &[f64]) -> Hysteretic {
+        let t = &self.terms[k];
+        match (t.state, t.branch) {
+            (Some(i), _) => Hysteretic {
+                z: y[i],
+                work: y[i + 1],
+            },
+            (None, Branch::Elastic { d0, z0 }) => Hysteretic {
+                z: z0 + d - d0,
+                work: 0.0,
+            },
+            (None, Branch::Plastic { z }) => Hysteretic { z, work: 0.0 },
+        }
+    }
+
+    /// Adds every storey's force to the bodies' `force` and writes the
+    /// Bouc–Wen states' rates into `dydt`.
+    pub fn apply(&self, y: &[f64], force: &mut [f64], dydt: &mut [f64]) {
+        for (k, t) in self.terms.iter().enumerate() {
+            let (d, dd) = self.drift(k, y);
+            let s = self.hysteretic(k, d, y);
+            let f = t.law.force(d, s);
+            force[t.above] -= f;
+            if let Some(b) = t.below {
+                force[b] += f;
+            }
+            if let (Some(i), StoreyLaw::BoucWen(w)) = (t.state, &t.law) {
+                let (dz, de) = w.slope(s, dd);
+                dydt[i] = dd * dz;
+                dydt[i + 1] = dd * de;
+            }
+        }
+    }
+
+    /// The bilinear storeys (the ones whose branch switches).
+    pub fn bilinear(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.terms.len()).filter(|&k| matches!(self.terms[k].law, StoreyLaw::Bilinear(_)))
+    }
+
+    /// Bilinear storey k's switch function in `y`: positive while its
+    /// branch holds, zero where it switches (yield from the elastic
+    /// branch, unloading from the plastic one).
+    pub fn switch_value(&self, k: usize, y: &[f64]) -> f64 {
+        let t = &self.terms[k];
+        let StoreyLaw::Bilinear(b) = t.law else {
+            return 1.0;
+        };
+        let (d, dd) = self.drift(k, y);
+        match t.branch {
+            Branch::Elastic { d0, z0 } => b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs(),
+            Branch::Plastic { z } => dd * z.signum(),
+        }
+    }
+
+    /// Switches bilinear storey k's branch in the state `y` where its
+    /// switch function vanished.
+    pub fn switch(&mut self, k: usize, y: &[f64]) {
+        let (d, _) = self.drift(k, y);
+        let s = self.hysteretic(k, d, y);
+        let t = &mut self.terms[k];
+        let StoreyLaw::Bilinear(b) = t.law else {
+            return;
+        };
+        t.branch = match t.branch {
+            Branch::Elastic { .. } => Branch::Plastic {
+                z: b.yield_drift.copysign(s.z),
+            },
+            Branch::Plastic { z } => Branch::Elastic { d0: d, z0: z },
+        };
+    }
+
+    /// Bilinear storey k's branch.
+    pub fn branch(&self, k: usize) -> Branch {
+        self.terms[k].branch
+    }
+}
