@@ -291,6 +291,9 @@ pub(in crate::simulate) fn run(
     let mut sample = vec![0.0; 2 * n];
     let mut next_sample = 0usize;
     // Emits the samples up to `t` (inclusive) from the current motion.
+    let mut whole = opts
+        .accelerations
+        .then(|| (ChainDynamics::new(model, false), vec![0.0; 2 * n]));
     let mut emit = |run: &mut Run, t: f64, stopped: &mut Option<f64>| {
         let Some(dt) = opts.output_step else { return };
         while stopped.is_none() {
@@ -299,10 +302,16 @@ pub(in crate::simulate) fn run(
                 break;
             }
             run.state_at(ts, &mut sample);
-            let body: Vec<f64> = (0..n)
+            let mut body: Vec<f64> = (0..n)
                 .map(|i| sample[2 * i])
                 .chain((0..n).map(|i| sample[2 * i + 1]))
                 .collect();
+            // The accelerations of the whole model at the sample (a Lankarani–
+            // Nikravesh contact's onset velocity is not tracked here).
+            if let Some((sys, rates)) = whole.as_mut() {
+                crate::integrate::OdeSystem::rhs(sys, ts, &sample, rates);
+                body.extend((0..n).map(|i| rates[2 * i + 1]));
+            }
             next_sample += 1;
             if !record(ts, &body) {
                 *stopped = Some(ts);

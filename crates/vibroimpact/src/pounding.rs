@@ -12,183 +12,19 @@
 //! damper α m_i from each floor to the ground and a damper β k_i beside
 //! each storey spring: exactly the model's body dampers and couplings.
 
-use nalgebra::{DMatrix, SymmetricEigen};
-
 use crate::contact::ContactLaw;
-use crate::dynamics::ChainDynamics;
 use crate::field_error::FieldError;
-use crate::integrate::{Method, OdeSystem};
-use crate::model::{Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model};
+use crate::hysteresis::StoreyLaw;
+use crate::integrate::Method;
+use crate::model::{
+    Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model, Storey,
+};
 use crate::record::Record;
 use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
 
-/// A shear frame: floors from the ground up.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ShearFrame {
-    /// Floor masses (kg), from the first floor up.
-    pub masses: Vec<f64>,
-    /// Storey stiffnesses (N/m): storey i joins floor i − 1 (the ground for
-    /// i = 1) to floor i.
-    pub stiffnesses: Vec<f64>,
-    /// Rayleigh damping ratio in the first two modes.
-    pub damping_ratio: f64,
-}
-
-/// Why a pounding study cannot run or did not finish.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum PoundingError {
-    /// The pair refused: the pair file where it came from one, the line
-    /// where known, the key at fault where known (`left`, `right`, `gap`,
-    /// `floors`, `law`), and what is wrong.
-    #[error("{}", pair_text(file.as_deref(), *line, message))]
-    Pair {
-        /// The pair file.
-        file: Option<String>,
-        /// The line in it.
-        line: Option<usize>,
-        /// The key at fault.
-        key: Option<&'static str>,
-        /// What is wrong (naming the frame and floor).
-        message: String,
-    },
-    /// A setting of the study refused, by its field (`sample`, `ratios`,
-    /// `gaps`, `records`).
-    #[error(transparent)]
-    Field(#[from] FieldError),
-    /// A run under a record failed: the record and why.
-    #[error("{record}: {message}")]
-    Run {
-        /// The record's source.
-        record: String,
-        /// Why.
-        message: String,
-    },
-}
-
-/// `FILE:LINE: message`, `FILE: message` or the message.
-fn pair_text(file: Option<&str>, line: Option<usize>, message: &str) -> String {
-    match (file, line) {
-        (Some(f), Some(l)) => format!("{f}:{l}: {message}"),
-        (Some(f), None) => format!("{f}: {message}"),
-        _ => message.to_string(),
-    }
-}
-
-impl PoundingError {
-    /// The pair refused at `key`.
-    fn pair(key: &'static str, message: String) -> Self {
-        PoundingError::Pair {
-            file: None,
-            line: None,
-            key: Some(key),
-            message,
-        }
-    }
-
-    /// A run under `record` failed.
-    fn run(record: &Record, message: impl ToString) -> Self {
-        PoundingError::Run {
-            record: record.source.clone(),
-            message: message.to_string(),
-        }
-    }
-
-    /// The error with the pair file it came from.
-    fn in_file(self, source: &str) -> Self {
-        match self {
-            PoundingError::Pair {
-                line, key, message, ..
-            } => PoundingError::Pair {
-                file: Some(source.to_string()),
-                line,
-                key,
-                message,
-            },
-            other => other,
-        }
-    }
-}
-
-impl ShearFrame {
-    /// Checks the frame: as many storeys as floors, masses and stiffnesses
-    /// positive and finite, a damping ratio in [0, 1).
-    pub fn check(&self, name: &str) -> Result<(), String> {
-        if self.masses.is_empty() || self.masses.len() != self.stiffnesses.len() {
-            return Err(format!(
-                "{name}: {} masses and {} storey stiffnesses; give one of each per floor",
-                self.masses.len(),
-                self.stiffnesses.len()
-            ));
-        }
-        for (i, (m, k)) in self.masses.iter().zip(&self.stiffnesses).enumerate() {
-            if !(m.is_finite() && *m > 0.0 && k.is_finite() && *k > 0.0) {
-                return Err(format!(
-                    "{name}: floor {}: mass {m} and stiffness {k} must be positive and finite",
-                    i + 1
-                ));
-            }
-        }
-        if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
-            return Err(format!(
-                "{name}: damping ratio {}: give a value in [0, 1)",
-                self.damping_ratio
-            ));
-        }
-        Ok(())
-    }
-
-    /// The stiffness matrix K (tridiagonal).
-    fn stiffness_matrix(&self) -> DMatrix<f64> {
-        let n = self.masses.len();
-        let k = &self.stiffnesses;
-        DMatrix::from_fn(n, n, |r, c| {
-            if r == c {
-                k[r] + k.get(r + 1).copied().unwrap_or(0.0)
-            } else if r + 1 == c {
-                -k[c]
-            } else if c + 1 == r {
-                -k[r]
-            } else {
-                0.0
-            }
-        })
-    }
-
-    /// The natural circular frequencies (rad/s), lowest first: the
-    /// eigenvalues of M^{-1/2} K M^{-1/2}.
-    pub fn natural_frequencies(&self) -> Vec<f64> {
-        let k = self.stiffness_matrix();
-        let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
-        let n = s.len();
-        let a = DMatrix::from_fn(n, n, |r, c| s[r] * k[(r, c)] * s[c]);
-        let mut w: Vec<f64> = SymmetricEigen::new(a)
-            .eigenvalues
-            .iter()
-            .map(|l| l.max(0.0).sqrt())
-            .collect();
-        w.sort_by(f64::total_cmp);
-        w
-    }
-
-    /// The fundamental period T1 (s).
-    pub fn period(&self) -> f64 {
-        2.0 * std::f64::consts::PI / self.natural_frequencies()[0]
-    }
-
-    /// Rayleigh's (α, β) with ζ in modes 1 and 2 (one storey: β = 0, α = 2ζω).
-    pub fn rayleigh(&self) -> (f64, f64) {
-        let w = self.natural_frequencies();
-        let z = self.damping_ratio;
-        match w.as_slice() {
-            [w1] => (2.0 * z * w1, 0.0),
-            [w1, w2, ..] => {
-                let alpha = 2.0 * z * w1 * w2 / (w1 + w2);
-                (alpha, 2.0 * z / (w1 + w2))
-            }
-            [] => (0.0, 0.0),
-        }
-    }
-}
+/// The free-vibration tail after the record for a pair with yielding
+/// storeys, in fundamental periods of the longer-period frame.
+pub const TAIL_PERIODS: f64 = 5.0;
 
 /// Two frames side by side, `left` of `right`, with a gap at some floors.
 #[derive(Clone, Debug)]
@@ -240,6 +76,10 @@ impl RunSettings {
 pub struct Response {
     /// Peak storey drifts max |u_i − u_{i−1}| (m), left then right frame.
     pub drift: [Vec<f64>; 2],
+    /// Residual storey drifts (m, signed): the mean drift over each frame's
+    /// last fundamental period (of the free-vibration tail that follows the
+    /// record for yielding storeys).
+    pub residual_drift: [Vec<f64>; 2],
     /// Peak absolute floor accelerations max |ü_i + a_g| over the samples
     /// (m/s²), left then right.
     pub acceleration: [Vec<f64>; 2],
@@ -336,22 +176,43 @@ impl PoundingPair {
         self.check()?;
         let mut bodies = Vec::new();
         let mut couplings = Vec::new();
+        let mut storeys = Vec::new();
         for (name, frame) in [("L", &self.left), ("R", &self.right)] {
             let first = bodies.len();
             let (alpha, beta) = frame.rayleigh();
+            let laws = frame.laws().map_err(|m| PoundingError::Pair {
+                file: None,
+                line: None,
+                key: Some("storeys"),
+                message: m,
+            })?;
             for (i, (&m, &k)) in frame.masses.iter().zip(&frame.stiffnesses).enumerate() {
                 let ground = i == 0;
+                let below = (!ground).then(|| first + i - 1);
+                // A yielding storey's spring is its law; its damper (β k on
+                // the initial stiffness) stays linear.
+                let spring = match laws[i] {
+                    StoreyLaw::Elastic { .. } => k,
+                    law => {
+                        storeys.push(Storey {
+                            below,
+                            above: first + i,
+                            law,
+                        });
+                        0.0
+                    }
+                };
                 bodies.push(Body {
                     name: format!("{name}{}", i + 1),
                     mass: m,
-                    stiffness: if ground { k } else { 0.0 },
+                    stiffness: if ground { spring } else { 0.0 },
                     damping: alpha * m + if ground { beta * k } else { 0.0 },
                 });
-                if !ground {
+                if let Some(a) = below {
                     couplings.push(Coupling {
-                        a: first + i - 1,
+                        a,
                         b: first + i,
-                        stiffness: k,
+                        stiffness: spring,
                         damping: beta * k,
                     });
                 }
@@ -373,8 +234,9 @@ impl PoundingPair {
         } else {
             Vec::new()
         };
+        let (times, acceleration) = self.excitation(record);
         let base = BaseExcitation::Record(
-            Accelerogram::new(record.times.clone(), record.acceleration.clone(), scale)
+            Accelerogram::new(times, acceleration, scale)
                 .map_err(|e| PoundingError::run(record, e))?,
         );
         Model::new(
@@ -386,12 +248,35 @@ impl PoundingPair {
             Vec::new(),
             Vec::new(),
         )
+        .and_then(|m| m.with_storeys(storeys))
         .map_err(|e| PoundingError::Pair {
             file: None,
             line: None,
             key: None,
             message: e.to_string(),
         })
+    }
+
+    /// The ground motion a run takes: the record, and after it, for a pair
+    /// with yielding storeys, a free-vibration tail of [`TAIL_PERIODS`] of
+    /// the longer fundamental period at rest (the residual drifts are read
+    /// in its last period).
+    fn excitation(&self, record: &Record) -> (Vec<f64>, Vec<f64>) {
+        let (mut times, mut acceleration) = (record.times.clone(), record.acceleration.clone());
+        if let Some(tail) = self.tail() {
+            let end = times.last().copied().unwrap_or(0.0);
+            let dt = record.dt.unwrap_or(tail / 1000.0);
+            times.extend([end + dt, end + tail]);
+            acceleration.extend([0.0, 0.0]);
+        }
+        (times, acceleration)
+    }
+
+    /// The free-vibration tail's length (s), for a pair with yielding
+    /// storeys.
+    fn tail(&self) -> Option<f64> {
+        (self.left.inelastic() || self.right.inelastic())
+            .then(|| TAIL_PERIODS * self.left.period().max(self.right.period()))
     }
 
     /// The peak response to `record` × `scale` over its duration, with the
@@ -406,31 +291,39 @@ impl PoundingPair {
         run: &RunSettings,
     ) -> Result<Response, PoundingError> {
         let model = self.model(record, scale, contacts)?;
-        let opts = self.options(record, run)?;
+        let opts = SimulationOptions {
+            accelerations: true,
+            ..self.options(record, run)?
+        };
         let nl = self.left.masses.len();
         let n = model.bodies().len();
-        let mut dynamics = ChainDynamics::new(&model, false);
-        let (mut y, mut dy) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
         let mut drift = [vec![0.0f64; nl], vec![0.0f64; n - nl]];
         let mut acceleration = drift.clone();
         let mut displacement = drift.clone();
+        // The residual drifts: the mean drift over the last fundamental
+        // period of each frame (of the free-vibration tail where there is
+        // one).
+        let windows = [self.left.period(), self.right.period()].map(|p| opts.t_end - p);
+        let mut residual = [(vec![0.0f64; nl], 0usize), (vec![0.0f64; n - nl], 0usize)];
         let mut closing = vec![f64::NEG_INFINITY; self.floors.len()];
-        // Peaks taken as the samples stream by (nothing stored).
+        // Peaks taken as the samples stream by (nothing stored); a sample
+        // is [u.., v.., a..].
         let sim = simulate_streaming(&model, &opts, |t, row| {
-            let u = &row[..n];
-            for (i, (&x, &v)) in row[..n].iter().zip(&row[n..]).enumerate() {
-                (y[2 * i], y[2 * i + 1]) = (x, v);
-            }
-            dynamics.rhs(t, &y, &mut dy);
+            let (u, a) = (&row[..n], &row[2 * n..]);
             let ag = model.base().at(t);
             for (side, (start, len)) in [(0, nl), (nl, n - nl)].into_iter().enumerate() {
+                let late = t >= windows[side];
                 for i in 0..len {
                     let below = if i == 0 { 0.0 } else { u[start + i - 1] };
-                    drift[side][i] = drift[side][i].max((u[start + i] - below).abs());
+                    let d = u[start + i] - below;
+                    drift[side][i] = drift[side][i].max(d.abs());
                     displacement[side][i] = displacement[side][i].max(u[start + i].abs());
-                    let a = dy[2 * (start + i) + 1] + ag;
-                    acceleration[side][i] = acceleration[side][i].max(a.abs());
+                    acceleration[side][i] = acceleration[side][i].max((a[start + i] + ag).abs());
+                    if late {
+                        residual[side].0[i] += d;
+                    }
                 }
+                residual[side].1 += usize::from(late);
             }
             for (c, &f) in self.floors.iter().enumerate() {
                 closing[c] = closing[c].max(u[f - 1] - u[nl + f - 1]);
@@ -441,8 +334,11 @@ impl PoundingPair {
         if let Some(e) = &sim.error {
             return Err(PoundingError::run(record, e));
         }
+        let residual_drift =
+            residual.map(|(sum, count)| sum.iter().map(|s| s / count.max(1) as f64).collect());
         Ok(Response {
             drift,
+            residual_drift,
             acceleration,
             displacement,
             peak_impact_force: sim.impacts.iter().fold(0.0, |m, i| m.max(i.peak_force)),
@@ -479,7 +375,7 @@ impl PoundingPair {
             return Err(FieldError::new("sample", run.sample, "give a positive step").into());
         }
         Ok(SimulationOptions {
-            t_end: record.times.last().copied().unwrap_or(0.0),
+            t_end: record.times.last().copied().unwrap_or(0.0) + self.tail().unwrap_or(0.0),
             rtol: run.rtol,
             atol: run.rtol * 1e-4 * self.gap.max(1e-3),
             output_step: Some(run.sample),
@@ -528,194 +424,16 @@ impl PoundingPair {
     }
 }
 
-/// One cell of a pounding spectrum: a gap and a period ratio, over the
-/// records.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SpectrumCell {
-    /// The gap (m).
-    pub gap: f64,
-    /// T_left / T_right (the right frame's stiffnesses scaled to it).
-    pub period_ratio: f64,
-    /// Per record: the largest impact force (N).
-    pub impact_force: Vec<f64>,
-    /// Per record: the impacts.
-    pub impacts: Vec<usize>,
-    /// Per record: the largest ratio of a storey drift with pounding to the
-    /// same drift of the free frames, over both frames.
-    pub drift_amplification: Vec<f64>,
-    /// Per record: the gap that avoids contact (m).
-    pub required_gap: Vec<f64>,
-}
+#[path = "pounding_file.rs"]
+mod file;
+#[path = "pounding_frame.rs"]
+mod frame;
+#[path = "pounding_spectrum.rs"]
+mod spectrum;
 
-/// The pair with the right frame's stiffnesses scaled so that T_left /
-/// T_right = `ratio`.
-pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, PoundingError> {
-    if !(ratio.is_finite() && ratio > 0.0) {
-        return Err(FieldError::new("ratios", ratio, "give positive period ratios").into());
-    }
-    pair.check()?;
-    let factor = (pair.right.period() * ratio / pair.left.period()).powi(2);
-    let mut out = pair.clone();
-    out.right.stiffnesses.iter_mut().for_each(|k| *k *= factor);
-    Ok(out)
-}
-
-/// The pounding spectrum: every (gap, period ratio) cell over `records`
-/// (each with its scale), in parallel, cells gap-major; each record's run
-/// as `run` says. The same numbers at any thread count.
-pub fn pounding_spectrum(
-    pair: &PoundingPair,
-    records: &[(Record, f64)],
-    gaps: &[f64],
-    ratios: &[f64],
-    run: &RunSettings,
-) -> Result<Vec<SpectrumCell>, PoundingError> {
-    use rayon::prelude::*;
-    for (field, empty) in [
-        ("records", records.is_empty()),
-        ("gaps", gaps.is_empty()),
-        ("ratios", ratios.is_empty()),
-    ] {
-        if empty {
-            let message = "a pounding spectrum needs records, gaps and period ratios";
-            return Err(FieldError::about(field, message).into());
-        }
-    }
-    if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
-        return Err(FieldError::new("gaps", g, "give finite gaps >= 0").into());
-    }
-    let pairs: Vec<PoundingPair> = ratios
-        .iter()
-        .map(|&r| with_period_ratio(pair, r))
-        .collect::<Result<_, _>>()?;
-    let cells: Vec<(usize, usize)> = (0..gaps.len())
-        .flat_map(|g| (0..ratios.len()).map(move |r| (g, r)))
-        .collect();
-    cells
-        .par_iter()
-        .map(|&(g, r)| {
-            let p = PoundingPair {
-                gap: gaps[g],
-                ..pairs[r].clone()
-            };
-            let mut cell = SpectrumCell {
-                gap: gaps[g],
-                period_ratio: ratios[r],
-                impact_force: Vec::new(),
-                impacts: Vec::new(),
-                drift_amplification: Vec::new(),
-                required_gap: Vec::new(),
-            };
-            for (record, scale) in records {
-                let res = p.analyse(record, *scale, run)?;
-                let amp = (0..2)
-                    .flat_map(|side| {
-                        let (a, b) = (&res.pounding.drift[side], &res.free.drift[side]);
-                        a.iter()
-                            .zip(b)
-                            .map(|(x, y)| if *y > 0.0 { x / y } else { 1.0 })
-                    })
-                    .fold(0.0f64, f64::max);
-                cell.impact_force.push(res.pounding.peak_impact_force);
-                cell.impacts.push(res.pounding.impacts);
-                cell.drift_amplification.push(amp);
-                cell.required_gap.push(res.required_gap);
-            }
-            Ok(cell)
-        })
-        .collect()
-}
-
-/// `FROM:TO:N` as N evenly spaced values (N = 1: FROM), the form of the
-/// spectrum's gaps and period ratios; `field` names the option.
-pub fn value_range(field: &'static str, text: &str) -> Result<Vec<f64>, FieldError> {
-    let bad = || FieldError::new(field, text, "give FROM:TO:N, e.g. 0.01:0.1:10");
-    let parts: Vec<&str> = text.split(':').collect();
-    let [a, b, n] = parts.as_slice() else {
-        return Err(bad());
-    };
-    let a: f64 = a.trim().parse().map_err(|_| bad())?;
-    let b: f64 = b.trim().parse().map_err(|_| bad())?;
-    let n: usize = n.trim().parse().map_err(|_| bad())?;
-    if n == 0 || !a.is_finite() || !b.is_finite() || (n > 1 && a == b) {
-        return Err(bad());
-    }
-    Ok((0..n)
-        .map(|i| {
-            if n == 1 {
-                a
-            } else {
-                a + (b - a) * i as f64 / (n - 1) as f64
-            }
-        })
-        .collect())
-}
-
-/// The empirical q-quantile (0 ≤ q ≤ 1) of `values` with linear
-/// interpolation between order statistics (NaN for none).
-pub fn quantile(values: &[f64], q: f64) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let x = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-    let (i, f) = (x.floor() as usize, x - x.floor());
-    if i + 1 < v.len() {
-        v[i] * (1.0 - f) + v[i + 1] * f
-    } else {
-        v[i]
-    }
-}
-
-#[derive(serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FrameSpec {
-    masses: Vec<f64>,
-    stiffnesses: Vec<f64>,
-    damping_ratio: f64,
-}
-
-#[derive(serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PairSpec {
-    left: FrameSpec,
-    right: FrameSpec,
-    gap: f64,
-    floors: Vec<usize>,
-    law: crate::model_file::LawSpec,
-}
-
-/// A pair from TOML text: `[left]` and `[right]` (`masses`, `stiffnesses`,
-/// `damping_ratio`), `gap`, `floors` and `law` (a contact law as in model
-/// files); messages name `source` and the line.
-pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, PoundingError> {
-    let spec: PairSpec = toml::from_str(text).map_err(|e| PoundingError::Pair {
-        file: Some(source.to_string()),
-        line: e
-            .span()
-            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1),
-        key: None,
-        message: e.message().trim().to_string(),
-    })?;
-    let frame = |f: FrameSpec| ShearFrame {
-        masses: f.masses,
-        stiffnesses: f.stiffnesses,
-        damping_ratio: f.damping_ratio,
-    };
-    let pair = PoundingPair {
-        left: frame(spec.left),
-        right: frame(spec.right),
-        gap: spec.gap,
-        floors: spec.floors,
-        law: spec
-            .law
-            .build()
-            .map_err(|e| PoundingError::pair("law", format!("law: {e}")).in_file(source))?,
-    };
-    pair.check().map_err(|e| e.in_file(source))?;
-    Ok(pair)
-}
+pub use file::{parse_pair, PoundingError};
+pub use frame::ShearFrame;
+pub use spectrum::{pounding_spectrum, quantile, value_range, with_period_ratio, SpectrumCell};
 
 #[path = "pounding_documents.rs"]
 pub mod documents;

@@ -19,12 +19,13 @@ pub fn pair_document(pair: &PoundingPair) -> Value {
     })
 }
 
-/// One response's peaks: drifts, floor accelerations and displacements
-/// per floor of each frame (`left`, `right`), the peak impact force, the
-/// impact count and the closing velocities.
+/// One response's peaks: drifts, residual drifts, floor accelerations and
+/// displacements per floor of each frame (`left`, `right`), the peak
+/// impact force, the impact count and the closing velocities.
 pub fn response_document(r: &Response) -> Value {
     json!({
         "peak_drift": { "left": r.drift[0], "right": r.drift[1] },
+        "residual_drift": { "left": r.residual_drift[0], "right": r.residual_drift[1] },
         "peak_floor_acceleration": { "left": r.acceleration[0], "right": r.acceleration[1] },
         "peak_displacement": { "left": r.displacement[0], "right": r.displacement[1] },
         "peak_impact_force": r.peak_impact_force,

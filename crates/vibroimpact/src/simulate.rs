@@ -78,6 +78,11 @@ pub struct SimulationOptions {
     /// or exact motion between contacts and the bodies in touch integrated
     /// ([`Integrator::Local`], docs/theory.md §10).
     pub integrator: Integrator,
+    /// Streamed samples carry the bodies' accelerations after their
+    /// displacements and velocities, `[u.., v.., a..]`, from the run's own
+    /// right-hand side (with its storeys' history and its contacts' onset
+    /// velocities); [`simulate_streaming`] only.
+    pub accelerations: bool,
 }
 
 impl Default for SimulationOptions {
@@ -96,6 +101,7 @@ impl Default for SimulationOptions {
             extrema_window: None,
             interrupt: None,
             integrator: Integrator::Auto,
+            accelerations: false,
         }
     }
 }
@@ -330,6 +336,12 @@ pub const MAX_SAMPLES: f64 = 1e9;
 /// values; [`simulate_streaming`] has no such limit).
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
+    if opts.accelerations {
+        return Err(OptionsError(
+            "accelerations: a kept history holds u and v only; stream the run for its accelerations"
+                .into(),
+        ));
+    }
     if let Some(dt) = opts.output_step {
         let values =
             ((opts.t_end - opts.output_from) / dt + 1.0) * (2 * model.bodies().len() + 1) as f64;

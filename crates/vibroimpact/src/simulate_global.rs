@@ -51,7 +51,7 @@ pub fn simulate_streaming(
     let mut output = Output::new(opts, (y0.len(), n2), &mut sink);
     let mut sink_stopped = None;
     if opts.output_step.is_some() && opts.output_from == 0.0 {
-        if !output.record(0.0, &y0) {
+        if !output.record(0.0, &y0, &mut sys) {
             sink_stopped = Some(0.0);
         }
         output.next = 1;
@@ -269,8 +269,11 @@ struct Output<'a, S> {
     next: usize,
     /// Dense output in the integrator's layout.
     buf: Vec<f64>,
-    /// One sample in body order [u.., v..].
+    /// One sample in body order [u.., v..] (and a.. with
+    /// `accelerations`).
     sample: Vec<f64>,
+    /// The right-hand side at a sample, for its accelerations.
+    rates: Option<Vec<f64>>,
     sink: &'a mut S,
 }
 
@@ -283,18 +286,26 @@ impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
             t_end: opts.t_end,
             next: 0,
             buf: vec![0.0; dims.0],
-            sample: vec![0.0; dims.1],
+            sample: vec![0.0; dims.1 + if opts.accelerations { dims.1 / 2 } else { 0 }],
+            rates: opts.accelerations.then(|| vec![0.0; dims.0]),
             sink,
         }
     }
 
-    /// Hands the interleaved state `y` at `t` to the sink; false if it
-    /// asks to stop.
-    fn record(&mut self, t: f64, y: &[f64]) -> bool {
-        let n = self.sample.len() / 2;
+    /// Hands the interleaved state `y` at `t` to the sink (with the
+    /// bodies' accelerations from `sys`, if asked); false if it asks to
+    /// stop.
+    fn record(&mut self, t: f64, y: &[f64], sys: &mut ChainDynamics) -> bool {
+        let n = sys.state_dim() / 2;
         for i in 0..n {
             self.sample[i] = y[2 * i];
             self.sample[n + i] = y[2 * i + 1];
+        }
+        if let Some(rates) = self.rates.as_mut() {
+            crate::integrate::OdeSystem::rhs(sys, t, y, rates);
+            for i in 0..n {
+                self.sample[2 * n + i] = rates[2 * i + 1];
+            }
         }
         (self.sink)(t, &self.sample)
     }
@@ -311,7 +322,7 @@ impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
             st.dense_output(sys, ts, &mut self.buf);
             self.next += 1;
             let buf = std::mem::take(&mut self.buf);
-            let go_on = self.record(ts, &buf);
+            let go_on = self.record(ts, &buf, sys);
             self.buf = buf;
             if !go_on {
                 return Some(ts);

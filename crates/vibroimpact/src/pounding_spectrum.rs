@@ -1,0 +1,146 @@
+//! Pounding spectra over gap × period ratio, value ranges and quantiles
+//! of an ensemble (docs/earthquakes.md).
+
+use super::{PoundingError, PoundingPair, RunSettings};
+use crate::field_error::FieldError;
+use crate::record::Record;
+
+/// One cell of a pounding spectrum: a gap and a period ratio, over the
+/// records.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectrumCell {
+    /// The gap (m).
+    pub gap: f64,
+    /// T_left / T_right (the right frame's stiffnesses scaled to it).
+    pub period_ratio: f64,
+    /// Per record: the largest impact force (N).
+    pub impact_force: Vec<f64>,
+    /// Per record: the impacts.
+    pub impacts: Vec<usize>,
+    /// Per record: the largest ratio of a storey drift with pounding to the
+    /// same drift of the free frames, over both frames.
+    pub drift_amplification: Vec<f64>,
+    /// Per record: the gap that avoids contact (m).
+    pub required_gap: Vec<f64>,
+}
+
+/// The pair with the right frame's stiffnesses scaled so that T_left /
+/// T_right = `ratio`.
+pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, PoundingError> {
+    if !(ratio.is_finite() && ratio > 0.0) {
+        return Err(FieldError::new("ratios", ratio, "give positive period ratios").into());
+    }
+    pair.check()?;
+    let factor = (pair.right.period() * ratio / pair.left.period()).powi(2);
+    let mut out = pair.clone();
+    out.right.stiffnesses.iter_mut().for_each(|k| *k *= factor);
+    Ok(out)
+}
+
+/// The pounding spectrum: every (gap, period ratio) cell over `records`
+/// (each with its scale), in parallel, cells gap-major; each record's run
+/// as `run` says. The same numbers at any thread count.
+pub fn pounding_spectrum(
+    pair: &PoundingPair,
+    records: &[(Record, f64)],
+    gaps: &[f64],
+    ratios: &[f64],
+    run: &RunSettings,
+) -> Result<Vec<SpectrumCell>, PoundingError> {
+    use rayon::prelude::*;
+    for (field, empty) in [
+        ("records", records.is_empty()),
+        ("gaps", gaps.is_empty()),
+        ("ratios", ratios.is_empty()),
+    ] {
+        if empty {
+            let message = "a pounding spectrum needs records, gaps and period ratios";
+            return Err(FieldError::about(field, message).into());
+        }
+    }
+    if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
+        return Err(FieldError::new("gaps", g, "give finite gaps >= 0").into());
+    }
+    let pairs: Vec<PoundingPair> = ratios
+        .iter()
+        .map(|&r| with_period_ratio(pair, r))
+        .collect::<Result<_, _>>()?;
+    let cells: Vec<(usize, usize)> = (0..gaps.len())
+        .flat_map(|g| (0..ratios.len()).map(move |r| (g, r)))
+        .collect();
+    cells
+        .par_iter()
+        .map(|&(g, r)| {
+            let p = PoundingPair {
+                gap: gaps[g],
+                ..pairs[r].clone()
+            };
+            let mut cell = SpectrumCell {
+                gap: gaps[g],
+                period_ratio: ratios[r],
+                impact_force: Vec::new(),
+                impacts: Vec::new(),
+                drift_amplification: Vec::new(),
+                required_gap: Vec::new(),
+            };
+            for (record, scale) in records {
+                let res = p.analyse(record, *scale, run)?;
+                let amp = (0..2)
+                    .flat_map(|side| {
+                        let (a, b) = (&res.pounding.drift[side], &res.free.drift[side]);
+                        a.iter()
+                            .zip(b)
+                            .map(|(x, y)| if *y > 0.0 { x / y } else { 1.0 })
+                    })
+                    .fold(0.0f64, f64::max);
+                cell.impact_force.push(res.pounding.peak_impact_force);
+                cell.impacts.push(res.pounding.impacts);
+                cell.drift_amplification.push(amp);
+                cell.required_gap.push(res.required_gap);
+            }
+            Ok(cell)
+        })
+        .collect()
+}
+
+/// `FROM:TO:N` as N evenly spaced values (N = 1: FROM), the form of the
+/// spectrum's gaps and period ratios; `field` names the option.
+pub fn value_range(field: &'static str, text: &str) -> Result<Vec<f64>, FieldError> {
+    let bad = || FieldError::new(field, text, "give FROM:TO:N, e.g. 0.01:0.1:10");
+    let parts: Vec<&str> = text.split(':').collect();
+    let [a, b, n] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let a: f64 = a.trim().parse().map_err(|_| bad())?;
+    let b: f64 = b.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 || !a.is_finite() || !b.is_finite() || (n > 1 && a == b) {
+        return Err(bad());
+    }
+    Ok((0..n)
+        .map(|i| {
+            if n == 1 {
+                a
+            } else {
+                a + (b - a) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect())
+}
+
+/// The empirical q-quantile (0 ≤ q ≤ 1) of `values` with linear
+/// interpolation between order statistics (NaN for none).
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let x = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (i, f) = (x.floor() as usize, x - x.floor());
+    if i + 1 < v.len() {
+        v[i] * (1.0 - f) + v[i + 1] * f
+    } else {
+        v[i]
+    }
+}
