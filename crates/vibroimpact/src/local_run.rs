@@ -302,16 +302,7 @@ pub(in crate::simulate) fn run(
                 break;
             }
             run.state_at(ts, &mut sample);
-            let mut body: Vec<f64> = (0..n)
-                .map(|i| sample[2 * i])
-                .chain((0..n).map(|i| sample[2 * i + 1]))
-                .collect();
-            // The accelerations of the whole model at the sample (a Lankarani–
-            // Nikravesh contact's onset velocity is not tracked here).
-            if let Some((sys, rates)) = whole.as_mut() {
-                crate::integrate::OdeSystem::rhs(sys, ts, &sample, rates);
-                body.extend((0..n).map(|i| rates[2 * i + 1]));
-            }
+            let body = body_sample(ts, &sample, whole.as_mut());
             next_sample += 1;
             if !record(ts, &body) {
                 *stopped = Some(ts);
@@ -416,6 +407,23 @@ pub(in crate::simulate) fn run(
         }
     }
     Ok(run.finish(out, t))
+}
+
+/// A streamed sample in body order from the interleaved state `y` at
+/// `t`: [u.., v..], and the accelerations of the whole model `whole` (its
+/// dynamics and a buffer) after them if asked (a Lankarani–Nikravesh
+/// contact's onset velocity is not tracked there).
+fn body_sample(t: f64, y: &[f64], whole: Option<&mut (ChainDynamics, Vec<f64>)>) -> Vec<f64> {
+    let n = y.len() / 2;
+    let mut body: Vec<f64> = (0..n)
+        .map(|i| y[2 * i])
+        .chain((0..n).map(|i| y[2 * i + 1]))
+        .collect();
+    if let Some((sys, rates)) = whole {
+        crate::integrate::OdeSystem::rhs(sys, t, y, rates);
+        body.extend((0..n).map(|i| rates[2 * i + 1]));
+    }
+    body
 }
 
 /// The requests the local integrator refuses: the energy audit with
