@@ -4,7 +4,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::hysteresis::{cyclic_protocol, under_drift, StoreySpec};
+use vibroimpact::hysteresis::{cyclic_protocol, parse_drifts as parse, under_drift, StoreySpec};
 use vibroimpact::results::hysteresis_document;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};
@@ -75,4 +75,16 @@ pub fn hysteresis<'py>(
     doc.set_item("dissipated", array1(py, rows.iter().map(|r| r.1).collect()))?;
     doc.set_item("drift", array1(py, drifts))?;
     Ok(doc)
+}
+
+/// The drifts of a drift file's text (`source` names it in errors), as
+/// `vibroimpact hysteresis --drift` reads them.
+#[pyfunction]
+pub fn parse_drifts<'py>(
+    py: Python<'py>,
+    text: &str,
+    source: &str,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let drifts = parse(text, source).map_err(|e| value_error(format!("drift: {e}")))?;
+    Ok(array1(py, drifts))
 }

@@ -61,6 +61,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(records::parse_measured, m)?)?;
     m.add_function(wrap_pyfunction!(records::response_spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(hysteresis::hysteresis, m)?)?;
+    m.add_function(wrap_pyfunction!(hysteresis::parse_drifts, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding_history, m)?)?;
     m.add_function(wrap_pyfunction!(records::value_range, m)?)?;

@@ -22,6 +22,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::integrate::{integrate_to, IntegrationError, IntegratorOptions, OdeSystem};
+use crate::record::RecordError;
 
 /// A storey law's setting refused: its key and what is wrong (the caller
 /// names the building and storey).
@@ -435,6 +436,41 @@ impl StoreySpec {
         law.check()?;
         Ok(law)
     }
+}
+
+/// A drift history from text (`source` names it in errors): one drift a
+/// line (m), blank lines and `#` comments skipped, text before the first
+/// number a header; every drift finite, at least one.
+pub fn parse_drifts(text: &str, source: &str) -> Result<Vec<f64>, RecordError> {
+    let mut drifts = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        match l.parse::<f64>() {
+            Ok(d) if d.is_finite() => drifts.push(d),
+            Ok(_) => {
+                return Err(RecordError::at(
+                    source,
+                    i + 1,
+                    format!("`{l}` is not finite"),
+                ))
+            }
+            Err(_) if drifts.is_empty() => continue,
+            Err(_) => {
+                return Err(RecordError::at(
+                    source,
+                    i + 1,
+                    format!("`{l}` is not a drift"),
+                ))
+            }
+        }
+    }
+    if drifts.is_empty() {
+        return Err(RecordError::whole(source, "no drifts"));
+    }
+    Ok(drifts)
 }
 
 /// The most samples a cyclic protocol may have (800 MB of drifts).

@@ -178,3 +178,22 @@ fn bad_settings_name_the_key() {
     }
     assert!(StoreyLaw::BoucWen(bouc_wen(2.0)).check().is_ok());
 }
+
+/// A drift file: a header and comments skipped, a bad or non-finite line
+/// named by file and line, an empty file refused.
+#[test]
+fn drift_files_are_read_with_their_lines() {
+    let d = parse_drifts("drift\n# m\n0.01\n\n-0.02\n", "d.txt").unwrap();
+    assert_eq!(d, vec![0.01, -0.02]);
+    let e = parse_drifts("drift\n0.01\nx\n", "d.txt").unwrap_err();
+    assert_eq!(
+        (e.line, e.to_string().as_str()),
+        (Some(3), "d.txt:3: `x` is not a drift")
+    );
+    let e = parse_drifts("0.01\nnan\n", "d.txt").unwrap_err();
+    assert_eq!(e.to_string(), "d.txt:2: `nan` is not finite");
+    assert_eq!(
+        parse_drifts("drift\n", "d.txt").unwrap_err().to_string(),
+        "d.txt: no drifts"
+    );
+}

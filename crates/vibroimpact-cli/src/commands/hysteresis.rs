@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use vibroimpact::hysteresis::{cyclic_protocol, under_drift, LawError, StoreySpec};
+use vibroimpact::hysteresis::{cyclic_protocol, parse_drifts, under_drift, LawError, StoreySpec};
 use vibroimpact::results::hysteresis_document;
 
 use crate::error::CliError;
@@ -122,38 +122,11 @@ fn law_error(e: LawError) -> CliError {
     ))
 }
 
-/// The drifts of a file: one number a line, a header line and `#`
-/// comments skipped; errors name the file and line.
+/// The drifts of a file ([`parse_drifts`]); errors name the file and line.
 fn read_drifts(path: &Path) -> Result<Vec<f64>, CliError> {
-    let name = path.display();
+    let name = path.display().to_string();
     let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
-    let mut drifts = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        match l.parse::<f64>() {
-            Ok(d) if d.is_finite() => drifts.push(d),
-            Ok(_) => {
-                return Err(CliError::new(format!(
-                    "{name}:{}: `{l}` is not finite",
-                    i + 1
-                )))
-            }
-            Err(_) if drifts.is_empty() => continue,
-            Err(_) => {
-                return Err(CliError::new(format!(
-                    "{name}:{}: `{l}` is not a drift",
-                    i + 1
-                )))
-            }
-        }
-    }
-    if drifts.is_empty() {
-        return Err(CliError::new(format!("{name}: no drifts")));
-    }
-    Ok(drifts)
+    parse_drifts(&text, &name).map_err(|e| CliError::new(e.to_string()))
 }
 
 /// Runs `vibroimpact hysteresis`.

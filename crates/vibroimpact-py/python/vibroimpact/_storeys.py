@@ -17,27 +17,18 @@ from ._results import Result
 
 def _drift_history(drift: Any) -> Optional[np.ndarray]:
     """The drifts of ``drift``: an array, or a file of one drift a line (a
-    header line and ``#`` comments skipped), as ``--drift FILE`` reads."""
+    header line and ``#`` comments skipped), read as ``--drift FILE`` reads
+    it."""
     if drift is None:
         return None
     if isinstance(drift, (str, os.PathLike)):
         path = os.fspath(drift)
         try:
             with open(path, encoding="utf-8") as f:
-                lines = f.read().splitlines()
+                text = f.read()
         except OSError as e:
             raise OSError(f"drift: {path}: cannot read: {e.strerror}") from None
-        values = []
-        for i, line in enumerate(lines):
-            text = line.strip()
-            if not text or text.startswith("#"):
-                continue
-            try:
-                values.append(float(text))
-            except ValueError:
-                if values:
-                    raise ValueError(f"drift: {path}:{i + 1}: `{text}` is not a drift") from None
-        drift = values
+        return _core.parse_drifts(text, path)
     d = _floats(drift, "drift", allow_scalar=False)
     if d.size == 0:
         raise ValueError("drift: no drifts")

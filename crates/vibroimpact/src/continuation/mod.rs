@@ -72,8 +72,8 @@ pub use events::{BranchEvent, Observed, TestValues, UserEvent};
 pub use orbit_study::{CheckedOrbit, Guess, OrbitOutcome, OrbitStudy};
 pub use start::amplitude_homotopy;
 pub use study::{
-    primary_orbit, BranchOutcome, BranchStudy, CheckedBranch, Linear, Start, StudyError,
-    StudyField, AUTO_KRYLOV_BODIES,
+    BranchOutcome, BranchStudy, CheckedBranch, Linear, Start, StudyError, StudyField,
+    AUTO_KRYLOV_BODIES,
 };
 pub use switching::{
     branch_switch_start, is_symmetric_orbit, period_doubled_start, switch_branch, SwitchError,

@@ -5,7 +5,7 @@
 //! matrix-free) and summarises the orbit over its period.
 
 use super::study::{Linear, StudyError, StudyField};
-use super::{is_symmetric_orbit, primary_orbit, ContinuationOptions};
+use super::{amplitude_homotopy, is_symmetric_orbit, ContinuationOptions};
 use crate::model::Model;
 use crate::model_file::ModelDocument;
 use crate::parameter::ParameterizedModel;
@@ -58,6 +58,9 @@ pub struct CheckedOrbit {
     /// The Arnoldi dimension if matrix-free (by the study's `linear` for
     /// the model's size), else None.
     pub krylov: Option<usize>,
+    /// For [`Guess::Homotopy`]: the document as a family in its forcing
+    /// amplitude, and that amplitude.
+    amplitude: Option<(ParameterizedModel, f64)>,
 }
 
 /// What an orbit study computed.
@@ -113,21 +116,25 @@ impl OrbitStudy {
                     format!("has {} values, the model needs {d} (u then v)", x.len()),
                 ));
             }
-            Guess::Homotopy => {
-                if let Err(e) = ParameterizedModel::in_amplitude(document.clone()) {
-                    return Err(invalid(
-                        StudyField::Guess,
-                        format!("the homotopy needs a forcing amplitude to vary: {e}"),
-                    ));
-                }
-            }
             _ => {}
         }
+        let amplitude = match self.guess {
+            Guess::Homotopy => Some(ParameterizedModel::in_amplitude(document.clone()).map_err(
+                |e| {
+                    invalid(
+                        StudyField::Guess,
+                        format!("the homotopy needs a forcing amplitude to vary: {e}"),
+                    )
+                },
+            )?),
+            _ => None,
+        };
         Ok(CheckedOrbit {
             study: self,
             document,
             model,
             krylov,
+            amplitude,
         })
     }
 }
@@ -154,14 +161,14 @@ impl CheckedOrbit {
                     },
                     ..ContinuationOptions::default()
                 };
-                // The homotopy is the guess here, not a branch's start.
-                primary_orbit(&self.document, &continuation).map_err(|e| match e {
-                    StudyError::Invalid { message, .. } => StudyError::Invalid {
+                // Found by check: the document in its forcing amplitude.
+                let Some((family, target)) = &self.amplitude else {
+                    return Err(StudyError::Invalid {
                         field: StudyField::Guess,
-                        message,
-                    },
-                    other => other,
-                })?
+                        message: "the homotopy's family was not checked".into(),
+                    });
+                };
+                amplitude_homotopy(family, *target, &continuation)?
             }
         };
         let solution = match self.krylov {

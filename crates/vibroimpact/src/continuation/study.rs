@@ -10,8 +10,7 @@ use super::{ContinuationError, ContinuationOptions, CurvesError, SwitchError};
 use crate::family::{Family, FamilyError};
 use crate::field_error::FieldError;
 use crate::model::Model;
-use crate::model_file::{ModelDocument, ModelFileError};
-use crate::parameter::ParameterizedModel;
+use crate::model_file::ModelFileError;
 use crate::periodic::{guess_by_simulation_with, PeriodicError};
 
 /// How a branch study finds its first periodic orbit.
@@ -365,17 +364,4 @@ fn no_amplitude(why: ModelFileError) -> StudyError {
         field: StudyField::Start,
         message: format!("the homotopy start needs a forcing amplitude to vary: {why}"),
     }
-}
-
-/// The periodic state of `document`'s model on the branch that grows
-/// from rest, by the homotopy in its forcing amplitude from zero to its
-/// own (everything else fixed): a guess for `periodic` that does not
-/// depend on where a simulation's transient ends.
-pub fn primary_orbit(
-    document: &ModelDocument,
-    opts: &ContinuationOptions,
-) -> Result<Vec<f64>, StudyError> {
-    let (family, target) =
-        ParameterizedModel::in_amplitude(document.clone()).map_err(no_amplitude)?;
-    Ok(super::amplitude_homotopy(family, target, opts)?)
 }
