@@ -126,12 +126,12 @@ fn pounding_of_two_frames() {
     ]);
     let run = &doc["runs"][0];
     assert_eq!(run["record"]["units"], "m/s2");
-    let need = run["required_gap"].as_f64().unwrap();
+    let need = run["joints"][0]["required_gap"].as_f64().unwrap();
     assert!(need > 0.02, "{need}");
     assert!(run["pounding"]["impacts"].as_u64().unwrap() > 0);
     assert!(run["pounding"]["peak_impact_force"].as_f64().unwrap() > 0.0);
     assert_eq!(run["free"]["impacts"], 0);
-    let g = &run["code_gaps"];
+    let g = &run["joints"][0]["code_gaps"];
     let (abs, srss, ddc) = (
         g["absolute_sum"].as_f64().unwrap(),
         g["srss"].as_f64().unwrap(),

@@ -5,9 +5,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::pounding::{
-    documents, pounding_spectrum, PoundingError, PoundingPair, RunSettings,
-};
+use vibroimpact::pounding::{documents, pounding_spectrum, PoundingError, Row, RunSettings};
 use vibroimpact::record::{parse_record as parse, Record, Units};
 use vibroimpact::results::spectrum_document;
 use vibroimpact::spectrum::response_spectrum as spectrum;
@@ -111,14 +109,14 @@ fn pair_and_run(
     pair_text: &str,
     source: &str,
     (sample, rtol, method, integrator): (f64, f64, &str, &str),
-) -> PyResult<(PoundingPair, RunSettings)> {
+) -> PyResult<(Row, RunSettings)> {
     let run = RunSettings {
         sample,
         rtol,
         method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
     };
-    let pair = vibroimpact::pounding::parse_pair(pair_text, source).map_err(pounding_error)?;
+    let pair = vibroimpact::pounding::parse_row(pair_text, source).map_err(pounding_error)?;
     Ok((pair, run))
 }
 
@@ -129,7 +127,7 @@ fn inputs(
     source: &str,
     (times, acceleration): (&PyReadonlyArray1<'_, f64>, &PyReadonlyArray1<'_, f64>),
     settings: (f64, f64, &str, &str),
-) -> PyResult<(PoundingPair, Record, RunSettings)> {
+) -> PyResult<(Row, Record, RunSettings)> {
     let (pair, run) = pair_and_run(pair_text, source, settings)?;
     let t = floats(times, "times")?;
     let a = floats(acceleration, "acceleration")?;
@@ -149,10 +147,10 @@ type RecordInput<'py> = (
 
 /// The pounding study of the pair in `pair_text` (TOML, named by
 /// `source`) under `records` × `scale`: the `vibroimpact pounding`
-/// document (`pair`, and `runs`, each with `record`, `pounding`, `free`,
-/// `amplification`, `required_gap` and `code_gaps`; with `free` false the
-/// pounding response alone); with `gaps` and `ratios` the pounding
-/// spectrum (`pair`, `records`, `cells`).
+/// document (`row`, and `runs`, each with `record`, `pounding`, `free`,
+/// `amplification` and `joints`; with `free` false the pounding response
+/// alone); with `gaps` and `ratios` the pounding spectrum (`row`,
+/// `records`, `cells`).
 #[pyfunction]
 #[pyo3(signature = (pair_text, source, records, scale, sample, rtol, method, integrator, free, gaps = None, ratios = None))]
 #[allow(clippy::too_many_arguments)]
@@ -189,10 +187,10 @@ pub fn pounding<'py>(
                 .map(|(r, s)| {
                     if free {
                         pair.analyse(r, *s, &run)
-                            .map(|res| documents::run_document(r, *s, &res))
+                            .map(|res| documents::run_document(&pair, r, *s, &res))
                     } else {
                         pair.respond(r, *s, true, &run)
-                            .map(|res| documents::pounding_only_document(r, *s, &res))
+                            .map(|res| documents::pounding_only_document(&pair, r, *s, &res))
                     }
                 })
                 .collect::<Result<Vec<_>, _>>()
@@ -219,10 +217,13 @@ pub fn value_range<'py>(
     Ok(array1(py, values))
 }
 
-/// The time history of the pair (TOML `pair_text`) with its contacts under
-/// the record × `scale`: `t`, `left` and `right` (floor displacements,
-/// floors × samples, m), and the impact log `impact_time`,
-/// `impact_floor` (1-based), `impact_peak_force` (N).
+/// The time history of the row (TOML `pair_text`) with its contacts
+/// under the record × `scale`: `t`; `floors`, per building name its floor
+/// displacements (floors × samples, m); `slab`, per isolated building its
+/// base slab's displacement (m); and the impact log `impact_time`,
+/// `impact_at` (`A–B floor F` between buildings, `A moat` on a moat
+/// wall), `impact_floor` (1-based; 0 for the slab), `impact_peak_force`
+/// (N).
 #[pyfunction]
 #[pyo3(signature = (pair_text, source, times, acceleration, scale, sample, rtol, method, integrator))]
 #[allow(clippy::too_many_arguments)]
@@ -238,35 +239,64 @@ pub fn pounding_history<'py>(
     method: &str,
     integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (pair, record, run) = inputs(
+    let (row, record, run) = inputs(
         pair_text,
         source,
         (&times, &acceleration),
         (sample, rtol, method, integrator),
     )?;
-    let sim = py
-        .detach(|| pair.history(&record, scale, &run))
+    let (rm, sim) = py
+        .detach(|| row.history(&record, scale, &run))
         .map_err(pounding_error)?;
-    let (nl, n) = (pair.left.masses.len(), sim.final_displacement.len());
-    let floors = |range: std::ops::Range<usize>| -> Vec<Vec<f64>> {
-        range
-            .map(|i| sim.states.chunks(2 * n).map(|row| row[i]).collect())
-            .collect()
-    };
+    let n = sim.final_displacement.len();
+    let series = |i: usize| -> Vec<f64> { sim.states.chunks(2 * n).map(|s| s[i]).collect() };
+    let floors = PyDict::new(py);
+    let slab = PyDict::new(py);
+    for (b, p) in row.buildings.iter().zip(&rm.placements) {
+        let rows: Vec<Vec<f64>> = (0..b.floors()).map(|f| series(p.first_floor + f)).collect();
+        floors.set_item(&b.name, rows)?;
+        if let Some(base) = p.base {
+            slab.set_item(&b.name, array1(py, series(base)))?;
+        }
+    }
+    let mut at = Vec::with_capacity(sim.impacts.len());
+    let mut floor = Vec::with_capacity(sim.impacts.len());
+    for i in &sim.impacts {
+        let joint = rm.joints.iter().enumerate().find_map(|(j, cs)| {
+            let k = cs.iter().position(|&c| c == i.contact)?;
+            Some((j, row.joints[j].floors[k]))
+        });
+        match joint {
+            Some((j, f)) => {
+                at.push(format!(
+                    "{}–{} floor {f}",
+                    row.buildings[j].name,
+                    row.buildings[j + 1].name
+                ));
+                floor.push(f);
+            }
+            None => {
+                let k = rm
+                    .placements
+                    .iter()
+                    .position(|p| p.moat.contains(&i.contact));
+                at.push(format!(
+                    "{} moat",
+                    k.map_or("?", |k| row.buildings[k].name.as_str())
+                ));
+                floor.push(0);
+            }
+        }
+    }
     let d = PyDict::new(py);
-    d.set_item("left", floors(0..nl))?;
-    d.set_item("right", floors(nl..n))?;
+    d.set_item("floors", floors)?;
+    d.set_item("slab", slab)?;
     d.set_item(
         "impact_time",
         array1(py, sim.impacts.iter().map(|i| i.start_time).collect()),
     )?;
-    d.set_item(
-        "impact_floor",
-        sim.impacts
-            .iter()
-            .map(|i| pair.floors[i.contact])
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("impact_at", at)?;
+    d.set_item("impact_floor", floor)?;
     d.set_item(
         "impact_peak_force",
         array1(py, sim.impacts.iter().map(|i| i.peak_force).collect()),

@@ -8,9 +8,12 @@
 //! couplings). With the energy audit on, three quadratures follow:
 //! `W` (work of the excitation), `D_c` (dissipation of the dampers) and
 //! `D_k` (dissipation of the contacts), so that
-//! `E(t) + D_c + D_k - W = E(0)` with the mechanical energy
-//! `E = Σ ½ m v² + Σ ½ k u² + Σ ½ k_ij Δu² + Σ P_contact(s)`
-//! (see [`ContactLaw::potential`]).
+//! `E(t) + D_c + D_k + D_h - W = E(0)` with the mechanical energy
+//! `E = Σ ½ m v² + Σ ½ k u² + Σ ½ k_ij Δu² + Σ P_contact(s) + Σ E_s`
+//! (see [`ContactLaw::potential`]), `E_s` what a hysteretic storey stores
+//! and `D_h` what it has dissipated, both from its state
+//! ([`StoreyLaw::stored`](crate::hysteresis::StoreyLaw::stored),
+//! [`StoreyLaw::dissipated`](crate::hysteresis::StoreyLaw::dissipated)).
 //!
 //! ## Contacts far apart are not evaluated
 //! Each right-hand side skips a contact whose force is certainly below
@@ -432,7 +435,7 @@ impl ChainDynamics {
             let (s, _) = self.approach(k, y);
             e += c.law.potential(s);
         }
-        e
+        e + self.storeys.stored_energy(y)
     }
 
     #[cfg(test)]

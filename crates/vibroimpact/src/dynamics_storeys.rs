@@ -4,8 +4,10 @@
 //! its hysteretic part with the state: (z, e) after the bodies' (u, v).
 //! A bilinear storey carries its branch as memory instead, as a contact
 //! carries its onset velocity: elastic through an anchor, z = z₀ + d − d₀,
-//! or plastic at z = ±u_y. Within a step its force is then linear in the
-//! drift; the run locates a switch (yield: |z| reaches u_y; unloading: ḋ
+//! or plastic at z = ±u_y, with the work of its hysteretic part at the
+//! branch's start (so the work is exact: ½ (1 − b) k (z² − z₀²) along an
+//! elastic branch, (1 − b) k z (d − d₀) along a plastic one). Within a step
+//! its force is then linear in the drift; the run locates a switch (yield: |z| reaches u_y; unloading: ḋ
 //! turns against z) on the step's dense output, takes the step again up to
 //! it and switches the branch there ([`StoreyTerms::switch_value`],
 //! [`StoreyTerms::switch`]).
@@ -27,11 +29,17 @@ pub enum Branch {
         d0: f64,
         /// z there.
         z0: f64,
+        /// The hysteretic part's work there (J).
+        e0: f64,
     },
     /// z held at ±u_y while the drift goes on outwards.
     Plastic {
         /// ±u_y.
         z: f64,
+        /// The drift where it yielded.
+        d0: f64,
+        /// The hysteretic part's work there (J).
+        e0: f64,
     },
 }
 
@@ -72,7 +80,11 @@ impl StoreyTerms {
                     below: s.below,
                     above: s.above,
                     law: s.law,
-                    branch: Branch::Elastic { d0, z0: 0.0 },
+                    branch: Branch::Elastic {
+                        d0,
+                        z0: 0.0,
+                        e0: 0.0,
+                    },
                     state,
                 }
             })
@@ -114,20 +126,56 @@ impl StoreyTerms {
         }
     }
 
-    /// Storey k's hysteretic state in `y`.
+    /// Storey k's hysteretic state in the state `y` (z and the work of its
+    /// hysteretic part; zero for an elastic storey).
+    pub fn state(&self, k: usize, y: &[f64]) -> Hysteretic {
+        let (d, _) = self.drift(k, y);
+        self.hysteretic(k, d, y)
+    }
+
+    /// Storey k's hysteretic state at drift `d` in `y`.
     fn hysteretic(&self, k: usize, d: f64, y: &[f64]) -> Hysteretic {
         let t = &self.terms[k];
+        let kh = match t.law {
+            StoreyLaw::Bilinear(b) => (1.0 - b.post_yield_ratio) * b.stiffness,
+            _ => 0.0,
+        };
         match (t.state, t.branch) {
             (Some(i), _) => Hysteretic {
                 z: y[i],
                 work: y[i + 1],
             },
-            (None, Branch::Elastic { d0, z0 }) => Hysteretic {
-                z: z0 + d - d0,
-                work: 0.0,
+            (None, Branch::Elastic { d0, z0, e0 }) => {
+                let z = z0 + d - d0;
+                Hysteretic {
+                    z,
+                    work: e0 + 0.5 * kh * (z * z - z0 * z0),
+                }
+            }
+            (None, Branch::Plastic { z, d0, e0 }) => Hysteretic {
+                z,
+                work: e0 + kh * z * (d - d0),
             },
-            (None, Branch::Plastic { z }) => Hysteretic { z, work: 0.0 },
         }
+    }
+
+    /// The energy the storeys store in `y`: ½ b k d² + ½ (1 − b) k z² each
+    /// (½ k d² for an elastic one).
+    pub fn stored_energy(&self, y: &[f64]) -> f64 {
+        (0..self.terms.len())
+            .map(|k| {
+                let (d, _) = self.drift(k, y);
+                let s = self.hysteretic(k, d, y);
+                self.terms[k].law.stored(d, s)
+            })
+            .sum()
+    }
+
+    /// The energy the storeys have dissipated by hysteresis in `y`.
+    pub fn dissipated(&self, y: &[f64]) -> f64 {
+        (0..self.terms.len())
+            .map(|k| self.terms[k].law.dissipated(self.state(k, y)))
+            .sum()
     }
 
     /// Adds every storey's force to the bodies' `force` and writes the
@@ -164,8 +212,10 @@ impl StoreyTerms {
         };
         let (d, dd) = self.drift(k, y);
         match t.branch {
-            Branch::Elastic { d0, z0 } => b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs(),
-            Branch::Plastic { z } => dd * z.signum(),
+            Branch::Elastic { d0, z0, .. } => {
+                b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs()
+            }
+            Branch::Plastic { z, .. } => dd * z.signum(),
         }
     }
 
@@ -181,8 +231,14 @@ impl StoreyTerms {
         t.branch = match t.branch {
             Branch::Elastic { .. } => Branch::Plastic {
                 z: b.yield_drift.copysign(s.z),
+                d0: d,
+                e0: s.work,
             },
-            Branch::Plastic { z } => Branch::Elastic { d0: d, z0: z },
+            Branch::Plastic { z, .. } => Branch::Elastic {
+                d0: d,
+                z0: z,
+                e0: s.work,
+            },
         };
     }
 

@@ -327,6 +327,18 @@ impl StoreyLaw {
         }
     }
 
+    /// The energy stored at drift `d` in state `s`: ½ b k d² + ½ (1 − b) k z²
+    /// (½ k d² for the elastic law). With [`StoreyLaw::dissipated`] it is
+    /// the work ∫ F dd done on the storey.
+    pub fn stored(&self, d: f64, s: Hysteretic) -> f64 {
+        let (k, b) = match self {
+            StoreyLaw::Elastic { stiffness } => return 0.5 * stiffness * d * d,
+            StoreyLaw::Bilinear(b) => (b.stiffness, b.post_yield_ratio),
+            StoreyLaw::BoucWen(w) => (w.stiffness, w.post_yield_ratio),
+        };
+        0.5 * k * (b * d * d + (1.0 - b) * s.z * s.z)
+    }
+
     /// The energy dissipated by hysteresis in state `s`: the hysteretic
     /// part's work less what it stores.
     pub fn dissipated(&self, s: Hysteretic) -> f64 {

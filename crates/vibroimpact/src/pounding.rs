@@ -1,42 +1,50 @@
-//! Pounding of adjacent structures (docs/earthquakes.md): two shear frames
-//! side by side on the same ground, separated by a gap at one or more
-//! floors where they may collide under a recorded ground motion. The pair
-//! becomes a model of the library's kind (floors are bodies on a line,
-//! storeys are springs and dampers, the gap is a contact with any of the
-//! contact laws), so a pounding run is a simulation like any other.
+//! Pounding of adjacent structures (docs/earthquakes.md): a row of K ≥ 2
+//! buildings side by side on the same ground, each separated from the
+//! next by a joint (a gap at one or more floors) where they may collide
+//! under a recorded ground motion. The row becomes a model of the
+//! library's kind (floors are bodies on a line, storeys are springs and
+//! dampers or hysteretic storeys, each joint's floors are contacts with any
+//! of the contact laws), so a pounding run is a simulation like any other.
+//! The two-frame pair is the row of two.
 //!
 //! Each frame has floor masses m_i, storey stiffnesses k_i (storey i joins
 //! floor i − 1, or the ground for i = 1, to floor i) and Rayleigh damping
 //! C = αM + βK with the ratio ζ in its first two modes (one storey: ζ
 //! exactly). In the floors' displacements relative to the ground, C is a
 //! damper α m_i from each floor to the ground and a damper β k_i beside
-//! each storey spring: exactly the model's body dampers and couplings.
+//! each storey spring: exactly the model's body dampers and couplings. A
+//! building may stand on an isolation layer with a moat wall
+//! ([`Building`]).
 
 use crate::contact::ContactLaw;
 use crate::field_error::FieldError;
-use crate::hysteresis::StoreyLaw;
 use crate::integrate::Method;
-use crate::model::{
-    Accelerogram, BaseExcitation, Body, Contact, ContactPair, Coupling, Model, Storey,
-};
+use crate::model::{Accelerogram, BaseExcitation, Contact, ContactPair, Model};
 use crate::record::Record;
 use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
 
-/// The free-vibration tail after the record for a pair with yielding
-/// storeys, in fundamental periods of the longer-period frame.
+/// The free-vibration tail after the record for a row with yielding
+/// storeys or hysteretic bearings, in fundamental periods of its
+/// longest-period building.
 pub const TAIL_PERIODS: f64 = 5.0;
 
-/// Two frames side by side, `left` of `right`, with a gap at some floors.
-#[derive(Clone, Debug)]
-pub struct PoundingPair {
-    /// The frame on the left.
-    pub left: ShearFrame,
-    /// The frame on the right.
-    pub right: ShearFrame,
+/// Buildings side by side, left to right, a joint between each
+/// neighbouring two.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// The buildings, left to right.
+    pub buildings: Vec<Building>,
+    /// `joints[j]` between buildings j and j + 1.
+    pub joints: Vec<Joint>,
+}
+
+/// A joint between two neighbouring buildings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
     /// The gap at rest (m).
     pub gap: f64,
     /// The floors (1-based) at which they may collide, each at most the
-    /// lower frame's height.
+    /// lower building's height.
     pub floors: Vec<usize>,
     /// The contact law of every pounding floor.
     pub law: ContactLaw,
@@ -49,7 +57,7 @@ pub struct RunSettings {
     /// impact forces are the impact log's exact peaks whatever the step.
     pub sample: f64,
     /// Relative tolerance of the integration (the absolute one is
-    /// `rtol · 1e-4 · max(gap, 1 mm)`).
+    /// `rtol · 1e-4 · max(smallest gap, 1 mm)`).
     pub rtol: f64,
     /// Integration method: DOP853, or DOPRI5 for loose tolerances (a
     /// record's samples limit the step; docs/earthquakes.md).
@@ -71,43 +79,75 @@ impl RunSettings {
     }
 }
 
-/// The peak response of the two frames to one record.
+/// The peak response of a row to one record; per building (left to
+/// right), per storey or floor from the ground up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Response {
-    /// Peak storey drifts max |u_i − u_{i−1}| (m), left then right frame.
-    pub drift: [Vec<f64>; 2],
-    /// Residual storey drifts (m, signed): the mean drift over each frame's
-    /// last fundamental period (of the free-vibration tail that follows the
-    /// record for yielding storeys).
-    pub residual_drift: [Vec<f64>; 2],
+    /// Peak storey drifts max |u_i − u_{i−1}| (m; storey 1 from the slab
+    /// of an isolated building).
+    pub drift: Vec<Vec<f64>>,
+    /// Residual storey drifts (m, signed): the mean drift over each
+    /// building's last fundamental period (of the free-vibration tail that
+    /// follows the record for yielding storeys).
+    pub residual_drift: Vec<Vec<f64>>,
     /// Peak absolute floor accelerations max |ü_i + a_g| over the samples
-    /// (m/s²), left then right.
-    pub acceleration: [Vec<f64>; 2],
+    /// (m/s²).
+    pub acceleration: Vec<Vec<f64>>,
     /// Peak floor displacements relative to the ground (m).
-    pub displacement: [Vec<f64>; 2],
-    /// Largest impact force (N), 0 without impacts.
+    pub displacement: Vec<Vec<f64>>,
+    /// The energy each storey dissipated by hysteresis (J; 0 for an
+    /// elastic storey).
+    pub hysteretic_energy: Vec<Vec<f64>>,
+    /// Per building, its isolation layer's response (None: fixed).
+    pub isolators: Vec<Option<IsolatorResponse>>,
+    /// Largest impact force between buildings (N), 0 without impacts.
     pub peak_impact_force: f64,
-    /// Impacts.
+    /// Impacts between buildings.
     pub impacts: usize,
-    /// Per pounding floor, the largest closing max (u_left − u_right) (m).
-    pub closing: Vec<f64>,
+    /// Per joint, per pounding floor, the largest closing
+    /// max (u_left − u_right) (m).
+    pub closing: Vec<Vec<f64>>,
 }
 
-/// One record's pounding study: the pair with and without its contacts.
+/// An isolation layer's response.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsolatorResponse {
+    /// Peak displacement of the slab relative to the ground (m).
+    pub peak_displacement: f64,
+    /// Its mean over the building's last fundamental period (m, signed).
+    pub residual_displacement: f64,
+    /// The energy the bearings dissipated by hysteresis (J).
+    pub hysteretic_energy: f64,
+    /// Whether the peak displacement passed the stated capacity.
+    pub beyond_capacity: bool,
+    /// Impacts on the moat wall.
+    pub moat_impacts: usize,
+    /// Largest moat impact force (N), 0 without.
+    pub moat_peak_force: f64,
+}
+
+/// One record's pounding study: the row with and without its contacts.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PoundingResult {
     /// With the contacts.
     pub pounding: Response,
-    /// The frames apart (no contacts).
+    /// The buildings apart (no contacts: no pounding, no moat wall).
     pub free: Response,
+    /// Per joint, the gap that avoids contact and the code rules' gaps.
+    pub joints: Vec<JointGaps>,
+}
+
+/// A joint's separation: what the free buildings need, and the code rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointGaps {
     /// The smallest gap that avoids contact: the largest closing of the
-    /// free frames over the pounding floors (m; 0 if they never close).
+    /// free buildings over the joint's floors (m; 0 if they never close).
     pub required_gap: f64,
-    /// The code rules from the free frames' peak displacements u_L, u_R at
-    /// the pounding floors (largest over them, m): absolute sum, SRSS, and
-    /// the double difference `√(u_L² + u_R² − 2ρ u_L u_R)` with ρ the
-    /// correlation of two oscillators of the frames' fundamental periods
-    /// and damping (Der Kiureghian's CQC coefficient).
+    /// The code rules from the free buildings' peak displacements u_L, u_R
+    /// at the joint's floors (largest over them, m): absolute sum, SRSS,
+    /// and the double difference `√(u_L² + u_R² − 2ρ u_L u_R)` with ρ the
+    /// correlation of two oscillators of the buildings' fundamental
+    /// periods and damping (Der Kiureghian's CQC coefficient).
     pub code_gaps: CodeGaps,
 }
 
@@ -134,133 +174,230 @@ pub fn correlation(r: f64, zi: f64, zj: f64) -> f64 {
     num / den
 }
 
-impl PoundingPair {
-    /// Checks the pair.
+/// A row's model with where each building's bodies, storeys and contacts
+/// sit in it.
+pub struct RowModel {
+    /// The model.
+    pub model: Model,
+    /// Per building.
+    pub placements: Vec<Placement>,
+    /// Per joint, its contacts (model indices, one per pounding floor).
+    pub joints: Vec<Vec<usize>>,
+}
+
+impl Row {
+    /// The pair: `left` and `right` frames (fixed) with one joint.
+    pub fn pair(
+        left: ShearFrame,
+        right: ShearFrame,
+        gap: f64,
+        floors: Vec<usize>,
+        law: ContactLaw,
+    ) -> Self {
+        let building = |name: &str, frame| Building {
+            name: name.into(),
+            frame,
+            isolation: None,
+        };
+        Self {
+            buildings: vec![building("left", left), building("right", right)],
+            joints: vec![Joint { gap, floors, law }],
+        }
+    }
+
+    /// Checks the row: at least two buildings with distinct names, each
+    /// checked; a joint between each two neighbours with a finite gap ≥ 0
+    /// and floors of both. Errors name the building or joint.
     pub fn check(&self) -> Result<(), PoundingError> {
         let pair = PoundingError::pair;
-        self.left.check("left frame").map_err(|m| pair("left", m))?;
-        self.right
-            .check("right frame")
-            .map_err(|m| pair("right", m))?;
-        if !(self.gap.is_finite() && self.gap >= 0.0) {
+        if self.buildings.len() < 2 {
             return Err(pair(
-                "gap",
-                format!("gap {}: give a finite gap >= 0", self.gap),
+                "building",
+                format!(
+                    "{} building(s): a row needs at least two",
+                    self.buildings.len()
+                ),
             ));
         }
-        let top = self.left.masses.len().min(self.right.masses.len());
-        if self.floors.is_empty() {
+        for (k, b) in self.buildings.iter().enumerate() {
+            if self.buildings[..k].iter().any(|o| o.name == b.name) {
+                return Err(pair(
+                    "name",
+                    format!("building name {:?} is used twice", b.name),
+                ));
+            }
+            b.check(&self.what(k)).map_err(|m| pair(self.key(k), m))?;
+        }
+        if self.joints.len() + 1 != self.buildings.len() {
             return Err(pair(
-                "floors",
-                "floors: give at least one pounding floor".into(),
+                "joint",
+                format!(
+                    "{} joints for {} buildings: give one between each two neighbours",
+                    self.joints.len(),
+                    self.buildings.len()
+                ),
             ));
         }
-        if let Some(f) = self.floors.iter().find(|f| **f == 0 || **f > top) {
-            return Err(pair(
-                "floors",
-                format!("floors: floor {f} is not a floor of both frames (1 to {top})"),
-            ));
+        for (j, joint) in self.joints.iter().enumerate() {
+            let what = self.joint_name(j);
+            if !(joint.gap.is_finite() && joint.gap >= 0.0) {
+                return Err(pair(
+                    "gap",
+                    format!("{what}gap {}: give a finite gap >= 0", joint.gap),
+                ));
+            }
+            if joint.floors.is_empty() {
+                return Err(pair(
+                    "floors",
+                    format!("{what}floors: give at least one pounding floor"),
+                ));
+            }
+            let top = self.buildings[j]
+                .floors()
+                .min(self.buildings[j + 1].floors());
+            if let Some(f) = joint.floors.iter().find(|f| **f == 0 || **f > top) {
+                return Err(pair(
+                    "floors",
+                    format!(
+                        "{what}floors: floor {f} is not a floor of both buildings (1 to {top})"
+                    ),
+                ));
+            }
         }
         Ok(())
     }
 
-    /// The pair as a model under `record` × `scale`: the left frame's
-    /// floors, then the right frame's, on one line; a contact per pounding
-    /// floor if `contacts`.
+    /// Whether this is the two-frame pair of a pair file.
+    fn is_pair(&self) -> bool {
+        self.buildings.len() == 2
+            && self.buildings[0].name == "left"
+            && self.buildings[1].name == "right"
+    }
+
+    /// Building k in messages: `left frame` in a pair, else `building NAME`.
+    fn what(&self, k: usize) -> String {
+        if self.is_pair() {
+            format!("{} frame", self.buildings[k].name)
+        } else {
+            format!("building {}", self.buildings[k].name)
+        }
+    }
+
+    /// Building k's key in errors: `left`/`right` in a pair, else
+    /// `building`.
+    fn key(&self, k: usize) -> &'static str {
+        match (self.is_pair(), k) {
+            (true, 0) => "left",
+            (true, _) => "right",
+            _ => "building",
+        }
+    }
+
+    /// Joint j in messages: nothing for a pair's one joint, else `joint
+    /// A–B: `.
+    fn joint_name(&self, j: usize) -> String {
+        if self.is_pair() {
+            String::new()
+        } else {
+            format!(
+                "joint {}–{}: ",
+                self.buildings[j].name,
+                self.buildings[j + 1].name
+            )
+        }
+    }
+
+    /// The row as a model under `record` × `scale`: each building's bodies
+    /// left to right on one line; a contact per joint floor and the moat
+    /// walls if `contacts`.
     pub fn model(
         &self,
         record: &Record,
         scale: f64,
         contacts: bool,
-    ) -> Result<Model, PoundingError> {
+    ) -> Result<RowModel, PoundingError> {
         self.check()?;
-        let mut bodies = Vec::new();
-        let mut couplings = Vec::new();
-        let mut storeys = Vec::new();
-        for (name, frame) in [("L", &self.left), ("R", &self.right)] {
-            let first = bodies.len();
-            let (alpha, beta) = frame.rayleigh();
-            let laws = frame.laws().map_err(|m| PoundingError::Pair {
-                file: None,
-                line: None,
-                key: Some("storeys"),
-                message: m,
-            })?;
-            for (i, (&m, &k)) in frame.masses.iter().zip(&frame.stiffnesses).enumerate() {
-                let ground = i == 0;
-                let below = (!ground).then(|| first + i - 1);
-                // A yielding storey's spring is its law; its damper (β k on
-                // the initial stiffness) stays linear.
-                let spring = match laws[i] {
-                    StoreyLaw::Elastic { .. } => k,
-                    law => {
-                        storeys.push(Storey {
-                            below,
-                            above: first + i,
-                            law,
-                        });
-                        0.0
-                    }
-                };
-                bodies.push(Body {
-                    name: format!("{name}{}", i + 1),
-                    mass: m,
-                    stiffness: if ground { spring } else { 0.0 },
-                    damping: alpha * m + if ground { beta * k } else { 0.0 },
-                });
-                if let Some(a) = below {
-                    couplings.push(Coupling {
-                        a,
-                        b: first + i,
-                        stiffness: spring,
-                        damping: beta * k,
-                    });
+        let mut parts = Parts::default();
+        let tags = self.tags();
+        let placements = self
+            .buildings
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                b.place(&tags[k], &mut parts, contacts)
+                    .map_err(|m| PoundingError::pair(self.key(k), format!("{}: {m}", self.what(k))))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let joints = self
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(j, joint)| {
+                if !contacts {
+                    return Vec::new();
                 }
-            }
-        }
-        let n_left = self.left.masses.len();
-        let contact_list = if contacts {
-            self.floors
-                .iter()
-                .map(|&f| Contact {
-                    pair: ContactPair::Bodies {
-                        left: f - 1,
-                        right: n_left + f - 1,
-                    },
-                    clearance: self.gap,
-                    law: self.law,
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+                let (a, b) = (&placements[j], &placements[j + 1]);
+                joint
+                    .floors
+                    .iter()
+                    .map(|&f| {
+                        parts.contacts.push(Contact {
+                            pair: ContactPair::Bodies {
+                                left: a.first_floor + f - 1,
+                                right: b.first_floor + f - 1,
+                            },
+                            clearance: joint.gap,
+                            law: joint.law,
+                        });
+                        parts.contacts.len() - 1
+                    })
+                    .collect()
+            })
+            .collect();
         let (times, acceleration) = self.excitation(record);
         let base = BaseExcitation::Record(
             Accelerogram::new(times, acceleration, scale)
                 .map_err(|e| PoundingError::run(record, e))?,
         );
-        Model::new(
-            bodies,
-            couplings,
-            contact_list,
+        let model = Model::new(
+            parts.bodies,
+            parts.couplings,
+            parts.contacts,
             base,
             Vec::new(),
             Vec::new(),
             Vec::new(),
         )
-        .and_then(|m| m.with_storeys(storeys))
+        .and_then(|m| m.with_storeys(parts.storeys))
         .map_err(|e| PoundingError::Pair {
             file: None,
             line: None,
             key: None,
             message: e.to_string(),
+        })?;
+        Ok(RowModel {
+            model,
+            placements,
+            joints,
         })
     }
 
-    /// The ground motion a run takes: the record, and after it, for a pair
-    /// with yielding storeys, a free-vibration tail of [`TAIL_PERIODS`] of
-    /// the longer fundamental period at rest (the residual drifts are read
-    /// in its last period).
+    /// The body-name prefix of each building: `L` and `R` for a pair, else
+    /// `B1`, `B2`, … followed by a dot.
+    fn tags(&self) -> Vec<String> {
+        if self.is_pair() {
+            vec!["L".into(), "R".into()]
+        } else {
+            (1..=self.buildings.len())
+                .map(|k| format!("B{k}."))
+                .collect()
+        }
+    }
+
+    /// The ground motion a run takes: the record, and after it, for a row
+    /// with yielding storeys or hysteretic bearings, a free-vibration tail
+    /// of [`TAIL_PERIODS`] of the longest fundamental period at rest (the
+    /// residual drifts are read in its last period).
     fn excitation(&self, record: &Record) -> (Vec<f64>, Vec<f64>) {
         let (mut times, mut acceleration) = (record.times.clone(), record.acceleration.clone());
         if let Some(tail) = self.tail() {
@@ -272,11 +409,17 @@ impl PoundingPair {
         (times, acceleration)
     }
 
-    /// The free-vibration tail's length (s), for a pair with yielding
-    /// storeys.
+    /// The free-vibration tail's length (s), for a row with yielding
+    /// storeys or hysteretic bearings.
     fn tail(&self) -> Option<f64> {
-        (self.left.inelastic() || self.right.inelastic())
-            .then(|| TAIL_PERIODS * self.left.period().max(self.right.period()))
+        self.buildings.iter().any(Building::inelastic).then(|| {
+            TAIL_PERIODS
+                * self
+                    .buildings
+                    .iter()
+                    .map(Building::period)
+                    .fold(0.0, f64::max)
+        })
     }
 
     /// The peak response to `record` × `scale` over its duration, with the
@@ -290,79 +433,40 @@ impl PoundingPair {
         contacts: bool,
         run: &RunSettings,
     ) -> Result<Response, PoundingError> {
-        let model = self.model(record, scale, contacts)?;
+        let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
             accelerations: true,
             ..self.options(record, run)?
         };
-        let nl = self.left.masses.len();
-        let n = model.bodies().len();
-        let mut drift = [vec![0.0f64; nl], vec![0.0f64; n - nl]];
-        let mut acceleration = drift.clone();
-        let mut displacement = drift.clone();
-        // The residual drifts: the mean drift over the last fundamental
-        // period of each frame (of the free-vibration tail where there is
-        // one).
-        let windows = [self.left.period(), self.right.period()].map(|p| opts.t_end - p);
-        let mut residual = [(vec![0.0f64; nl], 0usize), (vec![0.0f64; n - nl], 0usize)];
-        let mut closing = vec![f64::NEG_INFINITY; self.floors.len()];
-        // Peaks taken as the samples stream by (nothing stored); a sample
-        // is [u.., v.., a..].
-        let sim = simulate_streaming(&model, &opts, |t, row| {
-            let (u, a) = (&row[..n], &row[2 * n..]);
-            let ag = model.base().at(t);
-            for (side, (start, len)) in [(0, nl), (nl, n - nl)].into_iter().enumerate() {
-                let late = t >= windows[side];
-                for i in 0..len {
-                    let below = if i == 0 { 0.0 } else { u[start + i - 1] };
-                    let d = u[start + i] - below;
-                    drift[side][i] = drift[side][i].max(d.abs());
-                    displacement[side][i] = displacement[side][i].max(u[start + i].abs());
-                    acceleration[side][i] = acceleration[side][i].max((a[start + i] + ag).abs());
-                    if late {
-                        residual[side].0[i] += d;
-                    }
-                }
-                residual[side].1 += usize::from(late);
-            }
-            for (c, &f) in self.floors.iter().enumerate() {
-                closing[c] = closing[c].max(u[f - 1] - u[nl + f - 1]);
-            }
+        let mut peaks = Peaks::new(self, &rm, opts.t_end);
+        let model = &rm.model;
+        let sim = simulate_streaming(model, &opts, |t, row| {
+            peaks.sample(t, row, model.base().at(t));
             true
         })
         .map_err(|e| PoundingError::run(record, e.0))?;
         if let Some(e) = &sim.error {
             return Err(PoundingError::run(record, e));
         }
-        let residual_drift =
-            residual.map(|(sum, count)| sum.iter().map(|s| s / count.max(1) as f64).collect());
-        Ok(Response {
-            drift,
-            residual_drift,
-            acceleration,
-            displacement,
-            peak_impact_force: sim.impacts.iter().fold(0.0, |m, i| m.max(i.peak_force)),
-            impacts: sim.impacts.len(),
-            closing,
-        })
+        Ok(peaks.finish(self, &rm, &sim))
     }
 
-    /// The time history of the pair with its contacts under `record` ×
-    /// `scale`: every floor's displacement sampled every `run.sample`
-    /// seconds (body order: the left frame's floors, then the right
-    /// frame's) and the impact log.
+    /// The time history of the row with its contacts under `record` ×
+    /// `scale`: every body's displacement sampled every `run.sample`
+    /// seconds (the model's body order: building by building, left to
+    /// right) and the impact log, with the model it ran.
     pub fn history(
         &self,
         record: &Record,
         scale: f64,
         run: &RunSettings,
-    ) -> Result<crate::simulate::Simulation, PoundingError> {
-        let model = self.model(record, scale, true)?;
-        let sim = crate::simulate::simulate(&model, &self.options(record, run)?)
+    ) -> Result<(RowModel, crate::simulate::Simulation), PoundingError> {
+        let rm = self.model(record, scale, true)?;
+        let sim = crate::simulate::simulate(&rm.model, &self.options(record, run)?)
             .map_err(|e| PoundingError::run(record, e.0))?;
         match &sim.error {
             Some(e) => Err(PoundingError::run(record, e)),
-            None => Ok(sim),
+            None => Ok((rm, sim)),
         }
     }
 
@@ -374,10 +478,20 @@ impl PoundingPair {
         if !(run.sample.is_finite() && run.sample > 0.0) {
             return Err(FieldError::new("sample", run.sample, "give a positive step").into());
         }
+        let moats = self
+            .buildings
+            .iter()
+            .filter_map(|b| b.isolation.as_ref()?.moat.as_ref().map(|m| m.gap));
+        let gap = self
+            .joints
+            .iter()
+            .map(|j| j.gap)
+            .chain(moats)
+            .fold(f64::INFINITY, f64::min);
         Ok(SimulationOptions {
             t_end: record.times.last().copied().unwrap_or(0.0) + self.tail().unwrap_or(0.0),
             rtol: run.rtol,
-            atol: run.rtol * 1e-4 * self.gap.max(1e-3),
+            atol: run.rtol * 1e-4 * gap.max(1e-3),
             output_step: Some(run.sample),
             method: run.method,
             integrator: run.integrator,
@@ -385,8 +499,9 @@ impl PoundingPair {
         })
     }
 
-    /// The pounding study of one record: the pair with and without its
-    /// contacts, the gap that avoids contact and the code rules' gaps.
+    /// The pounding study of one record: the row with and without its
+    /// contacts, and per joint the gap that avoids contact and the code
+    /// rules' gaps.
     pub fn analyse(
         &self,
         record: &Record,
@@ -395,44 +510,63 @@ impl PoundingPair {
     ) -> Result<PoundingResult, PoundingError> {
         let pounding = self.respond(record, scale, true, run)?;
         let free = self.respond(record, scale, false, run)?;
-        let required_gap = free.closing.iter().fold(0.0f64, |m, c| m.max(*c));
-        let ul = self
-            .floors
+        let joints = self
+            .joints
             .iter()
-            .fold(0.0f64, |m, &f| m.max(free.displacement[0][f - 1]));
-        let ur = self
-            .floors
-            .iter()
-            .fold(0.0f64, |m, &f| m.max(free.displacement[1][f - 1]));
-        let (wl, wr) = (
-            self.left.natural_frequencies()[0],
-            self.right.natural_frequencies()[0],
-        );
-        let rho = correlation(wr / wl, self.left.damping_ratio, self.right.damping_ratio);
+            .enumerate()
+            .map(|(j, joint)| {
+                let required_gap = free.closing[j].iter().fold(0.0f64, |m, c| m.max(*c));
+                let peak = |k: usize| {
+                    joint
+                        .floors
+                        .iter()
+                        .fold(0.0f64, |m, &f| m.max(free.displacement[k][f - 1]))
+                };
+                let (ul, ur) = (peak(j), peak(j + 1));
+                let (a, b) = (&self.buildings[j], &self.buildings[j + 1]);
+                let rho = correlation(
+                    b.frequency() / a.frequency(),
+                    a.frame.damping_ratio,
+                    b.frame.damping_ratio,
+                );
+                JointGaps {
+                    required_gap,
+                    code_gaps: CodeGaps {
+                        absolute_sum: ul + ur,
+                        srss: (ul * ul + ur * ur).sqrt(),
+                        // ≥ (u_L − u_R)² ≥ 0 for ρ ≤ 1; the max only guards rounding.
+                        double_difference: (ul * ul + ur * ur - 2.0 * rho * ul * ur)
+                            .max(0.0)
+                            .sqrt(),
+                        correlation: rho,
+                    },
+                }
+            })
+            .collect();
         Ok(PoundingResult {
             pounding,
             free,
-            required_gap,
-            code_gaps: CodeGaps {
-                absolute_sum: ul + ur,
-                srss: (ul * ul + ur * ur).sqrt(),
-                // ≥ (u_L − u_R)² ≥ 0 for ρ ≤ 1; the max only guards rounding.
-                double_difference: (ul * ul + ur * ur - 2.0 * rho * ul * ur).max(0.0).sqrt(),
-                correlation: rho,
-            },
+            joints,
         })
     }
 }
 
+#[path = "pounding_building.rs"]
+mod building;
 #[path = "pounding_file.rs"]
 mod file;
 #[path = "pounding_frame.rs"]
 mod frame;
+#[path = "pounding_peaks.rs"]
+mod peaks;
 #[path = "pounding_spectrum.rs"]
 mod spectrum;
 
-pub use file::{parse_pair, PoundingError};
+use building::Parts;
+pub use building::{Bearing, Building, Isolation, Moat, Placement, Wall, GRAVITY};
+pub use file::{parse_row, PoundingError};
 pub use frame::ShearFrame;
+use peaks::Peaks;
 pub use spectrum::{pounding_spectrum, quantile, value_range, with_period_ratio, SpectrumCell};
 
 #[path = "pounding_documents.rs"]

@@ -1,37 +1,114 @@
 //! The documents of a pounding study, one shape for every face (the CLI's
 //! JSON is the schema; Python returns the same fields and nesting): the
-//! pair, each record's run with and without pounding, and the pounding
-//! spectrum over gaps × period ratios.
+//! row, each record's run with and without pounding (per building keyed by
+//! its name, per joint in order), and the pounding spectrum over gaps ×
+//! period ratios.
 
-use serde_json::{json, Value};
+use serde_json::{json, Map, Value};
 
-use super::{quantile, PoundingPair, PoundingResult, Response, SpectrumCell};
+use super::{quantile, PoundingResult, Response, Row, SpectrumCell};
+use crate::hysteresis::StoreyLaw;
 use crate::record::Record;
 
-/// The pair: both frames' fundamental periods, the gap and the pounding
-/// floors.
-pub fn pair_document(pair: &PoundingPair) -> Value {
-    json!({
-        "left_period": pair.left.period(),
-        "right_period": pair.right.period(),
-        "gap": pair.gap,
-        "floors": pair.floors,
-    })
+/// The row: each building's name, fundamental period, floors and whether
+/// it is isolated; each joint's two buildings, gap and pounding floors.
+pub fn row_document(row: &Row) -> Value {
+    let buildings: Vec<Value> = row
+        .buildings
+        .iter()
+        .map(|b| {
+            json!({
+                "name": b.name,
+                "period": b.period(),
+                "floors": b.floors(),
+                "isolated": b.isolation.is_some(),
+            })
+        })
+        .collect();
+    let joints: Vec<Value> = row
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            json!({
+                "between": [row.buildings[j].name, row.buildings[j + 1].name],
+                "gap": joint.gap,
+                "floors": joint.floors,
+            })
+        })
+        .collect();
+    json!({ "buildings": buildings, "joints": joints })
 }
 
-/// One response's peaks: drifts, residual drifts, floor accelerations and
-/// displacements per floor of each frame (`left`, `right`), the peak
-/// impact force, the impact count and the closing velocities.
-pub fn response_document(r: &Response) -> Value {
-    json!({
-        "peak_drift": { "left": r.drift[0], "right": r.drift[1] },
-        "residual_drift": { "left": r.residual_drift[0], "right": r.residual_drift[1] },
-        "peak_floor_acceleration": { "left": r.acceleration[0], "right": r.acceleration[1] },
-        "peak_displacement": { "left": r.displacement[0], "right": r.displacement[1] },
+/// `{name: value}` over the row's buildings.
+fn by_building<T: serde::Serialize>(row: &Row, values: impl IntoIterator<Item = T>) -> Value {
+    let map: Map<String, Value> = row
+        .buildings
+        .iter()
+        .zip(values)
+        .map(|(b, v)| (b.name.clone(), json!(v)))
+        .collect();
+    Value::Object(map)
+}
+
+/// The yield drift of a law (None for an elastic one).
+fn yield_drift(law: &StoreyLaw) -> Option<f64> {
+    match law {
+        StoreyLaw::Elastic { .. } => None,
+        StoreyLaw::Bilinear(b) => Some(b.yield_drift),
+        StoreyLaw::BoucWen(w) => Some(w.yield_drift),
+    }
+}
+
+/// One response's peaks per building (keyed by name): drifts, residual
+/// drifts, ductility demands (peak over yield drift; null for an elastic
+/// storey), hysteretic energies, floor accelerations and displacements;
+/// the isolators' response (isolated buildings); the peak impact force
+/// and impact count between buildings and each joint's closings.
+pub fn response_document(row: &Row, r: &Response) -> Value {
+    let ductility = row.buildings.iter().zip(&r.drift).map(|(b, drift)| {
+        let laws = b.frame.laws().unwrap_or_default();
+        drift
+            .iter()
+            .zip(laws.iter().map(yield_drift).chain(std::iter::repeat(None)))
+            .map(|(d, uy)| uy.map(|uy| d / uy))
+            .collect::<Vec<_>>()
+    });
+    let mut doc = json!({
+        "peak_drift": by_building(row, &r.drift),
+        "residual_drift": by_building(row, &r.residual_drift),
+        "ductility": by_building(row, ductility),
+        "hysteretic_energy": by_building(row, &r.hysteretic_energy),
+        "peak_floor_acceleration": by_building(row, &r.acceleration),
+        "peak_displacement": by_building(row, &r.displacement),
         "peak_impact_force": r.peak_impact_force,
         "impacts": r.impacts,
         "closing": r.closing,
-    })
+    });
+    let isolators: Map<String, Value> = row
+        .buildings
+        .iter()
+        .zip(&r.isolators)
+        .filter_map(|(b, i)| {
+            let (i, iso) = (i.as_ref()?, b.isolation.as_ref()?);
+            Some((
+                b.name.clone(),
+                json!({
+                    "peak_displacement": i.peak_displacement,
+                    "residual_displacement": i.residual_displacement,
+                    "hysteretic_energy": i.hysteretic_energy,
+                    "capacity": iso.capacity,
+                    "beyond_capacity": i.beyond_capacity,
+                    "moat_impacts": i.moat_impacts,
+                    "moat_peak_force": i.moat_peak_force,
+                }),
+            ))
+        })
+        .collect();
+    if !isolators.is_empty() {
+        doc["isolators"] = Value::Object(isolators);
+    }
+    doc
 }
 
 /// Per floor, `a / b` (1 where `b` is 0).
@@ -44,33 +121,46 @@ fn ratio(a: &[f64], b: &[f64]) -> Vec<f64> {
 
 /// One record's run: the record, the response with pounding and without
 /// it (`free`), the amplification of drifts and floor accelerations by
-/// pounding, the gap that avoids contact and the code rules' gaps.
-pub fn run_document(record: &Record, scale: f64, res: &PoundingResult) -> Value {
+/// pounding per building, and per joint the gap that avoids contact and
+/// the code rules' gaps.
+pub fn run_document(row: &Row, record: &Record, scale: f64, res: &PoundingResult) -> Value {
     let (p, f) = (&res.pounding, &res.free);
+    let amp = |a: &[Vec<f64>], b: &[Vec<f64>]| {
+        by_building(row, a.iter().zip(b).map(|(x, y)| ratio(x, y)))
+    };
+    let joints: Vec<Value> = res
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, g)| {
+            json!({
+                "between": [row.buildings[j].name, row.buildings[j + 1].name],
+                "required_gap": g.required_gap,
+                "code_gaps": {
+                    "absolute_sum": g.code_gaps.absolute_sum,
+                    "srss": g.code_gaps.srss,
+                    "double_difference": g.code_gaps.double_difference,
+                    "correlation": g.code_gaps.correlation,
+                },
+            })
+        })
+        .collect();
     json!({
         "record": record.metadata(scale),
-        "pounding": response_document(p),
-        "free": response_document(f),
+        "pounding": response_document(row, p),
+        "free": response_document(row, f),
         "amplification": {
-            "drift": { "left": ratio(&p.drift[0], &f.drift[0]),
-                       "right": ratio(&p.drift[1], &f.drift[1]) },
-            "floor_acceleration": { "left": ratio(&p.acceleration[0], &f.acceleration[0]),
-                                    "right": ratio(&p.acceleration[1], &f.acceleration[1]) },
+            "drift": amp(&p.drift, &f.drift),
+            "floor_acceleration": amp(&p.acceleration, &f.acceleration),
         },
-        "required_gap": res.required_gap,
-        "code_gaps": {
-            "absolute_sum": res.code_gaps.absolute_sum,
-            "srss": res.code_gaps.srss,
-            "double_difference": res.code_gaps.double_difference,
-            "correlation": res.code_gaps.correlation,
-        },
+        "joints": joints,
     })
 }
 
 /// One record's run with the contacts only (no free response, no gaps):
 /// the record and the response with pounding.
-pub fn pounding_only_document(record: &Record, scale: f64, r: &Response) -> Value {
-    json!({ "record": record.metadata(scale), "pounding": response_document(r) })
+pub fn pounding_only_document(row: &Row, record: &Record, scale: f64, r: &Response) -> Value {
+    json!({ "record": record.metadata(scale), "pounding": response_document(row, r) })
 }
 
 /// Median and 16/84 % quantiles of a list, with the list.
@@ -93,15 +183,15 @@ pub fn cell_document(c: &SpectrumCell) -> Value {
     })
 }
 
-/// The study's document: the pair with its runs, or (with `cells`) the
+/// The study's document: the row with its runs, or (with `cells`) the
 /// pounding spectrum over the records.
 pub fn study_document(
-    pair: &PoundingPair,
+    row: &Row,
     records: &[(Record, f64)],
     runs: Option<Vec<Value>>,
     cells: Option<&[SpectrumCell]>,
 ) -> Value {
-    let mut doc = json!({ "pair": pair_document(pair) });
+    let mut doc = json!({ "row": row_document(row) });
     if let Some(runs) = runs {
         doc["runs"] = Value::Array(runs);
     }

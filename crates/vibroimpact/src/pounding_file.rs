@@ -1,18 +1,21 @@
-//! The pounding pair file (docs/earthquakes.md) and the errors of a
+//! The pounding row file, or the pair file (docs/earthquakes.md) and the errors of a
 //! pounding study: the file's line and key, a setting's field, a run's
 //! record.
 
-use super::{PoundingPair, ShearFrame};
+use super::{Bearing, Building, Isolation, Joint, Moat, Row, ShearFrame, Wall};
+use crate::contact::ContactLaw;
 use crate::field_error::FieldError;
 use crate::hysteresis::StoreySpec;
+use crate::model_file::LawSpec;
 use crate::record::Record;
 
 /// Why a pounding study cannot run or did not finish.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PoundingError {
     /// The pair refused: the pair file where it came from one, the line
-    /// where known, the key at fault where known (`left`, `right`, `gap`,
-    /// `floors`, `law`), and what is wrong.
+    /// where known, the key at fault where known (`left`, `right`,
+    /// `building`, `name`, `joint`, `gap`, `floors`, `law`), and what is
+    /// wrong.
     #[error("{}", pair_text(file.as_deref(), *line, message))]
     Pair {
         /// The pair file.
@@ -48,7 +51,7 @@ fn pair_text(file: Option<&str>, line: Option<usize>, message: &str) -> String {
 }
 
 impl PoundingError {
-    /// The pair refused at `key`.
+    /// The row refused at `key`.
     pub(super) fn pair(key: &'static str, message: String) -> Self {
         PoundingError::Pair {
             file: None,
@@ -84,29 +87,116 @@ impl PoundingError {
 
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
+struct MoatSpec {
+    gap: f64,
+    law: LawSpec,
+    wall: Option<Wall>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct IsolationSpec {
+    mass: f64,
+    bearing: Bearing,
+    #[serde(default)]
+    damping: f64,
+    capacity: Option<f64>,
+    moat: Option<MoatSpec>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 struct FrameSpec {
     masses: Vec<f64>,
     stiffnesses: Vec<f64>,
     damping_ratio: f64,
     #[serde(default)]
     storeys: Vec<StoreySpec>,
+    isolation: Option<IsolationSpec>,
 }
 
+/// A `[[building]]` entry: a frame, its name, and (from the second on) the
+/// joint to the building on its left.
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PairSpec {
-    left: FrameSpec,
-    right: FrameSpec,
-    gap: f64,
-    floors: Vec<usize>,
-    law: crate::model_file::LawSpec,
+struct BuildingSpec {
+    name: Option<String>,
+    masses: Vec<f64>,
+    stiffnesses: Vec<f64>,
+    damping_ratio: f64,
+    #[serde(default)]
+    storeys: Vec<StoreySpec>,
+    isolation: Option<IsolationSpec>,
+    gap: Option<f64>,
+    floors: Option<Vec<usize>>,
+    law: Option<LawSpec>,
 }
 
-/// A pair from TOML text: `[left]` and `[right]` (`masses`, `stiffnesses`,
-/// `damping_ratio`), `gap`, `floors` and `law` (a contact law as in model
-/// files); messages name `source` and the line.
-pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, PoundingError> {
-    let spec: PairSpec = toml::from_str(text).map_err(|e| PoundingError::Pair {
+/// A pair file (`[left]`, `[right]`, one joint) or a row file
+/// (`[[building]]` entries, `law` the joints' law unless a building gives
+/// its own).
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RowSpec {
+    left: Option<FrameSpec>,
+    right: Option<FrameSpec>,
+    gap: Option<f64>,
+    floors: Option<Vec<usize>>,
+    law: Option<LawSpec>,
+    #[serde(default)]
+    building: Vec<BuildingSpec>,
+}
+
+/// A contact law, the error naming `key`.
+fn law(spec: &LawSpec, key: &'static str, what: &str) -> Result<ContactLaw, PoundingError> {
+    spec.build()
+        .map_err(|e| PoundingError::pair(key, format!("{what}{key}: {e}")))
+}
+
+/// The building `name` of a frame spec; `what` names it in errors.
+fn building(name: String, f: FrameSpec, what: &str) -> Result<Building, PoundingError> {
+    let isolation = f
+        .isolation
+        .map(|i| {
+            let moat = i
+                .moat
+                .map(|m| {
+                    Ok::<_, PoundingError>(Moat {
+                        gap: m.gap,
+                        law: law(&m.law, "law", &format!("{what}: isolation: moat."))?,
+                        wall: m.wall,
+                    })
+                })
+                .transpose()?;
+            Ok::<_, PoundingError>(Isolation {
+                mass: i.mass,
+                bearing: i.bearing,
+                damping: i.damping,
+                capacity: i.capacity,
+                moat,
+            })
+        })
+        .transpose()?;
+    Ok(Building {
+        name,
+        frame: ShearFrame {
+            masses: f.masses,
+            stiffnesses: f.stiffnesses,
+            damping_ratio: f.damping_ratio,
+            storeys: f.storeys,
+        },
+        isolation,
+    })
+}
+
+/// A row from the TOML text of a pair file (`[left]` and `[right]`
+/// frames, `gap`, `floors`, `law`) or a row file (`[[building]]` entries
+/// with `name`, the frame's keys, an optional `isolation` table, and from
+/// the second on `gap` and `floors` to the building on the left; `law` at
+/// the top or per building). Messages name `source`, the line where TOML
+/// knows it, and the building and key.
+pub fn parse_row(text: &str, source: &str) -> Result<Row, PoundingError> {
+    let spec: RowSpec = toml::from_str(text).map_err(|e| PoundingError::Pair {
         file: Some(source.to_string()),
         line: e
             .span()
@@ -114,22 +204,81 @@ pub fn parse_pair(text: &str, source: &str) -> Result<PoundingPair, PoundingErro
         key: None,
         message: e.message().trim().to_string(),
     })?;
-    let frame = |f: FrameSpec| ShearFrame {
-        masses: f.masses,
-        stiffnesses: f.stiffnesses,
-        damping_ratio: f.damping_ratio,
-        storeys: f.storeys,
-    };
-    let pair = PoundingPair {
-        left: frame(spec.left),
-        right: frame(spec.right),
-        gap: spec.gap,
-        floors: spec.floors,
-        law: spec
-            .law
-            .build()
-            .map_err(|e| PoundingError::pair("law", format!("law: {e}")).in_file(source))?,
-    };
-    pair.check().map_err(|e| e.in_file(source))?;
-    Ok(pair)
+    let row = row_of(spec).map_err(|e| e.in_file(source))?;
+    row.check().map_err(|e| e.in_file(source))?;
+    Ok(row)
+}
+
+/// The row a file spec describes, in either form.
+fn row_of(spec: RowSpec) -> Result<Row, PoundingError> {
+    let missing = |key: &'static str, message: &str| Err(PoundingError::pair(key, message.into()));
+    if spec.building.is_empty() {
+        let (Some(left), Some(right)) = (spec.left, spec.right) else {
+            return missing(
+                "building",
+                "give [left] and [right] frames, or [[building]] entries",
+            );
+        };
+        let (Some(gap), Some(floors), Some(l)) = (spec.gap, spec.floors, spec.law) else {
+            return missing("gap", "a pair needs gap, floors and law");
+        };
+        return Ok(Row {
+            buildings: vec![
+                building("left".into(), left, "left frame")?,
+                building("right".into(), right, "right frame")?,
+            ],
+            joints: vec![Joint {
+                gap,
+                floors,
+                law: law(&l, "law", "")?,
+            }],
+        });
+    }
+    if spec.left.is_some() || spec.right.is_some() || spec.gap.is_some() || spec.floors.is_some() {
+        return missing(
+            "building",
+            "[[building]] entries: give each joint's gap and floors in the building to its right, not [left]/[right], gap or floors at the top",
+        );
+    }
+    let mut buildings = Vec::new();
+    let mut joints = Vec::new();
+    for (k, b) in spec.building.into_iter().enumerate() {
+        let name = b.name.unwrap_or_else(|| format!("B{}", k + 1));
+        let what = format!("building {name}");
+        if k == 0 {
+            if b.gap.is_some() || b.floors.is_some() || b.law.is_some() {
+                return missing(
+                    "building",
+                    &format!("{what}: the first building has no joint to its left: give gap, floors and law from the second on"),
+                );
+            }
+        } else {
+            let (Some(gap), Some(floors)) = (b.gap, b.floors) else {
+                return missing(
+                    "gap",
+                    &format!("{what}: give gap and floors (the joint to the building on its left)"),
+                );
+            };
+            let Some(l) = b.law.as_ref().or(spec.law.as_ref()) else {
+                return missing(
+                    "law",
+                    &format!("{what}: give law (or a law at the top for every joint)"),
+                );
+            };
+            joints.push(Joint {
+                gap,
+                floors,
+                law: law(l, "law", &format!("{what}: "))?,
+            });
+        }
+        let frame = FrameSpec {
+            masses: b.masses,
+            stiffnesses: b.stiffnesses,
+            damping_ratio: b.damping_ratio,
+            storeys: b.storeys,
+            isolation: b.isolation,
+        };
+        buildings.push(building(name, frame, &what)?);
+    }
+    Ok(Row { buildings, joints })
 }

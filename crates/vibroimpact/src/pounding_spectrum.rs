@@ -1,7 +1,7 @@
 //! Pounding spectra over gap × period ratio, value ranges and quantiles
 //! of an ensemble (docs/earthquakes.md).
 
-use super::{PoundingError, PoundingPair, RunSettings};
+use super::{PoundingError, Row, RunSettings};
 use crate::field_error::FieldError;
 use crate::record::Record;
 
@@ -25,15 +25,24 @@ pub struct SpectrumCell {
 }
 
 /// The pair with the right frame's stiffnesses scaled so that T_left /
-/// T_right = `ratio`.
-pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair, PoundingError> {
+/// T_right = `ratio`. Only a pair of two fixed frames has this spectrum.
+pub fn with_period_ratio(row: &Row, ratio: f64) -> Result<Row, PoundingError> {
     if !(ratio.is_finite() && ratio > 0.0) {
         return Err(FieldError::new("ratios", ratio, "give positive period ratios").into());
     }
-    pair.check()?;
-    let factor = (pair.right.period() * ratio / pair.left.period()).powi(2);
-    let mut out = pair.clone();
-    out.right.stiffnesses.iter_mut().for_each(|k| *k *= factor);
+    row.check()?;
+    if row.buildings.len() != 2 || row.buildings.iter().any(|b| b.isolation.is_some()) {
+        let message =
+            "a period-ratio spectrum is of two fixed frames (a pair file without isolation)";
+        return Err(FieldError::about("ratios", message).into());
+    }
+    let factor = (row.buildings[1].period() * ratio / row.buildings[0].period()).powi(2);
+    let mut out = row.clone();
+    out.buildings[1]
+        .frame
+        .stiffnesses
+        .iter_mut()
+        .for_each(|k| *k *= factor);
     Ok(out)
 }
 
@@ -41,7 +50,7 @@ pub fn with_period_ratio(pair: &PoundingPair, ratio: f64) -> Result<PoundingPair
 /// (each with its scale), in parallel, cells gap-major; each record's run
 /// as `run` says. The same numbers at any thread count.
 pub fn pounding_spectrum(
-    pair: &PoundingPair,
+    pair: &Row,
     records: &[(Record, f64)],
     gaps: &[f64],
     ratios: &[f64],
@@ -61,7 +70,7 @@ pub fn pounding_spectrum(
     if let Some(g) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
         return Err(FieldError::new("gaps", g, "give finite gaps >= 0").into());
     }
-    let pairs: Vec<PoundingPair> = ratios
+    let pairs: Vec<Row> = ratios
         .iter()
         .map(|&r| with_period_ratio(pair, r))
         .collect::<Result<_, _>>()?;
@@ -71,10 +80,8 @@ pub fn pounding_spectrum(
     cells
         .par_iter()
         .map(|&(g, r)| {
-            let p = PoundingPair {
-                gap: gaps[g],
-                ..pairs[r].clone()
-            };
+            let mut p = pairs[r].clone();
+            p.joints[0].gap = gaps[g];
             let mut cell = SpectrumCell {
                 gap: gaps[g],
                 period_ratio: ratios[r],
@@ -85,7 +92,7 @@ pub fn pounding_spectrum(
             };
             for (record, scale) in records {
                 let res = p.analyse(record, *scale, run)?;
-                let amp = (0..2)
+                let amp = (0..res.pounding.drift.len())
                     .flat_map(|side| {
                         let (a, b) = (&res.pounding.drift[side], &res.free.drift[side]);
                         a.iter()
@@ -96,7 +103,7 @@ pub fn pounding_spectrum(
                 cell.impact_force.push(res.pounding.peak_impact_force);
                 cell.impacts.push(res.pounding.impacts);
                 cell.drift_amplification.push(amp);
-                cell.required_gap.push(res.required_gap);
+                cell.required_gap.push(res.joints[0].required_gap);
             }
             Ok(cell)
         })

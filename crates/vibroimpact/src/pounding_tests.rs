@@ -69,14 +69,14 @@ fn frame_frequencies_and_rayleigh_damping() {
         assert!((zeta - 0.04).abs() < 1e-12, "{zeta}");
     }
     // The model's body dampers and couplings are C.
-    let pair = PoundingPair {
-        left: f3.clone(),
-        right: frame(1, 1e5, 1e7),
-        gap: 1.0,
-        floors: vec![1],
-        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
-    };
-    let model = pair.model(&record(), 1.0, false).unwrap();
+    let pair = Row::pair(
+        f3.clone(),
+        frame(1, 1e5, 1e7),
+        1.0,
+        vec![1],
+        ContactLaw::hertz(1e9, 1.5).unwrap(),
+    );
+    let model = pair.model(&record(), 1.0, false).unwrap().model;
     let dynamics = ChainDynamics::new(&model, false);
     assert_eq!(dynamics.bodies(), 4);
 }
@@ -87,12 +87,14 @@ fn frame_frequencies_and_rayleigh_damping() {
 /// ordered DDC ≤ SRSS ≤ ABS, and ABS bounds the true gap.
 #[test]
 fn required_gap_and_code_rules() {
-    let pair = |gap: f64| PoundingPair {
-        left: frame(3, 2.0e5, 6.0e7),
-        right: frame(2, 3.0e5, 1.5e8),
-        gap,
-        floors: vec![1, 2],
-        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    let pair = |gap: f64| {
+        Row::pair(
+            frame(3, 2.0e5, 6.0e7),
+            frame(2, 3.0e5, 1.5e8),
+            gap,
+            vec![1, 2],
+            ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+        )
     };
     let rec = record();
     let far = pair(1.0)
@@ -100,7 +102,7 @@ fn required_gap_and_code_rules() {
         .unwrap();
     assert_eq!(far.pounding.impacts, 0);
     assert_eq!(far.pounding, far.free);
-    let need = far.required_gap;
+    let need = far.joints[0].required_gap;
     assert!(need > 1e-3, "{need}");
     let below = pair(0.98 * need)
         .analyse(&rec, 1.0, &RunSettings::new(0.0025, 1e-9))
@@ -113,7 +115,7 @@ fn required_gap_and_code_rules() {
     // The history of the pounding run: the same impacts and peak force,
     // its largest sampled drift the response's (same samples), a sample
     // every 2.5 ms over the record.
-    let h = pair(0.98 * need)
+    let (_, h) = pair(0.98 * need)
         .history(&rec, 1.0, &RunSettings::new(0.0025, 1e-9))
         .unwrap();
     assert_eq!(h.impacts.len(), below.pounding.impacts);
@@ -125,32 +127,31 @@ fn required_gap_and_code_rules() {
         .map(|j| (h.states[j * 10 + 2] - h.states[j * 10 + 1]).abs())
         .fold(0.0, f64::max);
     assert_eq!(top_drift, below.pounding.drift[0][2]);
-    let g = far.code_gaps;
+    let g = far.joints[0].code_gaps;
     assert!(g.double_difference <= g.srss && g.srss <= g.absolute_sum);
     assert!(need <= g.absolute_sum);
     assert!(g.correlation > 0.0 && g.correlation < 1.0);
     // Identical frames move together: no gap needed, and ρ = 1.
-    let same = PoundingPair {
-        right: frame(3, 2.0e5, 6.0e7),
-        ..pair(0.01)
-    };
+    let mut same = pair(0.01);
+    same.buildings[1].frame = frame(3, 2.0e5, 6.0e7);
     let r = same
         .analyse(&rec, 1.0, &RunSettings::new(0.0025, 1e-9))
         .unwrap();
-    assert!(r.required_gap.abs() < 1e-12, "{}", r.required_gap);
-    assert!((r.code_gaps.correlation - 1.0).abs() < 1e-12);
-    assert!(r.code_gaps.double_difference < 1e-9);
+    let j = r.joints[0];
+    assert!(j.required_gap.abs() < 1e-12, "{}", j.required_gap);
+    assert!((j.code_gaps.correlation - 1.0).abs() < 1e-12);
+    assert!(j.code_gaps.double_difference < 1e-9);
 }
 
 /// A 3-storey and a 2-storey frame, a 1 cm joint at floors 1 and 2, Hertz.
-fn storeys_3_and_2() -> PoundingPair {
-    PoundingPair {
-        left: frame(3, 2.0e5, 6.0e7),
-        right: frame(2, 3.0e5, 1.5e8),
-        gap: 0.01,
-        floors: vec![1, 2],
-        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
-    }
+fn storeys_3_and_2() -> Row {
+    Row::pair(
+        frame(3, 2.0e5, 6.0e7),
+        frame(2, 3.0e5, 1.5e8),
+        0.01,
+        vec![1, 2],
+        ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    )
 }
 
 /// DOPRI5 at a loose tolerance gives the pounding run's peaks of DOP853 at
@@ -214,44 +215,40 @@ fn the_local_integrator_matches_the_global_one() {
 
 #[test]
 fn bad_pairs_are_refused() {
-    let ok = PoundingPair {
-        left: frame(2, 1e5, 1e7),
-        right: frame(1, 1e5, 1e7),
-        gap: 0.01,
-        floors: vec![1],
-        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+    let ok = Row::pair(
+        frame(2, 1e5, 1e7),
+        frame(1, 1e5, 1e7),
+        0.01,
+        vec![1],
+        ContactLaw::hertz(1e9, 1.5).unwrap(),
+    );
+    let with = |f: &dyn Fn(&mut Row)| {
+        let mut r = ok.clone();
+        f(&mut r);
+        r
     };
     let cases = [
         (
-            PoundingPair {
-                floors: vec![2],
-                ..ok.clone()
-            },
+            with(&|r| r.joints[0].floors = vec![2]),
             "floor 2 is not a floor of both",
         ),
+        (with(&|r| r.joints[0].gap = -1.0), "gap -1"),
+        (with(&|r| r.joints[0].floors = vec![]), "at least one"),
         (
-            PoundingPair {
-                gap: -1.0,
-                ..ok.clone()
-            },
-            "gap -1",
-        ),
-        (
-            PoundingPair {
-                floors: vec![],
-                ..ok.clone()
-            },
-            "at least one",
-        ),
-        (
-            PoundingPair {
-                left: ShearFrame {
-                    stiffnesses: vec![1e7],
-                    ..frame(2, 1e5, 1e7)
-                },
-                ..ok.clone()
-            },
+            with(&|r| r.buildings[0].frame.stiffnesses = vec![1e7]),
             "left frame: 2 masses and 1 storey",
+        ),
+        (
+            with(&|r| r.buildings[1].name = "left".into()),
+            "building name \"left\" is used twice",
+        ),
+        (with(&|r| r.joints.clear()), "0 joints for 2 buildings"),
+        (
+            with(&|r| {
+                r.buildings.truncate(1);
+                r.joints.clear();
+            }),
+            "1 building(s): a row needs at least two",
         ),
     ];
     for (p, needle) in cases {
@@ -270,15 +267,15 @@ fn bad_pairs_are_refused() {
 /// one thread and on two.
 #[test]
 fn pounding_spectrum_cells() {
-    let pair = PoundingPair {
-        left: frame(3, 2.0e5, 6.0e7),
-        right: frame(2, 3.0e5, 1.5e8),
-        gap: 0.0,
-        floors: vec![1, 2],
-        law: ContactLaw::hertz(2.0e9, 1.5).unwrap(),
-    };
+    let pair = Row::pair(
+        frame(3, 2.0e5, 6.0e7),
+        frame(2, 3.0e5, 1.5e8),
+        0.0,
+        vec![1, 2],
+        ContactLaw::hertz(2.0e9, 1.5).unwrap(),
+    );
     let scaled = with_period_ratio(&pair, 1.7).unwrap();
-    assert!((scaled.left.period() / scaled.right.period() - 1.7).abs() < 1e-12);
+    assert!((scaled.buildings[0].period() / scaled.buildings[1].period() - 1.7).abs() < 1e-12);
     let records = vec![(record(), 1.0), (record(), 0.5)];
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
@@ -318,12 +315,16 @@ fn pair_files_are_parsed_and_checked() {
         "gap = 0.02\nfloors = [1]\nlaw = { law = \"hertz\", stiffness = 1e9, exponent = 1.5 }\n\
                 [left]\nmasses = [1e5]\nstiffnesses = [1e7]\ndamping_ratio = 0.05\n\
                 [right]\nmasses = [1e5, 1e5]\nstiffnesses = [2e7, 2e7]\ndamping_ratio = 0.02\n";
-    let p = parse_pair(text, "pair.toml").unwrap();
+    let p = parse_row(text, "pair.toml").unwrap();
     assert_eq!(
-        (p.left.masses.len(), p.right.masses.len(), p.gap),
+        (
+            p.buildings[0].floors(),
+            p.buildings[1].floors(),
+            p.joints[0].gap
+        ),
         (1, 2, 0.02)
     );
-    let e = parse_pair(
+    let e = parse_row(
         &text.replace("damping_ratio = 0.02", "dampingratio = 0.02"),
         "pair.toml",
     )
@@ -333,7 +334,7 @@ fn pair_files_are_parsed_and_checked() {
         e.starts_with("pair.toml:11:") && e.contains("dampingratio"),
         "{e}"
     );
-    let e = parse_pair(&text.replace("floors = [1]", "floors = [2]"), "pair.toml").unwrap_err();
+    let e = parse_row(&text.replace("floors = [1]", "floors = [2]"), "pair.toml").unwrap_err();
     assert!(
         matches!(&e, PoundingError::Pair { file: Some(f), key: Some("floors"), .. } if f == "pair.toml"),
         "{e:?}"
@@ -356,7 +357,7 @@ fn yielding_storeys_in_the_pair() {
                 storeys = [{ law = \"bilinear\", yield_drift = YD, post_yield_ratio = 0.05 }, \
                            { law = \"bilinear\", yield_drift = YD, post_yield_ratio = 0.05 }]\n\
                 [right]\nmasses = [1e5]\nstiffnesses = [2e7]\ndamping_ratio = 0.05\n";
-    let bad = parse_pair(
+    let bad = parse_row(
         &text
             .replace("YD", "0.002")
             .replace("post_yield_ratio = 0.05 }]", "post_yield_ratio = 1.5 }]"),
@@ -373,9 +374,9 @@ fn yielding_storeys_in_the_pair() {
         .filter(|l| !l.trim_start().starts_with("storeys"))
         .map(|l| format!("{l}\n"))
         .collect();
-    let elastic = parse_pair(&plain, "e.toml").unwrap();
-    let never = parse_pair(&text.replace("YD", "10.0"), "n.toml").unwrap();
-    let yielding = parse_pair(&text.replace("YD", "0.002"), "y.toml").unwrap();
+    let elastic = parse_row(&plain, "e.toml").unwrap();
+    let never = parse_row(&text.replace("YD", "10.0"), "n.toml").unwrap();
+    let yielding = parse_row(&text.replace("YD", "0.002"), "y.toml").unwrap();
     let run = RunSettings::new(0.005, 1e-9);
     let rec = record();
     let a = elastic.respond(&rec, 1.0, false, &run).unwrap();

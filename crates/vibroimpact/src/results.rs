@@ -592,7 +592,10 @@ pub struct EnergySummary {
     pub damping_dissipation: f64,
     /// Dissipated in contacts.
     pub contact_dissipation: f64,
-    /// E + D_c + D_k - W - E0.
+    /// Dissipated by hysteretic storeys (present where the model has them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hysteretic_dissipation: Option<f64>,
+    /// E + D_c + D_k + D_h - W - E0.
     pub residual: f64,
 }
 
@@ -645,6 +648,8 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
             input_work: e.input_work,
             damping_dissipation: e.damping_dissipation,
             contact_dissipation: e.contact_dissipation,
+            hysteretic_dissipation: (!model.storeys().is_empty())
+                .then_some(e.hysteretic_dissipation),
             residual: e.residual(),
         }),
         record: None,

@@ -153,12 +153,19 @@ pub struct EnergyBalance {
     pub damping_dissipation: f64,
     /// Dissipation of the contacts.
     pub contact_dissipation: f64,
+    /// Dissipation by the hysteretic storeys (their hysteretic parts' work
+    /// less what those store; the stored part is in `mechanical`).
+    pub hysteretic_dissipation: f64,
 }
 
 impl EnergyBalance {
-    /// `E(t) + D_c + D_k - W - E(0)`: zero up to the integration error.
+    /// `E(t) + D_c + D_k + D_h - W - E(0)`: zero up to the integration
+    /// error.
     pub fn residual(&self) -> f64 {
-        self.mechanical + self.damping_dissipation + self.contact_dissipation
+        self.mechanical
+            + self.damping_dissipation
+            + self.contact_dissipation
+            + self.hysteretic_dissipation
             - self.input_work
             - self.initial
     }
@@ -185,6 +192,9 @@ pub struct Simulation {
     pub contact_evaluations: u64,
     /// The energy audit, if requested.
     pub energy: Option<EnergyBalance>,
+    /// The energy each hysteretic storey has dissipated by the end (J, the
+    /// model's storey order; empty without storeys).
+    pub hysteretic_energy: Vec<f64>,
     /// The integration failure that stopped the simulation early, if any.
     pub error: Option<SimulationFailure>,
     /// Exact extrema over the requested window (up to `final_time`).
@@ -491,6 +501,7 @@ fn simulate_local(
         impacts,
         stats: run.stats,
         contact_evaluations: run.contact_evaluations,
+        hysteretic_energy: Vec::new(),
         energy: run
             .energy
             .map(|[input_work, damping_dissipation, contact_dissipation]| {
@@ -501,6 +512,8 @@ fn simulate_local(
                     input_work,
                     damping_dissipation,
                     contact_dissipation,
+                    // The local integrator runs no hysteretic storeys.
+                    hysteretic_dissipation: 0.0,
                 }
             }),
         error,

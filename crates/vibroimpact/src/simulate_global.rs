@@ -162,17 +162,10 @@ pub fn simulate_streaming(
 /// [`MAX_SAMPLES`], a record's duration within the record.
 pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
     check_options(opts)?;
-    if !model.storeys().is_empty() {
-        if opts.integrator == Integrator::Local {
-            return Err(OptionsError(
-                "integrator = local: the local integrator does not carry hysteretic storeys yet (docs/decisions.md D26); use global or auto".into(),
-            ));
-        }
-        if opts.energy {
-            return Err(OptionsError(
-                "energy: the energy audit does not carry hysteretic storeys yet (docs/decisions.md D26)".into(),
-            ));
-        }
+    if !model.storeys().is_empty() && opts.integrator == Integrator::Local {
+        return Err(OptionsError(
+            "integrator = local: the local integrator does not carry hysteretic storeys yet (docs/decisions.md D26); use global or auto".into(),
+        ));
     }
     if let Some(dt) = opts.output_step {
         let samples = (opts.t_end - opts.output_from) / dt + 1.0;
@@ -353,6 +346,7 @@ fn global_result(
         input_work: y[n2],
         damping_dissipation: y[n2 + 1],
         contact_dissipation: y[n2 + 2],
+        hysteretic_dissipation: sys.storeys().dissipated(&y),
     });
     let error = error.map(|source| {
         let state = match &source {
@@ -371,6 +365,12 @@ fn global_result(
         impacts,
         stats: st.stats(),
         contact_evaluations: sys.contact_evaluations(),
+        hysteretic_energy: model
+            .storeys()
+            .iter()
+            .enumerate()
+            .map(|(k, s)| s.law.dissipated(sys.storeys().state(k, &y)))
+            .collect(),
         energy,
         error,
         extrema,

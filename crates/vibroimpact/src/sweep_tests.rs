@@ -88,6 +88,7 @@ fn handover_skips_overlapping_states() {
         impacts: Vec::new(),
         stats: Default::default(),
         contact_evaluations: 0,
+        hysteretic_energy: Vec::new(),
         energy: None,
         error: None,
         extrema: None,

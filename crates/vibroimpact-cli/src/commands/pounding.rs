@@ -1,4 +1,5 @@
-//! `vibroimpact pounding`: two shear frames side by side under recorded
+//! `vibroimpact pounding`: a row of buildings (a pair of shear frames, or
+//! K buildings, fixed or isolated) side by side under recorded
 //! ground motions ([`vibroimpact::pounding`]): per record the response
 //! with and without pounding, the gap that avoids contact and the code
 //! rules; with `--gaps` and `--ratios` the pounding spectrum over an
@@ -9,7 +10,7 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::pounding::{
-    documents, parse_pair, pounding_spectrum, quantile, value_range, PoundingError, PoundingPair,
+    documents, parse_row, pounding_spectrum, quantile, value_range, PoundingError, Row,
     RunSettings, SpectrumCell,
 };
 
@@ -24,8 +25,8 @@ use crate::records;
 /// Options of `vibroimpact pounding`.
 #[derive(Args, Debug)]
 pub struct PoundingArgs {
-    /// The pair (TOML: `[left]` and `[right]` frames with `masses`,
-    /// `stiffnesses`, `damping_ratio`; `gap`, `floors`, `law`; see
+    /// The row (TOML: `[[building]]` entries, or a pair's `[left]` and
+    /// `[right]` frames with `gap`, `floors`, `law`; see
     /// docs/earthquakes.md).
     pair: PathBuf,
     /// Records (AT2, two columns or CSV), one run each.
@@ -148,7 +149,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let source = args.pair.display().to_string();
     let text =
         crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
-    let pair: PoundingPair = parse_pair(&text, &source).map_err(pounding_error)?;
+    let row: Row = parse_row(&text, &source).map_err(pounding_error)?;
     let runs = args
         .records
         .iter()
@@ -159,27 +160,27 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             let range = |field, text| value_range(field, text).map_err(|e| option_error(&e));
             let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
             let cells =
-                pounding_spectrum(&pair, &runs, &gaps, &ratios, &run).map_err(pounding_error)?;
+                pounding_spectrum(&row, &runs, &gaps, &ratios, &run).map_err(pounding_error)?;
             if let Some(dir) = &args.out {
                 ensure_dir(dir)?;
                 render(&spectrum_figure(&cells), &dir.join("spectrum"))?;
             }
-            let doc = documents::study_document(&pair, &runs, None, Some(&cells));
+            let doc = documents::study_document(&row, &runs, None, Some(&cells));
             (doc, Some(spectrum_csv(&cells)?))
         }
         _ => {
             let mut list = Vec::new();
             for (r, s) in &runs {
                 list.push(if args.free {
-                    let res = pair.analyse(r, *s, &run).map_err(pounding_error)?;
-                    documents::run_document(r, *s, &res)
+                    let res = row.analyse(r, *s, &run).map_err(pounding_error)?;
+                    documents::run_document(&row, r, *s, &res)
                 } else {
-                    let res = pair.respond(r, *s, true, &run).map_err(pounding_error)?;
-                    documents::pounding_only_document(r, *s, &res)
+                    let res = row.respond(r, *s, true, &run).map_err(pounding_error)?;
+                    documents::pounding_only_document(&row, r, *s, &res)
                 });
             }
             (
-                documents::study_document(&pair, &runs, Some(list), None),
+                documents::study_document(&row, &runs, Some(list), None),
                 None,
             )
         }
@@ -210,25 +211,63 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
 }
 
 fn print_table(doc: &Value) {
-    let p = &doc["pair"];
-    println!(
-        "T_left {:.4} s, T_right {:.4} s, gap {} m at floors {}",
-        p["left_period"].as_f64().unwrap_or(f64::NAN),
-        p["right_period"].as_f64().unwrap_or(f64::NAN),
-        p["gap"],
-        p["floors"]
-    );
-    if let Some(runs) = doc["runs"].as_array() {
-        for r in runs {
+    let row = &doc["row"];
+    for b in row["buildings"].as_array().into_iter().flatten() {
+        println!(
+            "{}: T1 {:.4} s, {} floors{}",
+            b["name"].as_str().unwrap_or("?"),
+            b["period"].as_f64().unwrap_or(f64::NAN),
+            b["floors"],
+            if b["isolated"] == true {
+                ", isolated"
+            } else {
+                ""
+            }
+        );
+    }
+    for j in row["joints"].as_array().into_iter().flatten() {
+        println!(
+            "joint {}–{}: gap {} m at floors {}",
+            j["between"][0].as_str().unwrap_or("?"),
+            j["between"][1].as_str().unwrap_or("?"),
+            j["gap"],
+            j["floors"]
+        );
+    }
+    for r in doc["runs"].as_array().into_iter().flatten() {
+        println!(
+            "{}: {} impacts, peak force {:.4e} N",
+            r["record"]["source"].as_str().unwrap_or("?"),
+            r["pounding"]["impacts"],
+            r["pounding"]["peak_impact_force"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+        );
+        for j in r["joints"].as_array().into_iter().flatten() {
             println!(
-                "{}: {} impacts, peak force {:.4e} N, required gap {:.4e} m (ABS {:.4e}, SRSS {:.4e}, DDC {:.4e})",
-                r["record"]["source"].as_str().unwrap_or("?"),
-                r["pounding"]["impacts"],
-                r["pounding"]["peak_impact_force"].as_f64().unwrap_or(f64::NAN),
-                r["required_gap"].as_f64().unwrap_or(f64::NAN),
-                r["code_gaps"]["absolute_sum"].as_f64().unwrap_or(f64::NAN),
-                r["code_gaps"]["srss"].as_f64().unwrap_or(f64::NAN),
-                r["code_gaps"]["double_difference"].as_f64().unwrap_or(f64::NAN),
+                "  joint {}–{}: required gap {:.4e} m (ABS {:.4e}, SRSS {:.4e}, DDC {:.4e})",
+                j["between"][0].as_str().unwrap_or("?"),
+                j["between"][1].as_str().unwrap_or("?"),
+                j["required_gap"].as_f64().unwrap_or(f64::NAN),
+                j["code_gaps"]["absolute_sum"].as_f64().unwrap_or(f64::NAN),
+                j["code_gaps"]["srss"].as_f64().unwrap_or(f64::NAN),
+                j["code_gaps"]["double_difference"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+            );
+        }
+        let isolators = r["pounding"]["isolators"].as_object();
+        for (name, i) in isolators.into_iter().flatten() {
+            println!(
+                "  {name} isolators: peak {:.4e} m{}, {} moat impacts, peak moat force {:.4e} N",
+                i["peak_displacement"].as_f64().unwrap_or(f64::NAN),
+                if i["beyond_capacity"] == true {
+                    " (BEYOND CAPACITY)"
+                } else {
+                    ""
+                },
+                i["moat_impacts"],
+                i["moat_peak_force"].as_f64().unwrap_or(f64::NAN),
             );
         }
     }

@@ -211,30 +211,34 @@ def pounding(
     gaps: Any = None,
     ratios: Any = None,
 ) -> Result:
-    """Pounding of two shear frames under recorded ground motions
-    (``vibroimpact pounding``): ``pair`` is a pair file (TOML,
-    docs/earthquakes.md) or its text; ``records`` one record or a list, each
-    a :func:`read_record` result or a file name (read with ``units`` when
-    its header does not state them), scaled by ``scale``. ``sample`` (s):
-    the sampling of drifts and floor accelerations. ``method``: "dop853",
-    or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the record's samples
-    limit the step; peaks within 1 % there, docs/earthquakes.md).
-    ``integrator="local"``: each frame moves exactly between poundings, per
-    record sample. ``free=False`` runs the pair with its contacts only
-    (half the work; no ``free``, ``amplification``, ``required_gap`` or
-    ``code_gaps``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
-    values): the pounding spectrum over gaps (m) × period ratios
+    """Pounding of a row of buildings under recorded ground motions
+    (``vibroimpact pounding``): ``pair`` is a row file (``[[building]]``
+    entries) or a pair file (``[left]``, ``[right]``), TOML
+    (docs/earthquakes.md), or its text; ``records`` one record or a list,
+    each a :func:`read_record` result or a file name (read with ``units``
+    when its header does not state them), scaled by ``scale``. ``sample``
+    (s): the sampling of drifts and floor accelerations. ``method``:
+    "dop853", or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the
+    record's samples limit the step; peaks within 1 % there,
+    docs/earthquakes.md). ``integrator="local"``: each frame moves exactly
+    between poundings, per record sample. ``free=False`` runs the row with
+    its contacts only (half the work; no ``free``, ``amplification`` or
+    ``joints``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
+    values): the pounding spectrum of a pair over gaps (m) × period ratios
     T_left/T_right instead of the runs.
 
-    Returns the CLI's document: ``pair`` (``left_period``,
-    ``right_period``, ``gap``, ``floors``) and ``runs``, one per record,
-    each with ``record``, ``pounding`` and ``free`` (``peak_drift``,
-    ``peak_floor_acceleration``, ``peak_displacement`` per floor of the
-    ``left`` and ``right`` frames, ``peak_impact_force``, ``impacts``,
-    ``closing``), ``amplification``, ``required_gap`` and ``code_gaps``
-    (``absolute_sum``, ``srss``, ``double_difference``, ``correlation``);
-    with ``gaps`` and ``ratios``, ``pair``, ``records`` and ``cells`` (per
-    gap and ratio the median, 16 and 84 % quantiles over the records)."""
+    Returns the CLI's document: ``row`` (``buildings``: ``name``,
+    ``period``, ``floors``, ``isolated``; ``joints``: ``between``, ``gap``,
+    ``floors``) and ``runs``, one per record, each with ``record``,
+    ``pounding`` and ``free`` (per building name: ``peak_drift``,
+    ``residual_drift``, ``ductility``, ``hysteretic_energy``,
+    ``peak_floor_acceleration``, ``peak_displacement``; ``isolators`` per
+    isolated building; ``peak_impact_force``, ``impacts``, ``closing`` per
+    joint), ``amplification`` and ``joints`` (``required_gap`` and
+    ``code_gaps``: ``absolute_sum``, ``srss``, ``double_difference``,
+    ``correlation``); with ``gaps`` and ``ratios``, ``row``, ``records``
+    and ``cells`` (per gap and ratio the median, 16 and 84 % quantiles over
+    the records)."""
     source, text = _pair_text(pair)
     _pounding_settings(scale, sample, rtol, method, integrator)
     if not isinstance(free, bool):
@@ -268,14 +272,15 @@ def pounding_history(
     method: str = "dop853",
     integrator: str = "auto",
 ) -> Result:
-    """The time history of a pounding pair with its contacts under one
+    """The time history of a row (or pair) with its contacts under one
     record (as :func:`pounding` takes them), sampled every ``sample``
-    seconds: ``t`` (s), ``left`` and ``right`` (floor displacements relative
-    to the ground, floors × samples, m) and the impact log
-    ``impact_time`` (s), ``impact_floor`` (1-based), ``impact_peak_force``
-    (N)."""
+    seconds: ``t`` (s); ``floors``, per building name its floor
+    displacements relative to the ground (floors × samples, m); ``slab``,
+    per isolated building its base slab's displacement (m); and the impact
+    log ``impact_time`` (s), ``impact_at`` (``"A–B floor F"`` between
+    buildings, ``"A moat"`` on a moat wall), ``impact_floor`` (1-based, 0
+    for a slab), ``impact_peak_force`` (N)."""
     d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method, integrator))
-    d["left"] = np.asarray(d["left"])
-    d["right"] = np.asarray(d["right"])
+    d["floors"] = {name: np.asarray(v) for name, v in d["floors"].items()}
     d["impact_floor"] = np.asarray(d["impact_floor"], dtype=np.int64)
     return Result(d)

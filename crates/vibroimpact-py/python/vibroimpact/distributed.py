@@ -177,8 +177,8 @@ def ensemble(
 
 
 def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
-    """One record × scale: the pair's periods and the record's run
-    (``vibroimpact pounding``'s ``pair`` and ``runs[0]``)."""
+    """One record × scale: the row and the record's run (``vibroimpact
+    pounding``'s ``row`` and ``runs[0]``)."""
     from . import _core
     from ._checks import _floats
 
@@ -191,7 +191,7 @@ def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
     doc = _core.pounding(
         text, source, [(name, header, units, t, a)], scale, sample, rtol, method, integrator, True
     )
-    return {"pair": dict(doc["pair"]), **dict(doc["runs"][0])}
+    return {"row": dict(doc["row"]), **dict(doc["runs"][0])}
 
 
 def ida(
@@ -212,15 +212,16 @@ def ida(
     every record × every scale factor, one Dask task each with ``client``
     (else here, one after the other; the same numbers either way). The
     intensity is the scaled record's pseudo-spectral acceleration Sa(T1) at
-    the left frame's fundamental period and ``damping``. ``sample``,
+    the first (left) building's fundamental period and ``damping``. ``sample``,
     ``rtol``, ``method`` and ``integrator`` as :func:`vibroimpact.pounding`
     takes them.
 
     Returns arrays over the runs, record-major: ``record`` (index),
     ``scale``, ``sa`` (m/s²), ``peak_impact_force`` (N), ``impacts``,
-    ``max_drift`` (the largest storey drift of both frames with pounding,
-    m), ``drift_amplification`` (largest ratio to the free frames'),
-    ``required_gap`` (m); and ``period`` (T1, s) and ``sources``."""
+    ``max_drift`` (the largest storey drift of every building with
+    pounding, m), ``drift_amplification`` (largest ratio to the free
+    buildings'), ``required_gap`` (the largest over the joints, m); and
+    ``period`` (T1, s) and ``sources``."""
     import os
 
     from ._earthquakes import (
@@ -254,14 +255,14 @@ def ida(
             for i, s in jobs
         ]
         results = _gather(futures, progress, len(futures))
-    period = float(results[0]["pair"]["left_period"])
+    period = float(results[0]["row"]["buildings"][0]["period"])
     sa_unit = [
         float(response_spectrum(r, [period], damping=damping)["pseudo_acceleration"][0])
         for r in recs
     ]
 
     def drifts(res, key):
-        return [d for side in ("left", "right") for d in res[key]["peak_drift"][side]]
+        return [d for name in sorted(res[key]["peak_drift"]) for d in res[key]["peak_drift"][name]]
 
     max_drift = [max(drifts(r, "pounding")) for r in results]
     amplification = [
@@ -279,7 +280,7 @@ def ida(
             "impacts": np.array([r["pounding"]["impacts"] for r in results]),
             "max_drift": np.array(max_drift),
             "drift_amplification": np.array(amplification),
-            "required_gap": np.array([r["required_gap"] for r in results]),
+            "required_gap": np.array([max(j["required_gap"] for j in r["joints"]) for r in results]),
         }
     )
 
