@@ -575,3 +575,7 @@ pub mod documents;
 #[cfg(test)]
 #[path = "pounding_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "pounding_row_tests.rs"]
+mod row_tests;
