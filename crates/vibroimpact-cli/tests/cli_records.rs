@@ -288,3 +288,62 @@ fn hysteresis_loop_and_bad_input() {
         assert_clean_error(&[&base[..], extra].concat(), needle);
     }
 }
+
+/// `pounding --moat-gaps` on the isolated example: the cells (no contacts
+/// first, then each gap), the moat struck at the smallest gap and not at
+/// a gap beyond the free slab's reach, the CSV and both figures; a pair
+/// without isolation refused by the option's name.
+#[test]
+fn moat_gap_study_of_an_isolated_building() {
+    let building = repo_file("examples/isolated-building.toml");
+    let quake = repo_file("examples/synthetic-quake.csv");
+    let dir = temp_dir("moat");
+    let doc = json(&[
+        "pounding",
+        &building,
+        &quake,
+        "--units",
+        "m/s2",
+        "--scale",
+        "2",
+        "--moat-gaps",
+        "0.05:1.5:2",
+        "--format",
+        "json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let cells = doc["moat_cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 3);
+    assert!(cells[0]["gap"].is_null());
+    let reach = cells[0]["isolator_displacement"]["median"]
+        .as_f64()
+        .unwrap();
+    assert!(reach > 0.05 && reach < 1.5, "{reach}");
+    assert!(cells[1]["moat_impacts"]["median"].as_f64().unwrap() > 0.0);
+    assert_eq!(cells[2]["moat_impacts"]["median"].as_f64().unwrap(), 0.0);
+    for f in [
+        "pounding.json",
+        "moat.csv",
+        "moat-drift.svg",
+        "moat-acceleration.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    let pair = repo_file("examples/pounding-frames.toml");
+    let out = run(&[
+        "pounding",
+        &pair,
+        &quake,
+        "--units",
+        "m/s2",
+        "--moat-gaps",
+        "0.1:0.2:2",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--moat-gaps") && err.contains("isolated building with a moat"),
+        "{err}"
+    );
+}

@@ -5,7 +5,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::pounding::{documents, pounding_spectrum, PoundingError, Row, RunSettings};
+use vibroimpact::pounding::{documents, PoundingError, Row, RunSettings, Study};
 use vibroimpact::record::{parse_record as parse, Record, Units};
 use vibroimpact::results::spectrum_document;
 use vibroimpact::spectrum::response_spectrum as spectrum;
@@ -145,14 +145,15 @@ type RecordInput<'py> = (
     PyReadonlyArray1<'py, f64>,
 );
 
-/// The pounding study of the pair in `pair_text` (TOML, named by
+/// The pounding study of the row in `pair_text` (TOML, named by
 /// `source`) under `records` × `scale`: the `vibroimpact pounding`
 /// document (`row`, and `runs`, each with `record`, `pounding`, `free`,
 /// `amplification` and `joints`; with `free` false the pounding response
 /// alone); with `gaps` and `ratios` the pounding spectrum (`row`,
-/// `records`, `cells`).
+/// `records`, `cells`); with `moat_gaps` the moat-gap study (`row`,
+/// `records`, `moat_cells`).
 #[pyfunction]
-#[pyo3(signature = (pair_text, source, records, scale, sample, rtol, method, integrator, free, gaps = None, ratios = None))]
+#[pyo3(signature = (pair_text, source, records, scale, sample, rtol, method, integrator, free, gaps = None, ratios = None, moat_gaps = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn pounding<'py>(
     py: Python<'py>,
@@ -167,8 +168,9 @@ pub fn pounding<'py>(
     free: bool,
     gaps: Option<Vec<f64>>,
     ratios: Option<Vec<f64>>,
+    moat_gaps: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (pair, run) = pair_and_run(pair_text, source, (sample, rtol, method, integrator))?;
+    let (row, run) = pair_and_run(pair_text, source, (sample, rtol, method, integrator))?;
     let mut runs = Vec::with_capacity(records.len());
     for (name, header, units, times, acceleration) in &records {
         let t = floats(times, "times")?;
@@ -178,23 +180,16 @@ pub fn pounding<'py>(
         record.units = Units::parse(units).map_err(value_error)?;
         runs.push((record, scale));
     }
+    let study = match (gaps, ratios, moat_gaps) {
+        (Some(gaps), Some(ratios), _) => Study::Spectrum { gaps, ratios },
+        (_, _, Some(gaps)) => Study::Moat { gaps },
+        _ => Study::Runs { free },
+    };
     let doc = py
-        .detach(|| match (&gaps, &ratios) {
-            (Some(g), Some(r)) => pounding_spectrum(&pair, &runs, g, r, &run)
-                .map(|cells| documents::study_document(&pair, &runs, None, Some(&cells))),
-            _ => runs
-                .iter()
-                .map(|(r, s)| {
-                    if free {
-                        pair.analyse(r, *s, &run)
-                            .map(|res| documents::run_document(&pair, r, *s, &res))
-                    } else {
-                        pair.respond(r, *s, true, &run)
-                            .map(|res| documents::pounding_only_document(&pair, r, *s, &res))
-                    }
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map(|list| documents::study_document(&pair, &runs, Some(list), None)),
+        .detach(|| {
+            study
+                .run(&row, &runs, &run)
+                .map(|outcome| documents::study_document(&row, &runs, &outcome))
         })
         .map_err(pounding_error)?;
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
@@ -210,6 +205,7 @@ pub fn value_range<'py>(
 ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
     let field = match field {
         "gaps" => "gaps",
+        "moat_gaps" => "moat_gaps",
         "ratios" => "ratios",
         other => return Err(value_error(format!("no range keyword {other:?}"))),
     };

@@ -248,6 +248,24 @@ def test_pounding_documents_have_one_shape(cli):
         vi.pounding(pair, quake, units="m/s2", gaps="0.01:0.03", ratios="1:2:2")
 
 
+def test_isolated_building_documents_have_one_shape(cli):
+    # An isolated building with yielding storeys against its moat wall:
+    # the runs (isolators, ductility, hysteretic energy) and the moat-gap
+    # study are the CLI's documents.
+    building = EXAMPLES / "isolated-building.toml"
+    quake = EXAMPLES / "synthetic-quake.csv"
+    doc = cli("pounding", building, quake, "--units", "m/s2", "--scale", "2")
+    r = vi.pounding(building, quake, units="m/s2", scale=2)
+    _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    iso = doc["runs"][0]["pounding"]["isolators"]["isolated"]
+    assert iso["moat_impacts"] > 0 and iso["capacity"] == 0.45
+    doc = cli("pounding", building, quake, "--units", "m/s2", "--scale", "2", "--moat-gaps", "0.1:0.3:2")
+    r = vi.pounding(building, quake, units="m/s2", scale=2, moat_gaps=[0.1, 0.3])
+    _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    with pytest.raises(ValueError, match="moat_gaps: give it or gaps and ratios"):
+        vi.pounding(building, quake, units="m/s2", gaps="0.1:0.2:2", ratios="1:2:2", moat_gaps="0.1:0.2:2")
+
+
 def test_periodic(cli):
     # The three-pendulum row's unstable symmetric orbit from the simulated
     # guess (the two-pendulum row's motion at 0.95 omega0 is irregular too:

@@ -1,11 +1,12 @@
-//! Pounding of adjacent structures (docs/earthquakes.md): a row of K ≥ 2
+//! Pounding of adjacent structures (docs/earthquakes.md): a row of
 //! buildings side by side on the same ground, each separated from the
 //! next by a joint (a gap at one or more floors) where they may collide
-//! under a recorded ground motion. The row becomes a model of the
-//! library's kind (floors are bodies on a line, storeys are springs and
-//! dampers or hysteretic storeys, each joint's floors are contacts with any
-//! of the contact laws), so a pounding run is a simulation like any other.
-//! The two-frame pair is the row of two.
+//! under a recorded ground motion. The two-frame pair is the row of two;
+//! one building alone is the row of one (an isolated building against its
+//! moat wall). The row becomes a model of the library's kind (floors are
+//! bodies on a line, storeys are springs and dampers or hysteretic
+//! storeys, each joint's floors are contacts with any of the contact
+//! laws), so a pounding run is a simulation like any other.
 //!
 //! Each frame has floor masses m_i, storey stiffnesses k_i (storey i joins
 //! floor i − 1, or the ground for i = 1, to floor i) and Rayleigh damping
@@ -205,19 +206,14 @@ impl Row {
         }
     }
 
-    /// Checks the row: at least two buildings with distinct names, each
-    /// checked; a joint between each two neighbours with a finite gap ≥ 0
-    /// and floors of both. Errors name the building or joint.
+    /// Checks the row: at least one building (one alone: an isolated
+    /// building and its moat wall), distinct names, each checked; a joint
+    /// between each two neighbours with a finite gap ≥ 0 and floors of
+    /// both. Errors name the building or joint.
     pub fn check(&self) -> Result<(), PoundingError> {
         let pair = PoundingError::pair;
-        if self.buildings.len() < 2 {
-            return Err(pair(
-                "building",
-                format!(
-                    "{} building(s): a row needs at least two",
-                    self.buildings.len()
-                ),
-            ));
+        if self.buildings.is_empty() {
+            return Err(pair("building", "no building: give at least one".into()));
         }
         for (k, b) in self.buildings.iter().enumerate() {
             if self.buildings[..k].iter().any(|o| o.name == b.name) {
@@ -557,17 +553,23 @@ mod building;
 mod file;
 #[path = "pounding_frame.rs"]
 mod frame;
+#[path = "pounding_moat.rs"]
+mod moat;
 #[path = "pounding_peaks.rs"]
 mod peaks;
 #[path = "pounding_spectrum.rs"]
 mod spectrum;
+#[path = "pounding_study.rs"]
+mod study;
 
 use building::Parts;
 pub use building::{Bearing, Building, Isolation, Moat, Placement, Wall, GRAVITY};
 pub use file::{parse_row, PoundingError};
 pub use frame::ShearFrame;
+pub use moat::{moat_study, MoatCell};
 use peaks::Peaks;
 pub use spectrum::{pounding_spectrum, quantile, value_range, with_period_ratio, SpectrumCell};
+pub use study::{Outcome, Study};
 
 #[path = "pounding_documents.rs"]
 pub mod documents;

@@ -6,7 +6,7 @@
 
 use serde_json::{json, Map, Value};
 
-use super::{quantile, PoundingResult, Response, Row, SpectrumCell};
+use super::{quantile, MoatCell, Outcome, PoundingResult, Response, Row, SpectrumCell};
 use crate::hysteresis::StoreyLaw;
 use crate::record::Record;
 
@@ -183,21 +183,39 @@ pub fn cell_document(c: &SpectrumCell) -> Value {
     })
 }
 
-/// The study's document: the row with its runs, or (with `cells`) the
-/// pounding spectrum over the records.
-pub fn study_document(
-    row: &Row,
-    records: &[(Record, f64)],
-    runs: Option<Vec<Value>>,
-    cells: Option<&[SpectrumCell]>,
-) -> Value {
+/// A cell of the moat-gap study: its gap (null: without contacts) and over
+/// the records the isolated superstructures' peak drift and floor
+/// acceleration, the isolators' displacement, the moat force and impacts
+/// (median, 16/84 % and the values), and how many records passed an
+/// isolator's capacity.
+pub fn moat_cell_document(c: &MoatCell) -> Value {
+    let impacts: Vec<f64> = c.moat_impacts.iter().map(|&i| i as f64).collect();
+    json!({
+        "gap": c.gap,
+        "peak_drift": stats(&c.drift),
+        "peak_floor_acceleration": stats(&c.acceleration),
+        "isolator_displacement": stats(&c.isolator),
+        "moat_peak_force": stats(&c.moat_force),
+        "moat_impacts": stats(&impacts),
+        "beyond_capacity": c.beyond_capacity.iter().filter(|b| **b).count(),
+    })
+}
+
+/// The study's document: the row, and its runs, or (with the records) the
+/// cells of the pounding spectrum or of the moat-gap study.
+pub fn study_document(row: &Row, records: &[(Record, f64)], outcome: &Outcome) -> Value {
     let mut doc = json!({ "row": row_document(row) });
-    if let Some(runs) = runs {
-        doc["runs"] = Value::Array(runs);
-    }
-    if let Some(cells) = cells {
-        doc["records"] = records.iter().map(|(r, s)| json!(r.metadata(*s))).collect();
-        doc["cells"] = cells.iter().map(cell_document).collect();
+    let metadata = || -> Value { records.iter().map(|(r, s)| json!(r.metadata(*s))).collect() };
+    match outcome {
+        Outcome::Runs(runs) => doc["runs"] = Value::Array(runs.clone()),
+        Outcome::Spectrum(cells) => {
+            doc["records"] = metadata();
+            doc["cells"] = cells.iter().map(cell_document).collect();
+        }
+        Outcome::Moat(cells) => {
+            doc["records"] = metadata();
+            doc["moat_cells"] = cells.iter().map(moat_cell_document).collect();
+        }
     }
     doc
 }

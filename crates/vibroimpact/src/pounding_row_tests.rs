@@ -280,6 +280,8 @@ fn bad_rows_are_refused() {
         1,
     );
     let e = parse_row(&storey, "iso.toml").unwrap_err().to_string();
+    let alone = good[..good.find("[[building]]\nname = \"next\"").unwrap()].to_string();
+    assert_eq!(parse_row(&alone, "iso.toml").unwrap().buildings.len(), 1);
     assert!(
         e.contains("iso.toml: building iso: storey 2: yield_drift = 0: must be finite and > 0"),
         "{e}"

@@ -3,15 +3,17 @@
 //! ground motions ([`vibroimpact::pounding`]): per record the response
 //! with and without pounding, the gap that avoids contact and the code
 //! rules; with `--gaps` and `--ratios` the pounding spectrum over an
-//! ensemble (median and 16/84 % quantiles).
+//! ensemble, with `--moat-gaps` the moat-gap study of isolated buildings
+//! (median and 16/84 % quantiles). The study is the library's
+//! [`Study`].
 
 use std::path::PathBuf;
 
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::pounding::{
-    documents, parse_row, pounding_spectrum, quantile, value_range, PoundingError, Row,
-    RunSettings, SpectrumCell,
+    documents, parse_row, quantile, value_range, MoatCell, Outcome, PoundingError, Row,
+    RunSettings, SpectrumCell, Study,
 };
 
 use crate::args::{IntegratorName, MethodName};
@@ -64,8 +66,15 @@ pub struct PoundingArgs {
     /// --gaps.
     #[arg(long, requires = "gaps")]
     ratios: Option<String>,
+    /// Moat-gap study of isolated buildings: moat gaps FROM:TO:N (m); per
+    /// gap, over the records, the superstructures' peak drift and floor
+    /// acceleration, the isolators' displacement and the moat impacts,
+    /// and the same without contacts.
+    #[arg(long, conflicts_with = "gaps")]
+    moat_gaps: Option<String>,
     /// Output folder for pounding.json (and, for a spectrum, spectrum.csv
-    /// and the figure spectrum.svg/.png).
+    /// and the figure spectrum.svg/.png; for a moat-gap study, moat.csv
+    /// and the figures moat-drift and moat-acceleration .svg/.png).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Format on standard output.
@@ -123,6 +132,95 @@ fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
     w.finish()
 }
 
+/// What a moat-gap figure shows.
+#[derive(Clone, Copy)]
+enum MoatQuantity {
+    /// The superstructures' peak storey drift.
+    Drift,
+    /// Their peak absolute floor acceleration.
+    Acceleration,
+}
+
+/// A moat-gap figure: the isolated superstructures' peak drift or floor
+/// acceleration against the moat gap, median and 16/84 % over the
+/// records, and the median without contacts.
+fn moat_figure(cells: &[MoatCell], quantity: MoatQuantity) -> Figure {
+    let (title, y_label, unit, pick): (_, _, f64, fn(&MoatCell) -> &Vec<f64>) = match quantity {
+        MoatQuantity::Drift => (
+            "Isolated building and its moat wall: peak storey drift",
+            "peak storey drift  [mm]",
+            1e3,
+            |c| &c.drift,
+        ),
+        MoatQuantity::Acceleration => (
+            "Isolated building and its moat wall: peak floor acceleration",
+            "peak floor acceleration  [m/s2]",
+            1.0,
+            |c| &c.acceleration,
+        ),
+    };
+    let mut fig = Figure::new(title, "moat gap  [m]", y_label).legend_at(LegendPosition::Best);
+    let walls: Vec<&MoatCell> = cells.iter().filter(|c| c.gap.is_some()).collect();
+    let curve = |q: f64| -> Vec<(f64, f64)> {
+        walls
+            .iter()
+            .map(|c| (c.gap.unwrap_or(0.0), unit * quantile(pick(c), q)))
+            .collect()
+    };
+    fig.push(Series::line("median, with the wall", curve(0.5)).with_color(0));
+    fig.push(Series::dashed("16 / 84 %", curve(0.16)).with_color(0));
+    fig.push(Series::dashed("", curve(0.84)).with_color(0));
+    if let (Some(free), Some(first), Some(last)) = (
+        cells.iter().find(|c| c.gap.is_none()),
+        walls.first(),
+        walls.last(),
+    ) {
+        let m = unit * quantile(pick(free), 0.5);
+        let ends = [(first.gap.unwrap_or(0.0), m), (last.gap.unwrap_or(0.0), m)];
+        fig.push(Series::line("median, no wall", ends).with_color(3));
+    }
+    fig
+}
+
+fn moat_csv(cells: &[MoatCell]) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    w.row([
+        "moat_gap",
+        "drift_median",
+        "drift_p16",
+        "drift_p84",
+        "acceleration_median",
+        "acceleration_p16",
+        "acceleration_p84",
+        "isolator_median",
+        "isolator_p84",
+        "moat_force_median",
+        "moat_force_p84",
+        "moat_impacts_median",
+        "beyond_capacity",
+    ])?;
+    for c in cells {
+        let q = |v: &[f64], p: f64| format!("{:e}", quantile(v, p));
+        let impacts: Vec<f64> = c.moat_impacts.iter().map(|&i| i as f64).collect();
+        w.row([
+            c.gap.map_or("none".to_string(), |g| format!("{g:e}")),
+            q(&c.drift, 0.5),
+            q(&c.drift, 0.16),
+            q(&c.drift, 0.84),
+            q(&c.acceleration, 0.5),
+            q(&c.acceleration, 0.16),
+            q(&c.acceleration, 0.84),
+            q(&c.isolator, 0.5),
+            q(&c.isolator, 0.84),
+            q(&c.moat_force, 0.5),
+            q(&c.moat_force, 0.84),
+            q(&impacts, 0.5),
+            c.beyond_capacity.iter().filter(|b| **b).count().to_string(),
+        ])?;
+    }
+    w.finish()
+}
+
 /// A pounding error in the command line's words: a setting by its option.
 fn pounding_error(e: PoundingError) -> CliError {
     match e {
@@ -155,36 +253,41 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         .iter()
         .map(|path| Ok((records::read(path, units)?, args.scale)))
         .collect::<Result<Vec<_>, CliError>>()?;
-    let (doc, csv) = match (&args.gaps, &args.ratios) {
-        (Some(g), Some(r)) => {
-            let range = |field, text| value_range(field, text).map_err(|e| option_error(&e));
-            let (gaps, ratios) = (range("gaps", g)?, range("ratios", r)?);
-            let cells =
-                pounding_spectrum(&row, &runs, &gaps, &ratios, &run).map_err(pounding_error)?;
-            if let Some(dir) = &args.out {
-                ensure_dir(dir)?;
-                render(&spectrum_figure(&cells), &dir.join("spectrum"))?;
-            }
-            let doc = documents::study_document(&row, &runs, None, Some(&cells));
-            (doc, Some(spectrum_csv(&cells)?))
-        }
-        _ => {
-            let mut list = Vec::new();
-            for (r, s) in &runs {
-                list.push(if args.free {
-                    let res = row.analyse(r, *s, &run).map_err(pounding_error)?;
-                    documents::run_document(&row, r, *s, &res)
-                } else {
-                    let res = row.respond(r, *s, true, &run).map_err(pounding_error)?;
-                    documents::pounding_only_document(&row, r, *s, &res)
-                });
-            }
-            (
-                documents::study_document(&row, &runs, Some(list), None),
-                None,
-            )
-        }
+    let range = |field, text: &String| value_range(field, text).map_err(|e| option_error(&e));
+    let study = match (&args.gaps, &args.ratios, &args.moat_gaps) {
+        (Some(g), Some(r), _) => Study::Spectrum {
+            gaps: range("gaps", g)?,
+            ratios: range("ratios", r)?,
+        },
+        (_, _, Some(g)) => Study::Moat {
+            gaps: range("moat_gaps", g)?,
+        },
+        _ => Study::Runs { free: args.free },
     };
+    let outcome = study.run(&row, &runs, &run).map_err(pounding_error)?;
+    let doc = documents::study_document(&row, &runs, &outcome);
+    let (csv, name) = match &outcome {
+        Outcome::Spectrum(cells) => (Some(spectrum_csv(cells)?), "spectrum"),
+        Outcome::Moat(cells) => (Some(moat_csv(cells)?), "moat"),
+        Outcome::Runs(_) => (None, ""),
+    };
+    if let Some(dir) = &args.out {
+        ensure_dir(dir)?;
+        match &outcome {
+            Outcome::Spectrum(cells) => render(&spectrum_figure(cells), &dir.join("spectrum"))?,
+            Outcome::Moat(cells) => {
+                render(
+                    &moat_figure(cells, MoatQuantity::Drift),
+                    &dir.join("moat-drift"),
+                )?;
+                render(
+                    &moat_figure(cells, MoatQuantity::Acceleration),
+                    &dir.join("moat-acceleration"),
+                )?;
+            }
+            Outcome::Runs(_) => {}
+        }
+    }
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
         write_atomic(
@@ -192,7 +295,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             serde_json::to_string_pretty(&doc)?.as_bytes(),
         )?;
         if let Some(c) = &csv {
-            write_atomic(&dir.join("spectrum.csv"), c.as_bytes())?;
+            write_atomic(&dir.join(format!("{name}.csv")), c.as_bytes())?;
         }
     }
     match args.format {
@@ -201,7 +304,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             match &csv {
                 Some(c) => print!("{c}"),
                 None => return Err(CliError::new(
-                    "--format csv: the CSV is the pounding spectrum's (give --gaps and --ratios)",
+                    "--format csv: the CSV is the pounding spectrum's (give --gaps and --ratios) or the moat-gap study's (--moat-gaps)",
                 )),
             }
         }

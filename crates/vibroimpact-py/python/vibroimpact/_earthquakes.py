@@ -210,6 +210,7 @@ def pounding(
     free: bool = True,
     gaps: Any = None,
     ratios: Any = None,
+    moat_gaps: Any = None,
 ) -> Result:
     """Pounding of a row of buildings under recorded ground motions
     (``vibroimpact pounding``): ``pair`` is a row file (``[[building]]``
@@ -225,7 +226,9 @@ def pounding(
     its contacts only (half the work; no ``free``, ``amplification`` or
     ``joints``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
     values): the pounding spectrum of a pair over gaps (m) × period ratios
-    T_left/T_right instead of the runs.
+    T_left/T_right instead of the runs; ``moat_gaps`` (the same forms): the
+    moat-gap study of isolated buildings instead (every moat at each gap,
+    and once without contacts).
 
     Returns the CLI's document: ``row`` (``buildings``: ``name``,
     ``period``, ``floors``, ``isolated``; ``joints``: ``between``, ``gap``,
@@ -238,13 +241,19 @@ def pounding(
     ``code_gaps``: ``absolute_sum``, ``srss``, ``double_difference``,
     ``correlation``); with ``gaps`` and ``ratios``, ``row``, ``records``
     and ``cells`` (per gap and ratio the median, 16 and 84 % quantiles over
-    the records)."""
+    the records); with ``moat_gaps``, ``row``, ``records`` and
+    ``moat_cells`` (per gap, null first for no contacts: ``peak_drift``,
+    ``peak_floor_acceleration``, ``isolator_displacement``,
+    ``moat_peak_force``, ``moat_impacts`` as median, 16/84 % and values;
+    ``beyond_capacity``, the records that passed an isolator's capacity)."""
     source, text = _pair_text(pair)
     _pounding_settings(scale, sample, rtol, method, integrator)
     if not isinstance(free, bool):
         raise TypeError(f"free: expected True or False, got {free!r}")
     if (gaps is None) != (ratios is None):
         raise ValueError("gaps, ratios: give both (the pounding spectrum) or neither")
+    if gaps is not None and moat_gaps is not None:
+        raise ValueError("moat_gaps: give it or gaps and ratios, not both")
     return Result(
         _core.pounding(
             text,
@@ -258,6 +267,7 @@ def pounding(
             free,
             _value_range(gaps, "gaps"),
             _value_range(ratios, "ratios"),
+            _value_range(moat_gaps, "moat_gaps"),
         )
     )
 
