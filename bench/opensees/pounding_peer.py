@@ -21,9 +21,22 @@ in one run (docs/earthquakes.md, "OpenSees as the peer"):
   pounding run alone, ``vi.pounding(free=False)``; OpenSees' model build
   and analysis); target ratio >= 10.
 
+``--case inelastic``: the same study of bench/opensees/inelastic-pair.toml
+(the frames with bilinear storeys, OpenSees ``Steel01``; Hertz-damp
+contact) run through its free-vibration tail, the residual drifts compared
+too: their difference over the storey's yield drift within 1 % (a residual
+drift can be near zero, so relative to itself it is reported but not
+judged); OpenSees' steps down to dt_rec / 64, and its agreement also at
+its own converged step (the coarsest within 1 % of its finest run);
+vibroimpact's integrator global only (the local one refuses yielding
+storeys); then OpenSees' convergence with the storeys Bouc-Wen (``BoucWen``,
+first order in the step: not timed); writes
+``results/inelastic-pounding-<date>.json``.
+
 Run it in the checkout's virtual environment after ``bash scripts/test.sh``:
-``.venv/bin/python bench/opensees/pounding_peer.py [--quick] [--out FILE]``
-(openseespy is installed by scripts/test.sh). The machine should be idle.
+``.venv/bin/python bench/opensees/pounding_peer.py [--case inelastic]
+[--quick] [--out FILE]`` (openseespy is installed by scripts/test.sh). The
+machine should be idle: the results record whether rustc or cargo ran.
 """
 
 from __future__ import annotations
@@ -31,9 +44,12 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import os
 import platform
 import statistics
+import subprocess
 import sys
+import threading
 import time
 import tomllib
 from pathlib import Path
@@ -47,9 +63,10 @@ sys.path.insert(0, str(HERE))
 import vibroimpact as vi  # noqa: E402
 from vibroimpact.records import fema_p695  # noqa: E402
 
-from opensees_pair import import_opensees, run  # noqa: E402
+from opensees_pair import import_opensees, inelastic, run  # noqa: E402
 
 PAIR = ROOT / "examples" / "pounding-frames.toml"
+INELASTIC_PAIR = HERE / "inelastic-pair.toml"
 LAWS = {
     "linear": {"law": "kelvin-voigt", "stiffness": 5e8, "damping": 0.0},
     "hertzdamp": {"law": "lankarani-nikravesh", "stiffness": 2.75e9, "exponent": 1.5, "restitution": 0.6},
@@ -70,19 +87,44 @@ def pair_with(law):
 
 
 def peaks_of_ours(result):
+    """The compared quantities of a one-record pounding document: peak force,
+    peak drifts [left, right] and, with yielding storeys, residual drifts."""
     p = result["runs"][0]["pounding"]
-    drift = p["peak_drift"]
-    return float(p["peak_impact_force"]), [list(map(float, drift[side])) for side in ("left", "right")]
+    out = {
+        "peak_impact_force": float(p["peak_impact_force"]),
+        "peak_drift": [list(map(float, p["peak_drift"][side])) for side in ("left", "right")],
+    }
+    if "residual_drift" in p:
+        out["residual_drift"] = [list(map(float, p["residual_drift"][side])) for side in ("left", "right")]
+    return out
 
 
-def error(force, drift, ref):
-    """Largest relative difference of the peak force and every peak drift."""
-    rf, rd = ref
-    worst = abs(force - rf) / rf
-    for side, rside in zip(drift, rd):
-        for d, r in zip(side, rside):
-            worst = max(worst, abs(d - r) / r)
-    return worst
+def yield_drifts(pair):
+    """[left, right] yield drifts of a pair's storeys (None if all elastic)."""
+    if not any(inelastic(pair[side]) for side in ("left", "right")):
+        return None
+    return [[s["yield_drift"] for s in pair[side]["storeys"]] for side in ("left", "right")]
+
+
+def errors(peaks, ref, uy=None):
+    """The differences from ``ref``: ``force`` and ``drift`` relative (the
+    largest over the storeys), with yield drifts ``uy`` the residual drifts'
+    ``residual`` (over the yield drift, judged) and ``residual_self`` (over
+    the reference residual itself, reported); ``error`` the judged worst."""
+    out = {"force": abs(peaks["peak_impact_force"] - ref["peak_impact_force"]) / ref["peak_impact_force"]}
+    out["drift"] = max(
+        abs(d - r) / r for side, rside in zip(peaks["peak_drift"], ref["peak_drift"]) for d, r in zip(side, rside)
+    )
+    if uy is not None:
+        pairs = [
+            (d, r, y)
+            for side, rside, yside in zip(peaks["residual_drift"], ref["residual_drift"], uy)
+            for d, r, y in zip(side, rside, yside)
+        ]
+        out["residual"] = max(abs(d - r) / y for d, r, y in pairs)
+        out["residual_self"] = max(abs(d - r) / abs(r) for d, r, _ in pairs)
+    out["error"] = max(v for k, v in out.items() if k != "residual_self")
+    return out
 
 
 def timed(f, repeats):
@@ -94,27 +136,48 @@ def timed(f, repeats):
     return statistics.median(times), out
 
 
-def study(name, law, record, quick):
-    pair, text = pair_with(law)
+def study(name, pair, text, record, quick):
+    """The study of one pair (parsed, and its TOML text) under ``record``."""
     t, a = np.asarray(record["times"]), np.asarray(record["acceleration"])
     rec_dt = record["dt"]
+    uy = yield_drifts(pair)
     ref_result = vi.pounding(text, record, sample=rec_dt / 32, rtol=1e-10, free=False)
     ref = peaks_of_ours(ref_result)
-    print(f"\n== {name}: {law}")
-    print(f"reference (vibroimpact rtol 1e-10, sample dt/32): peak force {ref[0]:.6e} N, "
-          f"{ref_result['runs'][0]['pounding']['impacts']} impacts, drifts {ref[1]}")
+    impacts = ref_result["runs"][0]["pounding"]["impacts"]
+    print(f"\n== {name}: {pair['law']}")
+    print(f"reference (vibroimpact rtol 1e-10, sample dt/32): peak force {ref['peak_impact_force']:.6e} N, "
+          f"{impacts} impacts, drifts {ref['peak_drift']}")
+    if uy is not None:
+        print(f"  residual drifts {ref['residual_drift']}, yield drifts {uy}, ductility "
+              f"{[[round(d / y, 2) for d, y in zip(ds, ys)] for ds, ys in zip(ref['peak_drift'], uy)]}")
+
+    def judged(peaks):
+        e = errors(peaks, ref, uy)
+        return e["error"], e
+
+    def shown(e):
+        return "  ".join(f"{k} {v:.1e}" for k, v in e.items() if k != "error")
 
     convergence = []
     print("OpenSees time-step convergence (Newmark average acceleration, Newton, BandGeneral):")
-    for m in (1, 2, 4, 8, 16, 32)[: 5 if quick else 6]:
+    # Yield and contact onsets fall inside steps: the inelastic pair's
+    # convergence is irregular, so it is followed one halving further.
+    for m in ((1, 2, 4, 8, 16, 32) + ((64,) if uy else ()))[: 5 if quick else None]:
         o = run(pair, t, a, 1.0, rec_dt / m)
-        err = error(o["peak_impact_force"], o["peak_drift"], ref)
-        convergence.append({**o, "m": m, "error": err})
-        print(f"  dt = dt_rec/{m:<2d} {o['seconds']:7.3f} s  peak force {o['peak_impact_force']:.6e} N  error {err:.2e}")
+        err, e = judged(o)
+        convergence.append({**o, "m": m, "error": err, "errors": e})
+        print(f"  dt = dt_rec/{m:<2d} {o['seconds']:7.3f} s  peak force {o['peak_impact_force']:.6e} N  "
+              f"error {err:.2e} ({shown(e)})")
     converged = [c for c in convergence if c["error"] <= TARGET_ACCURACY]
     if not converged:
         raise SystemExit(f"{name}: OpenSees did not reach {TARGET_ACCURACY:.0%} at any step")
     m = converged[0]["m"]
+    finest = convergence[-1]
+    # OpenSees converged on its own: the coarsest step within 1 % of its
+    # finest run (the reference there OpenSees', not ours).
+    own = min(
+        (c for c in convergence if errors(c, finest, uy)["error"] <= TARGET_ACCURACY), key=lambda c: c["m"]
+    )
 
     repeats = 3 if quick else 7
     settings = []
@@ -129,21 +192,23 @@ def study(name, law, record, quick):
     for v in variants:
         steps = (1, 2, 4, 8, 16) if v["integrator"] == "CentralDifference" else (m,)
         for mm in steps:
+            e = {}
             try:
                 secs, o = timed(lambda: run(pair, t, a, 1.0, rec_dt / mm, **v), repeats)
-                err = error(o["peak_impact_force"], o["peak_drift"], ref)
-            except (RuntimeError, ValueError) as e:
+                err, e = judged(o)
+            except (RuntimeError, ValueError) as ex:
                 secs, err = float("nan"), float("inf")
-                print(f"  {v} m={mm}: failed ({e})")
+                print(f"  {v} m={mm}: failed ({ex})")
             else:
                 print(f"  {v} m={mm}: {secs * 1e3:8.2f} ms  error {err:.2e}")
-            settings.append({**v, "m": mm, "seconds": secs, "error": err})
+            settings.append({**v, "m": mm, "seconds": secs, "error": err, **({"errors": e} if uy else {})})
     ok = [s for s in settings if s["error"] <= TARGET_ACCURACY]
     best_os = min(ok, key=lambda s: s["seconds"])
 
     ours = []
     print(f"vibroimpact settings (pounding run alone, median of {repeats}):")
-    for integrator in ("global", "local"):
+    # The local integrator refuses yielding storeys (docs/decisions.md D26).
+    for integrator in ("global",) if uy else ("global", "local"):
         for method in ("dop853", "dopri5"):
             for rtol in (1e-3, 1e-4, 1e-6, 1e-8):
                 for div in (1, 2, 4):
@@ -154,23 +219,31 @@ def study(name, law, record, quick):
                         ),
                         repeats,
                     )
-                    err = error(*peaks_of_ours(res), ref)
+                    err, e = judged(peaks_of_ours(res))
                     ours.append(
                         {"integrator": integrator, "method": method, "rtol": rtol, "sample": sample,
-                         "seconds": secs, "error": err}
+                         "seconds": secs, "error": err, **({"errors": e} if uy else {})}
                     )
                     print(f"  {integrator} {method} rtol {rtol:.0e} sample dt_rec/{div}: "
                           f"{secs * 1e3:8.2f} ms  error {err:.2e}")
     best_ours = min((s for s in ours if s["error"] <= TARGET_ACCURACY), key=lambda s: s["seconds"])
     ratio = best_os["seconds"] / best_ours["seconds"]
-    finest = convergence[-1]
-    agreement = error(finest["peak_impact_force"], finest["peak_drift"], ref)
-    print(f"OpenSees at dt_rec/{finest['m']} against the reference: {agreement:.2e}")
+    agreement = finest["error"]
+    print(f"OpenSees at dt_rec/{finest['m']} against the reference: {agreement:.2e} ({shown(finest['errors'])})")
+    print(f"OpenSees converged on its own (within 1 % of dt_rec/{finest['m']}) at dt_rec/{own['m']}: "
+          f"against the reference {own['error']:.2e} ({shown(own['errors'])})")
     print(f"best OpenSees {best_os['seconds'] * 1e3:.2f} ms ({best_os}), best vibroimpact "
           f"{best_ours['seconds'] * 1e3:.2f} ms ({best_ours}): ratio {ratio:.1f} (target >= {TARGET_RATIO:g})")
+    reference = {"peak_impact_force": ref["peak_impact_force"], "peak_drift": ref["peak_drift"], "impacts": impacts}
+    out = {"law": pair["law"], "reference": reference}
+    if uy is not None:
+        reference.update(residual_drift=ref["residual_drift"], yield_drift=uy)
+        out.update(
+            opensees_converged_step={"m": own["m"], "against_reference": own["errors"]},
+            opensees_finest_vs_reference_errors=finest["errors"],
+        )
     return {
-        "law": law,
-        "reference": {"peak_impact_force": ref[0], "peak_drift": ref[1], "impacts": ref_result["runs"][0]["pounding"]["impacts"]},
+        **out,
         "opensees_convergence": convergence,
         "opensees_settings": settings,
         "vibroimpact_settings": ours,
@@ -182,17 +255,104 @@ def study(name, law, record, quick):
     }
 
 
+def boucwen_convergence(record, quick):
+    """OpenSees' time-step convergence on the inelastic pair with its
+    storeys Bouc-Wen (n = 2, beta = gamma = 1/2: the defaults; the same
+    yield drifts): OpenSees' ``BoucWen`` takes one backward-Euler step per
+    drift increment, first order in the step, so it is kept out of the
+    speed comparison; its errors against our reference and their order."""
+    text = INELASTIC_PAIR.read_text().replace('law = "bilinear"', 'law = "bouc-wen"')
+    pair = tomllib.loads(text)
+    uy = yield_drifts(pair)
+    t, a = np.asarray(record["times"]), np.asarray(record["acceleration"])
+    rec_dt = record["dt"]
+    ref = peaks_of_ours(vi.pounding(text, record, sample=rec_dt / 32, rtol=1e-10, free=False))
+    print(f"\n== bouc-wen storeys (OpenSees BoucWen), convergence only; reference residual drifts "
+          f"{ref['residual_drift']}")
+    rows = []
+    for m in (1, 2, 4, 8, 16, 32, 64)[: 5 if quick else 7]:
+        o = run(pair, t, a, 1.0, rec_dt / m)
+        e = errors(o, ref, uy)
+        order = np.log2(rows[-1]["error"] / e["error"]) if rows else float("nan")
+        rows.append({**o, "m": m, "error": e["error"], "errors": e, "order": order})
+        print(f"  dt = dt_rec/{m:<2d} {o['seconds']:7.3f} s  error {e['error']:.2e} (order {order:.2f}; "
+              + "  ".join(f"{k} {v:.1e}" for k, v in e.items() if k != "error") + ")")
+    return {"law": pair["law"], "storeys": "bouc-wen, n = 2, beta = gamma = 0.5, the bilinear pair's yield drifts",
+            "reference": ref, "opensees_convergence": rows}
+
+
+def busy():
+    """Process ids of running compilers (rustc, cargo): the machine is not
+    idle while there are any."""
+    found = subprocess.run(["pgrep", "-x", "rustc|cargo"], capture_output=True, text=True).stdout.split()
+    return [int(pid) for pid in found]
+
+
+class Watch:
+    """Polls :func:`busy` every ``every`` seconds in a thread while the
+    study runs: the compilers seen, and how many polls saw one."""
+
+    def __init__(self, every=2.0):
+        self.every, self.polls, self.busy_polls, self.seen = every, 0, 0, set()
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._poll, daemon=True)
+
+    def _poll(self):
+        while not self.stop.is_set():
+            pids = busy()
+            self.polls += 1
+            self.busy_polls += bool(pids)
+            self.seen.update(pids)
+            self.stop.wait(self.every)
+
+    def __enter__(self):
+        self.load_before = os.getloadavg()
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.stop.set()
+        self.thread.join()
+        self.load_after = os.getloadavg()
+
+    def report(self):
+        return {
+            "idle": self.busy_polls == 0,
+            "polls": self.polls,
+            "polls_with_compilers": self.busy_polls,
+            "compiler_pids": sorted(self.seen),
+            "load_before": self.load_before,
+            "load_after": self.load_after,
+        }
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--record", type=int, default=0, help="index in the far-field set (0: record 1, component a)")
     ap.add_argument("--quick", action="store_true", help="fewer repeats and steps (a smoke run)")
-    ap.add_argument("--out", type=Path, default=HERE / "results" / f"pounding-{datetime.date.today()}.json")
+    ap.add_argument("--case", choices=("elastic", "inelastic"), default="elastic",
+                    help="elastic: examples/pounding-frames.toml with both laws; inelastic: inelastic-pair.toml")
+    ap.add_argument("--out", type=Path, help="default: results/pounding-<date>.json, "
+                    "results/inelastic-pounding-<date>.json with --case inelastic")
     args = ap.parse_args()
+    if args.out is None:
+        prefix = "inelastic-pounding" if args.case == "inelastic" else "pounding"
+        args.out = HERE / "results" / f"{prefix}-{datetime.date.today()}.json"
     record = fema_p695("farfield")[args.record]
     ops = import_opensees()
     print(f"record {record['source']}: {'; '.join(record['header'])}; dt {record['dt']} s, "
           f"{len(record['times'])} samples, PGA {record['pga']:.3f} m/s2")
-    results = {name: study(name, law, record, args.quick) for name, law in LAWS.items()}
+    with Watch() as watch:
+        if args.case == "inelastic":
+            text = INELASTIC_PAIR.read_text()
+            results = {
+                "bilinear-hertzdamp": study("bilinear-hertzdamp", tomllib.loads(text), text, record, args.quick),
+                "bouc-wen-convergence": boucwen_convergence(record, args.quick),
+            }
+        else:
+            results = {name: study(name, *pair_with(law), record, args.quick) for name, law in LAWS.items()}
+    idle = watch.report()
+    print(f"\nmachine idle (no rustc or cargo at any poll): {idle}")
     out = {
         "command": " ".join([".venv/bin/python", "bench/opensees/pounding_peer.py", *sys.argv[1:]]),
         "date": str(datetime.date.today()),
@@ -201,6 +361,7 @@ def main():
         "opensees": ops.version(),
         "vibroimpact": vi.__version__,
         "record": {k: record[k] for k in ("source", "header", "dt", "pga")},
+        "machine_idle": idle,
         "results": results,
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -208,7 +369,7 @@ def main():
     tmp.write_text(json.dumps(out, indent=1) + "\n")
     tmp.replace(args.out)
     print(f"\nwrote {args.out}")
-    failed = [n for n, r in results.items() if not r["meets_target"]]
+    failed = [n for n, r in results.items() if not r.get("meets_target", True)]
     if failed:
         raise SystemExit(f"targets not met: {', '.join(failed)}")
 
