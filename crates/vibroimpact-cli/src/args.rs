@@ -57,6 +57,48 @@ impl IntegratorName {
     }
 }
 
+/// How each run of a row of buildings under a record is computed
+/// (`pounding`, `collapse`).
+#[derive(Args, Debug, Clone)]
+pub struct RowRunArgs {
+    /// Units of the records when their headers do not state them.
+    #[arg(long)]
+    pub units: Option<String>,
+    /// Output sampling of drifts and accelerations (s).
+    #[arg(long, default_value_t = 0.0025)]
+    pub sample: f64,
+    /// Integration tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    /// Integration method (dopri5: the faster choice at tolerances of 1e-3
+    /// to 1e-5, where the record's samples limit the step).
+    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
+    pub method: MethodName,
+    /// Integrator: `local` moves each frame exactly between poundings, per
+    /// record sample.
+    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
+    pub integrator: IntegratorName,
+}
+
+impl RowRunArgs {
+    /// The library's settings (a sample step that is not positive and
+    /// finite is refused by name).
+    pub fn settings(&self) -> Result<vibroimpact::pounding::RunSettings, CliError> {
+        if !(self.sample.is_finite() && self.sample > 0.0) {
+            return Err(CliError::new(format!(
+                "--sample {}: give a positive step",
+                self.sample
+            )));
+        }
+        Ok(vibroimpact::pounding::RunSettings {
+            sample: self.sample,
+            rtol: self.rtol,
+            method: self.method.method(),
+            integrator: self.integrator.integrator(),
+        })
+    }
+}
+
 /// Parses `--mass2`: a mass in kg, or `wall`/`inf` for a rigid wall.
 pub fn parse_mass2(text: &str) -> Result<f64, CliError> {
     match text.trim() {

@@ -56,3 +56,12 @@ from_display!(
 pub fn option_error(e: &vibroimpact::field_error::FieldError) -> CliError {
     CliError::new(e.spelled(&format!("--{}", e.field.replace('_', "-")), " "))
 }
+
+/// A pounding or collapse error in the command line's words: a setting by
+/// its option.
+pub fn pounding_error(e: vibroimpact::pounding::PoundingError) -> CliError {
+    match e {
+        vibroimpact::pounding::PoundingError::Field(f) => option_error(&f),
+        other => CliError::new(other.to_string()),
+    }
+}

@@ -28,8 +28,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    basins, branch, chart, hysteresis, identify, impact, periodic, pounding, simulate, spectrum,
-    sweep,
+    basins, branch, chart, collapse, hysteresis, identify, impact, periodic, pounding, simulate,
+    spectrum, sweep,
 };
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
@@ -73,11 +73,16 @@ enum Command {
     /// drift history: its hysteresis loop and dissipated energy.
     #[command(allow_negative_numbers = true)]
     Hysteresis(hysteresis::HysteresisArgs),
-    /// Pounding of two shear frames under recorded ground motions: response
-    /// with and without pounding, the gap that avoids contact, code rules,
-    /// and pounding spectra over gap × period ratio.
+    /// Pounding of a row of buildings (a pair of frames, K buildings,
+    /// isolated ones in their moats) under recorded ground motions:
+    /// response with and without pounding, the gap that avoids contact,
+    /// code rules, pounding spectra, moat-gap studies.
     #[command(allow_negative_numbers = true)]
     Pounding(pounding::PoundingArgs),
+    /// The FEMA P695 collapse study of a row of buildings: per record an
+    /// IDA to collapse, the median collapse intensity, CMR and ACMR.
+    #[command(allow_negative_numbers = true)]
+    Collapse(collapse::CollapseArgs),
     /// Find a periodic solution by shooting, with its Floquet multipliers.
     #[command(allow_negative_numbers = true)]
     Periodic(periodic::PeriodicArgs),
@@ -157,6 +162,7 @@ fn main() -> ExitCode {
         Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Hysteresis(args)) => hysteresis::run(args),
         Some(Command::Pounding(args)) => pounding::run(args),
+        Some(Command::Collapse(args)) => collapse::run(args),
         Some(Command::Report { out }) => report::run(out),
         Some(Command::Options) => {
             println!("{:#}", options_document());

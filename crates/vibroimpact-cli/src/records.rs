@@ -21,3 +21,11 @@ pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
     let text = crate::input::read_text(path).map_err(|e| CliError::new(format!("{name}: {e}")))?;
     parse_record(&text, &name, units).map_err(|e| CliError::new(e.to_string()))
 }
+
+/// The row (or pair) file at `path`.
+pub fn row(path: &Path) -> Result<vibroimpact::pounding::Row, CliError> {
+    let source = path.display().to_string();
+    let text =
+        crate::input::read_text(path).map_err(|e| CliError::new(format!("{source}: {e}")))?;
+    vibroimpact::pounding::parse_row(&text, &source).map_err(crate::error::pounding_error)
+}

@@ -347,3 +347,84 @@ fn moat_gap_study_of_an_isolated_building() {
         "{err}"
     );
 }
+
+/// `collapse` on an undamped elastic–perfectly-plastic storey under a
+/// step of ground acceleration: the collapse bracket holds the closed
+/// form 1.9 (docs/earthquakes.md), CMR and ACMR follow from the given
+/// S_MT and SSF; a largest scale below it leaves the record censored and
+/// the median undetermined, said in the document; bad settings refused by
+/// option.
+#[test]
+fn collapse_of_an_elastic_perfectly_plastic_storey() {
+    let dir = temp_dir("collapse");
+    let row = dir.join("epp.toml");
+    std::fs::write(
+        &row,
+        "[[building]]\nname = \"epp\"\nmasses = [1e5]\nstiffnesses = [4e6]\ndamping_ratio = 0.0\n\
+         storeys = [{ law = \"bilinear\", yield_drift = 0.05, post_yield_ratio = 0.0 }]\n",
+    )
+    .unwrap();
+    let step = dir.join("step.txt");
+    std::fs::write(&step, "0 1\n40 1\n").unwrap();
+    let (row, step) = (row.display().to_string(), step.display().to_string());
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "collapse",
+            &row,
+            &step,
+            "--units",
+            "m/s2",
+            "--drift-limit",
+            "0.5",
+            "--first",
+            "0.5",
+            "--sample",
+            "0.002",
+            "--rtol",
+            "1e-10",
+            "--format",
+            "json",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let given = args(&["--period", "1", "--smt", "2", "--ssf", "1.2"]);
+    let doc = json(&given.iter().map(String::as_str).collect::<Vec<_>>());
+    let r = &doc["records"][0];
+    let (low, high) = (
+        r["survived"].as_f64().unwrap(),
+        r["collapse"].as_f64().unwrap(),
+    );
+    assert!(
+        low <= 1.9 && 1.9 <= high && high / low <= 1.02,
+        "[{low}, {high}]"
+    );
+    let s = &doc["summary"];
+    assert_eq!(s["median_collapse_scale"].as_f64().unwrap(), high);
+    let (s_t, cmr) = (s["s_t"].as_f64().unwrap(), s["cmr"].as_f64().unwrap());
+    assert!((cmr - high * s_t / 2.0).abs() < 1e-12);
+    assert!((s["acmr"].as_f64().unwrap() - 1.2 * cmr).abs() < 1e-12);
+    let short = args(&["--max-scale", "1.5"]);
+    let doc = json(&short.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(doc["records"][0]["note"], "no collapse up to scale 1.5");
+    assert!(doc["summary"]["median_collapse_scale"].is_null());
+    assert!(doc["summary"]["note"]
+        .as_str()
+        .unwrap()
+        .contains("not determined"));
+    for (extra, needle) in [
+        (vec!["--growth", "1"], "--growth 1"),
+        (vec!["--tolerance", "1.5"], "--tolerance 1.5"),
+        (vec!["--smt", "2"], "--period"),
+    ] {
+        let a = args(&extra);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let out = run(&a);
+        assert!(!out.status.success(), "{extra:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{extra:?}: {err}");
+    }
+}

@@ -100,7 +100,7 @@ pub fn response_spectrum<'py>(
 /// setting by its keyword), a failed run `VibroimpactError`.
 fn pounding_error(e: PoundingError) -> PyErr {
     match e {
-        PoundingError::Run { .. } => numerical_error(e),
+        PoundingError::Run { .. } | PoundingError::Diverged { .. } => numerical_error(e),
         other => value_error(other),
     }
 }

@@ -36,7 +36,10 @@
 //! - [`results`]: the documents of results (the CLI's JSON, Python's
 //!   result objects);
 //! - [`record`], [`spectrum`], [`pounding`]: earthquake records, their
-//!   response spectra, and pounding frames under them;
+//!   response spectra, and rows of buildings (fixed or isolated) pounding
+//!   under them;
+//! - [`collapse`]: incremental dynamic analysis to collapse, per record,
+//!   and the median collapse scale (FEMA P695);
 //! - [`hysteresis`]: the force–drift laws of inelastic storeys (bilinear,
 //!   Bouc–Wen);
 //! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) shared by
@@ -54,6 +57,7 @@
 pub mod attractor;
 pub mod basins;
 pub mod chart;
+pub mod collapse;
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;

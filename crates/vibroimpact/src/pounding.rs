@@ -58,7 +58,7 @@ pub struct RunSettings {
     /// impact forces are the impact log's exact peaks whatever the step.
     pub sample: f64,
     /// Relative tolerance of the integration (the absolute one is
-    /// `rtol · 1e-4 · max(smallest gap, 1 mm)`).
+    /// `rtol · 1e-4 · max(smallest gap, 1 mm)`, 1 mm without gaps).
     pub rtol: f64,
     /// Integration method: DOP853, or DOPRI5 for loose tolerances (a
     /// record's samples limit the step; docs/earthquakes.md).
@@ -398,7 +398,9 @@ impl Row {
         let (mut times, mut acceleration) = (record.times.clone(), record.acceleration.clone());
         if let Some(tail) = self.tail() {
             let end = times.last().copied().unwrap_or(0.0);
-            let dt = record.dt.unwrap_or(tail / 1000.0);
+            // One sample step down to rest (within the tail however coarse
+            // the record).
+            let dt = record.dt.unwrap_or(tail / 1000.0).min(0.5 * tail);
             times.extend([end + dt, end + tail]);
             acceleration.extend([0.0, 0.0]);
         }
@@ -429,6 +431,21 @@ impl Row {
         contacts: bool,
         run: &RunSettings,
     ) -> Result<Response, PoundingError> {
+        self.respond_until(record, scale, contacts, run, None)
+            .map(|(r, _)| r)
+    }
+
+    /// [`Row::respond`], stopped as soon as a storey drift passes `limit`
+    /// (if given): the response up to then, and the time it passed. A run
+    /// that fails to integrate is [`PoundingError::Diverged`].
+    pub fn respond_until(
+        &self,
+        record: &Record,
+        scale: f64,
+        contacts: bool,
+        run: &RunSettings,
+        limit: Option<f64>,
+    ) -> Result<(Response, Option<f64>), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
             accelerations: true,
@@ -436,15 +453,23 @@ impl Row {
         };
         let mut peaks = Peaks::new(self, &rm, opts.t_end);
         let model = &rm.model;
+        let mut passed = None;
         let sim = simulate_streaming(model, &opts, |t, row| {
-            peaks.sample(t, row, model.base().at(t));
-            true
+            let worst = peaks.sample(t, row, model.base().at(t));
+            if limit.is_some_and(|l| worst > l) {
+                passed = Some(t);
+            }
+            passed.is_none()
         })
         .map_err(|e| PoundingError::run(record, e.0))?;
-        if let Some(e) = &sim.error {
-            return Err(PoundingError::run(record, e));
+        match (&sim.error, passed) {
+            (Some(_), Some(_)) | (None, _) => Ok((peaks.finish(self, &rm, &sim), passed)),
+            (Some(e), None) => Err(PoundingError::Diverged {
+                record: record.source.clone(),
+                scale,
+                message: e.to_string(),
+            }),
         }
-        Ok(peaks.finish(self, &rm, &sim))
     }
 
     /// The time history of the row with its contacts under `record` ×
@@ -487,7 +512,8 @@ impl Row {
         Ok(SimulationOptions {
             t_end: record.times.last().copied().unwrap_or(0.0) + self.tail().unwrap_or(0.0),
             rtol: run.rtol,
-            atol: run.rtol * 1e-4 * gap.max(1e-3),
+            // 1 mm where there is no gap (a building alone).
+            atol: run.rtol * 1e-4 * if gap.is_finite() { gap.max(1e-3) } else { 1e-3 },
             output_step: Some(run.sample),
             method: run.method,
             integrator: run.integrator,

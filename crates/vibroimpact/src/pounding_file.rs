@@ -31,7 +31,19 @@ pub enum PoundingError {
     /// `gaps`, `records`).
     #[error(transparent)]
     Field(#[from] FieldError),
-    /// A run under a record failed: the record and why.
+    /// A run under a record did not integrate to its end (a step that
+    /// failed, the step limit): the record, its scale and why. A collapse
+    /// study counts it as a collapse.
+    #[error("{record} x {scale}: {message}")]
+    Diverged {
+        /// The record's source.
+        record: String,
+        /// Its scale.
+        scale: f64,
+        /// Why.
+        message: String,
+    },
+    /// A run under a record could not start or failed: the record and why.
     #[error("{record}: {message}")]
     Run {
         /// The record's source.

@@ -66,8 +66,9 @@ impl Peaks {
     }
 
     /// Takes the sample `row` = [u.., v.., a..] at `t` with ground
-    /// acceleration `ag`.
-    pub(super) fn sample(&mut self, t: f64, row: &[f64], ag: f64) {
+    /// acceleration `ag`; returns the largest storey drift in it.
+    pub(super) fn sample(&mut self, t: f64, row: &[f64], ag: f64) -> f64 {
+        let mut worst = 0.0f64;
         let n = row.len() / 3;
         let (u, a) = (&row[..n], &row[2 * n..]);
         for (k, &(first, base, floors)) in self.layout.iter().enumerate() {
@@ -76,6 +77,7 @@ impl Peaks {
             for i in 0..floors {
                 let below = if i == 0 { slab } else { u[first + i - 1] };
                 let d = u[first + i] - below;
+                worst = worst.max(d.abs());
                 self.drift[k][i] = self.drift[k][i].max(d.abs());
                 self.displacement[k][i] = self.displacement[k][i].max(u[first + i].abs());
                 self.acceleration[k][i] = self.acceleration[k][i].max((a[first + i] + ag).abs());
@@ -94,6 +96,7 @@ impl Peaks {
                 *c = c.max(u[*l] - u[*r]);
             }
         }
+        worst
     }
 
     /// The response: these peaks with the run's impacts (between buildings

@@ -4,6 +4,7 @@
 pub mod basins;
 pub mod branch;
 pub mod chart;
+pub mod collapse;
 pub mod hysteresis;
 pub mod identify;
 pub mod impact;

@@ -12,13 +12,12 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::pounding::{
-    documents, parse_row, quantile, value_range, MoatCell, Outcome, PoundingError, Row,
-    RunSettings, SpectrumCell, Study,
+    documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, Study,
 };
 
-use crate::args::{IntegratorName, MethodName};
+use crate::args::RowRunArgs;
 
-use crate::error::{option_error, CliError};
+use crate::error::{option_error, pounding_error, CliError};
 use crate::format::{CsvText, Format};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
@@ -34,26 +33,11 @@ pub struct PoundingArgs {
     /// Records (AT2, two columns or CSV), one run each.
     #[arg(required = true)]
     records: Vec<PathBuf>,
-    /// Units of the records when their headers do not state them.
-    #[arg(long)]
-    units: Option<String>,
     /// Scale factor applied to every record.
     #[arg(long, default_value_t = 1.0)]
     scale: f64,
-    /// Output sampling of drifts and accelerations (s).
-    #[arg(long, default_value_t = 0.0025)]
-    sample: f64,
-    /// Integration tolerance.
-    #[arg(long, default_value_t = 1e-8)]
-    rtol: f64,
-    /// Integration method (dopri5: the faster choice at tolerances of 1e-3
-    /// to 1e-5, where the record's samples limit the step).
-    #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
-    method: MethodName,
-    /// Integrator: `local` moves each frame exactly between poundings, per
-    /// record sample.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
-    integrator: IntegratorName,
+    #[command(flatten)]
+    run: RowRunArgs,
     /// Also the frames apart (`free`), the gap that avoids contact and the
     /// code rules' gaps; `false`: the pair with its contacts only (half the
     /// work).
@@ -221,33 +205,17 @@ fn moat_csv(cells: &[MoatCell]) -> Result<String, CliError> {
     w.finish()
 }
 
-/// A pounding error in the command line's words: a setting by its option.
-fn pounding_error(e: PoundingError) -> CliError {
-    match e {
-        PoundingError::Field(f) => option_error(&f),
-        other => CliError::new(other.to_string()),
-    }
-}
-
 /// Runs `vibroimpact pounding`.
 pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
-    let units = records::units(args.units.as_deref())?;
-    if !(args.scale.is_finite() && args.sample.is_finite() && args.sample > 0.0) {
+    let units = records::units(args.run.units.as_deref())?;
+    if !args.scale.is_finite() {
         return Err(CliError::new(format!(
-            "--scale {} --sample {}: give a finite scale and a positive sample step",
-            args.scale, args.sample
+            "--scale {}: give a finite scale",
+            args.scale
         )));
     }
-    let run = RunSettings {
-        sample: args.sample,
-        rtol: args.rtol,
-        method: args.method.method(),
-        integrator: args.integrator.integrator(),
-    };
-    let source = args.pair.display().to_string();
-    let text =
-        crate::input::read_text(&args.pair).map_err(|e| CliError::new(format!("{source}: {e}")))?;
-    let row: Row = parse_row(&text, &source).map_err(pounding_error)?;
+    let run = args.run.settings()?;
+    let row: Row = records::row(&args.pair)?;
     let runs = args
         .records
         .iter()

@@ -1,0 +1,193 @@
+//! `vibroimpact collapse`: the FEMA P695 collapse study of a row of
+//! buildings ([`vibroimpact::collapse`]): per record an IDA to collapse
+//! (drift limit, isolator capacity, non-convergence), bracketed by
+//! bisection; the median collapse scale and intensity Ŝ_CT, and with the
+//! tables' values given, CMR and ACMR. Records in parallel; the same
+//! numbers at any thread count.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use rayon::prelude::*;
+use serde_json::Value;
+use vibroimpact::collapse::{study_document, CollapseStudy, Criterion, IdaSettings};
+
+use crate::args::RowRunArgs;
+use crate::error::{pounding_error, CliError};
+use crate::format::Format;
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render, Figure, LegendPosition, Marker, Series};
+use crate::records;
+
+/// Options of `vibroimpact collapse`.
+#[derive(Args, Debug)]
+pub struct CollapseArgs {
+    /// The row (or pair) file (docs/earthquakes.md).
+    pair: PathBuf,
+    /// Records (AT2, two columns or CSV), normalized as the record set
+    /// asks (FEMA P695: by PGV); one IDA each.
+    #[arg(required = true)]
+    records: Vec<PathBuf>,
+    /// The storey drift at collapse (m): the storey height times the
+    /// collapse drift ratio.
+    #[arg(long)]
+    drift_limit: f64,
+    /// The period T (s) of the intensity S_T (the records' median spectral
+    /// acceleration there).
+    #[arg(long)]
+    period: Option<f64>,
+    /// The damping ratio of that spectral acceleration.
+    #[arg(long, default_value_t = 0.05)]
+    damping: f64,
+    /// The first scale of every IDA.
+    #[arg(long, default_value_t = 0.25)]
+    first: f64,
+    /// The hunt's growth factor.
+    #[arg(long, default_value_t = 1.5)]
+    growth: f64,
+    /// The largest scale: a record standing there is censored ("no
+    /// collapse up to scale X").
+    #[arg(long, default_value_t = 20.0)]
+    max_scale: f64,
+    /// The collapse bracket's relative width.
+    #[arg(long, default_value_t = 0.02)]
+    tolerance: f64,
+    /// With the row's contacts (pounding, moat walls), or without them.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    contacts: bool,
+    /// An isolator past its stated capacity collapses.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    capacity: bool,
+    /// S_MT of FEMA P695 (m/s², from its tables): gives CMR = Ŝ_CT / S_MT.
+    #[arg(long, requires = "period")]
+    smt: Option<f64>,
+    /// SSF of FEMA P695 (from its tables): gives ACMR = SSF · CMR.
+    #[arg(long, requires = "smt")]
+    ssf: Option<f64>,
+    #[command(flatten)]
+    run: RowRunArgs,
+    /// Output folder for collapse.json and the IDA figure ida.svg/.png.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// The IDA curves: per record the largest drift against the scale, the
+/// collapses marked, the drift limit as a line.
+fn ida_figure(doc: &Value, limit: f64) -> Figure {
+    let mut fig = Figure::new(
+        "Incremental dynamic analysis",
+        "largest storey drift  [m]",
+        "scale",
+    )
+    .legend_at(LegendPosition::LowerRight);
+    let mut fallen = Vec::new();
+    let mut top = 0.0f64;
+    for r in doc["records"].as_array().into_iter().flatten() {
+        let mut pts: Vec<(f64, f64)> = r["runs"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|p| {
+                let (s, d) = (p["scale"].as_f64()?, p["max_drift"].as_f64()?);
+                top = top.max(s);
+                if p["verdict"]["kind"] != "standing" {
+                    fallen.push((d.min(limit), s));
+                }
+                Some((d.min(limit), s))
+            })
+            .collect();
+        pts.sort_by(|a, b| a.1.total_cmp(&b.1));
+        fig.push(Series::line("", pts).with_color(0));
+    }
+    fig.push(Series::markers("collapse", fallen, Marker::Triangle).with_color(3));
+    fig.push(Series::dashed("drift limit", [(limit, 0.0), (limit, top)]).with_color(1));
+    fig
+}
+
+/// Runs `vibroimpact collapse`.
+pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
+    let units = records::units(args.run.units.as_deref())?;
+    let row = records::row(&args.pair)?;
+    let study = CollapseStudy {
+        criterion: Criterion {
+            drift: args.drift_limit,
+            capacity: args.capacity,
+            contacts: args.contacts,
+        },
+        ida: IdaSettings {
+            first: args.first,
+            growth: args.growth,
+            max_scale: args.max_scale,
+            tolerance: args.tolerance,
+        },
+        run: args.run.settings()?,
+        period: args.period,
+        damping: args.damping,
+    };
+    let recs = args
+        .records
+        .iter()
+        .map(|p| records::read(p, units))
+        .collect::<Result<Vec<_>, _>>()?;
+    let parts = recs
+        .par_iter()
+        .map(|r| study.record(&row, r))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(pounding_error)?;
+    let doc = study_document(&row, &study, &parts, args.smt, args.ssf);
+    if let Some(dir) = &args.out {
+        ensure_dir(dir)?;
+        write_atomic(
+            &dir.join("collapse.json"),
+            serde_json::to_string_pretty(&doc)?.as_bytes(),
+        )?;
+        render(&ida_figure(&doc, args.drift_limit), &dir.join("ida"))?;
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        Format::Csv => {
+            return Err(CliError::new(
+                "--format csv: the collapse study has no table; give json or table",
+            ))
+        }
+        Format::Table => print_table(&doc),
+    }
+    Ok(())
+}
+
+fn print_table(doc: &Value) {
+    for r in doc["records"].as_array().into_iter().flatten() {
+        let runs = r["runs"].as_array().map_or(0, Vec::len);
+        match r["collapse"].as_f64() {
+            Some(c) => println!(
+                "{}: collapse between scales {:.4} and {:.4} ({runs} runs)",
+                r["source"].as_str().unwrap_or("?"),
+                r["survived"].as_f64().unwrap_or(f64::NAN),
+                c
+            ),
+            None => println!(
+                "{}: {} ({runs} runs)",
+                r["source"].as_str().unwrap_or("?"),
+                r["note"].as_str().unwrap_or("")
+            ),
+        }
+    }
+    let s = &doc["summary"];
+    let num = |k: &str| s[k].as_f64().map_or("-".to_string(), |v| format!("{v:.4}"));
+    println!(
+        "{} of {} records collapsed; median collapse scale {}; S_T {} m/s2; S_CT {} m/s2; CMR {}; ACMR {}",
+        s["collapsed"],
+        s["records"],
+        num("median_collapse_scale"),
+        num("s_t"),
+        num("s_ct"),
+        num("cmr"),
+        num("acmr")
+    );
+    if let Some(n) = s["note"].as_str() {
+        println!("note: {n}");
+    }
+}
