@@ -16,6 +16,7 @@
 mod basins;
 mod branch;
 mod chart;
+mod collapse;
 mod convert;
 mod hysteresis;
 mod impact;
@@ -65,6 +66,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(records::pounding, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding_history, m)?)?;
     m.add_function(wrap_pyfunction!(records::value_range, m)?)?;
+    m.add_function(wrap_pyfunction!(collapse::collapse_record, m)?)?;
+    m.add_function(wrap_pyfunction!(collapse::collapse_document, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::parameter_values, m)?)?;
     Ok(())
 }

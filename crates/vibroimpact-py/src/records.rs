@@ -94,18 +94,18 @@ pub fn response_spectrum<'py>(
     Ok(doc)
 }
 
-/// The pair (TOML `pair_text` named by `source`) and the run settings
-/// `(sample, rtol, method, integrator)` of a pounding study.
 /// A pounding error in Python's words: bad input is `ValueError` (a
 /// setting by its keyword), a failed run `VibroimpactError`.
-fn pounding_error(e: PoundingError) -> PyErr {
+pub(crate) fn pounding_error(e: PoundingError) -> PyErr {
     match e {
         PoundingError::Run { .. } | PoundingError::Diverged { .. } => numerical_error(e),
         other => value_error(other),
     }
 }
 
-fn pair_and_run(
+/// The row (TOML `pair_text` named by `source`) and the run settings
+/// `(sample, rtol, method, integrator)` of a pounding study.
+pub(crate) fn pair_and_run(
     pair_text: &str,
     source: &str,
     (sample, rtol, method, integrator): (f64, f64, &str, &str),
@@ -137,13 +137,24 @@ fn inputs(
 
 /// A record handed over from Python: its source, header lines, units of
 /// the file, times (s) and accelerations (m/s²).
-type RecordInput<'py> = (
+pub(crate) type RecordInput<'py> = (
     String,
     Vec<String>,
     String,
     PyReadonlyArray1<'py, f64>,
     PyReadonlyArray1<'py, f64>,
 );
+
+/// The record a [`RecordInput`] hands over.
+pub(crate) fn record_of(input: &RecordInput<'_>) -> PyResult<Record> {
+    let (name, header, units, times, acceleration) = input;
+    let t = floats(times, "times")?;
+    let a = floats(acceleration, "acceleration")?;
+    let mut record = Record::from_samples(name, t, &a).map_err(value_error)?;
+    record.header.clone_from(header);
+    record.units = Units::parse(units).map_err(value_error)?;
+    Ok(record)
+}
 
 /// The pounding study of the row in `pair_text` (TOML, named by
 /// `source`) under `records` × `scale`: the `vibroimpact pounding`
@@ -171,15 +182,10 @@ pub fn pounding<'py>(
     moat_gaps: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (row, run) = pair_and_run(pair_text, source, (sample, rtol, method, integrator))?;
-    let mut runs = Vec::with_capacity(records.len());
-    for (name, header, units, times, acceleration) in &records {
-        let t = floats(times, "times")?;
-        let a = floats(acceleration, "acceleration")?;
-        let mut record = Record::from_samples(name, t, &a).map_err(value_error)?;
-        record.header.clone_from(header);
-        record.units = Units::parse(units).map_err(value_error)?;
-        runs.push((record, scale));
-    }
+    let runs = records
+        .iter()
+        .map(|r| Ok((record_of(r)?, scale)))
+        .collect::<PyResult<Vec<_>>>()?;
     let study = match (gaps, ratios, moat_gaps) {
         (Some(gaps), Some(ratios), _) => Study::Spectrum { gaps, ratios },
         (_, _, Some(gaps)) => Study::Moat { gaps },

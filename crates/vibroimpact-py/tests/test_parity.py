@@ -21,6 +21,7 @@ FUNCTIONS = {
     "spectrum": vi.response_spectrum,
     "pounding": vi.pounding,
     "hysteresis": vi.hysteresis,
+    "collapse": vi.collapse_study,
 }
 # Subcommands without a function: the default study's report.
 NO_FUNCTION = {"report"}

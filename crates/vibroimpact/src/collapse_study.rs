@@ -130,14 +130,13 @@ pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Optio
     })
 }
 
-/// The study's document: the row, the settings, every record and the
-/// summary.
+/// The study's document: the row, the settings, every record's document
+/// ([`record_document`]) and the summary ([`summary_document`]).
 pub fn study_document(
     row: &Row,
     study: &CollapseStudy,
-    records: &[RecordCollapse],
-    smt: Option<f64>,
-    ssf: Option<f64>,
+    records: Vec<Value>,
+    summary: Value,
 ) -> Value {
     json!({
         "row": crate::pounding::documents::row_document(row),
@@ -154,7 +153,7 @@ pub fn study_document(
         },
         "period": study.period,
         "damping": study.damping,
-        "records": records.iter().map(record_document).collect::<Vec<_>>(),
-        "summary": summary_document(records, smt, ssf),
+        "records": records,
+        "summary": summary,
     })
 }

@@ -10,7 +10,9 @@ use std::path::PathBuf;
 use clap::Args;
 use rayon::prelude::*;
 use serde_json::Value;
-use vibroimpact::collapse::{study_document, CollapseStudy, Criterion, IdaSettings};
+use vibroimpact::collapse::{
+    record_document, study_document, summary_document, CollapseStudy, Criterion, IdaSettings,
+};
 
 use crate::args::RowRunArgs;
 use crate::error::{pounding_error, CliError};
@@ -137,7 +139,12 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
         .map(|r| study.record(&row, r))
         .collect::<Result<Vec<_>, _>>()
         .map_err(pounding_error)?;
-    let doc = study_document(&row, &study, &parts, args.smt, args.ssf);
+    let doc = study_document(
+        &row,
+        &study,
+        parts.iter().map(record_document).collect(),
+        summary_document(&parts, args.smt, args.ssf),
+    );
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
         write_atomic(

