@@ -330,6 +330,22 @@ fn moat_gap_study_of_an_isolated_building() {
     ] {
         assert!(dir.join(f).is_file(), "{f}");
     }
+    // The runs themselves draw each yielding building's loops.
+    let runs = temp_dir("moat-runs");
+    json(&[
+        "pounding",
+        &building,
+        &quake,
+        "--units",
+        "m/s2",
+        "--scale",
+        "2",
+        "--format",
+        "json",
+        "--out",
+        runs.to_str().unwrap(),
+    ]);
+    assert!(runs.join("loops-1-isolated.svg").is_file());
     let pair = repo_file("examples/pounding-frames.toml");
     let out = run(&[
         "pounding",

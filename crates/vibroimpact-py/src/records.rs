@@ -222,7 +222,9 @@ pub fn value_range<'py>(
 /// The time history of the row (TOML `pair_text`) with its contacts
 /// under the record × `scale`: `t`; `floors`, per building name its floor
 /// displacements (floors × samples, m); `slab`, per isolated building its
-/// base slab's displacement (m); and the impact log `impact_time`,
+/// base slab's displacement (m); `loops`, per hysteretic storey its
+/// `building`, `storey` (1-based; None for the bearings), `drift` (m) and
+/// `force` (N) at the samples; and the impact log `impact_time`,
 /// `impact_at` (`A–B floor F` between buildings, `A moat` on a moat
 /// wall), `impact_floor` (1-based; 0 for the slab), `impact_peak_force`
 /// (N).
@@ -247,11 +249,12 @@ pub fn pounding_history<'py>(
         (&times, &acceleration),
         (sample, rtol, method, integrator),
     )?;
-    let (rm, sim) = py
+    let h = py
         .detach(|| row.history(&record, scale, &run))
         .map_err(pounding_error)?;
-    let n = sim.final_displacement.len();
-    let series = |i: usize| -> Vec<f64> { sim.states.chunks(2 * n).map(|s| s[i]).collect() };
+    let rm = &h.model;
+    let n = rm.model.bodies().len();
+    let series = |i: usize| -> Vec<f64> { h.displacement.chunks(n).map(|s| s[i]).collect() };
     let floors = PyDict::new(py);
     let slab = PyDict::new(py);
     for (b, p) in row.buildings.iter().zip(&rm.placements) {
@@ -261,9 +264,9 @@ pub fn pounding_history<'py>(
             slab.set_item(&b.name, array1(py, series(base)))?;
         }
     }
-    let mut at = Vec::with_capacity(sim.impacts.len());
-    let mut floor = Vec::with_capacity(sim.impacts.len());
-    for i in &sim.impacts {
+    let mut at = Vec::with_capacity(h.impacts.len());
+    let mut floor = Vec::with_capacity(h.impacts.len());
+    for i in &h.impacts {
         let joint = rm.joints.iter().enumerate().find_map(|(j, cs)| {
             let k = cs.iter().position(|&c| c == i.contact)?;
             Some((j, row.joints[j].floors[k]))
@@ -290,19 +293,29 @@ pub fn pounding_history<'py>(
             }
         }
     }
+    let loops = pyo3::types::PyList::empty(py);
+    for l in &h.loops {
+        let e = PyDict::new(py);
+        e.set_item("building", &row.buildings[l.building].name)?;
+        e.set_item("storey", l.storey.map(|s| s + 1))?;
+        e.set_item("drift", array1(py, l.drift.clone()))?;
+        e.set_item("force", array1(py, l.force.clone()))?;
+        loops.append(e)?;
+    }
     let d = PyDict::new(py);
     d.set_item("floors", floors)?;
     d.set_item("slab", slab)?;
+    d.set_item("loops", loops)?;
     d.set_item(
         "impact_time",
-        array1(py, sim.impacts.iter().map(|i| i.start_time).collect()),
+        array1(py, h.impacts.iter().map(|i| i.start_time).collect()),
     )?;
     d.set_item("impact_at", at)?;
     d.set_item("impact_floor", floor)?;
     d.set_item(
         "impact_peak_force",
-        array1(py, sim.impacts.iter().map(|i| i.peak_force).collect()),
+        array1(py, h.impacts.iter().map(|i| i.peak_force).collect()),
     )?;
-    d.set_item("t", array1(py, sim.times))?;
+    d.set_item("t", array1(py, h.times))?;
     Ok(d)
 }

@@ -262,6 +262,13 @@ def test_isolated_building_documents_have_one_shape(cli):
     doc = cli("pounding", building, quake, "--units", "m/s2", "--scale", "2", "--moat-gaps", "0.1:0.3:2")
     r = vi.pounding(building, quake, units="m/s2", scale=2, moat_gaps=[0.1, 0.3])
     _same_document(json.loads(json.dumps(r.to_dict())), doc)
+    h = vi.pounding_history(building, vi.read_record(quake, units="m/s2"), scale=2, sample=0.0025)
+    assert [(x["building"], x["storey"]) for x in h["loops"]] == [("isolated", None)] + [
+        ("isolated", k) for k in (1, 2, 3, 4)]
+    bearings = h["loops"][0]
+    assert bearings["drift"].shape == bearings["force"].shape == h["t"].shape
+    assert np.max(np.abs(bearings["drift"])) == pytest.approx(iso["peak_displacement"], rel=1e-12)
+    assert "isolated moat" in h["impact_at"] and h["slab"]["isolated"].shape == h["t"].shape
     with pytest.raises(ValueError, match="moat_gaps: give it or gaps and ratios"):
         vi.pounding(building, quake, units="m/s2", gaps="0.1:0.2:2", ratios="1:2:2", moat_gaps="0.1:0.2:2")
 

@@ -159,6 +159,12 @@ impl StoreyTerms {
         }
     }
 
+    /// Storey k's force F(d, z) in the state `y` (N).
+    pub fn force(&self, k: usize, y: &[f64]) -> f64 {
+        let (d, _) = self.drift(k, y);
+        self.terms[k].law.force(d, self.hysteretic(k, d, y))
+    }
+
     /// The energy the storeys store in `y`: ½ b k d² + ½ (1 − b) k z² each
     /// (½ k d² for an elastic one).
     pub fn stored_energy(&self, y: &[f64]) -> f64 {

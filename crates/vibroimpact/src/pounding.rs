@@ -108,6 +108,38 @@ pub struct Response {
     /// Per joint, per pounding floor, the largest closing
     /// max (u_left − u_right) (m).
     pub closing: Vec<Vec<f64>>,
+    /// The hysteresis loop of every hysteretic storey and bearing layer,
+    /// at the samples.
+    pub loops: Vec<StoreyLoop>,
+}
+
+/// A hysteretic storey's (or bearing layer's) loop: drift and force at
+/// the samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StoreyLoop {
+    /// The building (index in the row).
+    pub building: usize,
+    /// The storey from 0, or None for the bearings.
+    pub storey: Option<usize>,
+    /// Drift (m).
+    pub drift: Vec<f64>,
+    /// Force (N).
+    pub force: Vec<f64>,
+}
+
+/// A row's time history ([`Row::history`]).
+#[derive(Clone, Debug)]
+pub struct History {
+    /// The model it ran, with its layout.
+    pub model: RowModel,
+    /// Sample times (s).
+    pub times: Vec<f64>,
+    /// Per sample, every body's displacement (m), body order.
+    pub displacement: Vec<f64>,
+    /// The impacts (between buildings and on moat walls), by start time.
+    pub impacts: Vec<crate::simulate::ImpactRecord>,
+    /// The hysteretic storeys' loops.
+    pub loops: Vec<StoreyLoop>,
 }
 
 /// An isolation layer's response.
@@ -177,6 +209,7 @@ pub fn correlation(r: f64, zi: f64, zj: f64) -> f64 {
 
 /// A row's model with where each building's bodies, storeys and contacts
 /// sit in it.
+#[derive(Clone, Debug)]
 pub struct RowModel {
     /// The model.
     pub model: Model,
@@ -449,6 +482,7 @@ impl Row {
         let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
             accelerations: true,
+            storey_forces: true,
             ..self.options(record, run)?
         };
         let mut peaks = Peaks::new(self, &rm, opts.t_end);
@@ -473,22 +507,44 @@ impl Row {
     }
 
     /// The time history of the row with its contacts under `record` ×
-    /// `scale`: every body's displacement sampled every `run.sample`
-    /// seconds (the model's body order: building by building, left to
-    /// right) and the impact log, with the model it ran.
+    /// `scale`, sampled every `run.sample` seconds: every body's
+    /// displacement (the model's body order: building by building, left
+    /// to right), the hysteretic storeys' loops and the impact log, with
+    /// the model it ran.
     pub fn history(
         &self,
         record: &Record,
         scale: f64,
         run: &RunSettings,
-    ) -> Result<(RowModel, crate::simulate::Simulation), PoundingError> {
+    ) -> Result<History, PoundingError> {
         let rm = self.model(record, scale, true)?;
-        let sim = crate::simulate::simulate(&rm.model, &self.options(record, run)?)
-            .map_err(|e| PoundingError::run(record, e.0))?;
-        match &sim.error {
-            Some(e) => Err(PoundingError::run(record, e)),
-            None => Ok((rm, sim)),
+        let opts = SimulationOptions {
+            accelerations: true,
+            storey_forces: true,
+            ..self.options(record, run)?
+        };
+        let n = rm.model.bodies().len();
+        let mut peaks = Peaks::new(self, &rm, opts.t_end);
+        let (mut times, mut displacement) = (Vec::new(), Vec::new());
+        let model = &rm.model;
+        let sim = simulate_streaming(model, &opts, |t, row| {
+            times.push(t);
+            displacement.extend_from_slice(&row[..n]);
+            peaks.sample(t, row, model.base().at(t));
+            true
+        })
+        .map_err(|e| PoundingError::run(record, e.0))?;
+        if let Some(e) = &sim.error {
+            return Err(PoundingError::run(record, e));
         }
+        let loops = peaks.finish(self, &rm, &sim).loops;
+        Ok(History {
+            model: rm,
+            times,
+            displacement,
+            impacts: sim.impacts,
+            loops,
+        })
     }
 
     fn options(

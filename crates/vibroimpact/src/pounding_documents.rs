@@ -207,7 +207,7 @@ pub fn study_document(row: &Row, records: &[(Record, f64)], outcome: &Outcome) -
     let mut doc = json!({ "row": row_document(row) });
     let metadata = || -> Value { records.iter().map(|(r, s)| json!(r.metadata(*s))).collect() };
     match outcome {
-        Outcome::Runs(runs) => doc["runs"] = Value::Array(runs.clone()),
+        Outcome::Runs { documents, .. } => doc["runs"] = Value::Array(documents.clone()),
         Outcome::Spectrum(cells) => {
             doc["records"] = metadata();
             doc["cells"] = cells.iter().map(cell_document).collect();

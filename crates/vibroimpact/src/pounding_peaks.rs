@@ -3,7 +3,7 @@
 //! per building, closings per joint floor, the isolators' displacements;
 //! then the impact log and the storeys' hysteretic energy at the end.
 
-use super::{IsolatorResponse, Response, Row, RowModel};
+use super::{IsolatorResponse, Response, Row, RowModel, StoreyLoop};
 use crate::simulate::Simulation;
 
 /// Running peaks of one run.
@@ -22,7 +22,13 @@ pub(super) struct Peaks {
     slab: Vec<(f64, f64)>,
     /// Per joint, per floor: (left body, right body, largest closing).
     closing: Vec<Vec<(usize, usize, f64)>>,
+    /// Per hysteretic storey of the model (its order).
+    loops: Vec<Tracked>,
 }
+
+/// A hysteretic storey's body below (None: the ground) and above, and its
+/// loop so far.
+type Tracked = (Option<usize>, usize, StoreyLoop);
 
 impl Peaks {
     /// Empty peaks of `row` run as `rm` up to `t_end`.
@@ -53,7 +59,26 @@ impl Peaks {
                     .collect()
             })
             .collect();
+        let mut loops: Vec<(usize, Tracked)> = Vec::new();
+        for (k, p) in rm.placements.iter().enumerate() {
+            for &(s, storey) in &p.storeys {
+                let (below, above) = match storey {
+                    None => (None, p.base.unwrap_or(p.first_floor)),
+                    Some(0) => (p.base, p.first_floor),
+                    Some(i) => (Some(p.first_floor + i - 1), p.first_floor + i),
+                };
+                let empty = StoreyLoop {
+                    building: k,
+                    storey,
+                    drift: Vec::new(),
+                    force: Vec::new(),
+                };
+                loops.push((s, (below, above, empty)));
+            }
+        }
+        loops.sort_by_key(|l| l.0);
         Self {
+            loops: loops.into_iter().map(|l| l.1).collect(),
             windows: row.buildings.iter().map(|b| t_end - b.period()).collect(),
             drift: zeros.clone(),
             acceleration: zeros.clone(),
@@ -65,12 +90,17 @@ impl Peaks {
         }
     }
 
-    /// Takes the sample `row` = [u.., v.., a..] at `t` with ground
-    /// acceleration `ag`; returns the largest storey drift in it.
+    /// Takes the sample `row` = [u.., v.., a.., storey forces..] at `t`
+    /// with ground acceleration `ag`; returns the largest storey drift in
+    /// it.
     pub(super) fn sample(&mut self, t: f64, row: &[f64], ag: f64) -> f64 {
         let mut worst = 0.0f64;
-        let n = row.len() / 3;
-        let (u, a) = (&row[..n], &row[2 * n..]);
+        let n = (row.len() - self.loops.len()) / 3;
+        let (u, a, forces) = (&row[..n], &row[2 * n..3 * n], &row[3 * n..]);
+        for ((below, above, l), &f) in self.loops.iter_mut().zip(forces) {
+            l.drift.push(u[*above] - below.map_or(0.0, |b| u[b]));
+            l.force.push(f);
+        }
         for (k, &(first, base, floors)) in self.layout.iter().enumerate() {
             let late = t >= self.windows[k];
             let slab = base.map_or(0.0, |b| u[b]);
@@ -158,6 +188,7 @@ impl Peaks {
                 .into_iter()
                 .map(|j| j.into_iter().map(|(_, _, c)| c).collect())
                 .collect(),
+            loops: self.loops.into_iter().map(|(_, _, l)| l).collect(),
         }
     }
 }

@@ -73,11 +73,11 @@ fn chain_pounding_in_a_row_of_three() {
     assert_eq!(res.joints.len(), 2);
     assert_eq!(res.pounding.closing.len(), 2);
     assert!(res.joints.iter().all(|j| j.required_gap > 0.004), "{res:?}");
-    let (rm, h) = row.history(&record(), 1.0, &run).unwrap();
+    let h = row.history(&record(), 1.0, &run).unwrap();
     let at = |joint: usize| {
         h.impacts
             .iter()
-            .filter(|i| rm.joints[joint].contains(&i.contact))
+            .filter(|i| h.model.joints[joint].contains(&i.contact))
             .count()
     };
     assert!(at(0) > 0 && at(1) > 0, "impacts {} and {}", at(0), at(1));

@@ -6,7 +6,7 @@ use serde_json::Value;
 
 use super::{
     documents, moat_study, pounding_spectrum, MoatCell, PoundingError, Row, RunSettings,
-    SpectrumCell,
+    SpectrumCell, StoreyLoop,
 };
 use crate::record::Record;
 
@@ -35,9 +35,14 @@ pub enum Study {
 /// What a study gives.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Outcome {
-    /// One document per record ([`documents::run_document`] or
-    /// [`documents::pounding_only_document`]).
-    Runs(Vec<Value>),
+    /// Per record.
+    Runs {
+        /// Its document ([`documents::run_document`] or
+        /// [`documents::pounding_only_document`]).
+        documents: Vec<Value>,
+        /// The hysteresis loops of its run with the contacts.
+        loops: Vec<Vec<StoreyLoop>>,
+    },
     /// The pounding spectrum's cells.
     Spectrum(Vec<SpectrumCell>),
     /// The moat-gap study's cells (the first without contacts).
@@ -53,20 +58,22 @@ impl Study {
         run: &RunSettings,
     ) -> Result<Outcome, PoundingError> {
         Ok(match self {
-            Study::Runs { free } => Outcome::Runs(
-                records
-                    .iter()
-                    .map(|(r, s)| {
-                        if *free {
-                            row.analyse(r, *s, run)
-                                .map(|res| documents::run_document(row, r, *s, &res))
-                        } else {
-                            row.respond(r, *s, true, run)
-                                .map(|res| documents::pounding_only_document(row, r, *s, &res))
-                        }
-                    })
-                    .collect::<Result<_, _>>()?,
-            ),
+            Study::Runs { free } => {
+                let mut documents = Vec::with_capacity(records.len());
+                let mut loops = Vec::with_capacity(records.len());
+                for (r, s) in records {
+                    let (doc, pounding) = if *free {
+                        let res = row.analyse(r, *s, run)?;
+                        (documents::run_document(row, r, *s, &res), res.pounding)
+                    } else {
+                        let res = row.respond(r, *s, true, run)?;
+                        (documents::pounding_only_document(row, r, *s, &res), res)
+                    };
+                    documents.push(doc);
+                    loops.push(pounding.loops);
+                }
+                Outcome::Runs { documents, loops }
+            }
             Study::Spectrum { gaps, ratios } => {
                 Outcome::Spectrum(pounding_spectrum(row, records, gaps, ratios, run)?)
             }

@@ -83,6 +83,10 @@ pub struct SimulationOptions {
     /// right-hand side (with its storeys' history and its contacts' onset
     /// velocities); [`simulate_streaming`] only.
     pub accelerations: bool,
+    /// Streamed samples end with the hysteretic storeys' forces F(d, z)
+    /// (N, the model's storey order), after everything else;
+    /// [`simulate_streaming`] only.
+    pub storey_forces: bool,
 }
 
 impl Default for SimulationOptions {
@@ -102,6 +106,7 @@ impl Default for SimulationOptions {
             interrupt: None,
             integrator: Integrator::Auto,
             accelerations: false,
+            storey_forces: false,
         }
     }
 }
@@ -346,9 +351,9 @@ pub const MAX_SAMPLES: f64 = 1e9;
 /// values; [`simulate_streaming`] has no such limit).
 pub fn simulate(model: &Model, opts: &SimulationOptions) -> Result<Simulation, OptionsError> {
     check_options(opts)?;
-    if opts.accelerations {
+    if opts.accelerations || opts.storey_forces {
         return Err(OptionsError(
-            "accelerations: a kept history holds u and v only; stream the run for its accelerations"
+            "accelerations, storey_forces: a kept history holds u and v only; stream the run for them"
                 .into(),
         ));
     }

@@ -48,7 +48,7 @@ pub fn simulate_streaming(
         impacts: Vec::new(),
         previous: Vec::new(),
     };
-    let mut output = Output::new(opts, (y0.len(), n2), &mut sink);
+    let mut output = Output::new(opts, (y0.len(), n2, model.storeys().len()), &mut sink);
     let mut sink_stopped = None;
     if opts.output_step.is_some() && opts.output_from == 0.0 {
         if !output.record(0.0, &y0, &mut sys) {
@@ -267,20 +267,26 @@ struct Output<'a, S> {
     sample: Vec<f64>,
     /// The right-hand side at a sample, for its accelerations.
     rates: Option<Vec<f64>>,
+    /// Whether samples end with the storeys' forces.
+    storey_forces: bool,
     sink: &'a mut S,
 }
 
 impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
-    /// `dims`: the integrated state's length and the mechanical state's.
-    fn new(opts: &SimulationOptions, dims: (usize, usize), sink: &'a mut S) -> Self {
+    /// `dims`: the integrated state's length, the mechanical state's and
+    /// the number of hysteretic storeys.
+    fn new(opts: &SimulationOptions, dims: (usize, usize, usize), sink: &'a mut S) -> Self {
+        let extra = if opts.accelerations { dims.1 / 2 } else { 0 }
+            + if opts.storey_forces { dims.2 } else { 0 };
         Self {
             step: opts.output_step,
             from: opts.output_from,
             t_end: opts.t_end,
             next: 0,
             buf: vec![0.0; dims.0],
-            sample: vec![0.0; dims.1 + if opts.accelerations { dims.1 / 2 } else { 0 }],
+            sample: vec![0.0; dims.1 + extra],
             rates: opts.accelerations.then(|| vec![0.0; dims.0]),
+            storey_forces: opts.storey_forces,
             sink,
         }
     }
@@ -294,10 +300,17 @@ impl<'a, S: FnMut(f64, &[f64]) -> bool> Output<'a, S> {
             self.sample[i] = y[2 * i];
             self.sample[n + i] = y[2 * i + 1];
         }
+        let mut at = 2 * n;
         if let Some(rates) = self.rates.as_mut() {
             crate::integrate::OdeSystem::rhs(sys, t, y, rates);
             for i in 0..n {
-                self.sample[2 * n + i] = rates[2 * i + 1];
+                self.sample[at + i] = rates[2 * i + 1];
+            }
+            at += n;
+        }
+        if self.storey_forces {
+            for (k, f) in self.sample[at..].iter_mut().enumerate() {
+                *f = sys.storeys().force(k, y);
             }
         }
         (self.sink)(t, &self.sample)

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::pounding::{
-    documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, Study,
+    documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, StoreyLoop, Study,
 };
 
 use crate::args::RowRunArgs;
@@ -56,9 +56,11 @@ pub struct PoundingArgs {
     /// and the same without contacts.
     #[arg(long, conflicts_with = "gaps")]
     moat_gaps: Option<String>,
-    /// Output folder for pounding.json (and, for a spectrum, spectrum.csv
-    /// and the figure spectrum.svg/.png; for a moat-gap study, moat.csv
-    /// and the figures moat-drift and moat-acceleration .svg/.png).
+    /// Output folder for pounding.json (with hysteretic storeys, the
+    /// loops of each record's run, loops-RECORD-BUILDING.svg/.png; for a
+    /// spectrum, spectrum.csv and the figure spectrum.svg/.png; for a
+    /// moat-gap study, moat.csv and the figures moat-drift and
+    /// moat-acceleration .svg/.png).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Format on standard output.
@@ -114,6 +116,30 @@ fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
         ])?;
     }
     w.finish()
+}
+
+/// The hysteresis loops of one building's storeys (and bearings) in one
+/// record's run: force against drift.
+fn loops_figure(building: &str, loops: &[&StoreyLoop]) -> Figure {
+    let mut fig = Figure::new(
+        format!("Hysteresis loops: {building}"),
+        "drift  [mm]",
+        "force  [MN]",
+    )
+    .legend_at(LegendPosition::Best);
+    for (k, l) in loops.iter().enumerate() {
+        let label = match l.storey {
+            Some(i) => format!("storey {}", i + 1),
+            None => "bearings".to_string(),
+        };
+        let pts = l
+            .drift
+            .iter()
+            .zip(&l.force)
+            .map(|(d, f)| (1e3 * d, 1e-6 * f));
+        fig.push(Series::line(label, pts).with_color(k % 7));
+    }
+    fig
 }
 
 /// What a moat-gap figure shows.
@@ -237,7 +263,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let (csv, name) = match &outcome {
         Outcome::Spectrum(cells) => (Some(spectrum_csv(cells)?), "spectrum"),
         Outcome::Moat(cells) => (Some(moat_csv(cells)?), "moat"),
-        Outcome::Runs(_) => (None, ""),
+        Outcome::Runs { .. } => (None, ""),
     };
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
@@ -253,7 +279,18 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
                     &dir.join("moat-acceleration"),
                 )?;
             }
-            Outcome::Runs(_) => {}
+            Outcome::Runs { loops, .. } => {
+                for (r, loops) in loops.iter().enumerate() {
+                    for (k, b) in row.buildings.iter().enumerate() {
+                        let mine: Vec<&StoreyLoop> =
+                            loops.iter().filter(|l| l.building == k).collect();
+                        if !mine.is_empty() {
+                            let name = format!("loops-{}-{}", r + 1, b.name);
+                            render(&loops_figure(&b.name, &mine), &dir.join(name))?;
+                        }
+                    }
+                }
+            }
         }
     }
     if let Some(dir) = &args.out {

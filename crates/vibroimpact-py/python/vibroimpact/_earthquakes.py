@@ -286,8 +286,10 @@ def pounding_history(
     record (as :func:`pounding` takes them), sampled every ``sample``
     seconds: ``t`` (s); ``floors``, per building name its floor
     displacements relative to the ground (floors × samples, m); ``slab``,
-    per isolated building its base slab's displacement (m); and the impact
-    log ``impact_time`` (s), ``impact_at`` (``"A–B floor F"`` between
+    per isolated building its base slab's displacement (m); ``loops``, per
+    hysteretic storey (or bearing layer) its ``building``, ``storey``
+    (1-based; None for the bearings), ``drift`` (m) and ``force`` (N) at the
+    samples (its hysteresis loop); and the impact log ``impact_time`` (s), ``impact_at`` (``"A–B floor F"`` between
     buildings, ``"A moat"`` on a moat wall), ``impact_floor`` (1-based, 0
     for a slab), ``impact_peak_force`` (N)."""
     d = _core.pounding_history(*_pounding_args(pair, record, scale, sample, rtol, method, integrator))
