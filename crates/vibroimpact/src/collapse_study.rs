@@ -6,7 +6,7 @@
 use serde_json::{json, Value};
 
 use super::{median_collapse, record_ida, Criterion, IdaSettings, RecordIda, Verdict};
-use crate::pounding::{quantile, PoundingError, Row, RunSettings};
+use crate::pounding::{PoundingError, Row, RunSettings};
 use crate::record::Record;
 
 /// The settings of a collapse study.
@@ -96,14 +96,20 @@ pub fn record_document(r: &RecordCollapse) -> Value {
 /// The summary over the records' parts: the median collapse scale (null
 /// where censored records leave it undetermined, with a note naming
 /// them); with spectral accelerations, the set's median S_T at the period
-/// and the median collapse intensity Ŝ_CT = median scale × S_T; with
+/// (their geometric mean, as FEMA P695's S_NRT) and the median collapse
+/// intensity Ŝ_CT = median scale × S_T; with
 /// `smt` the collapse margin ratio CMR = Ŝ_CT / S_MT, and with `ssf` also
 /// ACMR = SSF × CMR.
 pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Option<f64>) -> Value {
     let idas: Vec<RecordIda> = records.iter().map(|r| r.ida.clone()).collect();
     let median = median_collapse(&idas);
     let sas: Option<Vec<f64>> = records.iter().map(|r| r.sa).collect();
-    let s_t = sas.as_deref().map(|v| quantile(v, 0.5));
+    // The set's median as FEMA P695 tabulates it (S_NRT, Table A-3): the
+    // geometric mean, the median of the lognormal fit.
+    let s_t = sas
+        .as_deref()
+        .filter(|v| !v.is_empty())
+        .map(|v| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp());
     let s_ct = median.zip(s_t).map(|(m, s)| m * s);
     let cmr = s_ct.zip(smt).map(|(c, m)| c / m);
     let censored: Vec<String> = idas
