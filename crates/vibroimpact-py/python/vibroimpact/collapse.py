@@ -243,7 +243,9 @@ def collapse_study(
     else:
         from .distributed import _gather
 
-        shipped = client.scatter(arrays)
+        # Unhashed: two studies of the same records must not share (and
+        # release) each other's scattered data.
+        shipped = client.scatter(arrays, hash=False)
         futures = [
             client.submit(_collapse_task, text, source, r, settings, retries=retries, pure=False)
             for r in shipped
