@@ -116,19 +116,8 @@ struct IsolationSpec {
     moat: Option<MoatSpec>,
 }
 
-#[derive(serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FrameSpec {
-    masses: Vec<f64>,
-    stiffnesses: Vec<f64>,
-    damping_ratio: f64,
-    #[serde(default)]
-    storeys: Vec<StoreySpec>,
-    isolation: Option<IsolationSpec>,
-}
-
-/// A `[[building]]` entry: a frame, its name, and (from the second on) the
-/// joint to the building on its left.
+/// A building's table: its frame (and isolation); in a row file also its
+/// name and, from the second on, the joint to the building on its left.
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct BuildingSpec {
@@ -144,14 +133,21 @@ struct BuildingSpec {
     law: Option<LawSpec>,
 }
 
+impl BuildingSpec {
+    /// Whether it gives a joint's key (`gap`, `floors`, `law`).
+    fn has_joint(&self) -> bool {
+        self.gap.is_some() || self.floors.is_some() || self.law.is_some()
+    }
+}
+
 /// A pair file (`[left]`, `[right]`, one joint) or a row file
 /// (`[[building]]` entries, `law` the joints' law unless a building gives
 /// its own).
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RowSpec {
-    left: Option<FrameSpec>,
-    right: Option<FrameSpec>,
+    left: Option<BuildingSpec>,
+    right: Option<BuildingSpec>,
     gap: Option<f64>,
     floors: Option<Vec<usize>>,
     law: Option<LawSpec>,
@@ -165,8 +161,8 @@ fn law(spec: &LawSpec, key: &'static str, what: &str) -> Result<ContactLaw, Poun
         .map_err(|e| PoundingError::pair(key, format!("{what}{key}: {e}")))
 }
 
-/// The building `name` of a frame spec; `what` names it in errors.
-fn building(name: String, f: FrameSpec, what: &str) -> Result<Building, PoundingError> {
+/// The building `name` of a building's table; `what` names it in errors.
+fn building(name: String, f: BuildingSpec, what: &str) -> Result<Building, PoundingError> {
     let isolation = f
         .isolation
         .map(|i| {
@@ -234,6 +230,15 @@ fn row_of(spec: RowSpec) -> Result<Row, PoundingError> {
         let (Some(gap), Some(floors), Some(l)) = (spec.gap, spec.floors, spec.law) else {
             return missing("gap", "a pair needs gap, floors and law");
         };
+        if let Some((side, _)) = [("left", &left), ("right", &right)]
+            .into_iter()
+            .find(|(_, f)| f.name.is_some() || f.has_joint())
+        {
+            return missing(
+                "building",
+                &format!("{side} frame: name, gap, floors and law belong to [[building]] entries; a pair file gives gap, floors and law at the top"),
+            );
+        }
         return Ok(Row {
             buildings: vec![
                 building("left".into(), left, "left frame")?,
@@ -255,17 +260,17 @@ fn row_of(spec: RowSpec) -> Result<Row, PoundingError> {
     let mut buildings = Vec::new();
     let mut joints = Vec::new();
     for (k, b) in spec.building.into_iter().enumerate() {
-        let name = b.name.unwrap_or_else(|| format!("B{}", k + 1));
+        let name = b.name.clone().unwrap_or_else(|| format!("B{}", k + 1));
         let what = format!("building {name}");
         if k == 0 {
-            if b.gap.is_some() || b.floors.is_some() || b.law.is_some() {
+            if b.has_joint() {
                 return missing(
                     "building",
                     &format!("{what}: the first building has no joint to its left: give gap, floors and law from the second on"),
                 );
             }
         } else {
-            let (Some(gap), Some(floors)) = (b.gap, b.floors) else {
+            let (Some(gap), Some(floors)) = (b.gap, b.floors.clone()) else {
                 return missing(
                     "gap",
                     &format!("{what}: give gap and floors (the joint to the building on its left)"),
@@ -283,14 +288,7 @@ fn row_of(spec: RowSpec) -> Result<Row, PoundingError> {
                 law: law(l, "law", &format!("{what}: "))?,
             });
         }
-        let frame = FrameSpec {
-            masses: b.masses,
-            stiffnesses: b.stiffnesses,
-            damping_ratio: b.damping_ratio,
-            storeys: b.storeys,
-            isolation: b.isolation,
-        };
-        buildings.push(building(name, frame, &what)?);
+        buildings.push(building(name, b, &what)?);
     }
     Ok(Row { buildings, joints })
 }

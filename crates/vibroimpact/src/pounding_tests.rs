@@ -334,6 +334,16 @@ fn pair_files_are_parsed_and_checked() {
         e.starts_with("pair.toml:11:") && e.contains("dampingratio"),
         "{e}"
     );
+    let e = parse_row(
+        &text.replace("[right]\n", "[right]\ngap = 0.1\n"),
+        "pair.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("pair.toml: right frame: name, gap, floors and law belong to [[building]]"),
+        "{e}"
+    );
     let e = parse_row(&text.replace("floors = [1]", "floors = [2]"), "pair.toml").unwrap_err();
     assert!(
         matches!(&e, PoundingError::Pair { file: Some(f), key: Some("floors"), .. } if f == "pair.toml"),
