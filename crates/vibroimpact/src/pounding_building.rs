@@ -239,6 +239,19 @@ pub(super) struct Parts {
     pub contacts: Vec<Contact>,
 }
 
+impl Parts {
+    /// Adds a flexible moat wall's body (`{tag}W{side}`); its index.
+    fn wall(&mut self, tag: &str, side: &str, w: Wall) -> usize {
+        self.bodies.push(Body {
+            name: format!("{tag}W{side}"),
+            mass: w.mass,
+            stiffness: w.stiffness,
+            damping: w.damping,
+        });
+        self.bodies.len() - 1
+    }
+}
+
 impl Building {
     /// How many floors.
     pub fn floors(&self) -> usize {
@@ -342,20 +355,9 @@ impl Building {
         parts: &mut Parts,
         contacts: bool,
     ) -> Result<Placement, String> {
-        let (alpha, beta) = self.frame.rayleigh();
-        let laws = self.frame.laws()?;
         let iso = self.isolation.as_ref();
         let wall = iso.and_then(|i| i.moat.as_ref()).and_then(|m| m.wall);
-        let wall_body = |side: &str, w: Wall| Body {
-            name: format!("{tag}W{side}"),
-            mass: w.mass,
-            stiffness: w.stiffness,
-            damping: w.damping,
-        };
-        let left_wall = wall.map(|w| {
-            parts.bodies.push(wall_body("-", w));
-            parts.bodies.len() - 1
-        });
+        let left_wall = wall.map(|w| parts.wall(tag, "-", w));
         let mut placement = Placement {
             first_floor: 0,
             base: None,
@@ -363,88 +365,23 @@ impl Building {
             moat: Vec::new(),
         };
         if let (Some(i), Some(law)) = (iso, self.bearing_law()?) {
-            let base = parts.bodies.len();
-            let spring = match law {
-                StoreyLaw::Elastic { stiffness } => stiffness,
-                law => {
-                    placement.storeys.push((parts.storeys.len(), None));
-                    parts.storeys.push(Storey {
-                        below: None,
-                        above: base,
-                        law,
-                    });
-                    0.0
-                }
-            };
+            placement.base = Some(parts.bodies.len());
+            let spring = Self::spring_or_storey(
+                law,
+                (None, parts.bodies.len()),
+                None,
+                parts,
+                &mut placement,
+            );
             parts.bodies.push(Body {
                 name: format!("{tag}0"),
                 mass: i.mass,
                 stiffness: spring,
                 damping: i.damping,
             });
-            placement.base = Some(base);
         }
-        let first = parts.bodies.len();
-        placement.first_floor = first;
-        for (i, (&m, &k)) in self
-            .frame
-            .masses
-            .iter()
-            .zip(&self.frame.stiffnesses)
-            .enumerate()
-        {
-            // Storey i + 1 joins the floor below (the slab, or the ground).
-            let below = if i == 0 {
-                placement.base
-            } else {
-                Some(first + i - 1)
-            };
-            // A yielding storey's spring is its law; its damper (β k on the
-            // initial stiffness) stays linear.
-            let spring = match laws[i] {
-                StoreyLaw::Elastic { .. } => k,
-                law => {
-                    placement.storeys.push((parts.storeys.len(), Some(i)));
-                    parts.storeys.push(Storey {
-                        below,
-                        above: first + i,
-                        law,
-                    });
-                    0.0
-                }
-            };
-            // The mass-proportional damper joins the floor to the slab (to
-            // the ground for a fixed building).
-            let to_ground = placement.base.is_none();
-            parts.bodies.push(Body {
-                name: format!("{tag}{}", i + 1),
-                mass: m,
-                stiffness: if below.is_none() { spring } else { 0.0 },
-                damping: if to_ground { alpha * m } else { 0.0 }
-                    + if below.is_none() { beta * k } else { 0.0 },
-            });
-            if let Some(b) = below {
-                let slab_damper = if !to_ground && i == 0 { alpha * m } else { 0.0 };
-                parts.couplings.push(Coupling {
-                    a: b,
-                    b: first + i,
-                    stiffness: spring,
-                    damping: beta * k + slab_damper,
-                });
-            }
-            if let (Some(base), true) = (placement.base, i > 0) {
-                parts.couplings.push(Coupling {
-                    a: base,
-                    b: first + i,
-                    stiffness: 0.0,
-                    damping: alpha * m,
-                });
-            }
-        }
-        let right_wall = wall.map(|w| {
-            parts.bodies.push(wall_body("+", w));
-            parts.bodies.len() - 1
-        });
+        self.place_floors(tag, parts, &mut placement)?;
+        let right_wall = wall.map(|w| parts.wall(tag, "+", w));
         if let (Some(moat), Some(base), true) =
             (iso.and_then(|i| i.moat.as_ref()), placement.base, contacts)
         {
@@ -474,5 +411,83 @@ impl Building {
             }
         }
         Ok(placement)
+    }
+
+    /// The spring of an elastic law; a hysteretic one becomes a storey
+    /// between `(below, above)` (`storey`: the building's storey from 0,
+    /// None for the bearings) and its spring is 0.
+    fn spring_or_storey(
+        law: StoreyLaw,
+        (below, above): (Option<usize>, usize),
+        storey: Option<usize>,
+        parts: &mut Parts,
+        placement: &mut Placement,
+    ) -> f64 {
+        match law {
+            StoreyLaw::Elastic { stiffness } => stiffness,
+            law => {
+                placement.storeys.push((parts.storeys.len(), storey));
+                parts.storeys.push(Storey { below, above, law });
+                0.0
+            }
+        }
+    }
+
+    /// Adds the floors above the slab (or the ground): storey i + 1 joins
+    /// the floor below to floor i + 1, its damper β k beside it (on the
+    /// initial stiffness, linear when the storey yields), and the
+    /// mass-proportional damper α m joins each floor to the slab (to the
+    /// ground for a fixed building).
+    fn place_floors(
+        &self,
+        tag: &str,
+        parts: &mut Parts,
+        placement: &mut Placement,
+    ) -> Result<(), String> {
+        let (alpha, beta) = self.frame.rayleigh();
+        let laws = self.frame.laws()?;
+        let first = parts.bodies.len();
+        placement.first_floor = first;
+        let to_ground = placement.base.is_none();
+        for (i, (&m, &k)) in self
+            .frame
+            .masses
+            .iter()
+            .zip(&self.frame.stiffnesses)
+            .enumerate()
+        {
+            let below = if i == 0 {
+                placement.base
+            } else {
+                Some(first + i - 1)
+            };
+            let spring =
+                Self::spring_or_storey(laws[i], (below, first + i), Some(i), parts, placement);
+            parts.bodies.push(Body {
+                name: format!("{tag}{}", i + 1),
+                mass: m,
+                stiffness: if below.is_none() { spring } else { 0.0 },
+                damping: if to_ground { alpha * m } else { 0.0 }
+                    + if below.is_none() { beta * k } else { 0.0 },
+            });
+            if let Some(b) = below {
+                let slab_damper = if !to_ground && i == 0 { alpha * m } else { 0.0 };
+                parts.couplings.push(Coupling {
+                    a: b,
+                    b: first + i,
+                    stiffness: spring,
+                    damping: beta * k + slab_damper,
+                });
+            }
+            if let (Some(base), true) = (placement.base, i > 0) {
+                parts.couplings.push(Coupling {
+                    a: base,
+                    b: first + i,
+                    stiffness: 0.0,
+                    damping: alpha * m,
+                });
+            }
+        }
+        Ok(())
     }
 }
