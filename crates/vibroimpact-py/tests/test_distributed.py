@@ -102,7 +102,7 @@ def test_missing_scheduler_is_a_clear_error():
 
 
 def test_ida_of_a_pounding_pair_is_the_same_on_the_cluster(client):
-    """Incremental dynamic analysis (records × scales, one task each): the
+    """Incremental dynamic analysis (one task per record, its scales in it): the
     cluster's numbers are the local ones bit for bit; the peak impact force
     grows with the scale; the fragility fit of 'impact force above 1 MN'
     gives a median capacity inside the intensities run."""

@@ -176,9 +176,10 @@ def ensemble(
     return [Result(d) for d in _gather(futures, progress, len(futures))]
 
 
-def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
-    """One record × scale: the row and the record's run (``vibroimpact
-    pounding``'s ``row`` and ``runs[0]``)."""
+def _pounding_task(text: str, source: str, record, scales, run: tuple):
+    """One record at every scale (one Dask task per record: its scheduling
+    cost paid once, not once per scale): per scale the row and the
+    record's run (``vibroimpact pounding``'s ``row`` and ``runs[0]``)."""
     from . import _core
     from ._checks import _floats
 
@@ -188,10 +189,14 @@ def _pounding_task(text: str, source: str, record, scale: float, run: tuple):
     t = _floats(times, "times", allow_scalar=False)
     a = _floats(acc, "acceleration", allow_scalar=False)
     sample, rtol, method, integrator = run
-    doc = _core.pounding(
-        text, source, [(name, header, units, t, a)], scale, sample, rtol, method, integrator, True
-    )
-    return {"row": dict(doc["row"]), **dict(doc["runs"][0])}
+    out = []
+    for scale in scales:
+        doc = _core.pounding(
+            text, source, [(name, header, units, t, a)], float(scale), sample, rtol, method,
+            integrator, True,
+        )
+        out.append({"row": dict(doc["row"]), **dict(doc["runs"][0])})
+    return out
 
 
 def ida(
@@ -209,8 +214,9 @@ def ida(
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Result:
     """Incremental dynamic analysis of a pounding pair (docs/earthquakes.md):
-    every record × every scale factor, one Dask task each with ``client``
-    (else here, one after the other; the same numbers either way). The
+    every record × every scale factor, one Dask task per record (its
+    scales inside) with ``client`` (else here, one after the other; the
+    same numbers either way); ``progress(done, total)`` counts records. The
     intensity is the scaled record's pseudo-spectral acceleration Sa(T1) at
     the first (left) building's fundamental period and ``damping``. ``sample``,
     ``rtol``, ``method`` and ``integrator`` as :func:`vibroimpact.pounding`
@@ -242,19 +248,21 @@ def ida(
     jobs = [(i, float(s)) for i in range(len(recs)) for s in scales]
     arrays = _record_inputs(recs, None)
     if client is None:
-        results = []
-        for k, (i, s) in enumerate(jobs):
-            results.append(_pounding_task(text, source, arrays[i], s, run))
+        per_record = []
+        for k, a in enumerate(arrays):
+            per_record.append(_pounding_task(text, source, a, scales, run))
             if progress is not None:
-                progress(k + 1, len(jobs))
+                progress(k + 1, len(arrays))
     else:
-        # Each record goes to the cluster once, not once per scale.
-        shipped = client.scatter(arrays)
+        # One task per record (its scales inside): the record goes to the
+        # cluster once, and a task's scheduling is paid once per record.
+        shipped = client.scatter(arrays, hash=False)
         futures = [
-            client.submit(_pounding_task, text, source, shipped[i], s, run, retries=retries, pure=False)
-            for i, s in jobs
+            client.submit(_pounding_task, text, source, r, scales, run, retries=retries, pure=False)
+            for r in shipped
         ]
-        results = _gather(futures, progress, len(futures))
+        per_record = _gather(futures, progress, len(futures))
+    results = [res for runs in per_record for res in runs]
     period = float(results[0]["row"]["buildings"][0]["period"])
     sa_unit = [
         float(response_spectrum(r, [period], damping=damping)["pseudo_acceleration"][0])
