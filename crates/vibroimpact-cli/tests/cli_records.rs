@@ -126,6 +126,15 @@ fn pounding_of_two_frames() {
     ]);
     let run = &doc["runs"][0];
     assert_eq!(run["record"]["units"], "m/s2");
+    // Rayleigh damping is stated: 5 % in modes 1 and 2, on the initial
+    // stiffness.
+    let rayleigh = &doc["row"]["buildings"][0]["rayleigh"];
+    assert_eq!(rayleigh["ratio"], 0.05);
+    assert!(rayleigh["alpha"].as_f64().unwrap() > 0.0 && rayleigh["beta"].as_f64().unwrap() > 0.0);
+    assert!(rayleigh["basis"]
+        .as_str()
+        .unwrap()
+        .contains("initial stiffness"));
     let need = run["joints"][0]["required_gap"].as_f64().unwrap();
     assert!(need > 0.02, "{need}");
     assert!(run["pounding"]["impacts"].as_u64().unwrap() > 0);

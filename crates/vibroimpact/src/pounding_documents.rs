@@ -10,18 +10,27 @@ use super::{quantile, MoatCell, Outcome, PoundingResult, Response, Row, Spectrum
 use crate::hysteresis::StoreyLaw;
 use crate::record::Record;
 
-/// The row: each building's name, fundamental period, floors and whether
-/// it is isolated; each joint's two buildings, gap and pounding floors.
+/// The row: each building's name, fundamental period, floors, whether it
+/// is isolated and its Rayleigh damping (ratio, α, β, on the initial
+/// stiffness in the fixed-base modes 1 and 2); each joint's two
+/// buildings, gap and pounding floors.
 pub fn row_document(row: &Row) -> Value {
     let buildings: Vec<Value> = row
         .buildings
         .iter()
         .map(|b| {
+            let (alpha, beta) = b.frame.rayleigh();
             json!({
                 "name": b.name,
                 "period": b.period(),
                 "floors": b.floors(),
                 "isolated": b.isolation.is_some(),
+                "rayleigh": {
+                    "ratio": b.frame.damping_ratio,
+                    "alpha": alpha,
+                    "beta": beta,
+                    "basis": "initial stiffness, fixed-base modes 1 and 2",
+                },
             })
         })
         .collect();

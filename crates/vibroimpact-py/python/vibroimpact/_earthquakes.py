@@ -231,8 +231,8 @@ def pounding(
     and once without contacts).
 
     Returns the CLI's document: ``row`` (``buildings``: ``name``,
-    ``period``, ``floors``, ``isolated``; ``joints``: ``between``, ``gap``,
-    ``floors``) and ``runs``, one per record, each with ``record``,
+    ``period``, ``floors``, ``isolated``, ``rayleigh``; ``joints``:
+    ``between``, ``gap``, ``floors``) and ``runs``, one per record, each with ``record``,
     ``pounding`` and ``free`` (per building name: ``peak_drift``,
     ``residual_drift``, ``ductility``, ``hysteretic_energy``,
     ``peak_floor_acceleration``, ``peak_displacement``; ``isolators`` per
