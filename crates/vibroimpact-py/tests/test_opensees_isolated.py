@@ -75,18 +75,21 @@ def test_the_isolated_building_agrees_with_opensees_at_its_converged_step(northr
 
 
 def test_our_fast_setting_agrees_with_converged_opensees(northridge):
-    # The speed study's picks (isolated_peer.py): with the linear moat law
-    # DOPRI5 at rtol 1e-3, drifts sampled at the record's step; with
-    # Hertz-damp DOP853 at rtol 1e-7 (Lankarani-Nikravesh needs it,
-    # ISOLATED.md). Within 1 % of OpenSees at dt_rec/16 (its residual
-    # drifts over u_y; measured: 9.5e-3 linear, 2.3e-3 Hertz-damp, the
-    # linear one's peak drifts sampled at dt_rec being the largest).
+    # Fast settings of the speed study (isolated_peer.py): Hertz-damp
+    # DOP853 at rtol 1e-7, drifts sampled at the record's step (its pick;
+    # Lankarani-Nikravesh needs the tight rtol, ISOLATED.md); linear DOPRI5
+    # at rtol 1e-4 sampled at dt_rec/2 (its pick samples at dt_rec, 7.7e-3
+    # from the reference but 1.3e-2 from OpenSees at dt_rec/8: the peak
+    # drifts sampled at the record's step are low by up to 0.8 %). Within
+    # 1 % of OpenSees at its converged step dt_rec/8 (drifts, slab, force
+    # relative; residual drifts over u_y). Measured: 3.8e-3 Hertz-damp,
+    # 6.5e-3 linear (both the residual drifts).
     dt = northridge["dt"]
-    for name, settings in (("linear", dict(method="dopri5", rtol=1e-3)),
-                           ("hertzdamp", dict(method="dop853", rtol=1e-7))):
+    for name, settings in (("hertzdamp", dict(method="dop853", rtol=1e-7, sample=dt)),
+                           ("linear", dict(method="dopri5", rtol=1e-4, sample=dt / 2))):
         building, text = case_with(LAWS[name])
-        fast = peaks_of_ours(vi.pounding(text, northridge, scale=SCALE, sample=dt, free=False, **settings))
-        e = errors(fast, _opensees(building, northridge, 16), yield_drifts(building))
+        fast = peaks_of_ours(vi.pounding(text, northridge, scale=SCALE, free=False, **settings))
+        e = errors(fast, _opensees(building, northridge, 8), yield_drifts(building))
         assert e["error"] < 0.01, (name, e)
 
 
