@@ -7,12 +7,15 @@
 //!
 //! A run collapses when a storey drift passes the drift limit (the run
 //! stops there), when an isolator passes its stated capacity (if the
-//! criterion says so), or when it fails to integrate (a step that fails,
-//! the step limit: non-convergence counts as collapse, as FEMA P695 has
-//! it). The scales follow a geometric hunt from `first` by `growth` up to
-//! `max_scale`; between the last scale survived and the first that
-//! collapsed, bisection (geometric midpoints) until their ratio is within
-//! `1 + tolerance`. The collapse scale is the bracket's upper end.
+//! criterion says so), or when it does not converge (a step size that
+//! underflows, the step limit: non-convergence counts as collapse, as FEMA
+//! P695 has it; an explicit method's stiffness or a run without progress
+//! depend on the method and stay errors). The scales follow a geometric
+//! hunt from `first` by `growth` up to `max_scale` (down by `growth` from
+//! `first` if that collapses already); between the last scale survived and
+//! the first that collapsed, bisection (geometric midpoints) until their
+//! ratio is within `1 + tolerance`. The collapse scale is the bracket's
+//! upper end.
 //!
 //! The intensity of FEMA P695 is the record set's median spectral
 //! acceleration S_T at the period: a record set scaled as one by a factor
@@ -20,7 +23,7 @@
 //! median(cᵢ) S_T. The faces compute S_T (the response spectra of the
 //! records as given, normalized as the set requires) and the margins.
 
-use crate::pounding::{PoundingError, Row, RunSettings};
+use crate::pounding::{PoundingError, Row, RunSettings, Stop};
 use crate::record::Record;
 
 /// When a run counts as a collapse.
@@ -104,7 +107,8 @@ impl Verdict {
 pub struct IdaPoint {
     /// The scale.
     pub scale: f64,
-    /// The largest storey drift over the buildings (m; up to the stop).
+    /// The largest storey drift over the buildings (m; up to the stop, or
+    /// up to where a run that did not converge ended).
     pub max_drift: f64,
     /// The verdict.
     pub verdict: Verdict,
@@ -118,7 +122,7 @@ pub struct RecordIda {
     /// The runs in the order made.
     pub points: Vec<IdaPoint>,
     /// The largest scale survived below the collapse (the bracket's lower
-    /// end; the largest scale run if censored, 0 if the first collapsed).
+    /// end; the largest scale run if censored).
     pub survived: f64,
     /// The collapse scale (the bracket's upper end), or None: no collapse
     /// up to `survived`.
@@ -166,18 +170,7 @@ impl Criterion {
         scale: f64,
         run: &RunSettings,
     ) -> Result<IdaPoint, PoundingError> {
-        let (r, passed) =
-            match row.respond_until(record, scale, self.contacts, run, Some(self.drift)) {
-                Ok(out) => out,
-                Err(PoundingError::Diverged { message, .. }) => {
-                    return Ok(IdaPoint {
-                        scale,
-                        max_drift: f64::NAN,
-                        verdict: Verdict::Diverged { message },
-                    })
-                }
-                Err(e) => return Err(e),
-            };
+        let (r, stop) = row.respond_until(record, scale, self.contacts, run, Some(self.drift))?;
         let mut worst = (0.0f64, 0, 0);
         for (k, drifts) in r.drift.iter().enumerate() {
             for (i, &d) in drifts.iter().enumerate() {
@@ -192,14 +185,15 @@ impl Criterion {
             .iter()
             .enumerate()
             .find_map(|(k, i)| i.filter(|i| i.beyond_capacity).map(|i| (k, i)));
-        let verdict = match (passed, beyond) {
-            (Some(time), _) => Verdict::Drift {
+        let verdict = match (stop, beyond) {
+            (Stop::Diverged { message }, _) => Verdict::Diverged { message },
+            (Stop::Limit { time }, _) => Verdict::Drift {
                 building: name(worst.1),
                 storey: worst.2 + 1,
                 drift: worst.0,
                 time,
             },
-            (None, Some((k, i))) if self.capacity => Verdict::Capacity {
+            (Stop::End, Some((k, i))) if self.capacity => Verdict::Capacity {
                 building: name(k),
                 displacement: i.peak_displacement,
             },
@@ -246,19 +240,29 @@ pub fn record_ida(
     }
     if let Some(mut high) = collapse {
         let mut low = survived;
-        // Bisection from the first scale down to zero is geometric from
-        // first/growth.
-        if low == 0.0 {
-            low = high / ida.growth;
-            let p = criterion.run(row, record, low, run)?;
+        // The first scale collapsed: down by the growth factor until a
+        // scale stands (a model that falls at every scale down to 1e-6 of
+        // the first is an error, not a collapse intensity).
+        while low == 0.0 {
+            let scale = high / ida.growth;
+            if scale < 1e-6 * ida.first {
+                return Err(PoundingError::Run {
+                    record: record.source.clone(),
+                    message: format!(
+                        "collapses at every scale down to {high:e}: check the model and the drift limit"
+                    ),
+                });
+            }
+            let p = criterion.run(row, record, scale, run)?;
             let fell = p.verdict.collapsed();
             points.push(p);
             if fell {
-                high = low;
-                low = 0.0;
+                high = scale;
+            } else {
+                low = scale;
             }
         }
-        while low > 0.0 && high / low > 1.0 + ida.tolerance {
+        while high / low > 1.0 + ida.tolerance {
             let mid = (low * high).sqrt();
             let p = criterion.run(row, record, mid, run)?;
             if p.verdict.collapsed() {

@@ -19,7 +19,7 @@
 
 use crate::contact::ContactLaw;
 use crate::field_error::FieldError;
-use crate::integrate::Method;
+use crate::integrate::{IntegrationError, Method};
 use crate::model::{Accelerogram, BaseExcitation, Contact, ContactPair, Model};
 use crate::record::Record;
 use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
@@ -125,6 +125,24 @@ pub struct StoreyLoop {
     pub drift: Vec<f64>,
     /// Force (N).
     pub force: Vec<f64>,
+}
+
+/// Why a run ([`Row::respond_until`]) ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    /// At the end of the record (and its tail).
+    End,
+    /// A storey drift passed the limit at `time` (s).
+    Limit {
+        /// When.
+        time: f64,
+    },
+    /// The run did not converge (a step size that underflowed, the step
+    /// limit).
+    Diverged {
+        /// Why.
+        message: String,
+    },
 }
 
 /// A row's time history ([`Row::history`]).
@@ -456,7 +474,8 @@ impl Row {
     /// The peak response to `record` × `scale` over its duration, with the
     /// contacts or without (`contacts`): drifts, floor accelerations and
     /// displacements sampled as `run` says, impact forces the impact log's
-    /// exact peaks.
+    /// exact peaks. A run that does not converge is
+    /// [`PoundingError::Diverged`].
     pub fn respond(
         &self,
         record: &Record,
@@ -464,13 +483,22 @@ impl Row {
         contacts: bool,
         run: &RunSettings,
     ) -> Result<Response, PoundingError> {
-        self.respond_until(record, scale, contacts, run, None)
-            .map(|(r, _)| r)
+        match self.respond_until(record, scale, contacts, run, None)? {
+            (r, Stop::End | Stop::Limit { .. }) => Ok(r),
+            (_, Stop::Diverged { message }) => Err(PoundingError::Diverged {
+                record: record.source.clone(),
+                scale,
+                message,
+            }),
+        }
     }
 
     /// [`Row::respond`], stopped as soon as a storey drift passes `limit`
-    /// (if given): the response up to then, and the time it passed. A run
-    /// that fails to integrate is [`PoundingError::Diverged`].
+    /// (if given), and kept (not an error) where the run does not
+    /// converge: the response up to the stop, and why it stopped. Not
+    /// converging is a step size that underflows or the step limit; the
+    /// other early ends (an explicit method's stiffness, no progress) depend
+    /// on the method, not the structure, and stay errors.
     pub fn respond_until(
         &self,
         record: &Record,
@@ -478,7 +506,7 @@ impl Row {
         contacts: bool,
         run: &RunSettings,
         limit: Option<f64>,
-    ) -> Result<(Response, Option<f64>), PoundingError> {
+    ) -> Result<(Response, Stop), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
             accelerations: true,
@@ -496,14 +524,18 @@ impl Row {
             passed.is_none()
         })
         .map_err(|e| PoundingError::run(record, e.0))?;
-        match (&sim.error, passed) {
-            (Some(_), Some(_)) | (None, _) => Ok((peaks.finish(self, &rm, &sim), passed)),
-            (Some(e), None) => Err(PoundingError::Diverged {
-                record: record.source.clone(),
-                scale,
-                message: e.to_string(),
-            }),
-        }
+        let stop = match (&sim.error, passed) {
+            (_, Some(time)) => Stop::Limit { time },
+            (None, None) => Stop::End,
+            (Some(e), None) => match e.source {
+                IntegrationError::StepSizeUnderflow { .. }
+                | IntegrationError::TooManySteps { .. } => Stop::Diverged {
+                    message: e.to_string(),
+                },
+                _ => return Err(PoundingError::run(record, e)),
+            },
+        };
+        Ok((peaks.finish(self, &rm, &sim), stop))
     }
 
     /// The time history of the row with its contacts under `record` ×

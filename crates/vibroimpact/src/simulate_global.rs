@@ -4,7 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
-use super::switches::{Switches, Verdict};
+use super::switches::{Event, Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -77,7 +77,8 @@ pub fn simulate_streaming(
         }
         _ => None,
     };
-    let mut switches = Switches::new(&sys, y0.len());
+    let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
+    let mut switches = Switches::new(&sys, y0.len(), s_on);
     let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
@@ -85,7 +86,17 @@ pub fn simulate_streaming(
         }
         let mut bound = breakpoints.get(next_break).copied().unwrap_or(opts.t_end);
         if let Some(sw) = switches.as_mut() {
-            bound = sw.before_step(&st, bound);
+            match sw.before_step(&st, bound) {
+                Ok(b) => bound = b,
+                // An event located at the step's start: applied there.
+                Err(event) => {
+                    if let Err(e) = apply_event(&mut st, &mut sys, event) {
+                        error = Some(e);
+                        break;
+                    }
+                    continue;
+                }
+            }
         }
         if let Err(e) = st.step(&mut sys, bound) {
             error = Some(e);
@@ -132,12 +143,11 @@ pub fn simulate_streaming(
             }
         }
         sink_stopped = output.samples(&mut st, &mut sys);
-        // A bilinear storey's branch switches where the step ended; the
-        // right-hand side changes there, so the stepper restarts.
-        if let Some(k) = switch_here {
-            let (t, y) = (st.t(), st.y().to_vec());
-            sys.storeys_mut().switch(k, &y);
-            if let Err(e) = st.reset(&mut sys, t, &y) {
+        // A bilinear storey's branch switches, or a contact's impact
+        // velocity is set, where the step ended; the right-hand side
+        // changes there, so the stepper restarts.
+        if let Some(event) = switch_here {
+            if let Err(e) = apply_event(&mut st, &mut sys, event) {
                 error = Some(e);
                 break;
             }
@@ -156,6 +166,25 @@ pub fn simulate_streaming(
         error,
         extrema,
     ))
+}
+
+/// Applies `event` at the stepper's point (a storey's branch switch, or a
+/// contact's impact velocity) and restarts the stepper there (the
+/// right-hand side changed).
+fn apply_event(
+    st: &mut Stepper,
+    sys: &mut ChainDynamics,
+    event: Event,
+) -> Result<(), IntegrationError> {
+    let (t, y) = (st.t(), st.y().to_vec());
+    match event {
+        Event::Storey(k) => sys.storeys_mut().switch(k, &y),
+        Event::Onset(k) => {
+            let (_, sd) = sys.approach(k, &y);
+            sys.set_onset_velocity(k, sd);
+        }
+    }
+    st.reset(sys, t, &y)
 }
 
 /// The checks of a run beyond the options' own: the output samples within

@@ -1,39 +1,70 @@
-//! The branch switches of bilinear storeys on a run's steps (docs/theory.md
-//! §11): within a step a bilinear storey's force is linear in its drift;
-//! where its switch function (yield, unloading) vanishes inside a step, the
-//! step is taken again up to that time, and the branch switches there.
+//! The events that change a run's right-hand side inside a step, located
+//! on the step's dense output: the branch switches of bilinear storeys
+//! (docs/theory.md §11: within a step a bilinear storey's force is linear
+//! in its drift; its switch function is yield or unloading), and the onset
+//! of a contact whose law needs its impact velocity (Lankarani–Nikravesh:
+//! the step that crosses the onset must not be taken with the previous
+//! impact's velocity). Where one happens inside a step, the step is taken
+//! again up to that time, and the event is applied there.
 
 use super::ChainDynamics;
 use crate::integrate::{IntegrationError, Stepper};
 use crate::numeric::brent;
 
-/// What a step's check found.
-pub(super) enum Verdict {
-    /// No switch in the step.
-    Clear,
-    /// A switch inside the step: the stepper is back at the step's start,
-    /// and the next steps end at the switch ([`Switches::bound`]).
-    Retake,
-    /// The step ended at storey k's switch.
-    Switch(usize),
+/// An event that changes the right-hand side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Event {
+    /// Bilinear storey k's branch switch.
+    Storey(usize),
+    /// Contact k reaches its onset approach: its impact velocity is set
+    /// there.
+    Onset(usize),
 }
 
-/// The switches of a run's bilinear storeys.
+/// What a step's check found.
+pub(super) enum Verdict {
+    /// No event in the step.
+    Clear,
+    /// An event inside the step: the stepper is back at the step's start,
+    /// and the next steps end at the event ([`Switches::before_step`]).
+    Retake,
+    /// The step ended at this event.
+    Switch(Event),
+}
+
+/// The events of a run: its bilinear storeys and the onsets of its
+/// contacts whose laws need the impact velocity.
 pub(super) struct Switches {
-    storeys: Vec<usize>,
+    events: Vec<Event>,
+    /// Per event, whether it can fire: an onset fires once per impact
+    /// (disarmed when applied, armed again once its contact is open at a
+    /// step's end).
+    armed: Vec<bool>,
+    /// Per contact, its onset approach s_on.
+    s_on: Vec<f64>,
     t_prev: f64,
     y_prev: Vec<f64>,
     buf: Vec<f64>,
-    /// The next switch's time and storey, once located.
-    pending: Option<(f64, usize)>,
+    /// The next event's time, once located.
+    pending: Option<(f64, Event)>,
 }
 
 impl Switches {
-    /// None for a model without bilinear storeys.
-    pub(super) fn new(sys: &ChainDynamics, dim: usize) -> Option<Self> {
-        let storeys: Vec<usize> = sys.storeys().bilinear().collect();
-        (!storeys.is_empty()).then(|| Self {
-            storeys,
+    /// None for a model without such events; `s_on` per contact.
+    pub(super) fn new(sys: &ChainDynamics, dim: usize, s_on: Vec<f64>) -> Option<Self> {
+        let onsets = (0..s_on.len())
+            .filter(|&k| sys.contact_law(k).needs_impact_velocity())
+            .map(Event::Onset);
+        let events: Vec<Event> = sys
+            .storeys()
+            .bilinear()
+            .map(Event::Storey)
+            .chain(onsets)
+            .collect();
+        (!events.is_empty()).then(|| Self {
+            armed: vec![true; events.len()],
+            events,
+            s_on,
             t_prev: 0.0,
             y_prev: vec![0.0; dim],
             buf: vec![0.0; dim],
@@ -42,14 +73,39 @@ impl Switches {
     }
 
     /// Keeps the state a step starts from; the step's `bound`, shortened to
-    /// a located switch.
-    pub(super) fn before_step(&mut self, st: &Stepper, bound: f64) -> f64 {
+    /// a located event; or the event itself where it is located at the
+    /// step's start (rounding: apply it there, no step).
+    pub(super) fn before_step(&mut self, st: &Stepper, bound: f64) -> Result<f64, Event> {
         self.t_prev = st.t();
         self.y_prev.copy_from_slice(st.y());
-        self.pending.map_or(bound, |(t, _)| bound.min(t))
+        match self.pending {
+            Some((t, e)) if t <= st.t() => {
+                self.pending = None;
+                self.disarm(e);
+                Err(e)
+            }
+            Some((t, _)) => Ok(bound.min(t)),
+            None => Ok(bound),
+        }
     }
 
-    /// Checks the step just taken for switches (at its end and at three
+    /// Marks `e` applied: an onset waits for its contact to open again.
+    fn disarm(&mut self, e: Event) {
+        if let (Event::Onset(_), Some(i)) = (e, self.events.iter().position(|x| *x == e)) {
+            self.armed[i] = false;
+        }
+    }
+
+    /// The event's function in the state `y`: positive before it, zero at
+    /// it (a contact's: s_on − s, positive while the contact is open).
+    fn value(&self, sys: &ChainDynamics, e: Event, y: &[f64]) -> f64 {
+        match e {
+            Event::Storey(k) => sys.storeys().switch_value(k, y),
+            Event::Onset(k) => self.s_on[k] - sys.approach(k, y).0,
+        }
+    }
+
+    /// Checks the step just taken for events (at its end and at three
     /// points inside on the dense output, located by Brent).
     pub(super) fn after_step(
         &mut self,
@@ -57,22 +113,30 @@ impl Switches {
         sys: &mut ChainDynamics,
     ) -> Result<Verdict, IntegrationError> {
         let (t0, t1) = (self.t_prev, st.t());
-        if let Some((t, k)) = self.pending {
+        if let Some((t, e)) = self.pending {
             if t1 >= t {
                 self.pending = None;
-                return Ok(Verdict::Switch(k));
+                self.disarm(e);
+                return Ok(Verdict::Switch(e));
             }
         }
-        let mut first: Option<(f64, usize)> = None;
-        for &k in &self.storeys {
-            let g0 = sys.storeys().switch_value(k, &self.y_prev);
-            if g0 <= 0.0 {
+        // An onset is armed again once its contact is open at a step's end.
+        for i in 0..self.events.len() {
+            if !self.armed[i] && self.value(sys, self.events[i], st.y()) > 0.0 {
+                self.armed[i] = true;
+            }
+        }
+        let mut first: Option<(f64, Event)> = None;
+        for (i, &e) in self.events.iter().enumerate() {
+            let g0 = self.value(sys, e, &self.y_prev);
+            if g0 <= 0.0 || !self.armed[i] {
                 continue;
             }
-            let g_end = sys.storeys().switch_value(k, st.y());
+            let g_end = self.value(sys, e, st.y());
+            let mut buf = std::mem::take(&mut self.buf);
             let mut g = |t: f64, buf: &mut Vec<f64>| {
                 st.dense_output(sys, t, buf);
-                sys.storeys().switch_value(k, buf)
+                self.value(sys, e, buf)
             };
             let (mut ta, mut ga) = (t0, g0);
             for j in 1..=4 {
@@ -81,24 +145,27 @@ impl Switches {
                 } else {
                     t0 + (t1 - t0) * j as f64 / 4.0
                 };
-                let gb = if j == 4 { g_end } else { g(tb, &mut self.buf) };
+                let gb = if j == 4 { g_end } else { g(tb, &mut buf) };
                 if gb <= 0.0 {
-                    let mut buf = std::mem::take(&mut self.buf);
                     let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
-                    let root = brent(|t| g(t, &mut buf), ta, tb, ga, gb, xtol, 200);
-                    self.buf = buf;
+                    let mut inner = vec![0.0; buf.len()];
+                    let root = brent(|t| g(t, &mut inner), ta, tb, ga, gb, xtol, 200);
                     let t = root.unwrap_or(tb);
                     if first.is_none_or(|(tf, _)| t < tf) {
-                        first = Some((t, k));
+                        first = Some((t, e));
                     }
                     break;
                 }
                 (ta, ga) = (tb, gb);
             }
+            self.buf = buf;
         }
         match first {
             None => Ok(Verdict::Clear),
-            Some((t, k)) if t >= t1 => Ok(Verdict::Switch(k)),
+            Some((t, e)) if t >= t1 => {
+                self.disarm(e);
+                Ok(Verdict::Switch(e))
+            }
             Some(found) => {
                 self.pending = Some(found);
                 st.reset(sys, t0, &self.y_prev)?;
