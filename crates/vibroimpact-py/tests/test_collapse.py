@@ -26,6 +26,10 @@ def test_median_with_and_without_censored_records():
         collapse.median_collapse(x, censored=cens6)
     with pytest.raises(ValueError, match="censored: 3 flags for 10"):
         collapse.median_collapse(x, censored=[True] * 3)
+    # A record censored below the median (no collapse up to 1.5 only)
+    # could collapse anywhere above 1.5: the median is not determined.
+    with pytest.raises(ValueError, match="censored below the median 3 .record 2: no collapse up to 1.5"):
+        collapse.median_collapse([1.0, 1.5, 3.0], censored=[False, True, False])
 
 
 def test_fragility_closed_form_and_censored_fit():

@@ -134,3 +134,27 @@ fn censored_records_and_the_median() {
     .unwrap_err();
     assert!(e.to_string().contains("growth"), "{e}");
 }
+
+/// A first scale that collapses already: the IDA goes down by the growth
+/// factor until a scale stands, then bisects: the same bracket of 1.9 to
+/// the tolerance.
+#[test]
+fn a_first_scale_that_collapses_goes_down() {
+    let criterion = Criterion {
+        drift: LIMIT,
+        capacity: true,
+        contacts: true,
+    };
+    let ida = IdaSettings {
+        first: 10.0,
+        ..IdaSettings::default()
+    };
+    let run = RunSettings::new(0.002, 1e-10);
+    let r = record_ida(&epp(), &step(), &criterion, &ida, &run).unwrap();
+    let c = r.collapse.unwrap();
+    assert!(
+        r.survived <= 1.9 && 1.9 <= c && c / r.survived <= 1.02,
+        "{r:?}"
+    );
+    assert!(r.points[0].verdict.collapsed() && r.points[0].scale == 10.0);
+}

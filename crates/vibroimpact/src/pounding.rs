@@ -89,7 +89,8 @@ pub struct Response {
     pub drift: Vec<Vec<f64>>,
     /// Residual storey drifts (m, signed): the mean drift over each
     /// building's last fundamental period (of the free-vibration tail that
-    /// follows the record for yielding storeys).
+    /// follows the record for yielding storeys); NaN for a run stopped
+    /// before that period.
     pub residual_drift: Vec<Vec<f64>>,
     /// Peak absolute floor accelerations max |ü_i + a_g| over the samples
     /// (m/s²).
@@ -222,7 +223,13 @@ pub fn correlation(r: f64, zi: f64, zj: f64) -> f64 {
     let den = (1.0 - r * r).powi(2)
         + 4.0 * zi * zj * r * (1.0 + r * r)
         + 4.0 * (zi * zi + zj * zj) * r * r;
-    num / den
+    // Two undamped oscillators of one frequency move alike: ρ = 1 (the
+    // formula is 0/0 there).
+    if den == 0.0 {
+        1.0
+    } else {
+        num / den
+    }
 }
 
 /// A row's model with where each building's bodies, storeys and contacts
@@ -302,6 +309,17 @@ impl Row {
             let top = self.buildings[j]
                 .floors()
                 .min(self.buildings[j + 1].floors());
+            if let Some(f) = joint
+                .floors
+                .iter()
+                .enumerate()
+                .find_map(|(i, f)| joint.floors[..i].contains(f).then_some(f))
+            {
+                return Err(pair(
+                    "floors",
+                    format!("{what}floors: floor {f} is given twice"),
+                ));
+            }
             if let Some(f) = joint.floors.iter().find(|f| **f == 0 || **f > top) {
                 return Err(pair(
                     "floors",

@@ -1,8 +1,8 @@
 //! The moat-gap study of isolated buildings (docs/earthquakes.md): the row
 //! under an ensemble of records with every moat at each of a list of
-//! gaps, and once without contacts; per gap, over the records, the
-//! superstructure's peak drift and floor acceleration, the isolators'
-//! displacement and the moat impacts.
+//! gaps, and once without contacts; per gap, over the records, the peak
+//! drift and floor acceleration of the superstructures of the buildings
+//! with a moat, their isolators' displacement and the moat impacts.
 
 use super::{PoundingError, Response, Row, RunSettings};
 use crate::field_error::FieldError;
@@ -14,8 +14,8 @@ use crate::record::Record;
 pub struct MoatCell {
     /// The moat gap (m), or None for the buildings without contacts.
     pub gap: Option<f64>,
-    /// The largest storey drift of the isolated buildings' superstructures
-    /// (m).
+    /// The largest storey drift of the superstructures of the buildings
+    /// with a moat wall (m).
     pub drift: Vec<f64>,
     /// Their largest absolute floor acceleration (m/s²).
     pub acceleration: Vec<f64>,

@@ -146,10 +146,19 @@ impl Peaks {
         }
         let in_joints = |c: usize| rm.joints.iter().any(|j| j.contains(&c));
         let between = sim.impacts.iter().filter(|i| in_joints(i.contact));
+        // A run stopped before a building's window opened (a collapse
+        // study's drift limit) has no residual: NaN (null in documents).
+        let mean = |sum: f64, count: usize| {
+            if count == 0 {
+                f64::NAN
+            } else {
+                sum / count as f64
+            }
+        };
         let residual: Vec<Vec<f64>> = self
             .residual
             .iter()
-            .map(|(sum, count)| sum.iter().map(|s| s / (*count).max(1) as f64).collect())
+            .map(|(sum, count)| sum.iter().map(|s| mean(*s, *count)).collect())
             .collect();
         let isolators = rm
             .placements
@@ -166,7 +175,7 @@ impl Peaks {
                 let (peak, sum) = self.slab[k];
                 Some(IsolatorResponse {
                     peak_displacement: peak,
-                    residual_displacement: sum / self.residual[k].1.max(1) as f64,
+                    residual_displacement: mean(sum, self.residual[k].1),
                     hysteretic_energy: bearing_energy[k],
                     beyond_capacity: iso.capacity.is_some_and(|c| peak > c),
                     moat_impacts: moat.len(),

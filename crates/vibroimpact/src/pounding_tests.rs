@@ -140,6 +140,8 @@ fn required_gap_and_code_rules() {
     let j = r.joints[0];
     assert!(j.required_gap.abs() < 1e-12, "{}", j.required_gap);
     assert!((j.code_gaps.correlation - 1.0).abs() < 1e-12);
+    // Undamped and of one frequency: ρ = 1, not 0/0.
+    assert_eq!(correlation(1.0, 0.0, 0.0), 1.0);
     assert!(j.code_gaps.double_difference < 1e-9);
 }
 
@@ -233,6 +235,13 @@ fn bad_pairs_are_refused() {
             "floor 2 is not a floor of both",
         ),
         (with(&|r| r.joints[0].gap = -1.0), "gap -1"),
+        (
+            with(&|r| {
+                r.buildings[1].frame = frame(2, 1e5, 1e7);
+                r.joints[0].floors = vec![1, 2, 1];
+            }),
+            "floors: floor 1 is given twice",
+        ),
         (with(&|r| r.joints[0].floors = vec![]), "at least one"),
         (
             with(&|r| r.buildings[0].frame.stiffnesses = vec![1e7]),

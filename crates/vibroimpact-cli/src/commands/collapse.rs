@@ -35,7 +35,7 @@ pub struct CollapseArgs {
     #[arg(long)]
     drift_limit: f64,
     /// The period T (s) of the intensity S_T (the records' median spectral
-    /// acceleration there).
+    /// acceleration there, as FEMA P695's S_NRT: their geometric mean).
     #[arg(long)]
     period: Option<f64>,
     /// The damping ratio of that spectral acceleration.

