@@ -168,7 +168,7 @@ def test_the_inelastic_pair_agrees_with_converged_opensees(northridge):
     # they are 0.2 to 1.5 yield drifts, so relative to themselves too).
     # Measured: tight (rtol 1e-8, sample dt_rec/16) force 1.0e-4, drift
     # 1.7e-4, residual 1.2e-3 of u_y (1.3e-3 of itself); fast (the study's
-    # pick, DOPRI5 rtol 1e-4, sample dt_rec) 5.8e-5, 1.1e-3, 1.4e-3 (1.1e-3).
+    # pick, DOPRI5 rtol 1e-3, sample dt_rec) 7.7e-5, 1.1e-3, 1.3e-3 (1.2e-3).
     text = INELASTIC_PAIR.read_text()
     pair = tomllib.loads(text)
     uy = yield_drifts(pair)
@@ -177,7 +177,7 @@ def test_the_inelastic_pair_agrees_with_converged_opensees(northridge):
     opensees = {m: run(pair, t, a, 1.0, dt / m) for m in (1, 16)}
     tight_doc = vi.pounding(text, northridge, sample=dt / 16, rtol=1e-8, free=False)
     tight = peaks_of_ours(tight_doc)
-    fast = peaks_of_ours(vi.pounding(text, northridge, sample=dt, rtol=1e-4, method="dopri5", free=False))
+    fast = peaks_of_ours(vi.pounding(text, northridge, sample=dt, rtol=1e-3, method="dopri5", free=False))
     # The pair is what the study needs: every storey yields (peak drift 2
     # to 5 yield drifts; measured 2.8 to 4.4) and the frames pound.
     ductility = np.concatenate([np.divide(d, y) for d, y in zip(tight["peak_drift"], uy)])
