@@ -45,6 +45,8 @@ pub(super) struct Switches {
     t_prev: f64,
     y_prev: Vec<f64>,
     buf: Vec<f64>,
+    /// The states at the three inside points of the last step.
+    inside: [Vec<f64>; 3],
     /// The next event's time, once located.
     pending: Option<(f64, Event)>,
 }
@@ -68,6 +70,7 @@ impl Switches {
             t_prev: 0.0,
             y_prev: vec![0.0; dim],
             buf: vec![0.0; dim],
+            inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
             pending: None,
         })
     }
@@ -126,30 +129,47 @@ impl Switches {
                 self.armed[i] = true;
             }
         }
-        let mut first: Option<(f64, Event)> = None;
-        for (i, &e) in self.events.iter().enumerate() {
-            let g0 = self.value(sys, e, &self.y_prev);
-            if g0 <= 0.0 || !self.armed[i] {
-                continue;
+        // The three inside points' states, taken once for all the events
+        // (a dense output may cost stages of its own), and only if an
+        // event is live.
+        let live: Vec<usize> = (0..self.events.len())
+            .filter(|&i| self.armed[i] && self.value(sys, self.events[i], &self.y_prev) > 0.0)
+            .collect();
+        if live.is_empty() {
+            return Ok(Verdict::Clear);
+        }
+        let times: [f64; 4] = [1.0, 2.0, 3.0, 4.0].map(|j| {
+            if j == 4.0 {
+                t1
+            } else {
+                t0 + (t1 - t0) * j / 4.0
             }
-            let g_end = self.value(sys, e, st.y());
-            let mut buf = std::mem::take(&mut self.buf);
-            let mut g = |t: f64, buf: &mut Vec<f64>| {
-                st.dense_output(sys, t, buf);
-                self.value(sys, e, buf)
-            };
-            let (mut ta, mut ga) = (t0, g0);
-            for j in 1..=4 {
-                let tb = if j == 4 {
-                    t1
-                } else {
-                    t0 + (t1 - t0) * j as f64 / 4.0
-                };
-                let gb = if j == 4 { g_end } else { g(tb, &mut buf) };
+        });
+        for (k, t) in times[..3].iter().enumerate() {
+            st.dense_output(sys, *t, &mut self.inside[k]);
+        }
+        let mut first: Option<(f64, Event)> = None;
+        for i in live {
+            let e = self.events[i];
+            let (mut ta, mut ga) = (t0, self.value(sys, e, &self.y_prev));
+            for (j, &tb) in times.iter().enumerate() {
+                let gb = self.value(sys, e, if j == 3 { st.y() } else { &self.inside[j] });
                 if gb <= 0.0 {
                     let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
-                    let mut inner = vec![0.0; buf.len()];
-                    let root = brent(|t| g(t, &mut inner), ta, tb, ga, gb, xtol, 200);
+                    let mut buf = std::mem::take(&mut self.buf);
+                    let root = brent(
+                        |t| {
+                            st.dense_output(sys, t, &mut buf);
+                            self.value(sys, e, &buf)
+                        },
+                        ta,
+                        tb,
+                        ga,
+                        gb,
+                        xtol,
+                        200,
+                    );
+                    self.buf = buf;
                     let t = root.unwrap_or(tb);
                     if first.is_none_or(|(tf, _)| t < tf) {
                         first = Some((t, e));
@@ -158,7 +178,6 @@ impl Switches {
                 }
                 (ta, ga) = (tb, gb);
             }
-            self.buf = buf;
         }
         match first {
             None => Ok(Verdict::Clear),
