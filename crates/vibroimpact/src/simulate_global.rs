@@ -88,10 +88,14 @@ pub fn simulate_streaming(
         if let Some(sw) = switches.as_mut() {
             match sw.before_step(&st, bound) {
                 Ok(b) => bound = b,
-                // An event located at the step's start: applied there.
+                // An event located at the step's start: applied there
+                // (counted as a step: events alone cannot run forever).
                 Err(event) => {
-                    if let Err(e) = apply_event(&mut st, &mut sys, event) {
-                        error = Some(e);
+                    steps += 1;
+                    error = apply_event(&mut st, &mut sys, event)
+                        .err()
+                        .or_else(|| early_end(&st, method, opts, steps));
+                    if error.is_some() {
                         break;
                     }
                     continue;
@@ -109,7 +113,16 @@ pub fn simulate_streaming(
                     error = Some(e);
                     break;
                 }
-                Ok(Verdict::Retake) => continue,
+                // A step taken again counts: retakes alone cannot run
+                // forever.
+                Ok(Verdict::Retake) => {
+                    steps += 1;
+                    error = early_end(&st, method, opts, steps);
+                    if error.is_some() {
+                        break;
+                    }
+                    continue;
+                }
                 Ok(Verdict::Switch(k)) => switch_here = Some(k),
                 Ok(Verdict::Clear) => {}
             }

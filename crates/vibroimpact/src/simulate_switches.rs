@@ -92,6 +92,16 @@ impl Switches {
         }
     }
 
+    /// Arms again every onset whose contact is open at the end of a step
+    /// that is kept (not one about to be taken again).
+    fn rearm(&mut self, sys: &ChainDynamics, y: &[f64]) {
+        for i in 0..self.events.len() {
+            if !self.armed[i] && self.value(sys, self.events[i], y) > 0.0 {
+                self.armed[i] = true;
+            }
+        }
+    }
+
     /// Marks `e` applied: an onset waits for its contact to open again.
     fn disarm(&mut self, e: Event) {
         if let (Event::Onset(_), Some(i)) = (e, self.events.iter().position(|x| *x == e)) {
@@ -123,12 +133,6 @@ impl Switches {
                 return Ok(Verdict::Switch(e));
             }
         }
-        // An onset is armed again once its contact is open at a step's end.
-        for i in 0..self.events.len() {
-            if !self.armed[i] && self.value(sys, self.events[i], st.y()) > 0.0 {
-                self.armed[i] = true;
-            }
-        }
         // The three inside points' states, taken once for all the events
         // (a dense output may cost stages of its own), and only if an
         // event is live.
@@ -136,6 +140,7 @@ impl Switches {
             .filter(|&i| self.armed[i] && self.value(sys, self.events[i], &self.y_prev) > 0.0)
             .collect();
         if live.is_empty() {
+            self.rearm(sys, st.y());
             return Ok(Verdict::Clear);
         }
         let times: [f64; 4] = [1.0, 2.0, 3.0, 4.0].map(|j| {
@@ -180,7 +185,10 @@ impl Switches {
             }
         }
         match first {
-            None => Ok(Verdict::Clear),
+            None => {
+                self.rearm(sys, st.y());
+                Ok(Verdict::Clear)
+            }
             Some((t, e)) if t >= t1 => {
                 self.disarm(e);
                 Ok(Verdict::Switch(e))

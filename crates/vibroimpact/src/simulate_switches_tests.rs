@@ -440,3 +440,43 @@ fn lankarani_nikravesh_onset_is_an_event() {
         "{out_ref} / {v_in}"
     );
 }
+
+/// Events cannot run a simulation forever: under an absurd base
+/// acceleration (1e300 m/s²) a Lankarani–Nikravesh onset is found at the
+/// start of every retaken step; the retakes count as steps, so the run
+/// ends with an error instead of looping at t = 0 (found by the fuzz
+/// test).
+#[test]
+fn events_alone_cannot_loop_forever() {
+    use crate::contact::{ContactLaw, ForceForm};
+    use crate::model::{Contact, ContactPair};
+    let law =
+        ContactLaw::lankarani_nikravesh(2.75e9, 1.5, 0.65, 1e-3, ForceForm::Published).unwrap();
+    let body = |name: &str, m: f64, w: f64| Body::from_frequency(name, m, w, 0.05);
+    let model = Model::new(
+        vec![body("A", 2e5, 12.566), body("B", 3e5, 6.0)],
+        vec![],
+        vec![Contact {
+            pair: ContactPair::Bodies { left: 0, right: 1 },
+            clearance: 0.02,
+            law,
+        }],
+        BaseExcitation::Harmonic {
+            amplitude: 1.1e300,
+            frequency: 10.0,
+            phase: 0.5,
+        },
+        vec![],
+        vec![],
+        vec![],
+    )
+    .unwrap();
+    let opts = SimulationOptions {
+        t_end: 0.05,
+        max_steps: 20_000,
+        integrator: Integrator::Global,
+        ..SimulationOptions::default()
+    };
+    let sim = simulate(&model, &opts).unwrap();
+    assert!(sim.error.is_some(), "{:?}", sim.final_time);
+}
