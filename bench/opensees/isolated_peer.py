@@ -53,10 +53,8 @@ import json
 import os
 import platform
 import re
-import statistics
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -70,6 +68,7 @@ from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_isolated import load, run, yield_drifts  # noqa: E402
 from opensees_pair import import_opensees  # noqa: E402
+from timing import Watch, retime, timed  # noqa: E402
 
 CASE = HERE / "isolated-moat.toml"
 SCALE = 2.2
@@ -136,15 +135,6 @@ def shown(e):
     return "  ".join(f"{k} {v:.1e}" for k, v in e.items() if k != "error")
 
 
-def timed(f, repeats):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
-
-
 def busy():
     """Process ids of what makes the machine busy: a process that ``pgrep -f
     'pounding_peer|cargo|rustc|pytest'`` lists whose program or script (its
@@ -192,65 +182,6 @@ def wait_idle(limit=3600.0, settle=10.0, every=5.0):
     if seen:
         print(f"  (waited {waited:.0f} s for an idle machine: {sorted(seen)})", flush=True)
     return entry
-
-
-class Watch:
-    """Polls :func:`busy` every ``every`` seconds in a thread while the
-    study runs: the processes seen, and how many polls saw one."""
-
-    def __init__(self, every=2.0):
-        self.every, self.polls, self.busy_polls, self.seen = every, 0, 0, set()
-        self.stop = threading.Event()
-        self.thread = threading.Thread(target=self._poll, daemon=True)
-
-    def _poll(self):
-        while not self.stop.is_set():
-            pids = busy()
-            self.polls += 1
-            self.busy_polls += bool(pids)
-            self.seen.update(pids)
-            self.stop.wait(self.every)
-
-    def __enter__(self):
-        self.load_before = os.getloadavg()
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc):
-        self.stop.set()
-        self.thread.join()
-        self.load_after = os.getloadavg()
-
-    def report(self):
-        return {
-            "idle": self.busy_polls == 0,
-            "polls": self.polls,
-            "polls_busy": self.busy_polls,
-            "busy_pids": sorted(self.seen),
-            "load_before": self.load_before,
-            "load_after": self.load_after,
-        }
-
-
-def retime(opensees, ours, rounds, repeats):
-    """The two best settings timed again, alternating, in ``rounds`` rounds
-    of ``repeats`` runs each (medians); a round is idle when nothing busy
-    ran at its start, between the two sides or at its end: the ratio of the
-    medians over the idle rounds (None if none was) and over all."""
-    out = []
-    for _ in range(rounds):
-        seen = busy()
-        os_secs, _ = timed(opensees, repeats)
-        seen += busy()
-        our_secs, _ = timed(ours, repeats)
-        seen += busy()
-        out.append({"opensees": os_secs, "vibroimpact": our_secs, "idle": not seen})
-    idle = [r for r in out if r["idle"]]
-
-    def ratio(rows):
-        return statistics.median(r["opensees"] for r in rows) / statistics.median(r["vibroimpact"] for r in rows)
-
-    return {"rounds": out, "idle_rounds": len(idle), "ratio_idle": ratio(idle) if idle else None, "ratio_all": ratio(out)}
 
 
 def study(name, building, text, record, quick, waits):
@@ -355,6 +286,7 @@ def study(name, building, text, record, quick, waits):
                             **{k: best_ours[k] for k in ("sample", "rtol", "method", "integrator")}),
         3 if quick else 7,
         repeats,
+        busy,
     )
     print(f"best OpenSees {best_os['seconds'] * 1e3:.2f} ms ({ {k: best_os[k] for k in ('system', 'algorithm', 'tol', 'integrator', 'm')} }, "
           f"error {best_os['error']:.1e}); best vibroimpact {best_ours['seconds'] * 1e3:.2f} ms "
@@ -430,7 +362,7 @@ def main():
     print(f"record {record['source']}: {'; '.join(record['header'])}; dt {record['dt']} s, "
           f"{len(record['times'])} samples, PGA {record['pga']:.3f} m/s2, x {SCALE}")
     waits = []
-    with Watch() as watch:
+    with Watch(busy) as watch:
         results = {name: study(name, *case_with(LAWS[name]), record, args.quick, waits)
                    for name in (args.law or list(LAWS))}
     idle = watch.report()

@@ -46,13 +46,9 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
-import os
 import platform
-import statistics
 import subprocess
 import sys
-import threading
-import time
 import tomllib
 from pathlib import Path
 
@@ -66,6 +62,7 @@ import vibroimpact as vi  # noqa: E402
 from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_pair import import_opensees, inelastic, run  # noqa: E402
+from timing import Watch, retime, timed  # noqa: E402
 
 PAIR = ROOT / "examples" / "pounding-frames.toml"
 INELASTIC_PAIR = HERE / "inelastic-pair.toml"
@@ -127,15 +124,6 @@ def errors(peaks, ref, uy=None):
         out["residual_self"] = max(abs(d - r) / abs(r) for d, r, _ in pairs)
     out["error"] = max(v for k, v in out.items() if k != "residual_self")
     return out
-
-
-def timed(f, repeats):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
 
 
 def study(name, pair, text, record, quick):
@@ -237,6 +225,7 @@ def study(name, pair, text, record, quick):
                             **{k: best_ours[k] for k in ("sample", "rtol", "method", "integrator")}),
         3 if quick else 9,
         repeats,
+        busy,
     )
     agreement = finest["error"]
     print(f"OpenSees at dt_rec/{finest['m']} against the reference: {agreement:.2e} ({shown(finest['errors'])})")
@@ -266,27 +255,6 @@ def study(name, pair, text, record, quick):
         "retimed": speed,
         "meets_target": ratio >= TARGET_RATIO and agreement <= TARGET_ACCURACY,
     }
-
-
-def retime(opensees, ours, rounds, repeats):
-    """The two best settings timed again, alternating, in ``rounds`` rounds
-    of ``repeats`` runs each (medians), a round idle when no compiler ran
-    at its start, between the two sides or at its end: the ratio of the
-    medians over the idle rounds (None if none was) and over all."""
-    out = []
-    for _ in range(rounds):
-        seen = busy()
-        os_secs, _ = timed(opensees, repeats)
-        seen += busy()
-        our_secs, _ = timed(ours, repeats)
-        seen += busy()
-        out.append({"opensees": os_secs, "vibroimpact": our_secs, "idle": not seen})
-    idle = [r for r in out if r["idle"]]
-
-    def ratio(rows):
-        return statistics.median(r["opensees"] for r in rows) / statistics.median(r["vibroimpact"] for r in rows)
-
-    return {"rounds": out, "idle_rounds": len(idle), "ratio_idle": ratio(idle) if idle else None, "ratio_all": ratio(out)}
 
 
 def boucwen_convergence(record, quick):
@@ -322,44 +290,6 @@ def busy():
     return [int(pid) for pid in found]
 
 
-class Watch:
-    """Polls :func:`busy` every ``every`` seconds in a thread while the
-    study runs: the compilers seen, and how many polls saw one."""
-
-    def __init__(self, every=2.0):
-        self.every, self.polls, self.busy_polls, self.seen = every, 0, 0, set()
-        self.stop = threading.Event()
-        self.thread = threading.Thread(target=self._poll, daemon=True)
-
-    def _poll(self):
-        while not self.stop.is_set():
-            pids = busy()
-            self.polls += 1
-            self.busy_polls += bool(pids)
-            self.seen.update(pids)
-            self.stop.wait(self.every)
-
-    def __enter__(self):
-        self.load_before = os.getloadavg()
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc):
-        self.stop.set()
-        self.thread.join()
-        self.load_after = os.getloadavg()
-
-    def report(self):
-        return {
-            "idle": self.busy_polls == 0,
-            "polls": self.polls,
-            "polls_with_compilers": self.busy_polls,
-            "compiler_pids": sorted(self.seen),
-            "load_before": self.load_before,
-            "load_after": self.load_after,
-        }
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--record", type=int, default=0, help="index in the far-field set (0: record 1, component a)")
@@ -376,7 +306,7 @@ def main():
     ops = import_opensees()
     print(f"record {record['source']}: {'; '.join(record['header'])}; dt {record['dt']} s, "
           f"{len(record['times'])} samples, PGA {record['pga']:.3f} m/s2")
-    with Watch() as watch:
+    with Watch(busy) as watch:
         if args.case == "inelastic":
             text = INELASTIC_PAIR.read_text()
             results = {
