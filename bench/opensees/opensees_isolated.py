@@ -71,7 +71,15 @@ from typing import Any, Dict, Union
 
 import numpy as np
 
-from opensees_pair import TAIL_PERIODS, _omegas, contact_material, import_opensees, rayleigh, storey_material
+from opensees_pair import (
+    TAIL_PERIODS,
+    _omegas,
+    add_storey,
+    contact_material,
+    import_opensees,
+    rayleigh,
+    storey_material,
+)
 
 
 def load(row: Union[str, os.PathLike, Dict[str, Any]]) -> Dict[str, Any]:
@@ -187,18 +195,7 @@ def run(
         for m, k, law in zip(building["masses"], building["stiffnesses"], laws):
             nd = new("node")
             ops.node(nd, 0.0, "-mass", m)
-            mat = new("mat")
-            ele = new("ele")
-            if law.get("law", "elastic") == "elastic":
-                ops.uniaxialMaterial("Elastic", mat, k, beta * k)
-                ops.element("zeroLength", ele, below, nd, "-mat", mat, "-dir", 1)
-            else:
-                name, args = storey_material(law, k)
-                ops.uniaxialMaterial(name, mat, *args)
-                ops.element("zeroLength", ele, below, nd, "-mat", mat, "-dir", 1)
-                if beta > 0.0:
-                    dashpot(below, nd, beta * k)
-            storeys.append(ele)
+            storeys.append(add_storey(ops, new, below, nd, k, law, beta))
             if alpha > 0.0:
                 dashpot(slab, nd, alpha * m)  # to the slab, not the ground
             below = nd

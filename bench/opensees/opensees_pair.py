@@ -139,6 +139,27 @@ def storey_material(spec: Dict[str, Any], k: float):
     raise ValueError(f"storey law {law!r}: OpenSees has no equal material here (bilinear or bouc-wen)")
 
 
+def add_storey(ops, new, below: int, node: int, k: float, law: Dict[str, Any], beta: float) -> int:
+    """A storey from node ``below`` to ``node``: ``zeroLength`` with an
+    ``Elastic`` material (E = k, eta = beta k) for an elastic law, else its
+    law's material (:func:`storey_material`) with a ``beta k`` dashpot
+    beside it (the damping stays linear on the initial stiffness). ``new``
+    hands out tags by kind. Returns the storey element's tag."""
+    mat, ele = new("mat"), new("ele")
+    if law.get("law", "elastic") == "elastic":
+        ops.uniaxialMaterial("Elastic", mat, k, beta * k)
+        ops.element("zeroLength", ele, below, node, "-mat", mat, "-dir", 1)
+        return ele
+    name, args = storey_material(law, k)
+    ops.uniaxialMaterial(name, mat, *args)
+    ops.element("zeroLength", ele, below, node, "-mat", mat, "-dir", 1)
+    if beta > 0.0:
+        damper = new("mat")
+        ops.uniaxialMaterial("Elastic", damper, 0.0, beta * k)
+        ops.element("zeroLength", new("ele"), below, node, "-mat", damper, "-dir", 1)
+    return ele
+
+
 def contact_material(law: Dict[str, Any], gap: float):
     """The OpenSees uniaxial material (name, args) equal to a vibroimpact
     law; only the two laws OpenSees has exactly."""
@@ -210,20 +231,7 @@ def run(
             for m, k, law in zip(frame["masses"], frame["stiffnesses"], laws):
                 nd = new("node")
                 ops.node(nd, 0.0, "-mass", m)
-                mat = new("mat")
-                ele = new("ele")
-                if law.get("law", "elastic") == "elastic":
-                    ops.uniaxialMaterial("Elastic", mat, k, beta * k)
-                    ops.element("zeroLength", ele, below, nd, "-mat", mat, "-dir", 1)
-                else:
-                    name, args = storey_material(law, k)
-                    ops.uniaxialMaterial(name, mat, *args)
-                    ops.element("zeroLength", ele, below, nd, "-mat", mat, "-dir", 1)
-                    if beta > 0.0:
-                        damper = new("mat")
-                        ops.uniaxialMaterial("Elastic", damper, 0.0, beta * k)
-                        ops.element("zeroLength", new("ele"), below, nd, "-mat", damper, "-dir", 1)
-                storeys.append(ele)
+                storeys.append(add_storey(ops, new, below, nd, k, law, beta))
                 dash = new("mat")
                 ops.uniaxialMaterial("Elastic", dash, 0.0, alpha * m)
                 ops.element("zeroLength", new("ele"), ground, nd, "-mat", dash, "-dir", 1)
