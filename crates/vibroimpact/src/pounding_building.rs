@@ -16,7 +16,7 @@ use serde::Deserialize;
 
 use super::ShearFrame;
 use crate::contact::ContactLaw;
-use crate::hysteresis::{Bilinear, BoucWen, Degradation, LawError, StoreyLaw};
+use crate::hysteresis::{BoucWen, Degradation, LawError, StoreyLaw, StoreySpec};
 use crate::model::{Body, Contact, ContactPair, Coupling, Storey};
 
 /// Standard gravity (m/s²), for a friction pendulum's weight.
@@ -99,16 +99,19 @@ impl Bearing {
     /// (W/R)/(W/R + μ W/u_y); without friction, the pendulum's spring.
     /// Errors name the key.
     pub fn law(&self, weight: f64) -> Result<StoreyLaw, LawError> {
+        // Lead-rubber bearings are the storey laws with their stiffness.
         let law = match *self {
             Bearing::Bilinear {
                 stiffness,
                 yield_drift,
                 post_yield_ratio,
-            } => StoreyLaw::Bilinear(Bilinear {
-                stiffness,
-                yield_drift,
-                post_yield_ratio,
-            }),
+            } => {
+                return StoreySpec::Bilinear {
+                    yield_drift,
+                    post_yield_ratio,
+                }
+                .law(stiffness)
+            }
             Bearing::BoucWen {
                 stiffness,
                 yield_drift,
@@ -116,15 +119,19 @@ impl Bearing {
                 exponent,
                 beta,
                 gamma,
-            } => StoreyLaw::BoucWen(BoucWen {
-                stiffness,
-                yield_drift,
-                post_yield_ratio,
-                exponent: exponent.unwrap_or(2.0),
-                beta: beta.unwrap_or(0.5),
-                gamma: gamma.unwrap_or(0.5),
-                degradation: Degradation::default(),
-            }),
+            } => {
+                return StoreySpec::BoucWen {
+                    yield_drift,
+                    post_yield_ratio,
+                    exponent,
+                    beta,
+                    gamma,
+                    degradation_a: None,
+                    degradation_nu: None,
+                    degradation_eta: None,
+                }
+                .law(stiffness)
+            }
             Bearing::FrictionPendulum {
                 radius,
                 friction,
