@@ -252,4 +252,50 @@ impl StoreyTerms {
     pub fn branch(&self, k: usize) -> Branch {
         self.terms[k].branch
     }
+
+    /// Sets bilinear storey k's branch (carried from another run's terms).
+    pub fn set_branch(&mut self, k: usize, branch: Branch) {
+        self.terms[k].branch = branch;
+    }
+
+    /// Where storey k's Bouc–Wen state (z, e) sits in the state, if it has
+    /// one.
+    pub fn state_index(&self, k: usize) -> Option<usize> {
+        self.terms[k].state
+    }
+
+    /// Storey k's bodies: (below, or None for the ground; above).
+    pub fn ends(&self, k: usize) -> (Option<usize>, usize) {
+        (self.terms[k].below, self.terms[k].above)
+    }
+
+    /// Storey k on a linear branch: F = k d + F₀ with its initial stiffness
+    /// k; returns F₀ (an elastic law's is 0; a bilinear storey's elastic
+    /// branch gives (1 − b) k (z₀ − d₀)). None on a plastic branch or for
+    /// Bouc–Wen, whose force is not linear in the drift.
+    pub fn linear_force(&self, k: usize) -> Option<f64> {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Elastic { .. }, _) => Some(0.0),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
+                Some((1.0 - b.post_yield_ratio) * b.stiffness * (z0 - d0))
+            }
+            _ => None,
+        }
+    }
+
+    /// The drifts between which storey k stays on its linear branch, shrunk
+    /// by `margin` of its yield drift at both ends (unbounded for an
+    /// elastic law); None where [`linear_force`](Self::linear_force) is.
+    pub fn linear_window(&self, k: usize, margin: f64) -> Option<(f64, f64)> {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Elastic { .. }, _) => Some((f64::NEG_INFINITY, f64::INFINITY)),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
+                let reach = b.yield_drift * (1.0 - margin);
+                Some((d0 - z0 - reach, d0 - z0 + reach))
+            }
+            _ => None,
+        }
+    }
 }

@@ -24,11 +24,14 @@
 //!   over-damped, and free bodies with ω0 = 0), for a group by
 //!   nalgebra's matrix exponential.
 //!
-//! It also bounds the motion ahead, for the contact scheduler: the group's
-//! mechanical energy `E` (kinetic and spring) can only grow by the work of
-//! the forcing, `d√E/dt ≤ G = ½ Σ_i |f_i|max √(2/m_i)`, so over a horizon
-//! `H` every velocity is at most `√(2E_H/m_i)` and every spring force at
-//! most `√(2 k E_H)` with `√E_H = √E₀ + G H`.
+//! A hysteretic storey on a linear branch (docs/theory.md §11: an elastic
+//! branch of a bilinear storey, `F = k d + F₀`) is a spring of its initial
+//! stiffness `k` with a constant force `F₀`: the group moves about its
+//! static rest state `x_s` (`K u_s = f₀`, zero velocities), `x(t) = x_s +`
+//! the motion above of `x − x_s` ([`FreeMotion::set_rest`]).
+//!
+//! It also bounds the motion ahead, for the contact scheduler
+//! (`free_motion_bounds.rs`).
 
 use nalgebra::{Complex, DMatrix, DVector};
 
@@ -71,8 +74,8 @@ pub struct Group {
     damping: Vec<f64>,
     /// Couplings inside the group: (local a, local b, k, c).
     couplings: Vec<(usize, usize, f64, f64)>,
-    /// Largest |external force| on each body (N).
-    force_max: Vec<f64>,
+    /// Sum of the harmonic forces' amplitudes on each body (N).
+    force_amplitude: Vec<f64>,
     /// Harmonic forces: (body in the group, P, Ω, φ).
     forces: Vec<(usize, f64, f64, f64)>,
     /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
@@ -83,6 +86,9 @@ pub struct Group {
     /// Without modes, under a uniform record: the matrix form of a whole
     /// sample step, computed once.
     hold_step: Option<HoldStep>,
+    /// The static rest state of its storeys' constant forces
+    /// (interleaved; zero without storeys).
+    rest: Vec<f64>,
 }
 
 /// The first-order-hold step of one record sample interval `τ`: `x(b) =
@@ -102,6 +108,8 @@ pub struct FreeMotion {
     /// (group, index in the group) of every body.
     place: Vec<(usize, usize)>,
     base: BaseExcitation,
+    /// The base's |z̈| over stretches of time, for the bounds.
+    peaks: bounds::Peaks,
 }
 
 /// Calls `step(τ, f(a), f')` for every interval `[a, a + τ]` between
@@ -172,8 +180,8 @@ fn single_exp(w2: f64, c2: f64, tau: f64) -> [f64; 4] {
     [ec - mu * es, es, -w2 * es, ec + mu * es]
 }
 
-/// The groups of `model`: the connected components of its couplings
-/// (union–find), as each body's (group, index in the group) and each
+/// The groups of `model`: the connected components of its couplings and
+/// storeys (union–find), as each body's (group, index in the group) and each
 /// group's bodies (ascending), groups in the order of their first body.
 pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usize>>) {
     let n = model.bodies().len();
@@ -185,8 +193,12 @@ pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usiz
         }
         i
     }
-    for c in model.couplings() {
-        let (a, b) = (find(&mut root, c.a), find(&mut root, c.b));
+    let storeys = model
+        .storeys()
+        .iter()
+        .filter_map(|s| Some((s.below?, s.above)));
+    for (p, q) in model.couplings().iter().map(|c| (c.a, c.b)).chain(storeys) {
+        let (a, b) = (find(&mut root, p), find(&mut root, q));
         root[a.max(b)] = a.min(b);
     }
     let mut place = vec![(usize::MAX, 0); n];
@@ -209,10 +221,9 @@ impl FreeMotion {
     /// group in resonance with a harmonic forcing term.
     pub fn new(model: &Model) -> Result<Self, FreeMotionError> {
         let (place, members) = spring_groups(model);
-        let zdd_max = model.base().peak();
         let mut groups = Vec::with_capacity(members.len());
         for bodies in members {
-            groups.push(Self::group(model, &place, bodies, zdd_max)?);
+            groups.push(Self::group(model, &place, bodies)?);
         }
         let record_step = match model.base() {
             BaseExcitation::Record(rec) => Some(uniform_step(rec.times())),
@@ -231,6 +242,7 @@ impl FreeMotion {
             groups,
             place,
             base: model.base().clone(),
+            peaks: bounds::Peaks::new(model.base()),
         })
     }
 
@@ -238,19 +250,28 @@ impl FreeMotion {
         model: &Model,
         place: &[(usize, usize)],
         bodies: Vec<usize>,
-        zdd_max: f64,
     ) -> Result<Group, FreeMotionError> {
         let m = bodies.len();
         let all = model.bodies();
         let mass: Vec<f64> = bodies.iter().map(|&i| all[i].mass).collect();
-        let stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let mut stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
         let damping: Vec<f64> = bodies.iter().map(|&i| all[i].damping).collect();
-        let couplings: Vec<(usize, usize, f64, f64)> = model
+        let here = place[bodies[0]].0;
+        let mut couplings: Vec<(usize, usize, f64, f64)> = model
             .couplings()
             .iter()
-            .filter(|c| place[c.a].0 == place[bodies[0]].0)
+            .filter(|c| place[c.a].0 == here)
             .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
             .collect();
+        // A storey is a spring of its initial stiffness (its constant
+        // force is the rest state's, `set_rest`).
+        for s in model.storeys().iter().filter(|s| place[s.above].0 == here) {
+            let k = s.law.initial_stiffness();
+            match s.below {
+                None => stiffness[place[s.above].1] += k,
+                Some(b) => couplings.push((place[b].1, place[s.above].1, k, 0.0)),
+            }
+        }
         let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
         for j in 0..m {
             a[(2 * j, 2 * j + 1)] = 1.0;
@@ -279,7 +300,7 @@ impl FreeMotion {
             }
             terms.push((frequency, phase, b));
         }
-        let mut force_max: Vec<f64> = mass.iter().map(|mi| mi * zdd_max).collect();
+        let mut force_amplitude = vec![0.0; m];
         let mut forces = Vec::new();
         for f in model.forces() {
             if place[f.body].0 != place[bodies[0]].0 {
@@ -288,7 +309,7 @@ impl FreeMotion {
             let j = place[f.body].1;
             let mut b = vec![0.0; 2 * m];
             b[2 * j + 1] = f.amplitude / mass[j];
-            force_max[j] += f.amplitude.abs();
+            force_amplitude[j] += f.amplitude.abs();
             forces.push((j, f.amplitude, f.frequency, f.phase));
             terms.push((f.frequency, f.phase, b));
         }
@@ -352,11 +373,12 @@ impl FreeMotion {
             stiffness,
             damping,
             couplings,
-            force_max,
+            force_amplitude,
             forces,
             rate,
             modal: None,
             hold_step: None,
+            rest: vec![0.0; 2 * m],
         })
     }
 
@@ -370,9 +392,53 @@ impl FreeMotion {
         self.place[i]
     }
 
-    /// Adds the harmonic steady state of group `g` at time `t`, times
-    /// `sign`, to `x`.
+    /// Sets group `g`'s rest state to the static displacement under the
+    /// constant forces `f` on its bodies (N, the group's order): `K u_s =
+    /// f`. A group without ground springs is solved in the least-squares
+    /// sense (its storeys' forces act in pairs, within the range of `K`).
+    /// Errors with the residual if `f` is not balanced by the springs.
+    pub fn set_rest(&mut self, g: usize, f: &[f64]) -> Result<(), f64> {
+        let group = &mut self.groups[g];
+        let m = group.bodies.len();
+        if f.iter().all(|&x| x == 0.0) {
+            group.rest.fill(0.0);
+            return Ok(());
+        }
+        let mut k = DMatrix::<f64>::zeros(m, m);
+        for j in 0..m {
+            k[(j, j)] = group.stiffness[j];
+        }
+        for &(a, b, kc, _) in &group.couplings {
+            k[(a, a)] += kc;
+            k[(b, b)] += kc;
+            k[(a, b)] -= kc;
+            k[(b, a)] -= kc;
+        }
+        let rhs = DVector::from_column_slice(f);
+        let eps = 1e-13 * k.amax();
+        let u = k
+            .clone()
+            .svd(true, true)
+            .solve(&rhs, eps)
+            .unwrap_or_else(|_| DVector::from_element(m, f64::NAN));
+        let residual = (&k * &u - &rhs).amax();
+        let scale = rhs.amax();
+        if residual.is_nan() || residual > 1e-9 * scale {
+            return Err(residual / scale);
+        }
+        for j in 0..m {
+            group.rest[2 * j] = u[j];
+            group.rest[2 * j + 1] = 0.0;
+        }
+        Ok(())
+    }
+
+    /// Adds the particular motion of group `g` at time `t` (its rest state
+    /// and harmonic steady state), times `sign`, to `x`.
     fn add_particular(&self, g: &Group, t: f64, sign: f64, x: &mut [f64]) {
+        for (xi, r) in x.iter_mut().zip(&g.rest) {
+            *xi += sign * r;
+        }
         for (w, phi, re, im) in &g.harmonic {
             let (s, c) = (w * t + phi).sin_cos();
             for (xi, (r, i)) in x.iter_mut().zip(re.iter().zip(im)) {
@@ -484,14 +550,17 @@ impl FreeMotion {
     /// forces and the base (m/s², relative to the base).
     pub fn acceleration(&self, g: usize, t: f64, x: &[f64], j: usize) -> f64 {
         let group = &self.groups[g];
-        let mut f = -group.stiffness[j] * x[2 * j] - group.damping[j] * x[2 * j + 1];
+        // Springs act on the displacement from rest (the storeys' constant
+        // forces balance there).
+        let u = |i: usize| x[2 * i] - group.rest[2 * i];
+        let mut f = -group.stiffness[j] * u(j) - group.damping[j] * x[2 * j + 1];
         for &(a, b, k, c) in &group.couplings {
             let other = match (a == j, b == j) {
                 (true, _) => b,
                 (_, true) => a,
                 _ => continue,
             };
-            f += k * (x[2 * other] - x[2 * j]) + c * (x[2 * other + 1] - x[2 * j + 1]);
+            f += k * (u(other) - u(j)) + c * (x[2 * other + 1] - x[2 * j + 1]);
         }
         for &(i, p, w, phi) in &group.forces {
             if i == j {
@@ -534,44 +603,6 @@ impl Group {
         &self.bodies
     }
 
-    /// Mechanical energy (kinetic and springs) of the interleaved state `x`.
-    pub fn energy(&self, x: &[f64]) -> f64 {
-        let mut e = 0.0;
-        for j in 0..self.mass.len() {
-            let (u, v) = (x[2 * j], x[2 * j + 1]);
-            e += 0.5 * self.mass[j] * v * v + 0.5 * self.stiffness[j] * u * u;
-        }
-        for &(a, b, k, _) in &self.couplings {
-            let du = x[2 * b] - x[2 * a];
-            e += 0.5 * k * du * du;
-        }
-        e
-    }
-
-    /// `G` of the module notes: `√E` grows at most this fast (√J/s).
-    pub fn growth(&self) -> f64 {
-        self.force_max
-            .iter()
-            .zip(&self.mass)
-            .map(|(f, m)| 0.5 * f * (2.0 / m).sqrt())
-            .sum()
-    }
-
-    /// Largest |acceleration| of body `j` (index in the group) while the
-    /// group's energy stays below `e_max` (m/s²).
-    pub fn acceleration_bound(&self, j: usize, e_max: f64) -> f64 {
-        let speed = |i: usize| (2.0 * e_max / self.mass[i]).sqrt();
-        let mut f = (2.0 * self.stiffness[j] * e_max).sqrt()
-            + self.damping[j] * speed(j)
-            + self.force_max[j];
-        for &(a, b, k, c) in &self.couplings {
-            if a == j || b == j {
-                f += (2.0 * k * e_max).sqrt() + c * (speed(a) + speed(b));
-            }
-        }
-        f / self.mass[j]
-    }
-
     /// Fastest natural frequency or forcing frequency of the group (rad/s;
     /// 0 for free bodies without forcing).
     pub fn rate(&self) -> f64 {
@@ -579,6 +610,8 @@ impl Group {
     }
 }
 
+#[path = "free_motion_bounds.rs"]
+mod bounds;
 #[path = "free_motion_modal.rs"]
 mod modal;
 

@@ -22,16 +22,25 @@
 //! of the set over its dense output; one that reaches `s_act` inside a
 //! step sends the set back to the step's start, to be integrated to that
 //! time exactly and the group joined there.
+//!
+//! Hysteretic storeys (`local_storeys.rs`): a storey on a linear branch is
+//! a spring with a constant force, so its group moves exactly about its
+//! rest state; a bilinear storey's approach to yield is checked like a
+//! contact's (its drift against the branch's window), and its group is
+//! integrated, its branches switched at located events, from within
+//! [`storeys::YIELD_APPROACH`] of yield until it is elastic and safely
+//! below yield again. A Bouc–Wen storey's group is integrated throughout.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+use super::switches::{apply_event, Event, Switches, Verdict};
 use super::*;
 use crate::contact::LawKind;
-use crate::dynamics::{Chain, SetSystem};
+use crate::dynamics::{Chain, SetSystem, StoreyTerms};
 use crate::free_motion::FreeMotion;
 use crate::integrate::Recorder;
-use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce};
+use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce, Storey};
 use crate::variational::Variational;
 
 #[path = "local_activation.rs"]
@@ -46,6 +55,8 @@ mod extrema;
 mod membership;
 #[path = "local_rebuild.rs"]
 mod rebuild;
+#[path = "local_storeys.rs"]
+mod storeys;
 #[path = "local_tape.rs"]
 mod tape;
 
@@ -60,7 +71,8 @@ use tape::TapeRecord;
 /// Work of the local integrator, beside the integrator's counters.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LocalStats {
-    /// Bound checks of contacts between exactly moving bodies.
+    /// Bound checks of contacts between exactly moving bodies (and of
+    /// storeys' approach to yield).
     pub contact_checks: u64,
     /// Times the active set was formed or changed.
     pub set_changes: u64,
@@ -116,6 +128,13 @@ struct ActiveSet {
     rate: f64,
     /// The extrema of its steps, when asked for.
     extrema: Option<ExtremaScan>,
+    /// Model indices of its storeys (the set's storey k is `storeys[k]`).
+    storeys: Vec<usize>,
+    /// Its storeys' branch switches and its contacts' onsets.
+    switches: Option<Switches>,
+    /// The event its last kept step ended at, applied once the step's
+    /// samples are taken.
+    event: Option<Event>,
 }
 
 /// The local integrator's run.
@@ -138,13 +157,15 @@ struct Run<'a> {
     /// Per body: index in the active set.
     slot: Vec<Option<usize>>,
     activation: Vec<Activation>,
-    /// Per group: its contacts, couplings and harmonic forces (model
-    /// indices, ascending).
+    /// Per group: its contacts, couplings, harmonic forces and checked
+    /// (bilinear and Bouc–Wen) storeys (model indices, ascending).
     group_contacts: Vec<Vec<usize>>,
+    group_storeys: Vec<Vec<usize>>,
     group_couplings: Vec<Vec<usize>>,
     group_forces: Vec<Vec<usize>>,
-    /// Per contact: the generation of its scheduled check (older queue
-    /// entries are stale).
+    /// Per check (contacts, then storeys: check `nc + s` is storey s's):
+    /// the generation of its scheduled check (older queue entries are
+    /// stale).
     generation: Vec<u64>,
     queue: BinaryHeap<Reverse<(Time, usize, u64)>>,
     set: Option<ActiveSet>,
@@ -155,8 +176,16 @@ struct Run<'a> {
     stats: Stats,
     contact_evaluations: u64,
     local: LocalStats,
-    /// Per contact: the checks made (which one crawls).
+    /// Per check (contacts, then storeys): the checks made (which one
+    /// crawls).
     checks_per_contact: Vec<u64>,
+    /// The storeys' memory for the whole model: the branches of those
+    /// moving exactly (the set's own are in its system until it is taken
+    /// apart, [`Run::sync_storeys`]), and `hysteretic`, the Bouc–Wen
+    /// states after the interleaved state (`storeys` reads them at index
+    /// 2N on).
+    storeys: StoreyTerms,
+    hysteretic: Vec<f64>,
     /// The extrema over the window, when asked for.
     extrema: Option<LocalExtrema>,
     /// Tangent columns carried (0: none).
@@ -177,13 +206,19 @@ struct Run<'a> {
 
 /// ω² of the two bodies of contact `c` if they move alike: each a group
 /// of its own (no coupling), the same k/m > 0 and c/m, and no harmonic
-/// force on either. Then the base drives both alike and their difference
+/// force or storey on either. Then the base drives both alike and their difference
 /// `Δ = u_l − u_r` is a free damped oscillator: its energy
 /// `Δ̇² + ω²Δ²` never grows, so `|Δ| <= sqrt(E)/ω` for all time.
 fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
     let (l, r) = (c.pair.left()?, c.pair.right()?);
     let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
-    let forced = |i: usize| model.forces().iter().any(|f| f.body == i);
+    let forced = |i: usize| {
+        model.forces().iter().any(|f| f.body == i)
+            || model
+                .storeys()
+                .iter()
+                .any(|s| s.above == i || s.below == Some(i))
+    };
     if !single(l) || !single(r) || forced(l) || forced(r) {
         return None;
     }
@@ -191,6 +226,29 @@ fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
     let w2 = a.stiffness / a.mass;
     (w2 > 0.0 && w2 == b.stiffness / b.mass && a.damping / a.mass == b.damping / b.mass)
         .then_some(w2)
+}
+
+/// The first time a quantity that starts `d` below its limit, at rate `b`
+/// and with |second derivative| <= 2 `cq`, can reach it: the root of `b τ +
+/// cq τ² = d` (infinite if it never does); None if it is there already,
+/// or within rounding of `size` and closing.
+fn reach_time(d: f64, b: f64, cq: f64, size: f64) -> Option<f64> {
+    Some(if d < 0.0 || (d <= 8.0 * f64::EPSILON * size && b > 0.0) {
+        return None;
+    } else if cq == 0.0 {
+        if b <= 0.0 {
+            f64::INFINITY
+        } else {
+            d / b
+        }
+    } else {
+        let root = (b * b + 4.0 * cq * d).sqrt();
+        if b > 0.0 {
+            2.0 * d / (b + root)
+        } else {
+            (root - b) / (2.0 * cq)
+        }
+    })
 }
 
 /// The rows `[u, v]` of `bodies` in an interleaved state `v` of the whole
@@ -230,18 +288,17 @@ impl Run<'_> {
         (x[2 * j], x[2 * j + 1])
     }
 
-    /// The time until which contact k (both sides moving exactly) surely
-    /// stays inactive, from `t`; None: active now (or so soon that the
-    /// bound cannot tell).
+    /// The time until which check k (a contact with both sides moving
+    /// exactly, or a storey moving exactly) surely stays inactive, from
+    /// `t`; None: active now (or so soon that the bound cannot tell).
     fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
         self.local.contact_checks += 1;
         self.checks_per_contact[k] += 1;
-        let c = &self.model.contacts()[k];
         // The sides' groups at t. Inside a step of the set they only go into
         // `deferred`: samples and a step taken back still ask for earlier
         // times of these groups, and exact motion never runs backward.
         let mut at: Vec<(usize, Vec<f64>)> = Vec::with_capacity(2);
-        for i in [c.pair.left(), c.pair.right()].into_iter().flatten() {
+        for i in self.sides(k).into_iter().flatten() {
             let g = self.free.place(i).0;
             if at.iter().any(|(h, _)| *h == g) {
                 continue;
@@ -289,7 +346,53 @@ impl Run<'_> {
     /// [`safe_until`](Self::safe_until) from the groups' interleaved states
     /// at `t` (`state(g)`), as if they moved exactly from there.
     fn bound<'s>(&self, k: usize, t: f64, state: impl Fn(usize) -> &'s [f64]) -> Option<f64> {
-        let c = &self.model.contacts()[k];
+        if let Some(c) = self.model.contacts().get(k) {
+            if let Some(until) = self.alike_bound(c, k, &state) {
+                return Some(until);
+            }
+        }
+        let remaining = self.opts.t_end - t;
+        let rate = self
+            .sides(k)
+            .iter()
+            .flatten()
+            .map(|&i| self.free.groups()[self.free.place(i).0].rate())
+            .fold(0.0f64, f64::max);
+        // The bound is tightest over a short horizon (the energy may grow
+        // with it): start at a quarter of the fastest period and double it
+        // while the bound lasts the whole horizon (a stiff body whose
+        // motion is tiny is safe for far longer than its period).
+        let mut horizon = if rate > 0.0 {
+            remaining.min(0.5 * std::f64::consts::PI / rate)
+        } else {
+            remaining
+        };
+        let floor = 1e-10 * horizon;
+        loop {
+            let zdd = self.free.base_peak(t, t + horizon);
+            let tau = match self.model.contacts().get(k) {
+                Some(c) => self.bound_over(c, k, (horizon, zdd), &state)?,
+                None => {
+                    let s = k - self.model.contacts().len();
+                    self.storey_bound_over(s, (horizon, zdd), &state)?
+                }
+            };
+            if tau < horizon || horizon >= remaining {
+                return (tau > floor && t + tau > t).then_some(t + tau);
+            }
+            horizon = remaining.min(2.0 * horizon);
+        }
+    }
+
+    /// For a contact between bodies that move alike: the run's end, if
+    /// their difference's energy keeps the gap below activation for all
+    /// time.
+    fn alike_bound<'s>(
+        &self,
+        c: &Contact,
+        k: usize,
+        state: &impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
         if let (Some(w2), Some(l), Some(r)) = (self.alike[k], c.pair.left(), c.pair.right()) {
             // Bodies that move alike: the gap's bound for all time.
             let (xl, xr) = (state(self.free.place(l).0), state(self.free.place(r).0));
@@ -306,39 +409,17 @@ impl Run<'_> {
                 return Some(self.opts.t_end);
             }
         }
-        let remaining = self.opts.t_end - t;
-        let sides = [c.pair.left(), c.pair.right()];
-        let rate = sides
-            .iter()
-            .flatten()
-            .map(|&i| self.free.groups()[self.free.place(i).0].rate())
-            .fold(0.0f64, f64::max);
-        // The bound is tightest over a short horizon (the energy may grow
-        // with it): start at a quarter of the fastest period and double it
-        // while the bound lasts the whole horizon (a stiff body whose
-        // motion is tiny is safe for far longer than its period).
-        let mut horizon = if rate > 0.0 {
-            remaining.min(0.5 * std::f64::consts::PI / rate)
-        } else {
-            remaining
-        };
-        let floor = 1e-10 * horizon;
-        loop {
-            let tau = self.bound_over(c, k, horizon, &state)?;
-            if tau < horizon || horizon >= remaining {
-                return (tau > floor && t + tau > t).then_some(t + tau);
-            }
-            horizon = remaining.min(2.0 * horizon);
-        }
+        None
     }
 
     /// The time within `horizon` until which contact `c` (index `k`) stays
-    /// inactive by the bound from the sides' states; None: active now.
+    /// inactive by the bound from the sides' states, the base's |z̈| below
+    /// `zdd` over the horizon; None: active now.
     fn bound_over<'s>(
         &self,
         c: &Contact,
         k: usize,
-        horizon: f64,
+        (horizon, zdd): (f64, f64),
         state: &impl Fn(usize) -> &'s [f64],
     ) -> Option<f64> {
         let (mut s0, mut sd0, mut acc) = (-c.clearance, 0.0, 0.0);
@@ -353,32 +434,15 @@ impl Run<'_> {
             s0 += sign * x[2 * j];
             sd0 += sign * x[2 * j + 1];
             let group = &self.free.groups()[g];
-            let root = group.energy(x).sqrt() + group.growth() * horizon;
-            acc += group.acceleration_bound(j, root * root);
+            let root = group.energy(x).sqrt() + group.growth(zdd) * horizon;
+            acc += group.acceleration_bound(j, root * root, zdd);
         }
         if !(s0.is_finite() && sd0.is_finite() && acc.is_finite()) {
             return None;
         }
         let speed = sd0.abs() + acc * horizon;
         let d = self.activation[k].gap(speed) - s0;
-        let (b, cq) = (sd0, 0.5 * acc);
-        let tau = if d < 0.0 || (d <= 8.0 * f64::EPSILON * size && b > 0.0) {
-            return None;
-        } else if cq == 0.0 {
-            if b <= 0.0 {
-                f64::INFINITY
-            } else {
-                d / b
-            }
-        } else {
-            let root = (b * b + 4.0 * cq * d).sqrt();
-            if b > 0.0 {
-                2.0 * d / (b + root)
-            } else {
-                (root - b) / (2.0 * cq)
-            }
-        };
-        Some(tau.min(horizon))
+        Some(reach_time(d, sd0, 0.5 * acc, size)?.min(horizon))
     }
 
     /// Schedules contact k's next check (both sides exact) from `t`, or
@@ -408,10 +472,10 @@ impl Run<'_> {
         None
     }
 
-    /// Whether contact k has a side in the active set.
+    /// Whether check k (a contact or a storey) has a side in the active
+    /// set.
     fn touches_set(&self, k: usize) -> bool {
-        let c = &self.model.contacts()[k];
-        [c.pair.left(), c.pair.right()]
+        self.sides(k)
             .into_iter()
             .flatten()
             .any(|i| self.slot[i].is_some())
@@ -442,3 +506,7 @@ impl Run<'_> {
 #[cfg(test)]
 #[path = "local_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "local_storeys_tests.rs"]
+mod storey_tests;

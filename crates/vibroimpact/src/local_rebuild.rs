@@ -19,6 +19,17 @@ struct Retired {
     h_prev: Option<f64>,
 }
 
+/// The set's own model: its bodies, the contacts within it (renumbered),
+/// the springs, forces and storeys of its groups; with the model ids of
+/// its contacts and storeys, and the contacts on its boundary (to a body
+/// outside).
+struct SubModel {
+    model: Model,
+    contacts: Vec<usize>,
+    boundary: Vec<usize>,
+    storeys: Vec<usize>,
+}
+
 impl Run<'_> {
     /// Rebuilds the active set with `groups` at time `t`, from the current
     /// set's state and the exact motion of the others.
@@ -33,7 +44,15 @@ impl Run<'_> {
                 self.deferred.retain(|(h, ..)| *h != g);
             }
         }
+        self.sync_storeys();
         let old = self.retire(&groups, t);
+        // Groups leaving move exactly about the rest of their storeys'
+        // branches.
+        for &g in &old.groups {
+            if !groups.contains(&g) && !self.group_storeys[g].is_empty() {
+                self.settle_rest(g)?;
+            }
+        }
         self.local.set_changes += 1;
         if groups.is_empty() {
             self.impacts = old.impacts;
@@ -42,11 +61,19 @@ impl Run<'_> {
             }
             return Ok(());
         }
-        let (bodies, y) = self.enter(&groups, &old, t);
-        let (sub, ids, boundary) = self.sub_model(&groups, &bodies)?;
+        let (bodies, mut y) = self.enter(&groups, &old, t);
+        let SubModel {
+            model: sub,
+            contacts: ids,
+            boundary,
+            storeys,
+        } = self.sub_model(&groups, &bodies)?;
         let energy = self.energy.is_some();
         let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
         let mut sys = Variational::new(chain, self.columns);
+        // (No tangent columns with storeys: their Bouc–Wen states follow
+        // the audit's quadratures.)
+        self.load_storeys(&mut sys, &storeys, &mut y);
         let trackers = ids
             .iter()
             .enumerate()
@@ -83,6 +110,15 @@ impl Run<'_> {
         }
         let mut st = Stepper::new(self.method, y.len(), int_opts)?;
         st.reset(&mut sys, t, &y)?;
+        let s_on = ids
+            .iter()
+            .map(|&k| {
+                model.contacts()[k]
+                    .law
+                    .onset_approach(self.opts.impact_force_threshold)
+            })
+            .collect();
+        let switches = Switches::new(sys.chain(), y.len(), s_on);
         if let Some(tape) = self.tape.as_mut() {
             let rec = sys.system();
             if rec.time(0) != Some(t) {
@@ -132,6 +168,9 @@ impl Run<'_> {
             saved: (t, y),
             rate,
             extrema,
+            storeys,
+            switches,
+            event: None,
         });
         Ok(())
     }
@@ -264,14 +303,8 @@ impl Run<'_> {
         (bodies, y)
     }
 
-    /// The set's own model: its bodies, the contacts within it (renumbered)
-    /// with their global ids, the springs and forces of its groups, and
-    /// the contacts on its boundary (to a body outside).
-    fn sub_model(
-        &self,
-        groups: &[usize],
-        bodies: &[usize],
-    ) -> Result<(Model, Vec<usize>, Vec<usize>), IntegrationError> {
+    /// The set's own model ([`SubModel`]) of `groups`, its `bodies`.
+    fn sub_model(&self, groups: &[usize], bodies: &[usize]) -> Result<SubModel, IntegrationError> {
         let model = self.model;
         let local = |i: Option<usize>| i.map(|i| self.slot[i]);
         let mut ids = Vec::new();
@@ -333,6 +366,24 @@ impl Run<'_> {
                 })
             })
             .collect();
+        let storey_ids: Vec<usize> = (0..model.storeys().len())
+            .filter(|&s| self.slot[model.storeys()[s].above].is_some())
+            .collect();
+        let storeys = storey_ids
+            .iter()
+            .map(|&s| &model.storeys()[s])
+            .filter_map(|s| {
+                let below = match s.below {
+                    Some(b) => Some(self.slot[b]?),
+                    None => None,
+                };
+                Some(Storey {
+                    below,
+                    above: self.slot[s.above]?,
+                    law: s.law,
+                })
+            })
+            .collect();
         let sub = Model::new(
             sub_bodies,
             couplings,
@@ -342,8 +393,14 @@ impl Run<'_> {
             Vec::new(),
             Vec::new(),
         )
+        .and_then(|m| m.with_storeys(storeys))
         .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-        Ok((sub, ids, boundary))
+        Ok(SubModel {
+            model: sub,
+            contacts: ids,
+            boundary,
+            storeys: storey_ids,
+        })
     }
 
     /// A fresh start knows nothing of the contacts' time scale, and a

@@ -8,6 +8,10 @@ use super::*;
 pub(super) enum Stepped {
     /// Taken back: an activation inside it; the set goes on to that time.
     RolledBack,
+    /// Taken back for an event of the set inside it (a branch switch, an
+    /// onset), or an event applied where the step was to start: counted
+    /// as a step (events alone cannot run forever).
+    Retaken,
     /// Kept, with the activation reached at its end if any.
     Kept(Crossing),
 }
@@ -34,6 +38,9 @@ pub(in crate::simulate) struct LocalRun {
     /// The energy audit's sums (excitation work, damper and contact
     /// dissipation), if asked for.
     pub energy: Option<[f64; 3]>,
+    /// The storeys' memory at the final time (`y` carries their Bouc–Wen
+    /// states after the interleaved state).
+    pub storeys: StoreyTerms,
     pub sink_stopped: Option<f64>,
 }
 
@@ -90,7 +97,8 @@ impl Run<'_> {
 
     /// Writes the whole interleaved state at `t` into `out`: the set's
     /// bodies from its dense output (its last step holds `t`), the others
-    /// from their exact motion.
+    /// from their exact motion; then the Bouc–Wen states, if `out` has
+    /// room for them.
     pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
         // Under a record the reference states move up to the sample
         // (everything before it has been sampled and checked): else every
@@ -131,10 +139,21 @@ impl Run<'_> {
             };
             put_rows(free.groups()[g].bodies(), x, out);
         }
+        let n2 = 2 * self.model.bodies().len();
+        let hysteretic = out.len() > n2;
+        if hysteretic {
+            out[n2..].copy_from_slice(&self.hysteretic);
+        }
         if let Some(set) = self.set.as_mut() {
             let mut y = vec![0.0; set.st.y().len()];
             set.st.dense_output(&mut set.sys, t, &mut y);
             put_rows(&set.bodies, &y, out);
+            let terms = set.sys.chain().storeys();
+            for (ks, &s) in set.storeys.iter().enumerate().filter(|_| hysteretic) {
+                if let (Some(i), Some(w)) = (terms.state_index(ks), self.storeys.state_index(s)) {
+                    out[w..w + 2].copy_from_slice(&y[i..i + 2]);
+                }
+            }
         }
     }
 
@@ -154,11 +173,20 @@ impl Run<'_> {
             .get(self.breakpoints.partition_point(|&b| b <= t))
             .copied()
             .unwrap_or(f64::INFINITY);
-        let bound = self
+        let mut bound = self
             .opts
             .t_end
             .min(next_break)
             .min(pending.map_or(f64::INFINITY, |p| p.0));
+        if let Some(sw) = set.switches.as_mut() {
+            match sw.before_step(&set.st, bound) {
+                Ok(b) => bound = b,
+                Err(event) => {
+                    apply_event(&mut set.st, &mut set.sys, event)?;
+                    return Ok(Stepped::Retaken);
+                }
+            }
+        }
         set.saved.0 = t;
         set.saved.1.clear();
         set.saved.1.extend_from_slice(set.st.y());
@@ -195,6 +223,21 @@ impl Run<'_> {
             *pending = Some((ts, k));
             set.st.limit_next_step(ts - t0);
             return Ok(Stepped::RolledBack);
+        }
+        // The set's own events: one inside the step takes it again up to
+        // there (a due check found at its end is queued again).
+        if let Some(sw) = set.switches.as_mut() {
+            match sw.after_step(&mut set.st, &mut set.sys)? {
+                Verdict::Retake => {
+                    if let Some((tf, k)) = first {
+                        self.generation[k] += 1;
+                        self.queue.push(Reverse((Time(tf), k, self.generation[k])));
+                    }
+                    return Ok(Stepped::Retaken);
+                }
+                Verdict::Switch(e) => set.event = Some(e),
+                Verdict::Clear => {}
+            }
         }
         if let (Some(tape), Some(first)) = (self.tape.as_mut(), recorded) {
             tape.step(t, h, set.sys.system(), first);
@@ -286,14 +329,16 @@ pub(in crate::simulate) fn run(
         tangents: None,
         tape: None,
         energy: None,
+        storeys: StoreyTerms::default(),
         sink_stopped: None,
     };
-    let mut sample = vec![0.0; 2 * n];
+    // The whole state, and the storeys' Bouc–Wen states after it.
+    let mut sample = vec![0.0; 2 * n + run.hysteretic.len()];
     let mut next_sample = 0usize;
     // Emits the samples up to `t` (inclusive) from the current motion.
     let mut whole = opts
         .accelerations
-        .then(|| (ChainDynamics::new(model, false), vec![0.0; 2 * n]));
+        .then(|| (ChainDynamics::new(model, false), vec![0.0; sample.len()]));
     let mut emit = |run: &mut Run, t: f64, stopped: &mut Option<f64>| {
         let Some(dt) = opts.output_step else { return };
         while stopped.is_none() {
@@ -302,16 +347,20 @@ pub(in crate::simulate) fn run(
                 break;
             }
             run.state_at(ts, &mut sample);
-            let body = body_sample(ts, &sample, whole.as_mut());
+            run.sync_storeys();
+            let body = body_sample(run, ts, &sample, whole.as_mut());
             next_sample += 1;
             if !record(ts, &body) {
                 *stopped = Some(ts);
             }
         }
     };
-    // Contacts active at the start form the first set; the others are
-    // scheduled.
-    for k in 0..nc {
+    // Contacts active at the start, and storeys near yield or integrated
+    // throughout, form the first set; the others are scheduled.
+    let checked = (0..model.storeys().len())
+        .filter(|&s| Run::checked_storey(model, s))
+        .map(|s| nc + s);
+    for k in (0..nc).chain(checked) {
         if !run.touches_set(k) && run.schedule(k, 0.0) {
             if let Err(e) = run.join(k, 0.0) {
                 out.error = Some(e);
@@ -372,6 +421,21 @@ pub(in crate::simulate) fn run(
                 break;
             }
             Ok(Stepped::RolledBack) => {}
+            Ok(Stepped::Retaken) => {
+                steps += 1;
+                if steps > opts.max_steps {
+                    out.error = Some(IntegrationError::TooManySteps { t, steps });
+                    break;
+                }
+                if let Some(e) = run
+                    .set
+                    .as_ref()
+                    .and_then(|set| pace(set, method, opts, steps))
+                {
+                    out.error = Some(e);
+                    break;
+                }
+            }
             Ok(Stepped::Kept(reached)) => {
                 steps += 1;
                 if steps > opts.max_steps {
@@ -389,6 +453,10 @@ pub(in crate::simulate) fn run(
                 run.scan_set_step();
                 emit(&mut run, t, &mut out.sink_stopped);
                 run.apply_deferred(t);
+                if let Err(e) = run.apply_set_event() {
+                    out.error = Some(e);
+                    break;
+                }
                 let result = match reached {
                     Some((_, k)) => run.join(k, t).map(|_| None),
                     None if pending.is_none() => run.release(),
@@ -409,26 +477,39 @@ pub(in crate::simulate) fn run(
     Ok(run.finish(out, t))
 }
 
-/// A streamed sample in body order from the interleaved state `y` at
-/// `t`: [u.., v..], and the accelerations of the whole model `whole` (its
-/// dynamics and a buffer) after them if asked (a Lankarani–Nikravesh
-/// contact's onset velocity is not tracked there).
-fn body_sample(t: f64, y: &[f64], whole: Option<&mut (ChainDynamics, Vec<f64>)>) -> Vec<f64> {
-    let n = y.len() / 2;
+/// A streamed sample in body order from the whole state `y` at `t`
+/// (interleaved, the Bouc–Wen states after it): [u.., v..], the
+/// accelerations of the whole model `whole` (its dynamics and a buffer)
+/// after them if asked (a Lankarani–Nikravesh contact's onset velocity is
+/// not tracked there), then the storeys' forces if asked.
+fn body_sample(
+    run: &Run,
+    t: f64,
+    y: &[f64],
+    whole: Option<&mut (ChainDynamics, Vec<f64>)>,
+) -> Vec<f64> {
+    let n = run.model.bodies().len();
     let mut body: Vec<f64> = (0..n)
         .map(|i| y[2 * i])
         .chain((0..n).map(|i| y[2 * i + 1]))
         .collect();
     if let Some((sys, rates)) = whole {
+        sys.storeys_mut().clone_from(&run.storeys);
         crate::integrate::OdeSystem::rhs(sys, t, y, rates);
         body.extend((0..n).map(|i| rates[2 * i + 1]));
+    }
+    if run.opts.storey_forces {
+        let at = body.len();
+        body.resize(at + run.model.storeys().len(), 0.0);
+        run.storey_forces(y, &mut body[at..]);
     }
     body
 }
 
 /// The requests the local integrator refuses: the energy audit with
 /// tangents or a tape, a tape with a law that needs the onset velocity or
-/// with a method other than DOP853.
+/// with a method other than DOP853, tangents or a tape with hysteretic
+/// storeys.
 fn check_request(
     model: &Model,
     opts: &SimulationOptions,
@@ -451,6 +532,11 @@ fn check_request(
     {
         return Err(OptionsError(
             "a tangent tape cannot follow a law that needs the impact's onset velocity".into(),
+        ));
+    }
+    if !model.storeys().is_empty() && (tape || tangents.is_some_and(|w| w.columns > 0)) {
+        return Err(OptionsError(
+            "tangent columns cannot follow hysteretic storeys (their branch switches and Bouc–Wen states are not in the variational equations)".into(),
         ));
     }
     if tape && method != Method::Dop853 {
@@ -480,8 +566,9 @@ fn checks_crawl(
         projected,
         limit: opts.max_steps,
     };
+    // (A storey's checks crawl: no contact to name.)
     let k = (0..nc).max_by_key(|&k| (run.checks_per_contact[k] - before[k], Reverse(k)));
-    Some((e, k))
+    Some((e, k.filter(|&k| k < run.model.contacts().len())))
 }
 
 impl<'a> Run<'a> {
@@ -516,6 +603,14 @@ impl<'a> Run<'a> {
         for (i, f) in model.forces().iter().enumerate() {
             group_forces[free.place(f.body).0].push(i);
         }
+        let mut group_storeys = vec![Vec::new(); ng];
+        for (s, st) in model.storeys().iter().enumerate() {
+            if Self::checked_storey(model, s) {
+                group_storeys[free.place(st.above).0].push(s);
+            }
+        }
+        let ns = model.storeys().len();
+        let storeys = StoreyTerms::new(model.storeys(), 2 * n, model.initial_displacement());
         let exact = free
             .groups()
             .iter()
@@ -557,7 +652,8 @@ impl<'a> Run<'a> {
             group_contacts,
             group_couplings,
             group_forces,
-            generation: vec![0; nc],
+            group_storeys,
+            generation: vec![0; nc + ns],
             queue: BinaryHeap::new(),
             set: None,
             impacts: Vec::new(),
@@ -568,7 +664,9 @@ impl<'a> Run<'a> {
                 body_evaluations: vec![0; n],
                 ..LocalStats::default()
             },
-            checks_per_contact: vec![0; nc],
+            checks_per_contact: vec![0; nc + ns],
+            hysteretic: vec![0.0; storeys.states()],
+            storeys,
             extrema: None,
             columns,
             tangents: tangent_refs,
@@ -577,6 +675,19 @@ impl<'a> Run<'a> {
             alike: Vec::new(),
             energy: None,
         };
+        // Every group with storeys on linear branches moves about its rest
+        // state (one with a Bouc–Wen storey joins the set at once).
+        let mut nonlinear = vec![false; ng];
+        for (s, st) in model.storeys().iter().enumerate() {
+            nonlinear[run.free.place(st.above).0] |= run.storeys.linear_force(s).is_none();
+        }
+        for st in model.storeys() {
+            let g = run.free.place(st.above).0;
+            if !nonlinear[g] {
+                run.settle_rest(g)
+                    .map_err(|e| OptionsError(e.to_string()))?;
+            }
+        }
         if opts.energy {
             run.energy = Some(LocalEnergy::new(model, &run.free));
         }
@@ -608,8 +719,9 @@ impl<'a> Run<'a> {
             Some(set) => set.st.t(),
             None => t.min(opts.t_end),
         };
-        let mut y = vec![0.0; 2 * n];
+        let mut y = vec![0.0; 2 * n + run.hysteretic.len()];
         run.state_at(t_final, &mut y);
+        run.sync_storeys();
         if run.columns > 0 {
             out.tangents = Some(run.tangents_at(t_final));
         }
@@ -638,6 +750,7 @@ impl<'a> Run<'a> {
         out.extrema = run.extrema.map(LocalExtrema::into_found);
         out.energy = run.energy.map(|e| e.sums);
         out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
+        out.storeys = run.storeys;
         out
     }
 }

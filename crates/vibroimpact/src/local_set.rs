@@ -99,16 +99,21 @@ impl Run<'_> {
         None
     }
 
-    /// The groups of contact k's bodies.
+    /// The groups of check k's bodies (a contact's, or a storey's group).
     pub(super) fn groups_of(&self, k: usize) -> Vec<usize> {
-        side_groups(&self.free, &self.model.contacts()[k])
+        let mut groups: Vec<usize> = self
+            .sides(k)
             .into_iter()
             .flatten()
-            .collect()
+            .map(|i| self.free.place(i).0)
+            .collect();
+        groups.dedup();
+        groups
     }
 
-    /// Joins the groups of contact k to the set at `t` (the set, if any, is
-    /// at `t`); the checks of the contacts that now touch the set lapse.
+    /// Joins the groups of check k (a contact, or a storey) to the set at
+    /// `t` (the set, if any, is at `t`); the checks of the contacts and
+    /// storeys that now touch the set lapse.
     pub(super) fn join(&mut self, k: usize, t: f64) -> Result<(), IntegrationError> {
         let mut groups = self.set.as_ref().map_or(Vec::new(), |s| s.groups.clone());
         for g in self.groups_of(k) {
@@ -117,9 +122,13 @@ impl Run<'_> {
             }
         }
         groups.sort_unstable();
+        let nc = self.model.contacts().len();
         for g in self.groups_of(k) {
-            for i in 0..self.group_contacts[g].len() {
-                let kk = self.group_contacts[g][i];
+            let checks = self.group_contacts[g]
+                .iter()
+                .copied()
+                .chain(self.group_storeys[g].iter().map(|s| nc + s));
+            for kk in checks {
                 self.generation[kk] += 1;
             }
         }
@@ -143,6 +152,7 @@ impl Run<'_> {
     /// exactly again; their contacts with other exact groups or walls are
     /// scheduled. Returns a contact that is active at once, if any.
     pub(super) fn release(&mut self) -> Result<Crossing, IntegrationError> {
+        self.sync_storeys();
         let Some(set) = self.set.as_ref() else {
             return Ok(None);
         };
@@ -187,6 +197,17 @@ impl Run<'_> {
                     .collect()
             })
             .collect();
+        // A group stays while its storeys are off a linear branch or near
+        // yield.
+        let groups = set.groups.clone();
+        for (p, &g) in groups.iter().enumerate() {
+            if !engaged[p] && self.storeys_engaged(g, t, lookahead, &states[p])? {
+                engaged[p] = true;
+            }
+        }
+        let Some(set) = self.set.as_ref() else {
+            return Ok(None);
+        };
         loop {
             let mut changed = false;
             for p in 0..set.groups.len() {
@@ -254,9 +275,13 @@ impl Run<'_> {
         }
         self.rebuild(keep, t)?;
         let mut first: Crossing = None;
+        let nc = self.model.contacts().len();
         let mut freed: Vec<usize> = leaving
             .iter()
-            .flat_map(|&g| self.group_contacts[g].iter().copied())
+            .flat_map(|&g| {
+                let storeys = self.group_storeys[g].iter().map(move |s| nc + s);
+                self.group_contacts[g].iter().copied().chain(storeys)
+            })
             .collect();
         freed.sort_unstable();
         freed.dedup();

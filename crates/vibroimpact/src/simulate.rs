@@ -506,19 +506,29 @@ fn simulate_local(
         impacts,
         stats: run.stats,
         contact_evaluations: run.contact_evaluations,
-        hysteretic_energy: Vec::new(),
+        hysteretic_energy: model
+            .storeys()
+            .iter()
+            .enumerate()
+            .map(|(k, s)| s.law.dissipated(run.storeys.state(k, &run.y)))
+            .collect(),
         energy: run
             .energy
             .map(|[input_work, damping_dissipation, contact_dissipation]| {
-                let sys = ChainDynamics::new(model, false);
+                // The start from rest on every storey's first branch, the
+                // end on the run's (the Bouc–Wen states after the state).
+                let mut sys = ChainDynamics::new(model, false);
+                let mut start = y0[..2 * n].to_vec();
+                start.resize(run.y.len(), 0.0);
+                let initial = sys.mechanical_energy(&start);
+                *sys.storeys_mut() = run.storeys.clone();
                 EnergyBalance {
-                    initial: sys.mechanical_energy(y0),
+                    initial,
                     mechanical: sys.mechanical_energy(&run.y),
                     input_work,
                     damping_dissipation,
                     contact_dissipation,
-                    // The local integrator runs no hysteretic storeys.
-                    hysteretic_dissipation: 0.0,
+                    hysteretic_dissipation: run.storeys.dissipated(&run.y),
                 }
             }),
         error,

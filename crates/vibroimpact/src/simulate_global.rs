@@ -4,7 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
-use super::switches::{Event, Switches, Verdict};
+use super::switches::{apply_event, Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -181,34 +181,10 @@ pub fn simulate_streaming(
     ))
 }
 
-/// Applies `event` at the stepper's point (a storey's branch switch, or a
-/// contact's impact velocity) and restarts the stepper there (the
-/// right-hand side changed).
-fn apply_event(
-    st: &mut Stepper,
-    sys: &mut ChainDynamics,
-    event: Event,
-) -> Result<(), IntegrationError> {
-    let (t, y) = (st.t(), st.y().to_vec());
-    match event {
-        Event::Storey(k) => sys.storeys_mut().switch(k, &y),
-        Event::Onset(k) => {
-            let (_, sd) = sys.approach(k, &y);
-            sys.set_onset_velocity(k, sd);
-        }
-    }
-    st.reset(sys, t, &y)
-}
-
 /// The checks of a run beyond the options' own: the output samples within
 /// [`MAX_SAMPLES`], a record's duration within the record.
 pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), OptionsError> {
     check_options(opts)?;
-    if !model.storeys().is_empty() && opts.integrator == Integrator::Local {
-        return Err(OptionsError(
-            "integrator = local: the local integrator does not carry hysteretic storeys yet (docs/decisions.md D26); use global or auto".into(),
-        ));
-    }
     if let Some(dt) = opts.output_step {
         let samples = (opts.t_end - opts.output_from) / dt + 1.0;
         if samples > MAX_SAMPLES {

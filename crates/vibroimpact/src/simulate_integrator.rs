@@ -38,12 +38,10 @@ impl Integrator {
     /// The integrator that runs `model`: [`Integrator::Auto`] is local for
     /// a model of at least [`AUTO_LOCAL_GROUPS`] groups whose free motion
     /// has a bounded steady state under its forcing (no undamped group
-    /// under harmonic forcing) and no hysteretic storeys, global
+    /// under harmonic forcing), global
     /// otherwise; the others are themselves.
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
-            // The local integrator does not carry hysteretic storeys yet.
-            Integrator::Auto if !model.storeys().is_empty() => Integrator::Global,
             Integrator::Auto => {
                 let (place, members) = crate::free_motion::spring_groups(model);
                 // Per group: damped (by a body's or a coupling's damper).

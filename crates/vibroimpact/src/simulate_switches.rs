@@ -8,6 +8,7 @@
 //! again up to that time, and the event is applied there.
 
 use super::ChainDynamics;
+use crate::dynamics::Chain;
 use crate::integrate::{IntegrationError, Stepper};
 use crate::numeric::brent;
 
@@ -120,10 +121,10 @@ impl Switches {
 
     /// Checks the step just taken for events (at its end and at three
     /// points inside on the dense output, located by Brent).
-    pub(super) fn after_step(
+    pub(super) fn after_step<S: Chain>(
         &mut self,
         st: &mut Stepper,
-        sys: &mut ChainDynamics,
+        sys: &mut S,
     ) -> Result<Verdict, IntegrationError> {
         let (t0, t1) = (self.t_prev, st.t());
         if let Some((t, e)) = self.pending {
@@ -137,10 +138,12 @@ impl Switches {
         // (a dense output may cost stages of its own), and only if an
         // event is live.
         let live: Vec<usize> = (0..self.events.len())
-            .filter(|&i| self.armed[i] && self.value(sys, self.events[i], &self.y_prev) > 0.0)
+            .filter(|&i| {
+                self.armed[i] && self.value(sys.chain(), self.events[i], &self.y_prev) > 0.0
+            })
             .collect();
         if live.is_empty() {
-            self.rearm(sys, st.y());
+            self.rearm(sys.chain(), st.y());
             return Ok(Verdict::Clear);
         }
         let times: [f64; 4] = [1.0, 2.0, 3.0, 4.0].map(|j| {
@@ -156,16 +159,20 @@ impl Switches {
         let mut first: Option<(f64, Event)> = None;
         for i in live {
             let e = self.events[i];
-            let (mut ta, mut ga) = (t0, self.value(sys, e, &self.y_prev));
+            let (mut ta, mut ga) = (t0, self.value(sys.chain(), e, &self.y_prev));
             for (j, &tb) in times.iter().enumerate() {
-                let gb = self.value(sys, e, if j == 3 { st.y() } else { &self.inside[j] });
+                let gb = self.value(
+                    sys.chain(),
+                    e,
+                    if j == 3 { st.y() } else { &self.inside[j] },
+                );
                 if gb <= 0.0 {
                     let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
                     let mut buf = std::mem::take(&mut self.buf);
                     let root = brent(
                         |t| {
                             st.dense_output(sys, t, &mut buf);
-                            self.value(sys, e, &buf)
+                            self.value(sys.chain(), e, &buf)
                         },
                         ta,
                         tb,
@@ -186,7 +193,7 @@ impl Switches {
         }
         match first {
             None => {
-                self.rearm(sys, st.y());
+                self.rearm(sys.chain(), st.y());
                 Ok(Verdict::Clear)
             }
             Some((t, e)) if t >= t1 => {
@@ -200,6 +207,26 @@ impl Switches {
             }
         }
     }
+}
+
+/// Applies `event` at the stepper's point (a storey's branch switch, or a
+/// contact's impact velocity) and restarts the stepper there (the
+/// right-hand side changed).
+pub(super) fn apply_event<S: Chain>(
+    st: &mut Stepper,
+    sys: &mut S,
+    event: Event,
+) -> Result<(), IntegrationError> {
+    let (t, y) = (st.t(), st.y().to_vec());
+    let chain = sys.chain_mut();
+    match event {
+        Event::Storey(k) => chain.storeys_mut().switch(k, &y),
+        Event::Onset(k) => {
+            let (_, sd) = chain.approach(k, &y);
+            chain.set_onset_velocity(k, sd);
+        }
+    }
+    st.reset(sys, t, &y)
 }
 
 #[cfg(test)]

@@ -1,0 +1,142 @@
+//! Bounds on a group's exact motion ahead, for the local integrator's
+//! checks (docs/theory.md §10).
+//!
+//! The group's mechanical energy `E` (kinetic and spring, about its rest
+//! state) can only grow by the work of the forcing: `d√E/dt ≤ G = ½ Σ_i
+//! |f_i|max √(2/m_i)`, so over a horizon `H` every velocity is at most
+//! `√(2E_H/m_i)` and every spring force at most `√(2 k E_H)` with `√E_H =
+//! √E₀ + G H`. The largest force `|f_i|max` is `m_i |z̈|max + Σ|P|` of the
+//! body's harmonic forces, with `|z̈|max` the base's largest over the
+//! horizon alone ([`Peaks`]): a record's quiet stretches bound the motion
+//! as tightly as the record's strong part does not.
+
+use super::{FreeMotion, Group};
+use crate::model::BaseExcitation;
+
+/// Samples per block of a record's peak table.
+const BLOCK: usize = 16;
+
+/// The largest |z̈| of a base excitation over a stretch of time: a
+/// record's block maxima with a sparse table over them (a query costs
+/// two partial blocks and one table lookup); a constant otherwise.
+#[derive(Clone, Debug)]
+pub(super) struct Peaks {
+    /// The sample times (empty: not a record).
+    times: Vec<f64>,
+    /// |z̈| at each sample.
+    values: Vec<f64>,
+    /// `table[l][b]`: the largest over blocks b .. b + 2^l.
+    table: Vec<Vec<f64>>,
+    /// The peak of a base that is not a record.
+    constant: f64,
+}
+
+impl Peaks {
+    pub(super) fn new(base: &BaseExcitation) -> Self {
+        let BaseExcitation::Record(rec) = base else {
+            return Self {
+                times: Vec::new(),
+                values: Vec::new(),
+                table: Vec::new(),
+                constant: base.peak(),
+            };
+        };
+        let times = rec.times().to_vec();
+        let values: Vec<f64> = times.iter().map(|&t| rec.at(t).abs()).collect();
+        let blocks: Vec<f64> = values
+            .chunks(BLOCK)
+            .map(|c| c.iter().fold(0.0f64, |m, v| m.max(*v)))
+            .collect();
+        let mut table = vec![blocks];
+        while 2 * (1 << (table.len() - 1)) <= table[0].len() {
+            let (prev, half) = (table.last().unwrap_or(&table[0]), 1 << (table.len() - 1));
+            let next = (0..prev.len() - half)
+                .map(|b| prev[b].max(prev[b + half]))
+                .collect();
+            table.push(next);
+        }
+        Self {
+            times,
+            values,
+            table,
+            constant: 0.0,
+        }
+    }
+
+    /// The largest |z̈| over `[a, b]` (zero outside a record; the samples
+    /// around `a` and `b` count, the interpolant being linear between
+    /// samples).
+    pub(super) fn between(&self, a: f64, b: f64) -> f64 {
+        if self.times.is_empty() {
+            return self.constant;
+        }
+        let n = self.times.len();
+        let i0 = self.times.partition_point(|&s| s <= a).saturating_sub(1);
+        let i1 = self.times.partition_point(|&s| s < b).min(n - 1);
+        if i1 < i0 {
+            return 0.0;
+        }
+        let (b0, b1) = (i0.div_ceil(BLOCK), (i1 + 1) / BLOCK);
+        if b0 >= b1 {
+            return self.values[i0..=i1].iter().fold(0.0f64, |m, v| m.max(*v));
+        }
+        let head = self.values[i0..b0 * BLOCK].iter();
+        let tail = self.values[b1 * BLOCK..=i1].iter();
+        let edges = head.chain(tail).fold(0.0f64, |m, v| m.max(*v));
+        let level = (usize::BITS - 1 - (b1 - b0).leading_zeros()) as usize;
+        let row = &self.table[level];
+        edges.max(row[b0]).max(row[b1 - (1 << level)])
+    }
+}
+
+impl FreeMotion {
+    /// The largest |z̈| of the base over `[a, b]` (m/s²).
+    pub fn base_peak(&self, a: f64, b: f64) -> f64 {
+        self.peaks.between(a, b)
+    }
+}
+
+impl Group {
+    /// Mechanical energy (kinetic and springs, about the rest state) of the
+    /// interleaved state `x`.
+    pub fn energy(&self, x: &[f64]) -> f64 {
+        let u = |i: usize| x[2 * i] - self.rest[2 * i];
+        let mut e = 0.0;
+        for j in 0..self.mass.len() {
+            let v = x[2 * j + 1];
+            e += 0.5 * self.mass[j] * v * v + 0.5 * self.stiffness[j] * u(j) * u(j);
+        }
+        for &(a, b, k, _) in &self.couplings {
+            let du = u(b) - u(a);
+            e += 0.5 * k * du * du;
+        }
+        e
+    }
+
+    /// `G` of the module notes while the base's |z̈| stays below `zdd`: `√E`
+    /// grows at most this fast (√J/s).
+    pub fn growth(&self, zdd: f64) -> f64 {
+        self.force_amplitude
+            .iter()
+            .zip(&self.mass)
+            .map(|(p, m)| 0.5 * (m * zdd + p) * (2.0 / m).sqrt())
+            .sum()
+    }
+
+    /// Largest |acceleration| of body `j` (index in the group) while the
+    /// group's energy stays below `e_max` and the base's |z̈| below `zdd`
+    /// (m/s²).
+    pub fn acceleration_bound(&self, j: usize, e_max: f64, zdd: f64) -> f64 {
+        let speed = |i: usize| (2.0 * e_max / self.mass[i]).sqrt();
+        let mut f = (2.0 * self.stiffness[j] * e_max).sqrt()
+            + self.damping[j] * speed(j)
+            + self.mass[j] * zdd
+            + self.force_amplitude[j];
+        for &(a, b, k, c) in &self.couplings {
+            if a == j || b == j {
+                f += (2.0 * k * e_max).sqrt() + c * (speed(a) + speed(b));
+            }
+        }
+        f / self.mass[j]
+    }
+}
