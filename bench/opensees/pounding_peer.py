@@ -30,8 +30,7 @@ too: their difference over the storey's yield drift within 1 % (a residual
 drift can be near zero, so relative to itself it is reported but not
 judged); OpenSees' steps down to dt_rec / 64, and its agreement also at
 its own converged step (the coarsest within 1 % of its finest run);
-vibroimpact's integrator global only (the local one refuses yielding
-storeys); then OpenSees' convergence with the storeys Bouc-Wen (``BoucWen``,
+vibroimpact's integrator global or local; then OpenSees' convergence with the storeys Bouc-Wen (``BoucWen``,
 first order in the step: not timed); writes
 ``results/inelastic-pounding-<date>.json``.
 
@@ -197,8 +196,7 @@ def study(name, pair, text, record, quick):
 
     ours = []
     print(f"vibroimpact settings (pounding run alone, median of {repeats}):")
-    # The local integrator refuses yielding storeys (docs/decisions.md D26).
-    for integrator in ("global",) if uy else ("global", "local"):
+    for integrator in ("global", "local"):
         for method in ("dop853", "dopri5"):
             for rtol in (1e-3, 1e-4, 1e-6, 1e-8):
                 for div in (1, 2, 4):

@@ -39,6 +39,7 @@ use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
 
 mod local;
+mod storeys;
 
 #[derive(Parser, Debug)]
 #[command(about = "Benchmarks of vibroimpact against SUNDIALS and SciPy on reference problem R2")]
@@ -52,7 +53,8 @@ struct Args {
     /// Write the results as JSON here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Run only one section: n3, n1000, scaling, shooting or local.
+    /// Run only one section: n3, n1000, scaling, shooting, local or
+    /// storeys.
     #[arg(long)]
     only: Option<String>,
 }
@@ -502,6 +504,9 @@ fn main() {
     }
     if run("local") {
         results.insert("local".into(), local::run(peers.as_ref(), args.quick));
+    }
+    if run("storeys") {
+        results.insert("storeys".into(), storeys::run(args.quick));
     }
     if let Some(out) = &args.out {
         let text = serde_json::to_string_pretty(&Value::Object(results)).expect("serialisable");

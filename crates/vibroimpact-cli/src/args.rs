@@ -38,7 +38,8 @@ impl MethodName {
 /// `--integrator`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum IntegratorName {
-    /// Local from 16 groups of bodies (joined by springs) up, global below
+    /// Local from 16 groups of bodies (joined by springs) up, unless a
+    /// record moves the base; global otherwise
     Auto,
     /// Every body integrated at every step.
     Global,

@@ -470,8 +470,8 @@ fn stiff_models_end_early_with_the_reason() {
 
 /// `Integrator::Auto` is the local integrator from [`AUTO_LOCAL_GROUPS`]
 /// groups up (the same bytes as asking for it) and the global one below,
-/// or where an undamped group is forced harmonically (its free motion may
-/// have no steady state).
+/// where an undamped group is forced harmonically (its free motion may
+/// have no steady state) or under a record.
 #[test]
 fn auto_chooses_the_integrator_by_groups() {
     let auto = |m: &Model| Integrator::Auto.resolve(m);
@@ -503,6 +503,13 @@ fn auto_chooses_the_integrator_by_groups() {
     };
     assert_eq!(auto(&undamped(harmonic)), Integrator::Global);
     assert_eq!(auto(&undamped(BaseExcitation::None)), Integrator::Local);
+    // A record moves every group: global (docs/decisions.md D26).
+    let record =
+        crate::model::Accelerogram::new(vec![0.0, 0.01, 0.02], vec![0.0, 1.0, 0.0], 1.0).unwrap();
+    assert_eq!(
+        auto(&undamped(BaseExcitation::Record(record))),
+        Integrator::Global
+    );
     let chain = crate::reference::struck_chain(AUTO_LOCAL_GROUPS, 1.0).unwrap();
     assert_eq!(auto(&chain), Integrator::Local);
     let opts = |integrator| SimulationOptions {

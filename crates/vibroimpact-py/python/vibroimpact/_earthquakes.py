@@ -222,7 +222,8 @@ def pounding(
     "dop853", or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the
     record's samples limit the step; peaks within 1 % there,
     docs/earthquakes.md). ``integrator="local"``: each frame moves exactly
-    between poundings, per record sample. ``free=False`` runs the row with
+    between poundings and away from yield, per record sample ("auto": the
+    global integrator, the faster under a record). ``free=False`` runs the row with
     its contacts only (half the work; no ``free``, ``amplification`` or
     ``joints``). ``gaps`` and ``ratios`` (``"FROM:TO:N"`` or lists of
     values): the pounding spectrum of a pair over gaps (m) × period ratios
