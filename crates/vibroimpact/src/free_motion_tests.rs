@@ -366,22 +366,18 @@ fn a_records_peak_over_a_stretch() {
 /// own speed, and stays so; unbalanced forces on it are refused.
 #[test]
 fn constant_forces_set_the_rest_state() {
-    let single = Model::new(
-        vec![Body {
-            name: "m".into(),
-            mass: 2.0,
-            stiffness: 50.0,
-            damping: 0.0,
-        }],
-        vec![],
-        vec![],
-        BaseExcitation::None,
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
-    let mut free = FreeMotion::new(&single).unwrap();
+    let undamped = |name: &str, mass: f64, stiffness: f64| Body {
+        name: name.into(),
+        mass,
+        stiffness,
+        damping: 0.0,
+    };
+    let motion = |bodies: Vec<Body>, couplings: Vec<Coupling>| {
+        let none = BaseExcitation::None;
+        let model = Model::new(bodies, couplings, vec![], none, vec![], vec![], vec![]).unwrap();
+        FreeMotion::new(&model).unwrap()
+    };
+    let mut free = motion(vec![undamped("m", 2.0, 50.0)], vec![]);
     free.set_rest(0, &[3.0]).unwrap();
     let (rest, w) = (3.0 / 50.0, 5.0f64);
     for t in [0.1, 1.3, 7.7] {
@@ -390,35 +386,14 @@ fn constant_forces_set_the_rest_state() {
         let u = rest + (0.01 - rest) * (w * t).cos();
         assert!((x[0] - u).abs() < 1e-12, "{} vs {u}", x[0]);
     }
-    let pair = Model::new(
-        vec![
-            Body {
-                name: "a".into(),
-                mass: 1.0,
-                stiffness: 0.0,
-                damping: 0.0,
-            },
-            Body {
-                name: "b".into(),
-                mass: 1.0,
-                stiffness: 0.0,
-                damping: 0.0,
-            },
-        ],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 40.0,
-            damping: 0.5,
-        }],
-        vec![],
-        BaseExcitation::None,
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap();
-    let mut free = FreeMotion::new(&pair).unwrap();
+    let coupling = Coupling {
+        a: 0,
+        b: 1,
+        stiffness: 40.0,
+        damping: 0.5,
+    };
+    let bodies = vec![undamped("a", 1.0, 0.0), undamped("b", 1.0, 0.0)];
+    let mut free = motion(bodies, vec![coupling]);
     free.set_rest(0, &[-2.0, 2.0]).unwrap();
     let mut x = vec![-0.025, 0.3, 0.025, 0.3];
     free.propagate(0, 0.0, 2.0, &mut x);

@@ -302,6 +302,21 @@ fn pace(
     None
 }
 
+/// Why the run ends after the set's `steps`-th step (kept or taken
+/// again) at `t`, if it does: past the step limit, or its pace.
+fn counted(
+    run: &Run,
+    (method, opts): (Method, &SimulationOptions),
+    (t, steps): (f64, u64),
+) -> Option<IntegrationError> {
+    if steps > opts.max_steps {
+        return Some(IntegrationError::TooManySteps { t, steps });
+    }
+    run.set
+        .as_ref()
+        .and_then(|set| pace(set, method, opts, steps))
+}
+
 /// Simulates `model` over `[0, opts.t_end]` by the local integrator,
 /// handing samples to `record` as [`simulate_streaming`] does.
 pub(in crate::simulate) fn run(
@@ -315,7 +330,7 @@ pub(in crate::simulate) fn run(
 ) -> Result<LocalRun, OptionsError> {
     check_request(model, opts, method, tape, tangents)?;
     let mut run = Run::new(model, opts, method, (y0, tangents), breakpoints, tape)?;
-    let (n, nc) = (model.bodies().len(), model.contacts().len());
+    let n = model.bodies().len();
     let mut out = LocalRun {
         t: 0.0,
         y: y0.to_vec(),
@@ -355,19 +370,7 @@ pub(in crate::simulate) fn run(
             }
         }
     };
-    // Contacts active at the start, and storeys near yield or integrated
-    // throughout, form the first set; the others are scheduled.
-    let checked = (0..model.storeys().len())
-        .filter(|&s| Run::checked_storey(model, s))
-        .map(|s| nc + s);
-    for k in (0..nc).chain(checked) {
-        if !run.touches_set(k) && run.schedule(k, 0.0) {
-            if let Err(e) = run.join(k, 0.0) {
-                out.error = Some(e);
-                break;
-            }
-        }
-    }
+    out.error = run.first_set().err();
     let mut pending: Crossing = None;
     let mut t = 0.0;
     let mut steps: u64 = 0;
@@ -423,30 +426,14 @@ pub(in crate::simulate) fn run(
             Ok(Stepped::RolledBack) => {}
             Ok(Stepped::Retaken) => {
                 steps += 1;
-                if steps > opts.max_steps {
-                    out.error = Some(IntegrationError::TooManySteps { t, steps });
-                    break;
-                }
-                if let Some(e) = run
-                    .set
-                    .as_ref()
-                    .and_then(|set| pace(set, method, opts, steps))
-                {
+                if let Some(e) = counted(&run, (method, opts), (t, steps)) {
                     out.error = Some(e);
                     break;
                 }
             }
             Ok(Stepped::Kept(reached)) => {
                 steps += 1;
-                if steps > opts.max_steps {
-                    out.error = Some(IntegrationError::TooManySteps { t, steps });
-                    break;
-                }
-                if let Some(e) = run
-                    .set
-                    .as_ref()
-                    .and_then(|set| pace(set, method, opts, steps))
-                {
+                if let Some(e) = counted(&run, (method, opts), (t, steps)) {
                     out.error = Some(e);
                     break;
                 }
@@ -705,6 +692,22 @@ impl<'a> Run<'a> {
             run.extrema = Some(LocalExtrema::new(window, model, &run.free, s_on));
         }
         Ok(run)
+    }
+
+    /// The first set at t = 0: the contacts active there, and the storeys
+    /// near yield or integrated throughout; every other check scheduled.
+    fn first_set(&mut self) -> Result<(), IntegrationError> {
+        let model = self.model;
+        let nc = model.contacts().len();
+        let checked = (0..model.storeys().len())
+            .filter(|&s| Run::checked_storey(model, s))
+            .map(|s| nc + s);
+        for k in (0..nc).chain(checked) {
+            if !self.touches_set(k) && self.schedule(k, 0.0) {
+                self.join(k, 0.0)?;
+            }
+        }
+        Ok(())
     }
 
     /// The run's result at its end `t` (where it stopped): the state, the

@@ -2,23 +2,10 @@
 //! runs, exact motion about a storey's rest state after it yielded, the
 //! Bouc–Wen groups integrated throughout, rows and isolated buildings.
 
+use super::tests::difference;
 use super::*;
+use crate::pounding::tests::record;
 use crate::pounding::{parse_row, Response, Row, RunSettings};
-use crate::record::Record;
-
-/// A 12-s record: a 1.5 Hz and a 3.2 Hz burst (m/s², dt 0.01).
-fn record() -> Record {
-    let times: Vec<f64> = (0..=1200).map(|k| k as f64 * 0.01).collect();
-    let a: Vec<f64> = times
-        .iter()
-        .map(|t| {
-            let env = (-((t - 4.0) / 2.0).powi(2)).exp();
-            env * (2.0 * (2.0 * std::f64::consts::PI * 1.5 * t).sin()
-                + 1.2 * (2.0 * std::f64::consts::PI * 3.2 * t).sin())
-        })
-        .collect();
-    Record::from_samples("burst", times, &a).unwrap()
-}
 
 const HERTZ: &str = "law = { law = \"hertz\", stiffness = 1e9, exponent = 1.5 }\n";
 const BILINEAR: &str = "{ law = \"bilinear\", yield_drift = YD, post_yield_ratio = 0.05 }";
@@ -57,19 +44,6 @@ fn both(model: &Model, rtol: f64) -> (Simulation, Simulation) {
         sim
     };
     (run(Integrator::Global), run(Integrator::Local))
-}
-
-/// Largest difference of the final states, relative to each row's (u or
-/// v) largest value in the global run.
-fn difference(g: &Simulation, l: &Simulation) -> f64 {
-    let rel = |x: &[f64], y: &[f64]| {
-        let scale = x.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
-        x.iter()
-            .zip(y)
-            .map(|(p, q)| (p - q).abs() / scale)
-            .fold(0.0, f64::max)
-    };
-    rel(&g.final_displacement, &l.final_displacement).max(rel(&g.final_velocity, &l.final_velocity))
 }
 
 /// A yielding frame pounding an elastic one: the local integrator logs

@@ -66,7 +66,7 @@ fn pounding_pair(duration: f64) -> Model {
 
 /// Largest difference of two final states relative to the largest
 /// displacement (u rows) and velocity (v rows) of the first.
-fn difference(a: &Simulation, b: &Simulation) -> f64 {
+pub(super) fn difference(a: &Simulation, b: &Simulation) -> f64 {
     let rel = |x: &[f64], y: &[f64]| {
         let scale = x.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
         x.iter()

@@ -708,7 +708,7 @@ pub mod documents;
 
 #[cfg(test)]
 #[path = "pounding_tests.rs"]
-mod tests;
+pub(crate) mod tests;
 
 #[cfg(test)]
 #[path = "pounding_row_tests.rs"]

@@ -16,7 +16,7 @@ fn frame(n: usize, m: f64, k: f64) -> ShearFrame {
 }
 
 /// A 12-s record: a 1.5 Hz and a 3.2 Hz burst (m/s², dt 0.01).
-fn record() -> Record {
+pub(crate) fn record() -> Record {
     let times: Vec<f64> = (0..=1200).map(|k| k as f64 * 0.01).collect();
     let a: Vec<f64> = times
         .iter()
