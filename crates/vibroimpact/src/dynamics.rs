@@ -5,7 +5,8 @@
 //! Interleaved, `y = [u_1, v_1, u_2, v_2, …, u_N, v_N]`, so that a chain whose
 //! couplings and contacts join bodies at most `d` apart has a banded
 //! Jacobian with lower/upper bandwidths `(2d + 1, 2d)` (`(1, 1)` without
-//! couplings). With the energy audit on, three quadratures follow:
+//! couplings). The Bouc–Wen storeys' states follow (`dynamics_storeys.rs`);
+//! with the energy audit on, three quadratures come last:
 //! `W` (work of the excitation), `D_c` (dissipation of the dampers) and
 //! `D_k` (dissipation of the contacts), so that
 //! `E(t) + D_c + D_k + D_h - W = E(0)` with the mechanical energy
@@ -156,7 +157,8 @@ struct ScreenSoA {
 }
 
 impl ChainDynamics {
-    /// The dynamics of `model`; `energy` appends the three energy quadratures.
+    /// The dynamics of `model`; `energy` appends the three energy
+    /// quadratures (after the storeys' states: [`Self::audit_index`]).
     pub fn new(model: &Model, energy: bool) -> Self {
         let bodies = model.bodies();
         let n = bodies.len();
@@ -192,8 +194,9 @@ impl ChainDynamics {
                 }
             })
             .collect::<Vec<_>>();
-        let first_state = 2 * n + if energy { 3 } else { 0 };
-        let storeys = StoreyTerms::new(model.storeys(), first_state, model.initial_displacement());
+        // The storeys' states right after (u, v), the audit's quadratures
+        // last: an error norm over the first components covers them.
+        let storeys = StoreyTerms::new(model.storeys(), 2 * n, model.initial_displacement());
         let mut reach = storeys.reach();
         for c in model.couplings() {
             reach = reach.max(c.a.abs_diff(c.b));
@@ -307,6 +310,12 @@ impl ChainDynamics {
     /// Sets the onset approach velocity of contact k's current impact.
     pub fn set_onset_velocity(&mut self, k: usize, v: f64) {
         self.onset_velocity[k] = v;
+    }
+
+    /// Where the energy quadratures begin in the state (after the bodies'
+    /// (u, v) and the storeys' states).
+    pub fn audit_index(&self) -> usize {
+        2 * self.n + self.storeys.states()
     }
 
     /// The initial ODE state of a model (interleaved, energy quadratures 0).
@@ -602,7 +611,7 @@ impl OdeSystem for ChainDynamics {
                 input -= self.mass[i] * zdd * v;
                 damper += self.damping[i] * v * v;
             }
-            let m = 2 * n;
+            let m = self.audit_index();
             dydt[m] = input;
             dydt[m + 1] = damper;
             dydt[m + 2] = contact;

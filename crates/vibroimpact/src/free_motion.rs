@@ -87,8 +87,9 @@ pub struct Group {
     /// sample step, computed once.
     hold_step: Option<HoldStep>,
     /// The static rest state of its storeys' constant forces
-    /// (interleaved; zero without storeys).
+    /// (interleaved; zero without storeys), and those forces.
     rest: Vec<f64>,
+    rest_forces: Vec<f64>,
 }
 
 /// The first-order-hold step of one record sample interval `τ`: `x(b) =
@@ -379,6 +380,7 @@ impl FreeMotion {
             modal: None,
             hold_step: None,
             rest: vec![0.0; 2 * m],
+            rest_forces: vec![0.0; m],
         })
     }
 
@@ -394,14 +396,18 @@ impl FreeMotion {
 
     /// Sets group `g`'s rest state to the static displacement under the
     /// constant forces `f` on its bodies (N, the group's order): `K u_s =
-    /// f`. A group without ground springs is solved in the least-squares
+    /// f` (solved again only if `f` changed). A group without ground springs is solved in the least-squares
     /// sense (its storeys' forces act in pairs, within the range of `K`).
     /// Errors with the residual if `f` is not balanced by the springs.
     pub fn set_rest(&mut self, g: usize, f: &[f64]) -> Result<(), f64> {
         let group = &mut self.groups[g];
         let m = group.bodies.len();
+        if f == group.rest_forces.as_slice() {
+            return Ok(());
+        }
         if f.iter().all(|&x| x == 0.0) {
             group.rest.fill(0.0);
+            group.rest_forces.fill(0.0);
             return Ok(());
         }
         let mut k = DMatrix::<f64>::zeros(m, m);
@@ -430,6 +436,7 @@ impl FreeMotion {
             group.rest[2 * j] = u[j];
             group.rest[2 * j + 1] = 0.0;
         }
+        group.rest_forces.copy_from_slice(f);
         Ok(())
     }
 

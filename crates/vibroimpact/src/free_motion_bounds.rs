@@ -7,8 +7,8 @@
 //! `√(2E_H/m_i)` and every spring force at most `√(2 k E_H)` with `√E_H =
 //! √E₀ + G H`. The largest force `|f_i|max` is `m_i |z̈|max + Σ|P|` of the
 //! body's harmonic forces, with `|z̈|max` the base's largest over the
-//! horizon alone ([`Peaks`]): a record's quiet stretches bound the motion
-//! as tightly as the record's strong part does not.
+//! horizon alone ([`Peaks`]): over a record's quiet stretches the bound is
+//! as tight as they are quiet, not as loose as the record's strongest part.
 
 use super::{FreeMotion, Group};
 use crate::model::BaseExcitation;
@@ -63,19 +63,17 @@ impl Peaks {
         }
     }
 
-    /// The largest |z̈| over `[a, b]` (zero outside a record; the samples
-    /// around `a` and `b` count, the interpolant being linear between
-    /// samples).
+    /// The largest |z̈| over `[a, b]`: for a record, the largest of the
+    /// samples that bracket the stretch (the interpolant is linear between
+    /// samples; beyond the record's ends, where z̈ is zero, its end samples
+    /// still count: a bound); otherwise the base's peak.
     pub(super) fn between(&self, a: f64, b: f64) -> f64 {
         if self.times.is_empty() {
             return self.constant;
         }
         let n = self.times.len();
         let i0 = self.times.partition_point(|&s| s <= a).saturating_sub(1);
-        let i1 = self.times.partition_point(|&s| s < b).min(n - 1);
-        if i1 < i0 {
-            return 0.0;
-        }
+        let i1 = self.times.partition_point(|&s| s < b).min(n - 1).max(i0);
         let (b0, b1) = (i0.div_ceil(BLOCK), (i1 + 1) / BLOCK);
         if b0 >= b1 {
             return self.values[i0..=i1].iter().fold(0.0f64, |m, v| m.max(*v));
@@ -111,6 +109,13 @@ impl Group {
             e += 0.5 * k * du * du;
         }
         e
+    }
+
+    /// The energy bound `E_H = (√E + G H)²` over `horizon` from the
+    /// interleaved state `x`, the base's |z̈| below `zdd`.
+    pub fn energy_ahead(&self, x: &[f64], horizon: f64, zdd: f64) -> f64 {
+        let root = self.energy(x).sqrt() + self.growth(zdd) * horizon;
+        root * root
     }
 
     /// `G` of the module notes while the base's |z̈| stays below `zdd`: `√E`

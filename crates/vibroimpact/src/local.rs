@@ -434,8 +434,7 @@ impl Run<'_> {
             s0 += sign * x[2 * j];
             sd0 += sign * x[2 * j + 1];
             let group = &self.free.groups()[g];
-            let root = group.energy(x).sqrt() + group.growth(zdd) * horizon;
-            acc += group.acceleration_bound(j, root * root, zdd);
+            acc += group.acceleration_bound(j, group.energy_ahead(x, horizon, zdd), zdd);
         }
         if !(s0.is_finite() && sd0.is_finite() && acc.is_finite()) {
             return None;

@@ -145,11 +145,11 @@ impl Run<'_> {
         }
     }
 
-    /// Adds the set's quadratures (the three components after its state in
-    /// `y`, `bodies` bodies) to the audit.
-    pub(super) fn energy_of_set(&mut self, y: &[f64], bodies: usize) {
+    /// Adds the set's quadratures (the three components from `at` in its
+    /// state `y`) to the audit.
+    pub(super) fn energy_of_set(&mut self, y: &[f64], at: usize) {
         if let Some(energy) = self.energy.as_mut() {
-            for (s, q) in energy.sums.iter_mut().zip(&y[2 * bodies..2 * bodies + 3]) {
+            for (s, q) in energy.sums.iter_mut().zip(&y[at..at + 3]) {
                 *s += q;
             }
         }

@@ -71,9 +71,13 @@ impl Run<'_> {
         let energy = self.energy.is_some();
         let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
         let mut sys = Variational::new(chain, self.columns);
-        // (No tangent columns with storeys: their Bouc–Wen states follow
-        // the audit's quadratures.)
+        // The storeys' Bouc–Wen states after the bodies', then the audit's
+        // quadratures (from 0: the old set's are in the sums). (No tangent
+        // columns with either.)
         self.load_storeys(&mut sys, &storeys, &mut y);
+        if energy {
+            y.extend([0.0; 3]);
+        }
         let trackers = ids
             .iter()
             .enumerate()
@@ -90,7 +94,7 @@ impl Run<'_> {
             atol: self.opts.atol,
             max_steps: self.opts.max_steps,
             h_init: old.h_prev,
-            error_components: energy.then_some(2 * bodies.len()),
+            error_components: energy.then_some(sys.chain().audit_index()),
             interrupt: self.opts.interrupt.clone(),
             ..IntegratorOptions::default()
         };
@@ -191,7 +195,7 @@ impl Run<'_> {
             }
             self.contact_evaluations += old.sys.chain().contact_evaluations();
             let old_y = old.st.y().to_vec();
-            self.energy_of_set(&old_y, old.bodies.len());
+            self.energy_of_set(&old_y, old.sys.chain().audit_index());
             for &i in &old.bodies {
                 self.slot[i] = None;
             }
@@ -268,11 +272,6 @@ impl Run<'_> {
             };
             y[2 * j] = u;
             y[2 * j + 1] = v;
-        }
-        // The audit's quadratures after the state (from 0: the old set's
-        // are in the sums).
-        if self.energy.is_some() {
-            y.extend([0.0; 3]);
         }
         // Tangent columns after the state: rows from the old set, or
         // from the joining groups' exact homogeneous motion.
@@ -369,21 +368,26 @@ impl Run<'_> {
         let storey_ids: Vec<usize> = (0..model.storeys().len())
             .filter(|&s| self.slot[model.storeys()[s].above].is_some())
             .collect();
+        // A storey joins bodies of one group: both in the set.
+        let slot = |i: usize| {
+            self.slot[i].ok_or_else(|| {
+                IntegrationError::InvalidOptions(format!(
+                    "a storey of {} reaches outside the integrated set (internal error)",
+                    model.bodies()[i].name
+                ))
+            })
+        };
         let storeys = storey_ids
             .iter()
             .map(|&s| &model.storeys()[s])
-            .filter_map(|s| {
-                let below = match s.below {
-                    Some(b) => Some(self.slot[b]?),
-                    None => None,
-                };
-                Some(Storey {
-                    below,
-                    above: self.slot[s.above]?,
+            .map(|s| {
+                Ok(Storey {
+                    below: s.below.map(slot).transpose()?,
+                    above: slot(s.above)?,
                     law: s.law,
                 })
             })
-            .collect();
+            .collect::<Result<Vec<_>, IntegrationError>>()?;
         let sub = Model::new(
             sub_bodies,
             couplings,

@@ -148,11 +148,10 @@ impl Run<'_> {
             let mut y = vec![0.0; set.st.y().len()];
             set.st.dense_output(&mut set.sys, t, &mut y);
             put_rows(&set.bodies, &y, out);
-            let terms = set.sys.chain().storeys();
-            for (ks, &s) in set.storeys.iter().enumerate().filter(|_| hysteretic) {
-                if let (Some(i), Some(w)) = (terms.state_index(ks), self.storeys.state_index(s)) {
-                    out[w..w + 2].copy_from_slice(&y[i..i + 2]);
-                }
+            let places =
+                storeys::hysteretic_places(set.sys.chain().storeys(), &self.storeys, &set.storeys);
+            for (i, w) in places.filter(|_| hysteretic) {
+                out[w..w + 2].copy_from_slice(&y[i..i + 2]);
             }
         }
     }
@@ -664,13 +663,12 @@ impl<'a> Run<'a> {
         };
         // Every group with storeys on linear branches moves about its rest
         // state (one with a Bouc–Wen storey joins the set at once).
-        let mut nonlinear = vec![false; ng];
-        for (s, st) in model.storeys().iter().enumerate() {
-            nonlinear[run.free.place(st.above).0] |= run.storeys.linear_force(s).is_none();
-        }
-        for st in model.storeys() {
-            let g = run.free.place(st.above).0;
-            if !nonlinear[g] {
+        for g in 0..ng {
+            let storeys = &run.group_storeys[g];
+            let linear = storeys
+                .iter()
+                .all(|&s| run.storeys.linear_force(s).is_some());
+            if !storeys.is_empty() && linear {
                 run.settle_rest(g)
                     .map_err(|e| OptionsError(e.to_string()))?;
             }
@@ -736,7 +734,7 @@ impl<'a> Run<'a> {
             }
         }
         if let Some(mut set) = run.set.take() {
-            run.energy_of_set(set.st.y(), set.bodies.len());
+            run.energy_of_set(set.st.y(), set.sys.chain().audit_index());
             run.absorb(&mut set);
             if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
                 ex.merge(&set, scan);

@@ -286,8 +286,13 @@ impl Run<'_> {
         freed.sort_unstable();
         freed.dedup();
         for k in freed {
-            if !self.touches_set(k) && self.schedule(k, t) && first.is_none() {
-                first = Some((t, k));
+            if !self.touches_set(k) && self.schedule(k, t) {
+                match first {
+                    None => first = Some((t, k)),
+                    // Another active at once: due at t (its check would
+                    // otherwise be lost, `schedule` queues none).
+                    Some(_) => self.queue.push(Reverse((Time(t), k, self.generation[k]))),
+                }
             }
         }
         Ok(first)

@@ -26,6 +26,20 @@ use crate::hysteresis::StoreyLaw;
 /// the checks of a storey that swings just below yield do not crawl.
 pub(super) const YIELD_APPROACH: f64 = 0.02;
 
+/// Where the Bouc–Wen states (z, e) of a set's storeys sit: (index in the
+/// set's state by its terms `set`, index in the whole extended state by
+/// the run's terms `whole`), for the set's `storeys` (model indices).
+pub(super) fn hysteretic_places<'a>(
+    set: &'a StoreyTerms,
+    whole: &'a StoreyTerms,
+    storeys: &'a [usize],
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    storeys
+        .iter()
+        .enumerate()
+        .filter_map(|(ks, &s)| Some((set.state_index(ks)?, whole.state_index(s)?)))
+}
+
 impl Run<'_> {
     /// The bodies of check k: a contact's sides, or a storey's (above,
     /// below).
@@ -64,10 +78,13 @@ impl Run<'_> {
         let of = |j: Option<usize>, r: usize| j.map_or(0.0, |j| x[2 * j + r]);
         let (d, dd) = (x[2 * ja] - of(jb, 0), x[2 * ja + 1] - of(jb, 1));
         let group = &self.free.groups()[g];
-        let root = group.energy(x).sqrt() + group.growth(zdd) * horizon;
-        let e = root * root;
-        let bound = |j: usize| group.acceleration_bound(j, e, zdd);
-        let acc = bound(ja) + jb.map_or(0.0, bound);
+        let e = group.energy_ahead(x, horizon, zdd);
+        // Between two bodies the base's acceleration cancels in the drift's
+        // (it still feeds the energy); to the ground it does not.
+        let acc = match jb {
+            Some(jb) => group.acceleration_bound(ja, e, 0.0) + group.acceleration_bound(jb, e, 0.0),
+            None => group.acceleration_bound(ja, e, zdd),
+        };
         if !(d.is_finite() && dd.is_finite() && acc.is_finite()) {
             return None;
         }
@@ -78,14 +95,12 @@ impl Run<'_> {
     }
 
     /// Sets group `g`'s rest state from its storeys' constant forces (each
-    /// on a linear branch).
+    /// on a linear branch; an elastic law's is zero).
     pub(super) fn settle_rest(&mut self, g: usize) -> Result<(), IntegrationError> {
         let first = self.free.groups()[g].bodies()[0];
         let mut f = vec![0.0; self.free.groups()[g].bodies().len()];
-        for (s, st) in self.model.storeys().iter().enumerate() {
-            if self.free.place(st.above).0 != g {
-                continue;
-            }
+        for &s in &self.group_storeys[g] {
+            let st = &self.model.storeys()[s];
             let f0 = self.storeys.linear_force(s).ok_or_else(|| {
                 IntegrationError::InvalidOptions(format!(
                     "storey {}: not on a linear branch where its group was to move exactly (internal error)",
@@ -115,14 +130,15 @@ impl Run<'_> {
         let first = 2 * self.model.bodies().len();
         for (ks, &s) in set.storeys.iter().enumerate() {
             self.storeys.set_branch(s, terms.branch(ks));
-            if let (Some(i), Some(w)) = (terms.state_index(ks), self.storeys.state_index(s)) {
-                self.hysteretic[w - first..w - first + 2].copy_from_slice(&y[i..i + 2]);
-            }
+        }
+        for (i, w) in hysteretic_places(terms, &self.storeys, &set.storeys) {
+            self.hysteretic[w - first..w - first + 2].copy_from_slice(&y[i..i + 2]);
         }
     }
 
     /// Gives a new set's system its storeys' memory (`storeys`, model
-    /// indices) and appends their Bouc–Wen states to its state `y`.
+    /// indices) and appends their Bouc–Wen states to its state `y` (the
+    /// bodies' (u, v) so far).
     pub(super) fn load_storeys(&self, sys: &mut SetSystem, storeys: &[usize], y: &mut Vec<f64>) {
         let first = 2 * self.model.bodies().len();
         let terms = sys.chain_mut().storeys_mut();
@@ -130,10 +146,8 @@ impl Run<'_> {
             terms.set_branch(ks, self.storeys.branch(s));
         }
         y.resize(y.len() + terms.states(), 0.0);
-        for (ks, &s) in storeys.iter().enumerate() {
-            if let (Some(i), Some(w)) = (terms.state_index(ks), self.storeys.state_index(s)) {
-                y[i..i + 2].copy_from_slice(&self.hysteretic[w - first..w - first + 2]);
-            }
+        for (i, w) in hysteretic_places(terms, &self.storeys, storeys) {
+            y[i..i + 2].copy_from_slice(&self.hysteretic[w - first..w - first + 2]);
         }
     }
 

@@ -26,7 +26,8 @@ pub fn simulate_streaming(
         rtol: opts.rtol,
         atol: opts.atol,
         max_steps: opts.max_steps,
-        error_components: opts.energy.then_some(n2),
+        // Not the audit's quadratures (the storeys' states come before).
+        error_components: opts.energy.then_some(sys.audit_index()),
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
@@ -371,12 +372,13 @@ fn global_result(
     let y = st.y().to_vec();
     let mut impacts = scan.impacts;
     by_start(&mut impacts);
+    let q = sys.audit_index();
     let energy = opts.energy.then(|| EnergyBalance {
         initial: e0,
         mechanical: sys.mechanical_energy(&y),
-        input_work: y[n2],
-        damping_dissipation: y[n2 + 1],
-        contact_dissipation: y[n2 + 2],
+        input_work: y[q],
+        damping_dissipation: y[q + 1],
+        contact_dissipation: y[q + 2],
         hysteretic_dissipation: sys.storeys().dissipated(&y),
     });
     let error = error.map(|source| {

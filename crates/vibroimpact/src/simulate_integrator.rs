@@ -41,7 +41,7 @@ impl Integrator {
     /// under harmonic forcing) and no recorded base motion, global
     /// otherwise; the others are themselves. (A record moves every group
     /// and the global integrator steps at its samples anyway: rows of 16
-    /// and 64 buildings ran 4.0–6.8× slower locally, docs/decisions.md D26.)
+    /// and 64 buildings ran 3.9–6.6× slower locally, docs/decisions.md D26.)
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
             Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {
