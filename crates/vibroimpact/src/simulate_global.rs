@@ -39,16 +39,6 @@ pub fn simulate_streaming(
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
     let mut next_break = 0;
-    let mut scan = StepScan {
-        ids: (0..model.contacts().len()).collect(),
-        trackers: model
-            .contacts()
-            .iter()
-            .map(|c| Tracker::new(&c.law, opts.impact_force_threshold))
-            .collect(),
-        impacts: Vec::new(),
-        previous: Vec::new(),
-    };
     let mut output = Output::new(opts, (y0.len(), n2, model.storeys().len()), &mut sink);
     let mut sink_stopped = None;
     if opts.output_step.is_some() && opts.output_from == 0.0 {
@@ -59,18 +49,7 @@ pub fn simulate_streaming(
     }
     let e0 = sys.mechanical_energy(&y0);
     let mut error: Option<IntegrationError> = st.reset(&mut sys, 0.0, &y0).err();
-    scan.previous = (0..model.contacts().len())
-        .map(|k| contact_end(&sys, k, st.y(), st.dydt()))
-        .collect();
-    // Contacts already engaged at the start (s_on < s <= 0) begin an impact
-    // at t = 0.
-    if error.is_none() {
-        for k in 0..model.contacts().len() {
-            if scan.previous[k].0 > scan.trackers[k].s_on {
-                scan.start(&mut st, &mut sys, k, 0.0);
-            }
-        }
-    }
+    let mut scan = start_scan(model, opts, (&mut st, &mut sys), error.is_none());
     let mut extrema = match (opts.extrema_window, &error) {
         (Some(window), None) => {
             let s_on = scan.trackers.iter().map(|tr| tr.s_on).collect();
@@ -180,6 +159,37 @@ pub fn simulate_streaming(
         error,
         extrema,
     ))
+}
+
+/// The impact scan of a global run from the stepper's start: every
+/// contact tracked; if `started` (the stepper is at t = 0), those already
+/// engaged there (s_on < s <= 0) in an impact from t = 0.
+fn start_scan(
+    model: &Model,
+    opts: &SimulationOptions,
+    (st, sys): (&mut Stepper, &mut ChainDynamics),
+    started: bool,
+) -> StepScan {
+    let mut scan = StepScan {
+        ids: (0..model.contacts().len()).collect(),
+        trackers: model
+            .contacts()
+            .iter()
+            .map(|c| Tracker::new(&c.law, opts.impact_force_threshold))
+            .collect(),
+        impacts: Vec::new(),
+        previous: (0..model.contacts().len())
+            .map(|k| contact_end(sys, k, st.y(), st.dydt()))
+            .collect(),
+    };
+    if started {
+        for k in 0..model.contacts().len() {
+            if scan.previous[k].0 > scan.trackers[k].s_on {
+                scan.start(st, sys, k, 0.0);
+            }
+        }
+    }
+    scan
 }
 
 /// The checks of a run beyond the options' own: the output samples within
