@@ -68,7 +68,7 @@ from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_isolated import load, run, yield_drifts  # noqa: E402
 from opensees_pair import import_opensees  # noqa: E402
-from timing import Watch, retime, timed  # noqa: E402
+from timing import Watch, retime, scan_opensees, timed  # noqa: E402
 
 CASE = HERE / "isolated-moat.toml"
 SCALE = 2.2
@@ -228,29 +228,9 @@ def study(name, building, text, record, quick, waits):
     m = ok[0]["m"]
 
     repeats = 2 if quick else 5
-    variants = [
-        {"system": s, "algorithm": alg, "tol": tol, "integrator": "Newmark"}
-        for s in ("BandGeneral", "FullGeneral", "ProfileSPD", "UmfPack")
-        for alg in ("Newton", "ModifiedNewton", "KrylovNewton")
-        for tol in (1e-10, 1e-6)
-    ]
-    variants += [{"system": "BandGeneral", "algorithm": "Linear", "tol": 0.0, "integrator": "CentralDifference"}]
     waits.append({"before": f"{name}: OpenSees settings", **wait_idle()})
     print(f"OpenSees settings at dt = dt_rec/{m} (median of {repeats}); the explicit one at every step:")
-    settings = []
-    for v in variants:
-        steps = (1, 2, 4, 8, 16) if v["integrator"] == "CentralDifference" else (m,)
-        for mm in steps:
-            e = {}
-            try:
-                secs, o = timed(lambda: run(text, t, a, SCALE, rec_dt / mm, **v), repeats)
-                err, e = judged(o)
-            except (RuntimeError, ValueError) as ex:
-                secs, err = float("nan"), float("inf")
-                print(f"  {v} m={mm}: failed ({ex})")
-            else:
-                print(f"  {v} m={mm}: {secs * 1e3:8.2f} ms  error {err:.2e}")
-            settings.append({**v, "m": mm, "seconds": secs, "error": err, "errors": e})
+    settings = scan_opensees(lambda mm, v: run(text, t, a, SCALE, rec_dt / mm, **v), judged, m, repeats)
     best_os = min((s for s in settings if s["error"] <= TARGET_ACCURACY), key=lambda s: s["seconds"])
 
     waits.append({"before": f"{name}: vibroimpact settings", **wait_idle()})

@@ -79,6 +79,7 @@ from opensees_pair import (
     import_opensees,
     rayleigh,
     storey_material,
+    transient,
 )
 
 
@@ -228,17 +229,7 @@ def run(
             ops.recorder("EnvelopeElement", "-file", files["force"], "-precision", 12, "-ele", *gaps, "force")
             if impacts:
                 ops.recorder("Element", "-file", files["gaps"], "-precision", 12, "-ele", *gaps, "deformation")
-        ops.constraints("Plain")
-        ops.numberer("Plain")
-        ops.system(system)
-        if integrator == "CentralDifference":
-            ops.algorithm("Linear")
-            ops.integrator("CentralDifference")
-        else:
-            ops.test("NormDispIncr", tol, 50)
-            ops.algorithm(algorithm)
-            ops.integrator("Newmark", 0.5, 0.25)
-        ops.analysis("Transient")
+        transient(ops, system, algorithm, tol, integrator)
         status = ops.analyze(first, dt)
         if status == 0:
             ops.recorder("Element", "-file", files["window"], "-time", "-precision", 12, "-ele", *watched, "deformation")

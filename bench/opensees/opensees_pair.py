@@ -160,6 +160,23 @@ def add_storey(ops, new, below: int, node: int, k: float, law: Dict[str, Any], b
     return ele
 
 
+def transient(ops, system: str, algorithm: str, tol: float, integrator: str) -> None:
+    """The transient analysis of a model: the equation ``system``; Newmark's
+    average acceleration with a Newton ``algorithm`` and a displacement test
+    at ``tol``, or the explicit ``CentralDifference`` (linear algorithm)."""
+    ops.constraints("Plain")
+    ops.numberer("Plain")
+    ops.system(system)
+    if integrator == "CentralDifference":
+        ops.algorithm("Linear")
+        ops.integrator("CentralDifference")
+    else:
+        ops.test("NormDispIncr", tol, 50)
+        ops.algorithm(algorithm)
+        ops.integrator("Newmark", 0.5, 0.25)
+    ops.analysis("Transient")
+
+
 def contact_material(law: Dict[str, Any], gap: float):
     """The OpenSees uniaxial material (name, args) equal to a vibroimpact
     law; only the two laws OpenSees has exactly."""
@@ -253,17 +270,7 @@ def run(
         window_file = os.path.join(tmp, "window.out")
         ops.recorder("EnvelopeElement", "-file", drift_file, "-ele", *storeys, "deformation")
         ops.recorder("EnvelopeElement", "-file", force_file, "-ele", *gaps, "force")
-        ops.constraints("Plain")
-        ops.numberer("Plain")
-        ops.system(system)
-        if integrator == "CentralDifference":
-            ops.algorithm("Linear")
-            ops.integrator("CentralDifference")
-        else:
-            ops.test("NormDispIncr", tol, 50)
-            ops.algorithm(algorithm)
-            ops.integrator("Newmark", 0.5, 0.25)
-        ops.analysis("Transient")
+        transient(ops, system, algorithm, tol, integrator)
         if not yielding:
             status = ops.analyze(steps, dt)
         else:

@@ -61,7 +61,7 @@ import vibroimpact as vi  # noqa: E402
 from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_pair import import_opensees, inelastic, run  # noqa: E402
-from timing import Watch, retime, timed  # noqa: E402
+from timing import Watch, retime, scan_opensees, timed  # noqa: E402
 
 PAIR = ROOT / "examples" / "pounding-frames.toml"
 INELASTIC_PAIR = HERE / "inelastic-pair.toml"
@@ -169,28 +169,10 @@ def study(name, pair, text, record, quick):
     )
 
     repeats = 3 if quick else 7
-    settings = []
-    variants = [
-        {"system": s, "algorithm": alg, "tol": tol, "integrator": "Newmark"}
-        for s in ("BandGeneral", "FullGeneral", "ProfileSPD", "UmfPack")
-        for alg in ("Newton", "ModifiedNewton", "KrylovNewton")
-        for tol in (1e-10, 1e-6)
-    ]
-    variants += [{"system": "BandGeneral", "algorithm": "Linear", "tol": 0.0, "integrator": "CentralDifference"}]
     print(f"OpenSees settings at dt = dt_rec/{m} (median of {repeats}); the explicit one at every step:")
-    for v in variants:
-        steps = (1, 2, 4, 8, 16) if v["integrator"] == "CentralDifference" else (m,)
-        for mm in steps:
-            e = {}
-            try:
-                secs, o = timed(lambda: run(pair, t, a, 1.0, rec_dt / mm, **v), repeats)
-                err, e = judged(o)
-            except (RuntimeError, ValueError) as ex:
-                secs, err = float("nan"), float("inf")
-                print(f"  {v} m={mm}: failed ({ex})")
-            else:
-                print(f"  {v} m={mm}: {secs * 1e3:8.2f} ms  error {err:.2e}")
-            settings.append({**v, "m": mm, "seconds": secs, "error": err, **({"errors": e} if uy else {})})
+    settings = scan_opensees(
+        lambda mm, v: run(pair, t, a, 1.0, rec_dt / mm, **v), judged, m, repeats, keep_errors=bool(uy)
+    )
     ok = [s for s in settings if s["error"] <= TARGET_ACCURACY]
     best_os = min(ok, key=lambda s: s["seconds"])
 

@@ -1,6 +1,7 @@
 """Timing shared by the OpenSees studies (pounding_peer.py, isolated_peer.py):
-medians of repeated runs, the two best settings retimed alternately, and a
-watch that polls whether the machine is busy while a study runs. ``busy``
+medians of repeated runs, OpenSees' solver settings scanned, the two best
+settings retimed alternately, and a watch that polls whether the machine
+is busy while a study runs. ``busy``
 is each study's own test (a function returning the busy process ids)."""
 
 from __future__ import annotations
@@ -19,6 +20,41 @@ def timed(f, repeats):
         out = f()
         times.append(time.perf_counter() - t0)
     return statistics.median(times), out
+
+
+# OpenSees' settings both studies scan: every equation solver, Newton
+# variant and test tolerance with Newmark's average acceleration, and the
+# explicit CentralDifference.
+OPENSEES_VARIANTS = [
+    {"system": s, "algorithm": alg, "tol": tol, "integrator": "Newmark"}
+    for s in ("BandGeneral", "FullGeneral", "ProfileSPD", "UmfPack")
+    for alg in ("Newton", "ModifiedNewton", "KrylovNewton")
+    for tol in (1e-10, 1e-6)
+] + [{"system": "BandGeneral", "algorithm": "Linear", "tol": 0.0, "integrator": "CentralDifference"}]
+
+
+def scan_opensees(run_at, judged, m, repeats, keep_errors=True):
+    """Every one of ``OPENSEES_VARIANTS`` timed (median of ``repeats``) by
+    ``run_at(mm, variant)`` at the step dt_rec/``m`` (the explicit one at
+    dt_rec/1 ... dt_rec/16) and judged by ``judged(output) -> (error,
+    errors)``; a run that fails has an infinite error. Returns the
+    settings with their times and errors (``errors`` kept if
+    ``keep_errors``)."""
+    settings = []
+    for v in OPENSEES_VARIANTS:
+        steps = (1, 2, 4, 8, 16) if v["integrator"] == "CentralDifference" else (m,)
+        for mm in steps:
+            e = {}
+            try:
+                secs, o = timed(lambda: run_at(mm, v), repeats)
+                err, e = judged(o)
+            except (RuntimeError, ValueError) as ex:
+                secs, err = float("nan"), float("inf")
+                print(f"  {v} m={mm}: failed ({ex})")
+            else:
+                print(f"  {v} m={mm}: {secs * 1e3:8.2f} ms  error {err:.2e}")
+            settings.append({**v, "m": mm, "seconds": secs, "error": err, **({"errors": e} if keep_errors else {})})
+    return settings
 
 
 def retime(opensees, ours, rounds, repeats, busy):
