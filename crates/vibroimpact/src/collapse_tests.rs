@@ -30,6 +30,19 @@ fn epp() -> Row {
 }
 
 /// A ground acceleration of 1 m/s² from t = 0 for 40 s.
+/// The IDA of the EPP storey under the step, collapse at the drift limit
+/// (or beyond capacity, or without convergence), sampled every 2 ms at
+/// `rtol`.
+fn epp_ida(ida: IdaSettings, rtol: f64) -> RecordIda {
+    let criterion = Criterion {
+        drift: LIMIT,
+        capacity: true,
+        contacts: true,
+    };
+    let run = RunSettings::new(0.002, rtol);
+    record_ida(&epp(), &step(), &criterion, &ida, &run).unwrap()
+}
+
 fn step() -> Record {
     Record::from_samples("step", vec![0.0, 40.0], &[1.0, 1.0]).unwrap()
 }
@@ -45,17 +58,13 @@ fn an_elastic_perfectly_plastic_storey_collapses_at_its_strength() {
     let w2 = K / M;
     let a_c = w2 * UY * (2.0 * LIMIT - UY) / (2.0 * LIMIT);
     assert!((a_c - 1.9).abs() < 1e-12);
-    let criterion = Criterion {
-        drift: LIMIT,
-        capacity: true,
-        contacts: true,
-    };
-    let ida = IdaSettings {
-        first: 0.5,
-        ..IdaSettings::default()
-    };
-    let run = RunSettings::new(0.002, 1e-10);
-    let r = record_ida(&epp(), &step(), &criterion, &ida, &run).unwrap();
+    let r = epp_ida(
+        IdaSettings {
+            first: 0.5,
+            ..IdaSettings::default()
+        },
+        1e-10,
+    );
     let c = r.collapse.unwrap();
     assert!(
         r.survived <= a_c * (1.0 + 1e-6) && c >= a_c * (1.0 - 1e-6),
@@ -140,17 +149,13 @@ fn censored_records_and_the_median() {
 /// the tolerance.
 #[test]
 fn a_first_scale_that_collapses_goes_down() {
-    let criterion = Criterion {
-        drift: LIMIT,
-        capacity: true,
-        contacts: true,
-    };
-    let ida = IdaSettings {
-        first: 10.0,
-        ..IdaSettings::default()
-    };
-    let run = RunSettings::new(0.002, 1e-10);
-    let r = record_ida(&epp(), &step(), &criterion, &ida, &run).unwrap();
+    let r = epp_ida(
+        IdaSettings {
+            first: 10.0,
+            ..IdaSettings::default()
+        },
+        1e-10,
+    );
     let c = r.collapse.unwrap();
     assert!(
         r.survived <= 1.9 && 1.9 <= c && c / r.survived <= 1.02,

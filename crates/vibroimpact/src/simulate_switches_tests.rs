@@ -9,6 +9,15 @@ const B: f64 = 0.1;
 const A: f64 = 3.0;
 const W: f64 = 5.0;
 
+/// The base acceleration A sin(Ωt).
+fn base() -> BaseExcitation {
+    BaseExcitation::Harmonic {
+        amplitude: A,
+        frequency: W,
+        phase: 0.0,
+    }
+}
+
 fn c() -> f64 {
     2.0 * 0.05 * (K * M).sqrt()
 }
@@ -22,12 +31,7 @@ fn sdof(uy: f64) -> Model {
         stiffness: 0.0,
         damping: c(),
     };
-    let base = BaseExcitation::Harmonic {
-        amplitude: A,
-        frequency: W,
-        phase: 0.0,
-    };
-    Model::new(vec![body], vec![], vec![], base, vec![], vec![], vec![])
+    Model::new(vec![body], vec![], vec![], base(), vec![], vec![], vec![])
         .unwrap()
         .with_storeys(vec![Storey {
             below: None,
@@ -191,12 +195,7 @@ fn an_unyielding_bilinear_storey_is_its_elastic_spring() {
         stiffness: K,
         damping: c(),
     };
-    let base = BaseExcitation::Harmonic {
-        amplitude: A,
-        frequency: W,
-        phase: 0.0,
-    };
-    let spring = Model::new(vec![body], vec![], vec![], base, vec![], vec![], vec![]).unwrap();
+    let spring = Model::new(vec![body], vec![], vec![], base(), vec![], vec![], vec![]).unwrap();
     let linear = simulate(&spring, &opts).unwrap();
     let scale = linear.final_displacement[0].abs().max(1e-3);
     assert!((storey.final_displacement[0] - linear.final_displacement[0]).abs() < 1e-10 * scale);
@@ -239,11 +238,7 @@ fn bouc_wen_storey_matches_its_equations() {
         }],
         vec![],
         vec![],
-        BaseExcitation::Harmonic {
-            amplitude: A,
-            frequency: W,
-            phase: 0.0,
-        },
+        base(),
         vec![],
         vec![],
         vec![],
@@ -342,11 +337,7 @@ fn energy_balances_with_yielding_storeys_and_impacts() {
             clearance: 0.01,
             law: ContactLaw::hunt_crossley(1e9, 1.5, 0.2, ForceForm::Published).unwrap(),
         }],
-        BaseExcitation::Harmonic {
-            amplitude: A,
-            frequency: W,
-            phase: 0.0,
-        },
+        base(),
         vec![],
         vec![],
         vec![],
