@@ -234,9 +234,9 @@ type SweepCase = (usize, &'static [f64], usize, usize, Option<usize>);
 
 /// Section 4: sweeps of R2 rows, global against local.
 fn sweeps(quick: bool) -> Value {
-    use vibroimpact::model_file::ModelDocument;
-    use vibroimpact::parameter::ParameterizedModel;
-    use vibroimpact::sweep::{sweep, SweepOptions};
+    use vibroimpact::maps::sweep::{sweep, SweepOptions};
+    use vibroimpact::model::file::ModelDocument;
+    use vibroimpact::model::parameter::ParameterizedModel;
     println!("\n== local integrator: sweeps of R2 (examples/fujita-row-n2.toml), values one after the other ==");
     let cases: &[SweepCase] = if quick {
         &[(100, &[6.0, 14.0], 10, 5, Some(2))]

@@ -19,7 +19,7 @@
 //! 4. Cost of one shooting period map with the full monodromy (dense
 //!    variational equations, banded Jacobian) for N = 10 … 160 at rtol
 //!    1e-8, with the fitted growth exponent (issue: no faster than N²).
-//! 5. The local integrator (docs/theory.md §10, `local.rs`): R2 N = 1000
+//! 5. The local integrator (docs/theory.md §10, `simulate/local/`): R2 N = 1000
 //!    over 3 periods against SUNDIALS at equal accuracy, the struck
 //!    Hertzian chain from 10³ to 10⁶ beads, R2 N = 2 and 3 at equal
 //!    accuracy against the global integrator.
@@ -34,8 +34,8 @@ use std::time::Instant;
 
 use clap::Parser;
 use serde_json::{json, Value};
+use vibroimpact::model::reference;
 use vibroimpact::model::Model;
-use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
 
 mod local;

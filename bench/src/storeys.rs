@@ -17,11 +17,11 @@
 
 use super::*;
 use vibroimpact::contact::ContactLaw;
-use vibroimpact::hysteresis::{Bilinear, StoreyLaw};
 use vibroimpact::integrate::Method;
+use vibroimpact::model::hysteresis::{Bilinear, StoreyLaw};
+use vibroimpact::model::record::{parse_record, Units};
 use vibroimpact::model::{BaseExcitation, Body, Contact, ContactPair, Storey};
-use vibroimpact::pounding::parse_row;
-use vibroimpact::record::{parse_record, Units};
+use vibroimpact::seismic::pounding::parse_row;
 use vibroimpact::simulate::Simulation;
 
 /// The struck row of `n` frames (bodies frame by frame, floors up).

@@ -8,7 +8,7 @@
 
 use std::time::Instant;
 
-use vibroimpact::model_file::ModelDocument;
+use vibroimpact::model::file::ModelDocument;
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 fn main() {

@@ -84,14 +84,14 @@ pub struct RowRunArgs {
 impl RowRunArgs {
     /// The library's settings (a sample step that is not positive and
     /// finite is refused by name).
-    pub fn settings(&self) -> Result<vibroimpact::pounding::RunSettings, CliError> {
+    pub fn settings(&self) -> Result<vibroimpact::seismic::pounding::RunSettings, CliError> {
         if !(self.sample.is_finite() && self.sample > 0.0) {
             return Err(CliError::new(format!(
                 "--sample {}: give a positive step",
                 self.sample
             )));
         }
-        Ok(vibroimpact::pounding::RunSettings {
+        Ok(vibroimpact::seismic::pounding::RunSettings {
             sample: self.sample,
             rtol: self.rtol,
             method: self.method.method(),
@@ -198,7 +198,7 @@ pub fn grid_axis(name: &str, from: f64, to: f64, points: usize) -> Result<Vec<f6
             "--{name}-points {points}: from 2 to 100000"
         )));
     }
-    Ok(vibroimpact::sweep::parameter_values(from, to, points))
+    Ok(vibroimpact::maps::sweep::parameter_values(from, to, points))
 }
 
 /// The grid of `chart` (two parameters) and `basins` (two state
@@ -277,8 +277,8 @@ impl AttractorRuns {
     pub fn options(
         &self,
         interrupt: vibroimpact::integrate::Interrupt,
-    ) -> vibroimpact::sweep::SweepOptions {
-        vibroimpact::sweep::SweepOptions {
+    ) -> vibroimpact::maps::sweep::SweepOptions {
+        vibroimpact::maps::sweep::SweepOptions {
             transient: self.transient,
             record: self.record,
             rtol: self.rtol,
@@ -287,7 +287,7 @@ impl AttractorRuns {
             cluster_tolerance: self.cluster_tolerance,
             interrupt: Some(interrupt),
             integrator: self.integrator.integrator(),
-            ..vibroimpact::sweep::SweepOptions::default()
+            ..vibroimpact::maps::sweep::SweepOptions::default()
         }
     }
 }

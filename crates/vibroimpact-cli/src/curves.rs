@@ -5,10 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use vibroimpact::continuation::BranchSpecialPoints;
 use vibroimpact::continuation::{CurveKind, CurveSelection, Curves};
-use vibroimpact::model_file::ModelDocument;
-use vibroimpact::parameter::ModelParameter;
-use vibroimpact::results::{branch_special_points, curves_document, BranchSpecialPoints};
+use vibroimpact::model::file::ModelDocument;
+use vibroimpact::model::parameter::ModelParameter;
+use vibroimpact::results::{branch_special_points, curves_document};
 
 use crate::error::{option_error, CliError};
 use crate::output::{ensure_dir, write_atomic};

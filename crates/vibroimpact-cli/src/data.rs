@@ -1,8 +1,8 @@
-//! Reading measured data files (CSV, see [`vibroimpact::measured`]).
+//! Reading measured data files (CSV, see [`vibroimpact::identify::measured`]).
 
 use std::path::Path;
 
-pub use vibroimpact::measured::{parse_csv, Table};
+pub use vibroimpact::identify::measured::{parse_csv, Table};
 
 use crate::error::CliError;
 

@@ -44,10 +44,10 @@ from_display!(
     vibroimpact::impact::ImpactError,
     vibroimpact::identify::IdentifyError,
     vibroimpact::model::ModelError,
-    vibroimpact::family::FamilyError,
-    vibroimpact::measured::TableError,
-    vibroimpact::model_file::ModelFileError,
-    vibroimpact::sweep::SweepError,
+    vibroimpact::model::family::FamilyError,
+    vibroimpact::identify::measured::TableError,
+    vibroimpact::model::file::ModelFileError,
+    vibroimpact::maps::sweep::SweepError,
     serde_json::Error
 );
 
@@ -59,9 +59,9 @@ pub fn option_error(e: &vibroimpact::field_error::FieldError) -> CliError {
 
 /// A pounding or collapse error in the command line's words: a setting by
 /// its option.
-pub fn pounding_error(e: vibroimpact::pounding::PoundingError) -> CliError {
+pub fn pounding_error(e: vibroimpact::seismic::pounding::PoundingError) -> CliError {
     match e {
-        vibroimpact::pounding::PoundingError::Field(f) => option_error(&f),
+        vibroimpact::seismic::pounding::PoundingError::Field(f) => option_error(&f),
         other => CliError::new(other.to_string()),
     }
 }

@@ -1,9 +1,9 @@
 //! Figures drawn by more than one command or by a command and the report.
 
-use vibroimpact::basins::Basins;
-use vibroimpact::chart::{Chart, ChartCell};
 use vibroimpact::continuation::{Branch, SpecialKind};
-use vibroimpact::sweep::{Direction, SweepSummary};
+use vibroimpact::maps::basins::Basins;
+use vibroimpact::maps::chart::{Chart, ChartCell};
+use vibroimpact::maps::sweep::{Direction, SweepSummary};
 
 use crate::plot::{Figure, LegendPosition, Marker, Series};
 

@@ -3,10 +3,7 @@
 //! measurement CSVs and the impact velocity ranges. No input may panic;
 //! every error names its source.
 
-#[path = "../../vibroimpact/tests/support/mutate.rs"]
-mod mutate;
-
-use mutate::{cases, mutant, no_panics, seed, Rng};
+use vibroimpact_fuzz::{cases, mutant, no_panics, seed, Rng};
 
 const RESTITUTION: &str = include_str!("../../../examples/seed-impacts/restitution.csv");
 const ACCELERATION: &str = include_str!("../../../examples/seed-impacts/acceleration.csv");
@@ -29,7 +26,7 @@ fn measurement_csv_mutants_never_panic() {
                 assert!(m.starts_with("r.csv") || m.starts_with("a.csv"), "{m}");
             }
             Ok(d) => {
-                let bodies = vibroimpact::reference::seed_bodies();
+                let bodies = vibroimpact::model::reference::seed_bodies();
                 let _ = d.identify(bodies, None, rng_flag(text));
             }
         }

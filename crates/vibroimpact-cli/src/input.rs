@@ -5,7 +5,7 @@
 use std::io::{self, Read};
 use std::path::Path;
 
-pub use vibroimpact::model_file::MAX_INPUT_BYTES;
+pub use vibroimpact::model::file::MAX_INPUT_BYTES;
 
 /// The text of the regular file `path`, refused (with the reason) if it is
 /// a directory, FIFO or device, or larger than [`MAX_INPUT_BYTES`].

@@ -1,11 +1,11 @@
 //! Model files from disk: reads the text (and any accelerogram file, relative
 //! to the model file) and hands it to the library's model-file schema
-//! ([`vibroimpact::model_file`]).
+//! ([`vibroimpact::model::file`]).
 
 use std::path::Path;
 
-use vibroimpact::model_file::{LoadedModel, ModelDocument};
-use vibroimpact::parameter::ParameterizedModel;
+use vibroimpact::model::file::{LoadedModel, ModelDocument};
+use vibroimpact::model::parameter::ParameterizedModel;
 
 use crate::error::CliError;
 use crate::input::read_text;

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use vibroimpact::record::{parse_record, Record, Units};
+use vibroimpact::model::record::{parse_record, Record, Units};
 
 use crate::error::{option_error, CliError};
 
@@ -23,9 +23,9 @@ pub fn read(path: &Path, units: Option<Units>) -> Result<Record, CliError> {
 }
 
 /// The row (or pair) file at `path`.
-pub fn row(path: &Path) -> Result<vibroimpact::pounding::Row, CliError> {
+pub fn row(path: &Path) -> Result<vibroimpact::seismic::pounding::Row, CliError> {
     let source = path.display().to_string();
     let text =
         crate::input::read_text(path).map_err(|e| CliError::new(format!("{source}: {e}")))?;
-    vibroimpact::pounding::parse_row(&text, &source).map_err(crate::error::pounding_error)
+    vibroimpact::seismic::pounding::parse_row(&text, &source).map_err(crate::error::pounding_error)
 }

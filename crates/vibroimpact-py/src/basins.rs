@@ -1,11 +1,11 @@
-//! The binding of [`vibroimpact::basins`]: basins of attraction in a plane
+//! The binding of [`vibroimpact::maps::basins`]: basins of attraction in a plane
 //! of initial states as the `basins` document.
 
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::basins::{basins as run_basins, Component};
-use vibroimpact::sweep::SweepOptions;
+use vibroimpact::maps::basins::{basins as run_basins, Component};
+use vibroimpact::maps::sweep::SweepOptions;
 
 use crate::convert::method;
 use crate::convert::{document, floats, thread_pool, value_error};

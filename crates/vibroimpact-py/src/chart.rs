@@ -1,11 +1,11 @@
-//! The binding of [`vibroimpact::chart`]: a stability chart over two
+//! The binding of [`vibroimpact::maps::chart`]: a stability chart over two
 //! parameters as the `chart` document.
 
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::chart::{chart as run_chart, ChartOptions};
-use vibroimpact::sweep::SweepOptions;
+use vibroimpact::maps::chart::{chart as run_chart, ChartOptions};
+use vibroimpact::maps::sweep::SweepOptions;
 
 use crate::convert::method;
 use crate::convert::{document, floats, thread_pool, value_error};

@@ -1,11 +1,11 @@
-//! The binding of [`vibroimpact::collapse`]: one record's part of a
+//! The binding of [`vibroimpact::seismic::collapse`]: one record's part of a
 //! collapse study (the task a cluster runs per record), and the study's
 //! document from the records' parts.
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
-use vibroimpact::collapse::{
+use vibroimpact::seismic::collapse::{
     record_document, study_document, summary_document, CollapseStudy, Criterion, IdaSettings,
     RecordCollapse, RecordIda,
 };
@@ -28,7 +28,7 @@ fn study(
     pair_text: &str,
     source: &str,
     settings: Settings,
-) -> PyResult<(vibroimpact::pounding::Row, CollapseStudy)> {
+) -> PyResult<(vibroimpact::seismic::pounding::Row, CollapseStudy)> {
     let (
         (drift, capacity, contacts),
         (first, growth, max_scale, tolerance),

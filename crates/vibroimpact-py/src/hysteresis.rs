@@ -4,7 +4,9 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::hysteresis::{cyclic_protocol, parse_drifts as parse, under_drift, StoreySpec};
+use vibroimpact::model::hysteresis::{
+    cyclic_protocol, parse_drifts as parse, under_drift, StoreySpec,
+};
 use vibroimpact::results::hysteresis_document;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};

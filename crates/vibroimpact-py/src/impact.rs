@@ -11,7 +11,7 @@ use vibroimpact::identify::{AccelerationSample, RestitutionSample};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::{ImpactError, TwoBodies};
 use vibroimpact::integrate::IntegrationError;
-use vibroimpact::model_file::LawSpec;
+use vibroimpact::model::file::LawSpec;
 use vibroimpact::results::{impact_document, ImpactMethod, ImpactRelations, IMPACT_COLUMNS};
 
 use crate::convert::{array1, document, floats, numerical_error, to_python, value_error};

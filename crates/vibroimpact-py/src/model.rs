@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use vibroimpact::model_file::{LoadedModel, ModelDocument};
+use vibroimpact::model::file::{LoadedModel, ModelDocument};
 
 use crate::convert::value_error;
 
@@ -107,7 +107,7 @@ impl PyModel {
         }
         // Regular files of at most MAX_INPUT_BYTES (as the CLI): a FIFO
         // would block, a device never end, a huge record exhaust memory.
-        use vibroimpact::model_file::MAX_INPUT_BYTES;
+        use vibroimpact::model::file::MAX_INPUT_BYTES;
         let regular = |p: &std::path::Path| match std::fs::metadata(p) {
             Ok(m) if !m.is_file() => Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,

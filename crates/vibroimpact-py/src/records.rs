@@ -1,14 +1,14 @@
-//! The binding of [`vibroimpact::record`] and [`vibroimpact::spectrum`]:
+//! The binding of [`vibroimpact::model::record`] and [`vibroimpact::seismic::spectrum`]:
 //! ground-motion records parsed from text (the Python side reads the
 //! file) and their response spectra.
 
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::pounding::{documents, PoundingError, Row, RunSettings, Study};
-use vibroimpact::record::{parse_record as parse, Record, Units};
+use vibroimpact::model::record::{parse_record as parse, Record, Units};
 use vibroimpact::results::spectrum_document;
-use vibroimpact::spectrum::response_spectrum as spectrum;
+use vibroimpact::seismic::pounding::{documents, PoundingError, Row, RunSettings, Study};
+use vibroimpact::seismic::spectrum::response_spectrum as spectrum;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};
 
@@ -46,7 +46,8 @@ pub fn parse_measured<'py>(
     wanted: Vec<String>,
 ) -> PyResult<Vec<Bound<'py, numpy::PyArray1<f64>>>> {
     let names: Vec<&str> = wanted.iter().map(String::as_str).collect();
-    let table = vibroimpact::measured::parse_csv(text, source, &names).map_err(value_error)?;
+    let table =
+        vibroimpact::identify::measured::parse_csv(text, source, &names).map_err(value_error)?;
     Ok(table.columns.into_iter().map(|c| array1(py, c)).collect())
 }
 
@@ -81,7 +82,7 @@ pub fn response_spectrum<'py>(
     let doc =
         to_python(py, &spectrum_document(&record, scale, damping, &rows))?.cast_into::<PyDict>()?;
     doc.del_item("rows")?;
-    let col = |f: fn(&vibroimpact::spectrum::SpectralPoint) -> f64| {
+    let col = |f: fn(&vibroimpact::seismic::spectrum::SpectralPoint) -> f64| {
         rows.iter().map(f).collect::<Vec<f64>>()
     };
     doc.set_item("period", array1(py, col(|r| r.period)))?;
@@ -116,7 +117,8 @@ pub(crate) fn pair_and_run(
         method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
     };
-    let pair = vibroimpact::pounding::parse_row(pair_text, source).map_err(pounding_error)?;
+    let pair =
+        vibroimpact::seismic::pounding::parse_row(pair_text, source).map_err(pounding_error)?;
     Ok((pair, run))
 }
 
@@ -215,7 +217,7 @@ pub fn value_range<'py>(
         "ratios" => "ratios",
         other => return Err(value_error(format!("no range keyword {other:?}"))),
     };
-    let values = vibroimpact::pounding::value_range(field, text).map_err(value_error)?;
+    let values = vibroimpact::seismic::pounding::value_range(field, text).map_err(value_error)?;
     Ok(array1(py, values))
 }
 

@@ -3,8 +3,8 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::parameter::ParameterizedModel;
-use vibroimpact::sweep::{sweep as run_sweep, Direction, SweepOptions};
+use vibroimpact::maps::sweep::{sweep as run_sweep, Direction, SweepOptions};
+use vibroimpact::model::parameter::ParameterizedModel;
 
 use crate::convert::{
     array1, array2, document, floats, method, numerical_error, thread_pool, value_error,
@@ -21,7 +21,7 @@ pub fn parameter_values<'py>(
     to: f64,
     k: usize,
 ) -> Bound<'py, numpy::PyArray1<f64>> {
-    array1(py, vibroimpact::sweep::parameter_values(from_, to, k))
+    array1(py, vibroimpact::maps::sweep::parameter_values(from_, to, k))
 }
 
 /// A brute-force sweep: the `sweep` document; every point also carries its

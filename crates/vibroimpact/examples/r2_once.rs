@@ -1,6 +1,6 @@
 //! One simulation of reference problem R2 (for profiling):
 //! `cargo run --release -p vibroimpact --example r2_once -- N PERIODS RTOL`.
-use vibroimpact::reference::{r2, CLEARANCE, NATURAL_FREQUENCY};
+use vibroimpact::model::reference::{r2, CLEARANCE, NATURAL_FREQUENCY};
 use vibroimpact::simulate::{simulate, SimulationOptions};
 
 fn main() {

@@ -4,49 +4,37 @@
 //! method for the vibrations of the multi-degree-of-freedom system with
 //! mutual impact interactions" (Seisan Kenkyu 29, 1977).
 //!
-//! Modules follow the physics:
+//! The modules follow the physics, from the ground up (each folder's
+//! `mod.rs` opens with a map of its files; `docs/architecture.md` is the
+//! one-page guide):
+//! - [`numeric`], [`linalg`], [`newton`]: scalar special functions and root
+//!   finders; the band LU, GMRES and Arnoldi, eigenvalues, the null vector;
+//!   the damped Newton method of every periodic solve;
 //! - [`contact`]: contact laws (Fujita's exponential law, seed eq. 1, and
 //!   Hertz, Kelvin–Voigt, Hunt–Crossley, Lankarani–Nikravesh);
+//! - [`field_error`]: an option refused by name, spelled by each face;
+//! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) on one step
+//!   driver, events, the tangent tape;
 //! - [`impact`]: two-body impact relations, closed form (seed eqs. 8–18)
 //!   and by direct integration;
 //! - [`identify`]: identification of a/b and α from measured impacts
-//!   (seed §3); [`measured`]: tables of measured data (CSV text);
-//! - [`model`]: N bodies, springs, contact pairs and excitation (§4);
-//! - [`dynamics`]: the equations of motion with their banded Jacobian;
-//! - [`simulate`]: time histories with an impact log, by the global or
-//!   the local integrator;
-//! - [`free_motion`]: the exact motion of bodies between contacts;
-//! - [`variational`]: sensitivities and monodromy matrices (§5);
-//! - [`newton`]: the damped Newton method of every periodic solve;
+//!   (seed §3), and the measured-data tables;
+//! - [`model`]: N bodies, springs, contact pairs, storeys and their laws,
+//!   excitation and ground-motion records (§4); the model file, its
+//!   parameters and families; the reference problems R1–R3;
+//! - [`dynamics`]: the equations of motion with their banded Jacobian, and
+//!   the variational equations (§5);
+//! - [`simulate`]: time histories with an impact log, by the global or the
+//!   local integrator (exact motion between contacts);
 //! - [`periodic`]: periodic solutions by shooting, Floquet multipliers;
-//! - [`lyapunov`]: Lyapunov exponents by QR re-orthonormalisation;
-//! - [`continuation`]: branches of periodic solutions and their special
-//!   points;
-//! - [`sweep`]: brute-force bifurcation diagrams (Poincaré samples);
-//! - [`attractor`]: the attractor a simulation reaches, and whether two
-//!   runs reached the same one;
-//! - [`chart`]: brute-force stability charts over two parameters;
-//! - [`basins`]: basins of attraction in a plane of initial states;
-//! - [`model_file`]: the model-file schema (TOML text → [`model::Model`]);
-//! - [`parameter`]: a numeric key of a model file made a parameter;
-//! - [`field_error`]: an option refused by name, spelled by each face;
-//! - [`family`]: a family of models in one or two parameters, the problem
-//!   every parameter study takes;
-//! - [`reference`](mod@reference): the reference problems R1–R3 (`docs/theory.md` §6);
-//! - [`results`]: the documents of results (the CLI's JSON, Python's
-//!   result objects);
-//! - [`record`], [`spectrum`], [`pounding`]: earthquake records, their
-//!   response spectra, and rows of buildings (fixed or isolated) pounding
-//!   under them;
-//! - [`collapse`]: incremental dynamic analysis to collapse, per record,
-//!   and the median collapse scale (FEMA P695);
-//! - [`hysteresis`]: the force–drift laws of inelastic storeys (bilinear,
-//!   Bouc–Wen);
-//! - [`integrate`]: the integrators (DOP853, DOPRI5, RODAS) shared by
-//!   every time integration;
-//! - [`linalg`]: the band LU, GMRES and Arnoldi, eigenvalues of general
-//!   real matrices, the null vector;
-//! - [`numeric`]: scalar special functions and root finders.
+//! - [`continuation`]: branches of periodic solutions, their special points
+//!   and curves of special points in two parameters;
+//! - [`maps`]: brute-force maps: sweeps, stability charts, basins,
+//!   attractors, Lyapunov exponents;
+//! - [`seismic`]: response spectra, rows of pounding buildings, collapse
+//!   studies (FEMA P695);
+//! - [`results`]: the documents of results (the CLI's JSON, Python's result
+//!   objects) and their readers.
 //!
 //! The library does no I/O: callers hand it numbers and text and get
 //! numbers back.
@@ -54,34 +42,19 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
-pub mod attractor;
-pub mod basins;
-pub mod chart;
-pub mod collapse;
 pub mod contact;
 pub mod continuation;
 pub mod dynamics;
-pub mod family;
 pub mod field_error;
-pub mod free_motion;
-pub mod hysteresis;
 pub mod identify;
 pub mod impact;
 pub mod integrate;
 pub mod linalg;
-pub mod lyapunov;
-pub mod measured;
+pub mod maps;
 pub mod model;
-pub mod model_file;
 pub mod newton;
 pub mod numeric;
-pub mod parameter;
 pub mod periodic;
-pub mod pounding;
-pub mod record;
-pub mod reference;
 pub mod results;
+pub mod seismic;
 pub mod simulate;
-pub mod spectrum;
-pub mod sweep;
-pub mod variational;

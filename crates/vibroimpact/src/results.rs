@@ -7,13 +7,15 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use crate::contact::{ContactLaw, LawKind};
-use crate::continuation::{Branch, ContinueOutcome, Curves, SpecialKind, SpecialPoint};
+use crate::continuation::{
+    Branch, BranchSpecialPoints, ContinueOutcome, Curves, SpecialKind, SpecialPoint,
+};
 use crate::impact::closed_form::ExponentialImpact;
 use crate::impact::direct::{integrate_impact, DirectOptions};
 use crate::impact::{ImpactError, TwoBodies};
+use crate::model::file::ModelDocument;
+use crate::model::parameter::ModelParameter;
 use crate::model::Model;
-use crate::model_file::ModelDocument;
-use crate::parameter::ModelParameter;
 use crate::periodic::{OrbitSummary, PeriodicSolution};
 use crate::simulate::Simulation;
 
@@ -314,18 +316,6 @@ pub fn branch_document(branch: &Branch, model: &Model, name: &str) -> Value {
 #[error("{0}")]
 pub struct BranchDocumentError(pub String);
 
-/// What the curves need of a branch document: its special points, whether
-/// the branch is on the half map, and its period multiple.
-#[derive(Clone, Debug)]
-pub struct BranchSpecialPoints {
-    /// The special points (their states and parameters).
-    pub special: Vec<SpecialPoint>,
-    /// On the half map.
-    pub symmetric: bool,
-    /// Its period multiple.
-    pub subharmonic: u32,
-}
-
 /// Reads back the special points of a [`branch_document`] of `document`
 /// (its `parameter_name` must be the key of `first`).
 pub fn branch_special_points(
@@ -396,8 +386,8 @@ pub fn branch_special_points(
 }
 
 /// A storey law's name and parameters, defaults resolved.
-pub fn storey_law_document(law: &crate::hysteresis::StoreyLaw) -> Value {
-    use crate::hysteresis::StoreyLaw;
+pub fn storey_law_document(law: &crate::model::hysteresis::StoreyLaw) -> Value {
+    use crate::model::hysteresis::StoreyLaw;
     match law {
         StoreyLaw::Elastic { stiffness } => json!({"law": "elastic", "stiffness": stiffness}),
         StoreyLaw::Bilinear(b) => json!({
@@ -425,7 +415,7 @@ pub fn storey_law_document(law: &crate::hysteresis::StoreyLaw) -> Value {
 /// (force, dissipated energy), the peak force and the total dissipated
 /// energy.
 pub fn hysteresis_document(
-    law: &crate::hysteresis::StoreyLaw,
+    law: &crate::model::hysteresis::StoreyLaw,
     drifts: &[f64],
     rows: &[(f64, f64)],
 ) -> Value {
@@ -443,10 +433,10 @@ pub fn hysteresis_document(
 /// The `spectrum` document: the record (scaled by `scale`), the damping,
 /// how the peaks are taken, the units and a row per period.
 pub fn spectrum_document(
-    record: &crate::record::Record,
+    record: &crate::model::record::Record,
     scale: f64,
     damping: f64,
-    rows: &[crate::spectrum::SpectralPoint],
+    rows: &[crate::seismic::spectrum::SpectralPoint],
 ) -> Value {
     json!({
         "record": record.metadata(scale),
@@ -551,9 +541,9 @@ pub struct SimulationSummary {
     /// Energy audit (J), with --energy.
     pub energy: Option<EnergySummary>,
     /// The recorded ground motion, when the excitation is one (set by the
-    /// caller from [`crate::model_file::LoadedModel::record`]).
+    /// caller from [`crate::model::file::LoadedModel::record`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub record: Option<crate::record::RecordMetadata>,
+    pub record: Option<crate::model::record::RecordMetadata>,
 }
 
 /// Impacts of one contact.

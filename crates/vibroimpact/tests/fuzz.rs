@@ -14,14 +14,12 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use vibroimpact::contact::{ContactLaw, ForceForm};
 use vibroimpact::integrate::Method;
+use vibroimpact::model::file::{parse_accelerogram_csv, ModelDocument, ModelFileError};
+use vibroimpact::model::parameter::ParameterizedModel;
 use vibroimpact::model::{BaseExcitation, Model};
-use vibroimpact::model_file::{parse_accelerogram_csv, ModelDocument, ModelFileError};
-use vibroimpact::parameter::ParameterizedModel;
 use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
 
-#[path = "support/mutate.rs"]
-mod mutate;
-use mutate::{cases, mutant, no_panics, seed, Rng, NUMBERS};
+use vibroimpact_fuzz::{cases, mutant, no_panics, seed, Rng, NUMBERS};
 
 const ROW: &str = include_str!("../../../examples/fujita-row.toml");
 const ROW2: &str = include_str!("../../../examples/fujita-row-n2.toml");
@@ -62,7 +60,7 @@ acceleration = [0.0, 1.0, -1.0, 0.0]
 
 /// The record loader of the fuzzed model files: the example record, or an
 /// error for any other name.
-fn loader(name: &str) -> Result<vibroimpact::record::Record, ModelFileError> {
+fn loader(name: &str) -> Result<vibroimpact::model::record::Record, ModelFileError> {
     if name == "synthetic-quake.csv" {
         parse_accelerogram_csv(QUAKE, name)
     } else {

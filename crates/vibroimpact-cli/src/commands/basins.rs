@@ -1,11 +1,11 @@
 //! `vibroimpact basins`: basins of attraction in a plane of initial states
-//! ([`vibroimpact::basins`]), their CSV, JSON, figure and table of
+//! ([`vibroimpact::maps::basins`]), their CSV, JSON, figure and table of
 //! attractors.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::basins::{basins, BasinError, Basins, Component};
+use vibroimpact::maps::basins::{basins, BasinError, Basins, Component};
 
 use crate::args::{AttractorRuns, GridAxes};
 use crate::error::{option_error, CliError};

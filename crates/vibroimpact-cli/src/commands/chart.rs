@@ -1,12 +1,12 @@
 //! `vibroimpact chart`: the brute-force stability chart of
-//! [`vibroimpact::chart`] over two parameters, its CSV, JSON, figure and
+//! [`vibroimpact::maps::chart`] over two parameters, its CSV, JSON, figure and
 //! table of classes.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::chart::{chart, Chart, ChartError, ChartOptions};
-use vibroimpact::sweep::SweepOptions;
+use vibroimpact::maps::chart::{chart, Chart, ChartError, ChartOptions};
+use vibroimpact::maps::sweep::SweepOptions;
 
 use crate::args::{AttractorRuns, GridAxes};
 use crate::error::{option_error, CliError};

@@ -1,5 +1,5 @@
 //! `vibroimpact collapse`: the FEMA P695 collapse study of a row of
-//! buildings ([`vibroimpact::collapse`]): per record an IDA to collapse
+//! buildings ([`vibroimpact::seismic::collapse`]): per record an IDA to collapse
 //! (drift limit, isolator capacity, non-convergence), bracketed by
 //! bisection; the median collapse scale and intensity Ŝ_CT, and with the
 //! tables' values given, CMR and ACMR. Records in parallel; the same
@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use clap::Args;
 use rayon::prelude::*;
 use serde_json::Value;
-use vibroimpact::collapse::{
+use vibroimpact::seismic::collapse::{
     record_document, study_document, summary_document, CollapseStudy, Criterion, IdaSettings,
 };
 

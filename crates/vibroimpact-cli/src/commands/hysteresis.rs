@@ -1,4 +1,4 @@
-//! `vibroimpact hysteresis`: a storey law ([`vibroimpact::hysteresis`])
+//! `vibroimpact hysteresis`: a storey law ([`vibroimpact::model::hysteresis`])
 //! under a cyclic drift protocol or a drift history from a file: its loop
 //! (force and dissipated energy at every drift) as JSON, CSV or a table,
 //! with a figure of the loop.
@@ -6,7 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use vibroimpact::hysteresis::{cyclic_protocol, parse_drifts, under_drift, LawError, StoreySpec};
+use vibroimpact::model::hysteresis::{
+    cyclic_protocol, parse_drifts, under_drift, LawError, StoreySpec,
+};
 use vibroimpact::results::hysteresis_document;
 
 use crate::error::CliError;

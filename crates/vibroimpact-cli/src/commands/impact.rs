@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use vibroimpact::contact::{ContactLaw, ForceForm};
 use vibroimpact::impact::direct::DirectOptions;
 use vibroimpact::impact::TwoBodies;
-use vibroimpact::reference;
+use vibroimpact::model::reference;
 use vibroimpact::results::{impact_document, impact_rows, ImpactMethod, IMPACT_COLUMNS};
 
 use crate::args::parse_mass2;

@@ -1,6 +1,6 @@
 //! `vibroimpact pounding`: a row of buildings (a pair of shear frames, or
 //! K buildings, fixed or isolated) side by side under recorded
-//! ground motions ([`vibroimpact::pounding`]): per record the response
+//! ground motions ([`vibroimpact::seismic::pounding`]): per record the response
 //! with and without pounding, the gap that avoids contact and the code
 //! rules; with `--gaps` and `--ratios` the pounding spectrum over an
 //! ensemble, with `--moat-gaps` the moat-gap study of isolated buildings
@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde_json::Value;
-use vibroimpact::pounding::{
+use vibroimpact::seismic::pounding::{
     documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, StoreyLoop, Study,
 };
 

@@ -13,7 +13,7 @@ use crate::model_io::read_model;
 use crate::output::{commit_temp, temp_path, Pending};
 use crate::output::{ensure_dir, write_atomic, OutputError};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
-use vibroimpact::model_file::LoadedModel;
+use vibroimpact::model::file::LoadedModel;
 use vibroimpact::results::{simulation_summary, SimulationSummary};
 
 /// Options of `vibroimpact simulate`.
@@ -444,7 +444,7 @@ mod tests {
     fn history_file_streams_and_keeps_a_bounded_sample() {
         let dir = std::env::temp_dir().join(format!("vi-history-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let model = vibroimpact::reference::r2(2, 1e-3, 7.0).unwrap();
+        let model = vibroimpact::model::reference::r2(2, 1e-3, 7.0).unwrap();
         let opts = SimulationOptions {
             t_end: 1e6,
             output_step: Some(1.0),

@@ -1,12 +1,12 @@
 //! `vibroimpact spectrum`: the elastic response spectra of a recorded
-//! ground motion ([`vibroimpact::spectrum`]) as JSON, CSV or a table, with
+//! ground motion ([`vibroimpact::seismic::spectrum`]) as JSON, CSV or a table, with
 //! a figure of the pseudo-acceleration.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use vibroimpact::results::spectrum_document;
-use vibroimpact::spectrum::{periods, response_spectrum, SpectralPoint};
+use vibroimpact::seismic::spectrum::{periods, response_spectrum, SpectralPoint};
 
 use crate::error::{option_error, CliError};
 use crate::format::{CsvText, Format};

@@ -1,10 +1,10 @@
 //! `vibroimpact sweep`: the brute-force bifurcation diagram of
-//! [`vibroimpact::sweep`], its CSV, figures and table.
+//! [`vibroimpact::maps::sweep`], its CSV, figures and table.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::sweep::{
+use vibroimpact::maps::sweep::{
     parameter_values, sweep, Direction, SweepError, SweepOptions, SweepSummary,
 };
 

@@ -9,13 +9,13 @@ use std::time::Instant;
 use vibroimpact::continuation::{
     branch_switch_start, continue_branch, Branch, ContinuationOptions,
 };
-use vibroimpact::family::of;
 use vibroimpact::integrate::Interrupt;
+use vibroimpact::maps::sweep::{sweep, Direction, SweepOptions, SweepSummary};
+use vibroimpact::model::family::of;
+use vibroimpact::model::reference;
 use vibroimpact::model::{Model, ModelError};
 use vibroimpact::periodic::{guess_by_simulation_with, ShootingOptions};
-use vibroimpact::reference;
 use vibroimpact::simulate::Integrator;
-use vibroimpact::sweep::{sweep, Direction, SweepOptions, SweepSummary};
 
 use super::{html_escape, html_table, DataFile, Report};
 use crate::error::CliError;

@@ -5,7 +5,7 @@
 use vibroimpact::contact::{ContactLaw, ForceForm};
 use vibroimpact::identify::{Estimate, Identification};
 use vibroimpact::impact::closed_form::ExponentialImpact;
-use vibroimpact::reference;
+use vibroimpact::model::reference;
 
 use super::{estimate_text, html_table, logspace, DataFile, Report};
 use crate::error::CliError;

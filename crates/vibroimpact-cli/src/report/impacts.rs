@@ -5,7 +5,7 @@
 
 use vibroimpact::impact::closed_form::{peak_force_dimensionless, restitution, ExponentialImpact};
 use vibroimpact::impact::direct::{integrate_impact, DirectOptions};
-use vibroimpact::reference;
+use vibroimpact::model::reference;
 
 use super::{html_table, logspace, DataFile, Report};
 use crate::error::CliError;

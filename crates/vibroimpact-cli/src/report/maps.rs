@@ -7,18 +7,18 @@
 
 use std::time::Instant;
 
-use vibroimpact::basins::{basins, Basins, Component};
-use vibroimpact::chart::{chart, Chart, ChartOptions};
 use vibroimpact::continuation::{
     Branch, BranchStudy, ContinuationOptions, ContinueStudy, Curve, CurveKind, CurveSelection,
     Curves, CurvesRequest, Linear, Start,
 };
 use vibroimpact::integrate::Interrupt;
-use vibroimpact::model_file::ModelDocument;
-use vibroimpact::parameter::ParameterizedModel;
+use vibroimpact::maps::basins::{basins, Basins, Component};
+use vibroimpact::maps::chart::{chart, Chart, ChartOptions};
+use vibroimpact::maps::sweep::{sweep, SweepOptions, SweepSummary};
+use vibroimpact::model::file::ModelDocument;
+use vibroimpact::model::parameter::ParameterizedModel;
+use vibroimpact::model::reference::NATURAL_FREQUENCY as W0;
 use vibroimpact::periodic::ShootingOptions;
-use vibroimpact::reference::NATURAL_FREQUENCY as W0;
-use vibroimpact::sweep::{sweep, SweepOptions, SweepSummary};
 
 use super::{html_table, DataFile, Report};
 use crate::error::CliError;

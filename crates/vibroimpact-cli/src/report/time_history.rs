@@ -5,8 +5,8 @@
 use vibroimpact::impact::closed_form::ExponentialImpact;
 use vibroimpact::impact::TwoBodies;
 use vibroimpact::integrate::Interrupt;
+use vibroimpact::model::reference;
 use vibroimpact::model::Model;
-use vibroimpact::reference;
 use vibroimpact::simulate::{simulate, ImpactRecord, Simulation, SimulationOptions};
 
 use super::{html_escape, html_table, logspace, DataFile, Report};

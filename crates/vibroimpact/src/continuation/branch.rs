@@ -2,7 +2,7 @@
 //! step (predictor, corrector, step control, special points between the
 //! points), ending with the reason it stopped.
 
-use crate::family::Family;
+use crate::model::family::Family;
 use nalgebra::Complex;
 
 use super::events::{BranchEvent, BUILT_IN};

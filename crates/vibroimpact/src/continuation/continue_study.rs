@@ -4,12 +4,24 @@
 //! differ only in how they spell its settings and write its results.
 
 use super::study::{BranchOutcome, BranchStudy, CheckedBranch, StudyError, StudyField};
-use super::{curves_of_branch, BranchOrigin, BranchPoint, CurveSelection, Curves};
-use crate::family::ParameterizedModel2;
-use crate::model_file::ModelDocument;
-use crate::parameter::ParameterizedModel;
+use super::{curves_of_branch, BranchOrigin, BranchPoint, CurveSelection, Curves, SpecialPoint};
+use crate::model::family::ParameterizedModel2;
+use crate::model::file::ModelDocument;
+use crate::model::parameter::ParameterizedModel;
 use crate::periodic::ShootingOptions;
-use crate::results::BranchSpecialPoints;
+
+/// What the curves need of a branch, as read back from its document: its
+/// special points, whether the branch is on the half map, and its period
+/// multiple.
+#[derive(Clone, Debug)]
+pub struct BranchSpecialPoints {
+    /// The special points (their states and parameters).
+    pub special: Vec<SpecialPoint>,
+    /// On the half map.
+    pub symmetric: bool,
+    /// Its period multiple.
+    pub subharmonic: u32,
+}
 
 /// The curves a [`ContinueStudy`] follows after its branch.
 #[derive(Clone, Debug)]
@@ -156,7 +168,7 @@ impl CheckedContinue {
 mod tests {
     use super::*;
     use crate::continuation::{Start, StudyField};
-    use crate::reference;
+    use crate::model::reference;
 
     const ROW: &str = include_str!("../../../../examples/fujita-row-n2.toml");
 
@@ -218,7 +230,8 @@ mod tests {
     /// homotopy start is refused by name, before any work.
     #[test]
     fn a_family_built_in_code_has_no_homotopy_start() {
-        let family = crate::family::of("frequency", |w| reference::r2(2, reference::CLEARANCE, w));
+        let family =
+            crate::model::family::of("frequency", |w| reference::r2(2, reference::CLEARANCE, w));
         let branch = BranchStudy {
             start: Start::Homotopy,
             ..study(None).branch

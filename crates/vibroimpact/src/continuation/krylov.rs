@@ -4,7 +4,7 @@
 //! dominant Floquet multipliers by Arnoldi, so that nothing of size d² is
 //! ever formed: memory O(d · (Krylov dimension + recorded stages)).
 
-use crate::family::Family;
+use crate::model::family::Family;
 use nalgebra::Complex;
 
 use super::problem::{unit_along, Linear, Problem};

@@ -2,6 +2,19 @@
 //! Floquet stability and detection and location of special points
 //! (docs/theory.md §5).
 //!
+//! ## Files
+//! - `problem.rs` — the extended system in scaled variables, corrector, tangent;
+//! - `events.rs` — special points as events: test values, location;
+//! - `branch.rs` — the [`Continuation`] iterator over a branch's steps;
+//! - `switching.rs` — starts on crossing and period-doubled branches;
+//! - `start.rs` — the homotopy start on the primary branch;
+//! - `krylov.rs` — the matrix-free extended system for long rows;
+//! - `curve/` — two-parameter curves of special points;
+//! - `study.rs`, `continue_study.rs`, `orbit_study.rs` — the studies every
+//!   face runs (a branch on any family; a branch of a model file with its
+//!   curves; one periodic orbit);
+//! - `tests.rs` — the linear limit, R2 branches against AUTO-07p's points.
+//!
 //! ## Formulation
 //! Unknowns `z = (x, p)`: the state at t = 0 of an nT-periodic orbit and the
 //! parameter, in scaled variables (`x̂ = x / scale`, displacement scale and
@@ -34,19 +47,6 @@
 //! Each is an [`BranchEvent`], located by bisection of the arclength
 //! between the two points (re-correcting from the earlier point), until the
 //! parameter is known to `locate_tol`.
-//!
-//! ## Code
-//! - `problem`: the extended system, corrector and tangent;
-//! - `events`: test values, the event trait, location;
-//! - `branch`: the [`Continuation`] iterator over the steps of a branch;
-//! - `switching`: starts on crossing and period-doubled branches;
-//! - `curve`: two-parameter curves of folds, period doublings and
-//!   symmetry-breaking points ([`continue_curve`]);
-//! - [`continue_branch`]: the iterator collected into a [`Branch`];
-//! - the studies every face runs: [`BranchStudy`] (checks, start,
-//!   branch, switch) on any family, [`ContinueStudy`] (a branch of a model
-//!   file with the curves of its special points) and [`OrbitStudy`] (one
-//!   periodic orbit: guess, shooting, summary).
 
 mod branch;
 mod continue_study;
@@ -62,7 +62,9 @@ mod switching;
 mod tests;
 
 pub use branch::{spectral_distance, validate_size, BranchStep, Continuation};
-pub use continue_study::{CheckedContinue, ContinueOutcome, ContinueStudy, CurvesRequest};
+pub use continue_study::{
+    BranchSpecialPoints, CheckedContinue, ContinueOutcome, ContinueStudy, CurvesRequest,
+};
 pub use curve::{
     continue_curve, curves_of_branch, grazing_margin, starts_grazing, BranchOrigin, Codim2Kind,
     Curve, CurveKind, CurveOptions, CurvePoint, CurveSelection, CurveSpecial, CurveStop, Curves,
@@ -81,7 +83,7 @@ pub use switching::{
 
 use nalgebra::Complex;
 
-use crate::family::{Family, FamilyError};
+use crate::model::family::{Family, FamilyError};
 use crate::periodic::{PeriodicError, ShootingOptions};
 
 /// Kinds of special points.

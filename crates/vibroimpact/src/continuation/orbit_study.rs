@@ -6,9 +6,9 @@
 
 use super::study::{Linear, StudyError, StudyField};
 use super::{amplitude_homotopy, is_symmetric_orbit, ContinuationOptions};
+use crate::model::file::ModelDocument;
+use crate::model::parameter::ParameterizedModel;
 use crate::model::Model;
-use crate::model_file::ModelDocument;
-use crate::parameter::ParameterizedModel;
 use crate::periodic::{
     guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, OrbitSummary,
     PeriodicSolution, ShootingOptions, MIN_ARNOLDI,

@@ -3,7 +3,7 @@
 //! tangent, and a converged point evaluated in full (orbit summary,
 //! multipliers, test values).
 
-use crate::family::Family;
+use crate::model::family::Family;
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};

@@ -10,7 +10,7 @@
 //! land on another attractor or none.
 
 use super::{continue_branch, ContinuationError, ContinuationOptions, StopReason};
-use crate::family::Family;
+use crate::model::family::Family;
 
 /// Start of the homotopy, as a fraction of the target amplitude.
 const START_FRACTION: f64 = 1e-3;
@@ -76,7 +76,7 @@ where
 mod tests {
     use super::*;
     use crate::continuation::Continuation;
-    use crate::reference::{self, NATURAL_FREQUENCY as W0};
+    use crate::model::reference::{self, NATURAL_FREQUENCY as W0};
 
     /// R2 with N = 4 under the base acceleration `amplitude` sin(ω t).
     fn r2_n4_forced(
@@ -93,7 +93,7 @@ mod tests {
     fn homotopy_starts_r2_n4_where_a_simulated_guess_does_not() {
         let w = 1.5 * W0;
         let model = |a: f64| r2_n4_forced(w, a);
-        let family = crate::family::of("amplitude", model);
+        let family = crate::model::family::of("amplitude", model);
         let opts = ContinuationOptions::default();
         let x = amplitude_homotopy(family, reference::BASE_AMPLITUDE, &opts).unwrap();
         let target = model(reference::BASE_AMPLITUDE).unwrap();
@@ -101,7 +101,7 @@ mod tests {
         assert!(sol.converged);
         assert!(sol.residual_history[0] < 1e-6, "{:?}", sol.residual_history);
         // The main continuation in the frequency starts from it.
-        let freq = crate::family::of("frequency", |p: f64| {
+        let freq = crate::model::family::of("frequency", |p: f64| {
             reference::r2(4, reference::CLEARANCE, p)
         });
         let start = Continuation::new(freq, w, &x, 0.5 * W0, &opts);
@@ -120,7 +120,7 @@ mod tests {
         let mut opts = ContinuationOptions::default();
         opts.shooting.interrupt = Some(interrupt.clone());
         let mut calls = 0;
-        let family = crate::family::of("amplitude", |a: f64| {
+        let family = crate::model::family::of("amplitude", |a: f64| {
             calls += 1;
             if calls == 30 {
                 interrupt.request();

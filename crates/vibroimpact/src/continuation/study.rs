@@ -7,10 +7,10 @@
 
 use super::{continue_branch, switch_branch, validate_size, Branch, BranchPoint};
 use super::{ContinuationError, ContinuationOptions, CurvesError, SwitchError};
-use crate::family::{Family, FamilyError};
 use crate::field_error::FieldError;
+use crate::model::family::{Family, FamilyError};
+use crate::model::file::ModelFileError;
 use crate::model::Model;
-use crate::model_file::ModelFileError;
 use crate::periodic::{guess_by_simulation_with, PeriodicError};
 
 /// How a branch study finds its first periodic orbit.

@@ -2,7 +2,7 @@
 //! symmetry-breaking pitchfork or a simple crossing) and the period-2n
 //! branch at a period doubling; [`switch_branch`] continues from them.
 
-use crate::family::Family;
+use crate::model::family::Family;
 use nalgebra::DMatrix;
 
 use super::branch::parameter_scale;

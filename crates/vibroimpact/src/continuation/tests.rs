@@ -1,15 +1,15 @@
 //! Tests of continuation: the linear limit, the R2 branches against
 //! AUTO-07p and brute force, branch switching.
 use super::*;
-use crate::family::of;
+use crate::model::family::of;
 use crate::model::{Model, ModelError};
 use crate::periodic::{orbit_summary, period_map, shoot};
 use crate::simulate::{simulate, SimulationOptions};
 
-use crate::reference::NATURAL_FREQUENCY as W0;
+use crate::model::reference::NATURAL_FREQUENCY as W0;
 
 fn r2(n: usize, clearance: f64, omega: f64) -> Result<Model, ModelError> {
-    crate::reference::r2(n, clearance, omega)
+    crate::model::reference::r2(n, clearance, omega)
 }
 
 /// Tight tolerances for branches in the linear limit, compared with exact
@@ -28,7 +28,7 @@ fn tight_options() -> ContinuationOptions {
 
 /// R2 N = 2 with this clearance, forced at `w` with the base amplitude `a`.
 fn r2_forced(clearance: f64, w: f64, a: f64) -> Result<Model, ModelError> {
-    crate::reference::r2_forced(2, clearance, w, a)
+    crate::model::reference::r2_forced(2, clearance, w, a)
 }
 
 /// R2 with N bodies in the linear limit (gaps of 1 km) from 0.8 to 1.2 ω0,
@@ -56,7 +56,7 @@ fn linear_branch_is_exact() {
     assert!(b.points.len() > 10);
     for p in &b.points {
         let w = p.parameter;
-        let exact = crate::reference::r3_steady_amplitude(w);
+        let exact = crate::model::reference::r3_steady_amplitude(w);
         // The exact extremum (located on the dense output).
         assert!(
             (p.max_displacement[0] / exact - 1.0).abs() < 1e-8,
@@ -99,10 +99,10 @@ fn steps_do_not_shrink_with_the_row_length() {
 fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
     let w = 0.9 * W0;
     let family = of("amplitude", |a: f64| {
-        r2_forced(crate::reference::R3_CLEARANCE, w, a)
+        r2_forced(crate::model::reference::R3_CLEARANCE, w, a)
     });
     let opts = tight_options();
-    let a_ref = crate::reference::BASE_AMPLITUDE;
+    let a_ref = crate::model::reference::BASE_AMPLITUDE;
     let b = continue_branch(family, 0.0, &[0.0; 4], a_ref, &opts, |_| true).unwrap();
     assert_eq!(b.stop, StopReason::ReachedEnd);
     // At least 2 / ds_max = 40 steps, and not many more: the state moves
@@ -114,7 +114,7 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
     );
     assert_eq!(b.points.last().unwrap().parameter, a_ref);
     for p in &b.points {
-        let exact = crate::reference::r3_steady_amplitude(w) * p.parameter / a_ref;
+        let exact = crate::model::reference::r3_steady_amplitude(w) * p.parameter / a_ref;
         assert!(
             (p.max_displacement[0] - exact).abs() < 1e-8 * exact.max(1e-12),
             "at A = {}: {} vs {exact}",
@@ -133,7 +133,7 @@ fn an_amplitude_branch_from_zero_forcing_is_exact_and_short() {
 fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
     // The example row (R2 N = 2 at 0.95 ω0) in its forcing amplitude.
     let family = of("amplitude", |a: f64| {
-        r2_forced(crate::reference::CLEARANCE, 0.95 * W0, a)
+        r2_forced(crate::model::reference::CLEARANCE, 0.95 * W0, a)
     });
     let opts = ContinuationOptions::default();
     let main = continue_branch(family, 0.0, &[0.0; 4], 0.05, &opts, |_| true).unwrap();
@@ -177,7 +177,7 @@ fn a_branch_from_zero_forcing_switches_at_its_branch_point() {
 /// needs no special handling.
 #[test]
 fn iterator_steps_and_user_event() {
-    let level = crate::reference::r3_steady_amplitude(0.9 * W0);
+    let level = crate::model::reference::r3_steady_amplitude(0.9 * W0);
     let opts = tight_options();
     let family = of("frequency", |w: f64| r2(2, 1e3, w));
     let steps = Continuation::new(family, 0.8 * W0, &[0.0; 4], 1.2 * W0, &opts)
@@ -210,7 +210,7 @@ fn iterator_steps_and_user_event() {
     assert!(user[1].parameter > W0);
     for u in user {
         assert_eq!(u.kind, SpecialKind::User);
-        let amplitude = crate::reference::r3_steady_amplitude(u.parameter);
+        let amplitude = crate::model::reference::r3_steady_amplitude(u.parameter);
         assert!(
             (amplitude / level - 1.0).abs() < 1e-6,
             "{amplitude} vs {level}"
@@ -229,6 +229,22 @@ fn iterator_steps_and_user_event() {
 const AUTO_BP: [f64; 6] = [0.983100, 0.949393, 0.794528, 0.552497, 0.534043, 0.509475];
 const AUTO_TR: f64 = 0.502479;
 
+/// The periodic state (body order) of [`r2`] at `frequency` on the
+/// branch that grows from rest, by the homotopy in the forcing amplitude:
+/// a test's start that does not depend on where a long chaotic transient
+/// of a simulation ends (at 0.5 ω0 that is the last bits of the step
+/// sequence).
+fn r2_primary_orbit(n: usize, clearance: f64, frequency: f64) -> Vec<f64> {
+    amplitude_homotopy(
+        of("amplitude", |a| {
+            crate::model::reference::r2_forced(n, clearance, frequency, a)
+        }),
+        crate::model::reference::BASE_AMPLITUDE,
+        &Default::default(),
+    )
+    .unwrap()
+}
+
 /// The start of R2's branches at `from` ω0 (gaps 1 mm): above resonance
 /// the impacting orbit a simulation settles on (AUTO-07p's branch; the
 /// homotopy from rest gives the in-phase orbit without impacts there),
@@ -240,7 +256,7 @@ fn start_orbit(n: usize, from: f64) -> Vec<f64> {
         let start = r2(n, 1e-3, from * W0).unwrap();
         crate::periodic::guess_by_simulation(&start, 200.0, 1e-9).unwrap()
     } else {
-        crate::reference::r2_primary_orbit(n, 1e-3, from * W0)
+        r2_primary_orbit(n, 1e-3, from * W0)
     }
 }
 

@@ -344,11 +344,11 @@ mod tests {
 
     #[test]
     fn reproduces_theory_table() {
-        for crate::reference::R1Row {
+        for crate::model::reference::R1Row {
             v,
             e: e_ref,
             f_max: f_ref,
-        } in crate::reference::R1_TABLE
+        } in crate::model::reference::R1_TABLE
         {
             let e = restitution(v).unwrap();
             // docs/theory.md prints 12 decimals, but its V = 0.01 entry is rounded
@@ -484,8 +484,8 @@ mod tests {
     /// reaches the maximum penetration at y = 0.
     #[test]
     fn trajectory_endpoints_and_peak() {
-        let law = crate::reference::seed_law();
-        let imp = ExponentialImpact::new(&law, crate::reference::seed_bodies()).unwrap();
+        let law = crate::model::reference::seed_law();
+        let imp = ExponentialImpact::new(&law, crate::model::reference::seed_bodies()).unwrap();
         let u = 0.3;
         let x_start = 3e-5;
         let c = imp.impact(u).unwrap();

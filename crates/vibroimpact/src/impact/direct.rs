@@ -339,7 +339,7 @@ mod tests {
     use super::*;
 
     fn seed_law() -> ContactLaw {
-        crate::reference::seed_law()
+        crate::model::reference::seed_law()
     }
 
     /// Closed form and direct integration agree to 1e-9 in e over V in
@@ -347,7 +347,7 @@ mod tests {
     /// maximum penetration.
     #[test]
     fn exponential_law_matches_closed_form() {
-        let bodies = crate::reference::seed_bodies();
+        let bodies = crate::model::reference::seed_bodies();
         let law = seed_law();
         let cf = ExponentialImpact::new(&law, bodies).unwrap();
         let mut v: f64 = 1e-3;
@@ -403,7 +403,7 @@ mod tests {
     #[test]
     fn hertz_is_elastic_with_classical_contact_time() {
         let law = ContactLaw::hertz(5e9, 1.5).unwrap();
-        let bodies = crate::reference::seed_bodies();
+        let bodies = crate::model::reference::seed_bodies();
         let u = 0.3;
         let d = integrate_impact(&law, bodies, u, &DirectOptions::default()).unwrap();
         assert!((d.restitution - 1.0).abs() < 1e-10, "e = {}", d.restitution);
@@ -428,7 +428,7 @@ mod tests {
     fn kelvin_voigt_matches_damped_oscillator() {
         let (k, c) = (1e6, 40.0);
         let law = ContactLaw::kelvin_voigt(k, c, ForceForm::Published).unwrap();
-        let bodies = crate::reference::seed_bodies();
+        let bodies = crate::model::reference::seed_bodies();
         let mu = 0.1135;
         let wn = (k / mu).sqrt();
         let zeta = c / (2.0 * (k * mu).sqrt());
@@ -458,7 +458,7 @@ mod tests {
             ContactLaw::lankarani_nikravesh(5e9, 1.5, 0.9, 1e-6, ForceForm::Published).unwrap();
         let d = integrate_impact(
             &law,
-            crate::reference::seed_bodies(),
+            crate::model::reference::seed_bodies(),
             0.3,
             &DirectOptions::default(),
         )

@@ -1,5 +1,9 @@
 //! Two-body impact relations (docs/theory.md §2, seed eqs. 4–18).
 //!
+//! ## Files
+//! - `closed_form.rs` — seed eqs. 8–18 in closed form;
+//! - `direct.rs` — impacts by direct integration, any law.
+//!
 //! Two bodies on a line (or a body and a wall, `m2 = ∞`) collide through a
 //! contact law. Their relative motion `x = s` obeys
 //! `μ ẍ = -F(x, ẋ)` with the reduced mass `μ = m1 m2 / (m1 + m2)`.

@@ -67,7 +67,7 @@ impl EventLocator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::test_systems::Harmonic;
+    use crate::integrate::tests::systems::Harmonic;
     use crate::integrate::StepMethod;
     use crate::integrate::{Dop853Method, Driver, IntegratorOptions, RodasMethod};
 

@@ -1,5 +1,15 @@
 //! Numerical integration of ordinary differential equations `y' = f(t, y)`.
 //!
+//! ## Files
+//! - `driver.rs` — the one step driver and the [`StepMethod`] interface;
+//! - `explicit.rs` — what the explicit Runge–Kutta methods share;
+//! - `dop853/`, `dopri5/`, `rosenbrock/` — the three methods (DOP853 with
+//!   its tableau, DOPRI5, RODAS), each with its tests;
+//! - `stepper.rs` — any method behind one interface, automatic switching;
+//! - `events.rs` — event location on the dense output;
+//! - `tangent.rs` — the tangent tape: products replayed on recorded steps;
+//! - `tests/` — the conformance suite and the shared test systems.
+//!
 //! Three integrators with the same step-by-step interface:
 //!
 //! * [`Dop853`]: an adaptive explicit Runge–Kutta method of order 8, the
@@ -36,7 +46,6 @@
 //! Integration always runs forward in time (`t_end > t0`).
 
 mod dop853;
-mod dop853_tableau;
 mod dopri5;
 mod driver;
 pub mod events;
@@ -46,9 +55,7 @@ mod stepper;
 pub mod tangent;
 
 #[cfg(test)]
-mod conformance_tests;
-#[cfg(test)]
-mod test_systems;
+mod tests;
 
 pub use crate::linalg::{BandMatrix, Singular};
 pub use dop853::{Dop853, Dop853Method};

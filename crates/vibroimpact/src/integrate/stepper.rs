@@ -271,7 +271,7 @@ impl Stepper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::test_systems::Harmonic;
+    use crate::integrate::tests::systems::Harmonic;
     use crate::integrate::BandMatrix;
 
     /// y' = −λ (y − cos t), with analytic Jacobian.

@@ -22,7 +22,7 @@
 //! a row, the two partial derivatives of each contact force that is not
 //! screened out), so memory is O(steps × stages × active terms).
 
-use super::dop853_tableau::{A, B, C, N_STAGES};
+use super::dop853::tableau::{A, B, C, N_STAGES};
 use super::explicit::combine;
 use super::{BandMatrix, Dop853, IntegrationError, IntegratorOptions, OdeSystem, Stats};
 
@@ -266,7 +266,7 @@ impl<S: RecordedJacobian> TangentTape<S> {
 /// Integrates `sys` from `(t0, y0)` to `t_end` with DOP853, as
 /// [`integrate_to`](super::integrate_to), and records the tape of the
 /// system that `recorder` reaches inside it (the state of a
-/// [`Variational`](crate::variational::Variational) extension, say: the
+/// [`Variational`](crate::dynamics::variational::Variational) extension, say: the
 /// state's steps and Jacobians; the extension's columns only ride along).
 /// Fails if the record does not match DOP853's stages (an internal error).
 pub fn integrate_recorded<V, S>(

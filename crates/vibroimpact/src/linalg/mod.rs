@@ -5,6 +5,9 @@
 //! ([`eigen`]) and the null vector of branch switching. Dense
 //! factorisations, SVD and Schur come from nalgebra (docs/decisions.md
 //! says why each of these is written here).
+//!
+//! Files: `band.rs`, `krylov.rs`, `eigen.rs`, and the null vector in
+//! `mod.rs`.
 
 pub mod band;
 pub mod eigen;

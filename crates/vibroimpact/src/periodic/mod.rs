@@ -1,6 +1,13 @@
 //! Periodic solutions by shooting and their Floquet stability (docs/theory.md §5;
 //! the seed's parts I–II).
 //!
+//! ## Files
+//! - `map.rs` — the period map and its derivatives;
+//! - `shooting.rs` — dense and Newton–Krylov shooting;
+//! - `floquet.rs` — Floquet multipliers;
+//! - `orbit.rs` — orbits from simulation (guesses, summaries);
+//! - `tests.rs` — the checks.
+//!
 //! Under forcing of period `T = 2π/Ω`, a periodic solution of period `nT`
 //! (n = 1 harmonic, n > 1 subharmonic) is a fixed point of the period map
 //! `P(x) = φ(nT; x)` (forcing phase 0 at t = 0). Newton's method on
@@ -25,6 +32,7 @@
 
 use nalgebra::{Complex, DMatrix};
 
+use crate::dynamics::variational::Variational;
 use crate::dynamics::{from_interleaved, interleaved_index, to_interleaved, ChainDynamics};
 use crate::integrate::{
     integrate_recorded, integrate_to, IntegrationError, IntegratorOptions, Interrupt, OdeSystem,
@@ -34,7 +42,6 @@ use crate::model::Model;
 use crate::newton::NewtonStop;
 use crate::simulate::local::LocalTape;
 use crate::simulate::{local_flow, simulate, Integrator, OptionsError, SimulationOptions};
-use crate::variational::Variational;
 
 /// Largest Newton step in the scaled norm (displacement scales).
 const TRUST: f64 = 0.5;

@@ -3,10 +3,10 @@ use super::*;
 use crate::model::BaseExcitation;
 use crate::simulate::Integrator;
 
-use crate::reference::{DAMPING_RATIO as ZETA, NATURAL_FREQUENCY as W0};
+use crate::model::reference::{DAMPING_RATIO as ZETA, NATURAL_FREQUENCY as W0};
 
 fn r2(n: usize, clearance: f64, omega: f64) -> Model {
-    crate::reference::r2(n, clearance, omega).unwrap()
+    crate::model::reference::r2(n, clearance, omega).unwrap()
 }
 
 /// R3: the periodic solution is the exact steady state to 1e-10 and the
@@ -254,7 +254,7 @@ fn r2_n1000_orbit_by_newton_krylov() {
     let model = r2(1000, 1e-3, omega);
     let t = 2.0 * std::f64::consts::PI / omega;
     let guess = guess_by_simulation(&model, 200.0, 1e-9).unwrap();
-    let linear = crate::reference::r3_steady_amplitude(omega);
+    let linear = crate::model::reference::r3_steady_amplitude(omega);
     let decay = (-ZETA * W0 * t).exp();
     krylov_on_both_maps(&model, &guess, t, |_, sol, orbit| {
         assert!(sol.stable());

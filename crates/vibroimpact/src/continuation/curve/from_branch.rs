@@ -5,8 +5,8 @@
 use super::CurveStop;
 use super::{continue_curve, grazing_margin, starts_grazing, Curve, CurveKind, CurveOptions};
 use crate::continuation::{SpecialKind, SpecialPoint};
-use crate::family::{Family2, FamilyError};
 use crate::field_error::FieldError;
+use crate::model::family::{Family2, FamilyError};
 use crate::periodic::ShootingOptions;
 
 /// Which curves to follow and how far.

@@ -16,8 +16,8 @@
 
 use super::system::{Constraint, Observation};
 use super::{bound_crossed, CurveKind, CurveOptions, CurveSystem, Scales};
-use crate::family::Family2;
 use crate::linalg::{arnoldi_matrix, gmres};
+use crate::model::family::Family2;
 use crate::model::Model;
 use crate::newton::NewtonSystem;
 use crate::periodic::{

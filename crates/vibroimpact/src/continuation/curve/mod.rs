@@ -3,6 +3,13 @@
 //! points, Neimark–Sacker points and grazings, each as the solutions
 //! `z = (x, p, q[, κ])` of the minimally augmented system
 //!
+//! ## Files
+//! - `system.rs` — the dense minimally augmented system;
+//! - `krylov.rs` — its matrix-free form for long rows;
+//! - `codim2.rs` — codimension-two points on a curve;
+//! - `from_branch.rs` — the curves through a branch's special points;
+//! - `tests.rs` — curves against the one-parameter branches.
+//!
 //! `G(x; p, q) = 0` (the orbit), `g(x; p, q[, κ]) = 0` (the singularity),
 //!
 //! where `g` is taken from the solution of the bordered system
@@ -27,7 +34,7 @@ mod from_branch;
 mod krylov;
 mod system;
 
-use crate::family::Family2;
+use crate::model::family::Family2;
 use nalgebra::Complex;
 use serde::Serialize;
 

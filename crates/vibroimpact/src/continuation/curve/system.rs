@@ -2,7 +2,7 @@
 //! variables: the orbit residual, the test function(s) from a bordered
 //! system, their forward-difference Jacobian and the Newton corrector.
 
-use crate::family::Family2;
+use crate::model::family::Family2;
 use nalgebra::{Complex, DMatrix, DVector};
 
 use super::{CurveKind, CurveOptions, CurvePoint, CurveSystem, Scales};

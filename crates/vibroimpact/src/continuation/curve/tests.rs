@@ -3,14 +3,14 @@
 
 use super::*;
 use crate::continuation::{continue_branch, ContinuationOptions, SpecialKind};
-use crate::family::{of, of2};
+use crate::model::family::{of, of2};
 use crate::model::ModelError;
 use crate::periodic::{map_multipliers, period_map};
 
-use crate::reference::NATURAL_FREQUENCY as W0;
+use crate::model::reference::NATURAL_FREQUENCY as W0;
 
 fn r2(n: usize, frequency: f64, amplitude: f64) -> Result<Model, ModelError> {
-    crate::reference::r2_forced(n, 1e-3, frequency, amplitude)
+    crate::model::reference::r2_forced(n, 1e-3, frequency, amplitude)
 }
 
 /// R2 N = 1: the fold curve in (frequency, amplitude) from the fold LP1 of
@@ -141,8 +141,8 @@ fn r2_family(p: f64, q: f64) -> Result<Model, ModelError> {
 /// A row of `n` seed pendulums (walls `(left, right)`) at base amplitude q
 /// and frequency p.
 fn row(n: usize, walls: (bool, bool), p: f64, q: f64) -> Result<Model, ModelError> {
+    use crate::model::reference::{seed_law, DAMPING_RATIO, MASS};
     use crate::model::BaseExcitation;
-    use crate::reference::{seed_law, DAMPING_RATIO, MASS};
     Model::row(
         n,
         MASS,
@@ -432,18 +432,18 @@ fn neimark_sacker_curve_ends_at_a_double_branch_point() {
 }
 
 /// The run settings of charts (transient, record) for the rows above.
-fn chart_settings(transient: usize, record: usize) -> crate::sweep::Settings {
+fn chart_settings(transient: usize, record: usize) -> crate::maps::sweep::Settings {
     let text = include_str!("../../../../../examples/fujita-row-n2.toml");
-    let loaded = crate::model_file::ModelDocument::from_toml(text, "fujita-row-n2.toml")
+    let loaded = crate::model::file::ModelDocument::from_toml(text, "fujita-row-n2.toml")
         .unwrap()
         .build()
         .unwrap();
-    crate::attractor::settings(
+    crate::maps::attractor::settings(
         &loaded,
-        &crate::sweep::SweepOptions {
+        &crate::maps::sweep::SweepOptions {
             transient,
             record,
-            ..crate::sweep::SweepOptions::default()
+            ..crate::maps::sweep::SweepOptions::default()
         },
     )
     .unwrap()
@@ -486,7 +486,7 @@ fn chart_cells_agree_with_the_curves() {
             let orbit = crate::periodic::shoot(&m, &pt.state, &ShootingOptions::default()).unwrap();
             assert!(orbit.converged);
             let start: Vec<f64> = orbit.initial_state.iter().map(|x| 1.01 * x).collect();
-            let (run, _) = crate::attractor::run_from(&m, f * pt.p, start, &settings);
+            let (run, _) = crate::maps::attractor::run_from(&m, f * pt.p, start, &settings);
             let flip = orbit.multipliers.iter().map(|m| m.re).fold(0.0, f64::min);
             if orbit.stable() {
                 assert_eq!(run.period, Some(1), "at ({}, {})", f * pt.p, pt.q);
@@ -535,13 +535,13 @@ fn chart_cells_agree_with_the_curves() {
         }
         stable += 1;
         let start: Vec<f64> = orbit.initial_state.iter().map(|x| 1.01 * x).collect();
-        let (run, rec) = crate::attractor::run_from(&inside, 0.98 * pt.p, start, &settings);
+        let (run, rec) = crate::maps::attractor::run_from(&inside, 0.98 * pt.p, start, &settings);
         assert_eq!(run.period, Some(1));
         let back = dist(rec.samples.last().unwrap(), &orbit.initial_state);
         assert!(back < 1e-3, "at ({}, {}): {back}", pt.p, pt.q);
         let outside = row(1, walls, 1.02 * pt.p, pt.q).unwrap();
         let (_, rec) =
-            crate::attractor::run_from(&outside, 1.02 * pt.p, pt.state.clone(), &settings);
+            crate::maps::attractor::run_from(&outside, 1.02 * pt.p, pt.state.clone(), &settings);
         let jump = dist(rec.samples.last().unwrap(), &pt.state);
         assert!(jump > 1.0, "at ({}, {}): {jump}", pt.p, pt.q);
     }

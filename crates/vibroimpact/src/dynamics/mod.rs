@@ -1,0 +1,740 @@
+//! The equations of motion of a [`Model`] as a first-order ODE
+//! (docs/theory.md §4), for the integrators.
+//!
+//! ## Files
+//! - `mod.rs` — [`ChainDynamics`]: the right-hand side, banded Jacobian,
+//!   energy audit;
+//! - `storeys.rs` — the hysteretic storeys' terms and states;
+//! - `variational.rs` — the variational equations (sensitivities,
+//!   monodromy matrices, docs/theory.md §5);
+//! - `tests.rs` — the checks.
+//!
+//! ## State layout
+//! Interleaved, `y = [u_1, v_1, u_2, v_2, …, u_N, v_N]`, so that a chain whose
+//! couplings and contacts join bodies at most `d` apart has a banded
+//! Jacobian with lower/upper bandwidths `(2d + 1, 2d)` (`(1, 1)` without
+//! couplings). The Bouc–Wen storeys' states follow (`storeys.rs`);
+//! with the energy audit on, three quadratures come last:
+//! `W` (work of the excitation), `D_c` (dissipation of the dampers) and
+//! `D_k` (dissipation of the contacts), so that
+//! `E(t) + D_c + D_k + D_h - W = E(0)` with the mechanical energy
+//! `E = Σ ½ m v² + Σ ½ k u² + Σ ½ k_ij Δu² + Σ P_contact(s) + Σ E_s`
+//! (see [`ContactLaw::potential`]), `E_s` what a hysteretic storey stores
+//! and `D_h` what it has dissipated, both from its state
+//! ([`StoreyLaw::stored`](crate::model::hysteresis::StoreyLaw::stored),
+//! [`StoreyLaw::dissipated`](crate::model::hysteresis::StoreyLaw::dissipated)).
+//!
+//! ## Contacts far apart are not evaluated
+//! Each right-hand side skips a contact whose force is certainly below
+//! `1e-3 ε` (ε = f64::EPSILON) of its force scale `F_ref` (the smaller of
+//! the two bodies' `k g + m max|z̈|`; `a` when that is zero), i.e. far below
+//! rounding of the other forces on those bodies: for the exponential law
+//! when `α s + ln a + b|ṡ|/a < ln(1e-3 ε F_ref)` (a bound of
+//! `ln((a + b|ṡ|) e^{αs})` that needs no exp or ln), for laws with compact
+//! support when `s <= 0`. For the seed's row (R2) this skips a contact while
+//! its gap exceeds about 0.36 mm, so the cost of a right-hand side grows with
+//! the number of contacts actually closing, and linearly with N.
+
+use crate::contact::{ContactForce, ContactLaw, LawKind};
+use crate::dynamics::variational::Variational;
+use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian, Recorder};
+use crate::model::{BaseExcitation, Model};
+
+mod storeys;
+pub mod variational;
+pub use storeys::{Branch, StoreyTerms};
+
+/// Index in the interleaved state `[u_1, v_1, …]` of component k of a
+/// body-order state `[u_1..u_N, v_1..v_N]` of N bodies.
+#[inline]
+pub fn interleaved_index(k: usize, n: usize) -> usize {
+    if k < n {
+        2 * k
+    } else {
+        2 * (k - n) + 1
+    }
+}
+
+/// Body-order `[u.., v..]` to interleaved `[u_1, v_1, …]`.
+pub fn to_interleaved(x: &[f64]) -> Vec<f64> {
+    let n = x.len() / 2;
+    let mut y = vec![0.0; x.len()];
+    for (k, &v) in x.iter().enumerate() {
+        y[interleaved_index(k, n)] = v;
+    }
+    y
+}
+
+/// Interleaved `[u_1, v_1, …]` (first 2N entries of `y`) to body order.
+pub fn from_interleaved(y: &[f64], n: usize) -> Vec<f64> {
+    (0..2 * n).map(|k| y[interleaved_index(k, n)]).collect()
+}
+
+/// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
+/// (`-ml F` on the left, `+mr F` on the right; masks 0 for a wall side).
+/// Returns the dissipated power `(F(s, ṡ) - F(s, 0)) ṡ` when `energy`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn apply_contact(
+    law: &ContactLaw,
+    onset_velocity: f64,
+    force: &mut [f64],
+    (l, r): (usize, usize),
+    (ml, mr): (f64, f64),
+    s: f64,
+    sdot: f64,
+    energy: bool,
+) -> f64 {
+    let f = law.force(s, sdot, onset_velocity);
+    force[l] -= ml * f;
+    force[r] += mr * f;
+    if energy {
+        (f - law.force(s, 0.0, onset_velocity)) * sdot
+    } else {
+        0.0
+    }
+}
+
+/// How a contact is screened before evaluation.
+#[derive(Clone, Copy, Debug)]
+enum Screen {
+    /// Skip when `alpha s + b_over_a |ṡ| < limit`.
+    Exponential {
+        alpha: f64,
+        b_over_a: f64,
+        limit: f64,
+    },
+    /// Skip when `s <= 0`.
+    CompactSupport,
+}
+
+#[derive(Clone, Debug)]
+struct ContactTerm {
+    left: Option<usize>,
+    right: Option<usize>,
+    clearance: f64,
+    law: ContactLaw,
+    screen: Screen,
+    absurd: f64,
+}
+
+/// Equations of motion of a model, ready for an integrator.
+#[derive(Clone, Debug)]
+pub struct ChainDynamics {
+    n: usize,
+    mass: Vec<f64>,
+    inv_mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    couplings: Vec<(usize, usize, f64, f64)>,
+    contacts: Vec<ContactTerm>,
+    forces: Vec<(usize, f64, f64, f64)>,
+    base: BaseExcitation,
+    /// Onset approach velocity of each contact's current impact (read by
+    /// laws that need it: Lankarani–Nikravesh).
+    onset_velocity: Vec<f64>,
+    energy: bool,
+    force: Vec<f64>,
+    contact_evaluations: u64,
+    bandwidth: (usize, usize),
+    screen: ScreenSoA,
+    storeys: StoreyTerms,
+}
+
+/// Contact screening in structure-of-arrays form (the hot loop of every
+/// right-hand side): `s = ml u_l - mr u_r - g`, `ṡ = ml v_l - mr v_r`, with
+/// the masks `ml`, `mr` 0 for a wall side (index 0 then) and 1 otherwise;
+/// contact k is evaluated only if `alpha s + boa |ṡ| >= limit` (exponential
+/// law: see the module notes; compact support: alpha = 1, boa = 0,
+/// limit = 0, i.e. `s >= 0`). Branch-free up to the final test.
+#[derive(Clone, Debug, Default)]
+struct ScreenSoA {
+    /// Contact index of the pair (body 0, body 1) when the contacts between
+    /// neighbours are stored consecutively (a chain: the row); then contact
+    /// `first_pair + i` joins bodies i and i + 1 and the pair loop needs no
+    /// index gathers.
+    chain: Option<usize>,
+    l: Vec<usize>,
+    r: Vec<usize>,
+    ml: Vec<f64>,
+    mr: Vec<f64>,
+    g: Vec<f64>,
+    alpha: Vec<f64>,
+    boa: Vec<f64>,
+    limit: Vec<f64>,
+}
+
+impl ChainDynamics {
+    /// The dynamics of `model`; `energy` appends the three energy
+    /// quadratures (after the storeys' states: [`Self::audit_index`]).
+    pub fn new(model: &Model, energy: bool) -> Self {
+        let bodies = model.bodies();
+        let n = bodies.len();
+        let contacts = model
+            .contacts()
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                let f_ref = model.contact_force_scale(k);
+                let (screen, absurd) = match *c.law.kind() {
+                    LawKind::Exponential { a, b, alpha } => {
+                        let f_ref = f_ref.unwrap_or(a);
+                        let limit = (1e-3 * f64::EPSILON * f_ref).ln() - a.ln();
+                        // Beyond α s = 100 the force exceeds a e^100: no physical state.
+                        (
+                            Screen::Exponential {
+                                alpha,
+                                b_over_a: b / a,
+                                limit,
+                            },
+                            100.0 / alpha,
+                        )
+                    }
+                    _ => (Screen::CompactSupport, f64::INFINITY),
+                };
+                ContactTerm {
+                    left: c.pair.left(),
+                    right: c.pair.right(),
+                    clearance: c.clearance,
+                    law: c.law,
+                    screen,
+                    absurd,
+                }
+            })
+            .collect::<Vec<_>>();
+        // The storeys' states right after (u, v), the audit's quadratures
+        // last: an error norm over the first components covers them.
+        let storeys = StoreyTerms::new(model.storeys(), 2 * n, model.initial_displacement());
+        let mut reach = storeys.reach();
+        for c in model.couplings() {
+            reach = reach.max(c.a.abs_diff(c.b));
+        }
+        for c in &contacts {
+            if let (Some(l), Some(r)) = (c.left, c.right) {
+                reach = reach.max(l.abs_diff(r));
+            }
+        }
+        let bandwidth = if reach == 0 {
+            (1, 1)
+        } else {
+            (2 * reach + 1, 2 * reach)
+        };
+        let mut screen = ScreenSoA::default();
+        for c in &contacts {
+            screen.l.push(c.left.unwrap_or(0));
+            screen.r.push(c.right.unwrap_or(0));
+            screen.ml.push(if c.left.is_some() { 1.0 } else { 0.0 });
+            screen.mr.push(if c.right.is_some() { 1.0 } else { 0.0 });
+            screen.g.push(c.clearance);
+            let (alpha, boa, limit) = match c.screen {
+                Screen::Exponential {
+                    alpha,
+                    b_over_a,
+                    limit,
+                } => (alpha, b_over_a, limit),
+                Screen::CompactSupport => (1.0, 0.0, 0.0),
+            };
+            screen.alpha.push(alpha);
+            screen.boa.push(boa);
+            screen.limit.push(limit);
+        }
+        screen.chain = (n >= 2)
+            .then(|| {
+                contacts
+                    .iter()
+                    .position(|c| c.left == Some(0) && c.right == Some(1))
+                    .filter(|&fp| {
+                        fp + n - 1 <= contacts.len()
+                            && (0..n - 1).all(|i| {
+                                contacts[fp + i].left == Some(i)
+                                    && contacts[fp + i].right == Some(i + 1)
+                            })
+                    })
+            })
+            .flatten();
+        Self {
+            n,
+            mass: bodies.iter().map(|b| b.mass).collect(),
+            inv_mass: bodies.iter().map(|b| 1.0 / b.mass).collect(),
+            stiffness: bodies.iter().map(|b| b.stiffness).collect(),
+            damping: bodies.iter().map(|b| b.damping).collect(),
+            couplings: model
+                .couplings()
+                .iter()
+                .map(|c| (c.a, c.b, c.stiffness, c.damping))
+                .collect(),
+            onset_velocity: vec![0.0; contacts.len()],
+            contacts,
+            forces: model
+                .forces()
+                .iter()
+                .map(|f| (f.body, f.amplitude, f.frequency, f.phase))
+                .collect(),
+            base: model.base().clone(),
+            energy,
+            force: vec![0.0; n],
+            contact_evaluations: 0,
+            bandwidth,
+            screen,
+            storeys,
+        }
+    }
+
+    /// Number of bodies.
+    pub fn bodies(&self) -> usize {
+        self.n
+    }
+
+    /// Dimension of the mechanical state (2N).
+    pub fn state_dim(&self) -> usize {
+        2 * self.n
+    }
+
+    /// Lower and upper bandwidths of the mechanical Jacobian.
+    pub fn bandwidth(&self) -> (usize, usize) {
+        self.bandwidth
+    }
+
+    /// Contact law evaluations so far (skipped contacts not counted).
+    pub fn contact_evaluations(&self) -> u64 {
+        self.contact_evaluations
+    }
+
+    /// The hysteretic storeys.
+    pub fn storeys(&self) -> &StoreyTerms {
+        &self.storeys
+    }
+
+    /// The hysteretic storeys, to switch a bilinear storey's branch.
+    pub fn storeys_mut(&mut self) -> &mut StoreyTerms {
+        &mut self.storeys
+    }
+
+    /// The onset approach velocity of contact k's current impact.
+    pub fn onset_velocity(&self, k: usize) -> f64 {
+        self.onset_velocity[k]
+    }
+
+    /// Sets the onset approach velocity of contact k's current impact.
+    pub fn set_onset_velocity(&mut self, k: usize, v: f64) {
+        self.onset_velocity[k] = v;
+    }
+
+    /// Where the energy quadratures begin in the state (after the bodies'
+    /// (u, v) and the storeys' states).
+    pub fn audit_index(&self) -> usize {
+        2 * self.n + self.storeys.states()
+    }
+
+    /// The initial ODE state of a model (interleaved, energy quadratures 0).
+    pub fn initial_state(&self, model: &Model) -> Vec<f64> {
+        let mut y = vec![0.0; self.dim()];
+        for i in 0..self.n {
+            y[2 * i] = model.initial_displacement()[i];
+            y[2 * i + 1] = model.initial_velocity()[i];
+        }
+        y
+    }
+
+    /// Approach coordinate and its rate of contact k in state y.
+    #[inline]
+    pub fn approach(&self, k: usize, y: &[f64]) -> (f64, f64) {
+        let c = &self.contacts[k];
+        let (ul, vl) = c.left.map_or((0.0, 0.0), |l| (y[2 * l], y[2 * l + 1]));
+        let (ur, vr) = c.right.map_or((0.0, 0.0), |r| (y[2 * r], y[2 * r + 1]));
+        (ul - ur - c.clearance, vl - vr)
+    }
+
+    /// State indices of (u_l, v_l, u_r, v_r) of contact k (None for walls).
+    pub fn contact_indices(&self, k: usize) -> [Option<usize>; 4] {
+        let c = &self.contacts[k];
+        [
+            c.left.map(|l| 2 * l),
+            c.left.map(|l| 2 * l + 1),
+            c.right.map(|r| 2 * r),
+            c.right.map(|r| 2 * r + 1),
+        ]
+    }
+
+    /// Force of contact k at approach s and rate ṡ (N), as used in the
+    /// equations of motion.
+    #[inline]
+    pub fn contact_force(&self, k: usize, s: f64, sdot: f64) -> f64 {
+        self.contacts[k].law.force(s, sdot, self.onset_velocity[k])
+    }
+
+    /// Rate dF/dt of contact k's force at (s, ṡ) with s̈ (N/s).
+    #[inline]
+    pub fn contact_force_rate(&self, k: usize, s: f64, sdot: f64, sddot: f64) -> f64 {
+        let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
+        c.d_ds * sdot + c.d_dsdot * sddot
+    }
+
+    /// Clearance of contact k (m).
+    pub fn clearance(&self, k: usize) -> f64 {
+        self.contacts[k].clearance
+    }
+
+    /// The contact law of contact k.
+    pub fn contact_law(&self, k: usize) -> &ContactLaw {
+        &self.contacts[k].law
+    }
+
+    /// The part of the right-hand side that depends on time alone (the
+    /// base acceleration and the harmonic forces, per unit mass) at `t`,
+    /// in the interleaved state layout of the 2N mechanical components:
+    /// `f(t, y) = f(0-forcing; y) + source(t)` there. The energy
+    /// quadratures (with `energy`) are not covered: the input work's rate
+    /// depends on the forcing and the state together.
+    pub fn source(&self, t: f64, out: &mut [f64]) {
+        let zdd = self.base.at(t);
+        for i in 0..self.n {
+            out[2 * i] = 0.0;
+            out[2 * i + 1] = -zdd;
+        }
+        for &(body, p, w, phi) in &self.forces {
+            out[2 * body + 1] += p * (w * t + phi).sin() * self.inv_mass[body];
+        }
+    }
+
+    /// [`source`](Self::source) of the bodies `bodies` (ascending) alone,
+    /// into `out` (resized to their interleaved state).
+    pub fn source_of(&self, t: f64, bodies: &[usize], out: &mut Vec<f64>) {
+        let zdd = self.base.at(t);
+        out.clear();
+        for _ in bodies {
+            out.extend([0.0, -zdd]);
+        }
+        for &(body, p, w, phi) in &self.forces {
+            if let Ok(j) = bodies.binary_search(&body) {
+                out[2 * j + 1] += p * (w * t + phi).sin() * self.inv_mass[body];
+            }
+        }
+    }
+
+    /// Number of contacts.
+    pub fn contacts(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// The contacts not screened out at `y`, with their laws' force and
+    /// partial derivatives there (for the Jacobian).
+    fn evaluated_contacts<'a>(
+        &'a self,
+        y: &'a [f64],
+    ) -> impl Iterator<Item = (usize, ContactForce)> + 'a {
+        let sc = &self.screen;
+        (0..sc.l.len()).filter_map(move |k| {
+            let (s, sdot) = self.approach(k, y);
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                None
+            } else {
+                Some((
+                    k,
+                    self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]),
+                ))
+            }
+        })
+    }
+
+    /// Mechanical energy E (J) of state y (see the module notes).
+    pub fn mechanical_energy(&self, y: &[f64]) -> f64 {
+        let mut e = 0.0;
+        for i in 0..self.n {
+            let (u, v) = (y[2 * i], y[2 * i + 1]);
+            e += 0.5 * self.mass[i] * v * v + 0.5 * self.stiffness[i] * u * u;
+        }
+        for &(a, b, k, _) in &self.couplings {
+            let du = y[2 * b] - y[2 * a];
+            e += 0.5 * k * du * du;
+        }
+        for (k, c) in self.contacts.iter().enumerate() {
+            let (s, _) = self.approach(k, y);
+            e += c.law.potential(s);
+        }
+        e + self.storeys.stored_energy(y)
+    }
+
+    #[cfg(test)]
+    fn skip(screen: Screen, s: f64, sdot: f64) -> bool {
+        match screen {
+            Screen::Exponential {
+                alpha,
+                b_over_a,
+                limit,
+            } => alpha * s + b_over_a * sdot.abs() < limit,
+            Screen::CompactSupport => s <= 0.0,
+        }
+    }
+}
+
+/// A system whose state begins with a row's interleaved `[u, v]`: the row
+/// itself, or the row with carried columns ([`Variational`]), so that the
+/// event scan of a step reads the row whichever is integrated.
+pub trait Chain: OdeSystem {
+    /// The row's dynamics.
+    fn chain(&self) -> &ChainDynamics;
+    /// The row's dynamics, mutably (an impact's onset velocity).
+    fn chain_mut(&mut self) -> &mut ChainDynamics;
+}
+
+impl Chain for ChainDynamics {
+    fn chain(&self) -> &ChainDynamics {
+        self
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self
+    }
+}
+
+impl Chain for Variational<ChainDynamics> {
+    fn chain(&self) -> &ChainDynamics {
+        self.system()
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self.system_mut()
+    }
+}
+
+/// The local integrator's active set: a row with tangent columns, its
+/// Jacobian recorded at every evaluation while a tangent tape is made.
+pub(crate) type SetSystem = Variational<Recorder<ChainDynamics>>;
+
+impl Chain for SetSystem {
+    fn chain(&self) -> &ChainDynamics {
+        self.system().system()
+    }
+
+    fn chain_mut(&mut self) -> &mut ChainDynamics {
+        self.system_mut().system_mut()
+    }
+}
+
+impl OdeSystem for ChainDynamics {
+    fn dim(&self) -> usize {
+        2 * self.n + if self.energy { 3 } else { 0 } + self.storeys.states()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let zdd = self.base.at(t);
+        let n = self.n;
+        for ((((f, uv), k), c), m) in self
+            .force
+            .iter_mut()
+            .zip(y[..2 * n].chunks_exact(2))
+            .zip(&self.stiffness)
+            .zip(&self.damping)
+            .zip(&self.mass)
+        {
+            *f = -k * uv[0] - c * uv[1] - m * zdd;
+        }
+        let mut input = 0.0;
+        let mut damper = 0.0;
+        let mut contact = 0.0;
+        for &(body, p, w, phi) in &self.forces {
+            let f = p * (w * t + phi).sin();
+            self.force[body] += f;
+            input += f * y[2 * body + 1];
+        }
+        for &(a, b, k, c) in &self.couplings {
+            let du = y[2 * b] - y[2 * a];
+            let dv = y[2 * b + 1] - y[2 * a + 1];
+            let f = k * du + c * dv;
+            self.force[a] += f;
+            self.force[b] -= f;
+            damper += c * dv * dv;
+        }
+        self.storeys.apply(y, &mut self.force, dydt);
+        let (sc, contacts, onset, force) = (
+            &self.screen,
+            &self.contacts,
+            &self.onset_velocity,
+            &mut self.force,
+        );
+        let energy = self.energy;
+        let mut evaluations = 0;
+        let nc = sc.l.len();
+        let (chain_start, chain_end) = match sc.chain {
+            Some(fp) => (fp, fp + n - 1),
+            None => (0, 0),
+        };
+        if chain_end > chain_start {
+            // Neighbour pairs of a chain: contiguous, no gathers.
+            let (g, al, boa, lim) = (
+                &sc.g[chain_start..chain_end],
+                &sc.alpha[chain_start..chain_end],
+                &sc.boa[chain_start..chain_end],
+                &sc.limit[chain_start..chain_end],
+            );
+            for i in 0..n - 1 {
+                let w = &y[2 * i..2 * i + 4];
+                let s = w[0] - w[2] - g[i];
+                let sdot = w[1] - w[3];
+                if al[i] * s + boa[i] * sdot.abs() < lim[i] {
+                    continue;
+                }
+                let k = chain_start + i;
+                evaluations += 1;
+                contact += apply_contact(
+                    &contacts[k].law,
+                    onset[k],
+                    force,
+                    (i, i + 1),
+                    (1.0, 1.0),
+                    s,
+                    sdot,
+                    energy,
+                );
+            }
+        }
+        for k in (0..chain_start).chain(chain_end..nc) {
+            let (l, r) = (sc.l[k], sc.r[k]);
+            let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - sc.g[k];
+            let sdot = sc.ml[k] * y[2 * l + 1] - sc.mr[k] * y[2 * r + 1];
+            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                continue;
+            }
+            evaluations += 1;
+            contact += apply_contact(
+                &contacts[k].law,
+                onset[k],
+                force,
+                (l, r),
+                (sc.ml[k], sc.mr[k]),
+                s,
+                sdot,
+                energy,
+            );
+        }
+        self.contact_evaluations += evaluations;
+        for i in 0..n {
+            dydt[2 * i] = y[2 * i + 1];
+            dydt[2 * i + 1] = self.force[i] * self.inv_mass[i];
+        }
+        if self.energy {
+            for i in 0..n {
+                let v = y[2 * i + 1];
+                input -= self.mass[i] * zdd * v;
+                damper += self.damping[i] * v * v;
+            }
+            let m = self.audit_index();
+            dydt[m] = input;
+            dydt[m + 1] = damper;
+            dydt[m + 2] = contact;
+        }
+    }
+
+    /// A body's displacement and velocity: the error of the bodies that
+    /// move is not averaged with that of bodies at rest.
+    fn error_block(&self) -> Option<usize> {
+        Some(2)
+    }
+
+    /// Banded for the mechanical state; dense with the energy quadratures
+    /// (their rows depend on every velocity).
+    fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
+        (!self.energy && !self.storeys.integrated()).then_some(self.bandwidth)
+    }
+
+    /// Analytic ∂f/∂y: springs, dampers, couplings and every contact not
+    /// screened out, with the laws' analytic partial derivatives. The energy
+    /// quadratures' rows are left to finite differences (returns false then).
+    fn jacobian(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        // The storeys' hysteretic terms are left to finite differences.
+        if self.energy || !self.storeys.is_empty() {
+            return false;
+        }
+        for i in 0..self.n {
+            let im = self.inv_mass[i];
+            jac.set(2 * i, 2 * i + 1, 1.0);
+            jac.add(2 * i + 1, 2 * i, -self.stiffness[i] * im);
+            jac.add(2 * i + 1, 2 * i + 1, -self.damping[i] * im);
+        }
+        let pair = |jac: &mut BandMatrix, a: usize, b: usize, ds: f64, dv: f64| {
+            // Force +(ds Δu + dv Δv) on a, -(…) on b, with Δ = (b) - (a).
+            let (ia, ib) = (self.inv_mass[a], self.inv_mass[b]);
+            jac.add(2 * a + 1, 2 * a, -ds * ia);
+            jac.add(2 * a + 1, 2 * b, ds * ia);
+            jac.add(2 * a + 1, 2 * a + 1, -dv * ia);
+            jac.add(2 * a + 1, 2 * b + 1, dv * ia);
+            jac.add(2 * b + 1, 2 * a, ds * ib);
+            jac.add(2 * b + 1, 2 * b, -ds * ib);
+            jac.add(2 * b + 1, 2 * a + 1, dv * ib);
+            jac.add(2 * b + 1, 2 * b + 1, -dv * ib);
+        };
+        for &(a, b, k, c) in &self.couplings {
+            pair(jac, a, b, k, c);
+        }
+        for (k, c) in self.evaluated_contacts(y) {
+            match (self.contacts[k].left, self.contacts[k].right) {
+                // -F on l, +F on r, F = F(u_l - u_r - g, v_l - v_r): the same
+                // shape as a coupling of stiffness ∂F/∂s between r and l.
+                (Some(l), Some(r)) => pair(jac, l, r, c.d_ds, c.d_dsdot),
+                (Some(l), None) => {
+                    jac.add(2 * l + 1, 2 * l, -c.d_ds * self.inv_mass[l]);
+                    jac.add(2 * l + 1, 2 * l + 1, -c.d_dsdot * self.inv_mass[l]);
+                }
+                (None, Some(r)) => {
+                    // s = -u_r - g: ∂(+F)/∂u_r = -∂F/∂s.
+                    jac.add(2 * r + 1, 2 * r, -c.d_ds * self.inv_mass[r]);
+                    jac.add(2 * r + 1, 2 * r + 1, -c.d_dsdot * self.inv_mass[r]);
+                }
+                (None, None) => {}
+            }
+        }
+        true
+    }
+
+    fn admissible(&self, _t: f64, y: &[f64]) -> bool {
+        self.contacts.iter().enumerate().all(|(k, c)| {
+            let (s, _) = self.approach(k, y);
+            s <= c.absurd
+        })
+    }
+}
+
+/// The Jacobian recorded for tangent replay: springs, dampers and
+/// couplings are the model's (constant); each contact not screened out
+/// contributes its index and its force's partial derivatives
+/// `(∂F/∂s, ∂F/∂ṡ)`, as in [`OdeSystem::jacobian`].
+impl RecordedJacobian for ChainDynamics {
+    type Entry = (u32, f64, f64);
+
+    fn record_jacobian(&self, y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
+        out.extend(
+            self.evaluated_contacts(y)
+                .map(|(k, c)| (k as u32, c.d_ds, c.d_dsdot)),
+        );
+    }
+
+    fn apply_recorded(&self, entries: &[(u32, f64, f64)], v: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        for i in 0..n {
+            out[2 * i] = v[2 * i + 1];
+            out[2 * i + 1] = -self.stiffness[i] * v[2 * i] - self.damping[i] * v[2 * i + 1];
+        }
+        for &(a, b, k, c) in &self.couplings {
+            let f = k * (v[2 * b] - v[2 * a]) + c * (v[2 * b + 1] - v[2 * a + 1]);
+            out[2 * a + 1] += f;
+            out[2 * b + 1] -= f;
+        }
+        let sc = &self.screen;
+        for &(k, d_ds, d_dsdot) in entries {
+            let k = k as usize;
+            let (l, r, ml, mr) = (sc.l[k], sc.r[k], sc.ml[k], sc.mr[k]);
+            let ds = ml * v[2 * l] - mr * v[2 * r];
+            let dsdot = ml * v[2 * l + 1] - mr * v[2 * r + 1];
+            let f = d_ds * ds + d_dsdot * dsdot;
+            out[2 * l + 1] -= ml * f;
+            out[2 * r + 1] += mr * f;
+        }
+        for i in 0..n {
+            out[2 * i + 1] *= self.inv_mass[i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,301 @@
+//! The hysteretic storeys in the equations of motion (docs/theory.md §11).
+//!
+//! A Bouc–Wen storey integrates its hysteretic drift z and the work e of
+//! its hysteretic part with the state: (z, e) after the bodies' (u, v).
+//! A bilinear storey carries its branch as memory instead, as a contact
+//! carries its onset velocity: elastic through an anchor, z = z₀ + d − d₀,
+//! or plastic at z = ±u_y, with the work of its hysteretic part at the
+//! branch's start (so the work is exact: ½ (1 − b) k (z² − z₀²) along an
+//! elastic branch, (1 − b) k z (d − d₀) along a plastic one). Within a step
+//! its force is then linear in the drift; the run locates a switch (yield: |z| reaches u_y; unloading: ḋ
+//! turns against z) on the step's dense output, takes the step again up to
+//! it and switches the branch there ([`StoreyTerms::switch_value`],
+//! [`StoreyTerms::switch`]).
+
+use crate::model::hysteresis::{Hysteretic, StoreyLaw};
+use crate::model::Storey;
+
+/// How far past the yield drift (relative) the elastic branch may go
+/// before a switch counts: a switch just located (ḋ = 0 to the last bits)
+/// does not switch back at once.
+const YIELD_SLACK: f64 = 1e-10;
+
+/// A bilinear storey's branch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Branch {
+    /// z = z₀ + d − d₀.
+    Elastic {
+        /// The drift at the anchor.
+        d0: f64,
+        /// z there.
+        z0: f64,
+        /// The hysteretic part's work there (J).
+        e0: f64,
+    },
+    /// z held at ±u_y while the drift goes on outwards.
+    Plastic {
+        /// ±u_y.
+        z: f64,
+        /// The drift where it yielded.
+        d0: f64,
+        /// The hysteretic part's work there (J).
+        e0: f64,
+    },
+}
+
+/// One storey's term.
+#[derive(Clone, Debug)]
+struct Term {
+    below: Option<usize>,
+    above: usize,
+    law: StoreyLaw,
+    /// The branch of a bilinear storey.
+    branch: Branch,
+    /// Where a Bouc–Wen storey's (z, e) sit in the state.
+    state: Option<usize>,
+}
+
+/// The hysteretic storeys of a model, as the equations of motion use them.
+#[derive(Clone, Debug, Default)]
+pub struct StoreyTerms {
+    terms: Vec<Term>,
+    states: usize,
+}
+
+impl StoreyTerms {
+    /// The terms of `storeys`; a Bouc–Wen storey's state from index
+    /// `first_state` on (two each); every bilinear storey elastic from
+    /// rest at the initial drifts of `u0` (displacements, body order).
+    pub fn new(storeys: &[Storey], first_state: usize, u0: &[f64]) -> Self {
+        let mut states = 0;
+        let terms = storeys
+            .iter()
+            .map(|s| {
+                let d0 = u0[s.above] - s.below.map_or(0.0, |b| u0[b]);
+                let state = matches!(s.law, StoreyLaw::BoucWen(_)).then(|| {
+                    states += 2;
+                    first_state + states - 2
+                });
+                Term {
+                    below: s.below,
+                    above: s.above,
+                    law: s.law,
+                    branch: Branch::Elastic {
+                        d0,
+                        z0: 0.0,
+                        e0: 0.0,
+                    },
+                    state,
+                }
+            })
+            .collect();
+        Self { terms, states }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.terms.is_empty()
+    }
+
+    /// How many states the Bouc–Wen storeys add.
+    pub fn states(&self) -> usize {
+        self.states
+    }
+
+    /// Whether any storey integrates a state (then the Jacobian is dense).
+    pub fn integrated(&self) -> bool {
+        self.states > 0
+    }
+
+    /// The farthest apart two bodies a storey joins (for the bandwidth).
+    pub fn reach(&self) -> usize {
+        self.terms
+            .iter()
+            .filter_map(|t| t.below.map(|b| b.abs_diff(t.above)))
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Storey k's drift and drift rate in the interleaved state `y`.
+    fn drift(&self, k: usize, y: &[f64]) -> (f64, f64) {
+        let t = &self.terms[k];
+        let (u, v) = (y[2 * t.above], y[2 * t.above + 1]);
+        match t.below {
+            Some(b) => (u - y[2 * b], v - y[2 * b + 1]),
+            None => (u, v),
+        }
+    }
+
+    /// Storey k's hysteretic state in the state `y` (z and the work of its
+    /// hysteretic part; zero for an elastic storey).
+    pub fn state(&self, k: usize, y: &[f64]) -> Hysteretic {
+        let (d, _) = self.drift(k, y);
+        self.hysteretic(k, d, y)
+    }
+
+    /// Storey k's hysteretic state at drift `d` in `y`.
+    fn hysteretic(&self, k: usize, d: f64, y: &[f64]) -> Hysteretic {
+        let t = &self.terms[k];
+        let kh = match t.law {
+            StoreyLaw::Bilinear(b) => (1.0 - b.post_yield_ratio) * b.stiffness,
+            _ => 0.0,
+        };
+        match (t.state, t.branch) {
+            (Some(i), _) => Hysteretic {
+                z: y[i],
+                work: y[i + 1],
+            },
+            (None, Branch::Elastic { d0, z0, e0 }) => {
+                let z = z0 + d - d0;
+                Hysteretic {
+                    z,
+                    work: e0 + 0.5 * kh * (z * z - z0 * z0),
+                }
+            }
+            (None, Branch::Plastic { z, d0, e0 }) => Hysteretic {
+                z,
+                work: e0 + kh * z * (d - d0),
+            },
+        }
+    }
+
+    /// Storey k's force F(d, z) in the state `y` (N).
+    pub fn force(&self, k: usize, y: &[f64]) -> f64 {
+        let (d, _) = self.drift(k, y);
+        self.terms[k].law.force(d, self.hysteretic(k, d, y))
+    }
+
+    /// The energy the storeys store in `y`: ½ b k d² + ½ (1 − b) k z² each
+    /// (½ k d² for an elastic one).
+    pub fn stored_energy(&self, y: &[f64]) -> f64 {
+        (0..self.terms.len())
+            .map(|k| {
+                let (d, _) = self.drift(k, y);
+                let s = self.hysteretic(k, d, y);
+                self.terms[k].law.stored(d, s)
+            })
+            .sum()
+    }
+
+    /// The energy the storeys have dissipated by hysteresis in `y`.
+    pub fn dissipated(&self, y: &[f64]) -> f64 {
+        (0..self.terms.len())
+            .map(|k| self.terms[k].law.dissipated(self.state(k, y)))
+            .sum()
+    }
+
+    /// Adds every storey's force to the bodies' `force` and writes the
+    /// Bouc–Wen states' rates into `dydt`.
+    pub fn apply(&self, y: &[f64], force: &mut [f64], dydt: &mut [f64]) {
+        for (k, t) in self.terms.iter().enumerate() {
+            let (d, dd) = self.drift(k, y);
+            let s = self.hysteretic(k, d, y);
+            let f = t.law.force(d, s);
+            force[t.above] -= f;
+            if let Some(b) = t.below {
+                force[b] += f;
+            }
+            if let (Some(i), StoreyLaw::BoucWen(w)) = (t.state, &t.law) {
+                let (dz, de) = w.slope(s, dd);
+                dydt[i] = dd * dz;
+                dydt[i + 1] = dd * de;
+            }
+        }
+    }
+
+    /// The bilinear storeys (the ones whose branch switches).
+    pub fn bilinear(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.terms.len()).filter(|&k| matches!(self.terms[k].law, StoreyLaw::Bilinear(_)))
+    }
+
+    /// Bilinear storey k's switch function in `y`: positive while its
+    /// branch holds, zero where it switches (yield from the elastic
+    /// branch, unloading from the plastic one).
+    pub fn switch_value(&self, k: usize, y: &[f64]) -> f64 {
+        let t = &self.terms[k];
+        let StoreyLaw::Bilinear(b) = t.law else {
+            return 1.0;
+        };
+        let (d, dd) = self.drift(k, y);
+        match t.branch {
+            Branch::Elastic { d0, z0, .. } => {
+                b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs()
+            }
+            Branch::Plastic { z, .. } => dd * z.signum(),
+        }
+    }
+
+    /// Switches bilinear storey k's branch in the state `y` where its
+    /// switch function vanished.
+    pub fn switch(&mut self, k: usize, y: &[f64]) {
+        let (d, _) = self.drift(k, y);
+        let s = self.hysteretic(k, d, y);
+        let t = &mut self.terms[k];
+        let StoreyLaw::Bilinear(b) = t.law else {
+            return;
+        };
+        t.branch = match t.branch {
+            Branch::Elastic { .. } => Branch::Plastic {
+                z: b.yield_drift.copysign(s.z),
+                d0: d,
+                e0: s.work,
+            },
+            Branch::Plastic { z, .. } => Branch::Elastic {
+                d0: d,
+                z0: z,
+                e0: s.work,
+            },
+        };
+    }
+
+    /// Bilinear storey k's branch.
+    pub fn branch(&self, k: usize) -> Branch {
+        self.terms[k].branch
+    }
+
+    /// Sets bilinear storey k's branch (carried from another run's terms).
+    pub fn set_branch(&mut self, k: usize, branch: Branch) {
+        self.terms[k].branch = branch;
+    }
+
+    /// Where storey k's Bouc–Wen state (z, e) sits in the state, if it has
+    /// one.
+    pub fn state_index(&self, k: usize) -> Option<usize> {
+        self.terms[k].state
+    }
+
+    /// Storey k's bodies: (below, or None for the ground; above).
+    pub fn ends(&self, k: usize) -> (Option<usize>, usize) {
+        (self.terms[k].below, self.terms[k].above)
+    }
+
+    /// Storey k on a linear branch: F = k d + F₀ with its initial stiffness
+    /// k; returns F₀ (an elastic law's is 0; a bilinear storey's elastic
+    /// branch gives (1 − b) k (z₀ − d₀)). None on a plastic branch or for
+    /// Bouc–Wen, whose force is not linear in the drift.
+    pub fn linear_force(&self, k: usize) -> Option<f64> {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Elastic { .. }, _) => Some(0.0),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
+                Some((1.0 - b.post_yield_ratio) * b.stiffness * (z0 - d0))
+            }
+            _ => None,
+        }
+    }
+
+    /// The drifts between which storey k stays on its linear branch, shrunk
+    /// by `margin` of its yield drift at both ends (unbounded for an
+    /// elastic law); None where [`linear_force`](Self::linear_force) is.
+    pub fn linear_window(&self, k: usize, margin: f64) -> Option<(f64, f64)> {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Elastic { .. }, _) => Some((f64::NEG_INFINITY, f64::INFINITY)),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
+                let reach = b.yield_drift * (1.0 - margin);
+                Some((d0 - z0 - reach, d0 - z0 + reach))
+            }
+            _ => None,
+        }
+    }
+}

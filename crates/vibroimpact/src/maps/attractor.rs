@@ -1,0 +1,285 @@
+//! Attractors reached by simulation: one run from an initial state (a
+//! transient, then recorded periods as in a [`sweep`](crate::maps::sweep)),
+//! classified by the period of its Poincaré samples, and the test whether
+//! two runs reached the same attractor (docs/theory.md §8). Shared by the
+//! stability chart and the basins of attraction.
+
+use serde::Serialize;
+
+use crate::field_error::FieldError;
+use crate::maps::sweep::{
+    run_value, Direction, Settings, Start, SweepError, SweepOptions, SweepPoint,
+};
+use crate::model::file::LoadedModel;
+use crate::model::Model;
+
+/// Relative tolerance of the integrations of charts and basins unless the
+/// options or the model's `[simulation]` give one. The Poincaré samples of
+/// an impacting orbit under the seed's stiff law carry an integration
+/// noise of ~1e3 × rtol: at 1e-6 it reaches [`DEFAULT_CLUSTER_TOLERANCE`]
+/// (R2 N = 2 at 1.1 ω0: the period-3 orbit classed not periodic; of a 20 ×
+/// 20 (frequency, amplitude) chart, 46 period-1 cells against 90 at 1e-8),
+/// at 1e-7 the classes are those of 1e-8.
+pub const DEFAULT_RTOL: f64 = 1e-7;
+
+/// Relative tolerance of two equal Poincaré samples unless the options
+/// give one: coarser than a sweep's 1e-5, since 100 transient periods leave
+/// a free oscillation of the lightly damped bodies (ζ = 0.013 in R2) of
+/// up to ~4e-3 of its initial size at 1.5 ω0.
+pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
+
+/// Input errors of charts and basins (numerical failures are kept in the
+/// runs).
+#[derive(Debug, thiserror::Error)]
+pub enum MapError {
+    /// An option refused by name.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// Any other input error.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl From<SweepError> for MapError {
+    fn from(e: SweepError) -> Self {
+        match e {
+            SweepError::Field(f) => Self::Field(f),
+            SweepError::Input(m) => Self::Input(m),
+        }
+    }
+}
+
+/// The run settings of charts and basins: `options` for models like
+/// `base`, with [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`] where
+/// neither the options nor the model give a value.
+pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Settings, SweepError> {
+    let options = SweepOptions {
+        rtol: options.rtol.or(base.simulation.rtol).or(Some(DEFAULT_RTOL)),
+        cluster_tolerance: options
+            .cluster_tolerance
+            .or(Some(DEFAULT_CLUSTER_TOLERANCE)),
+        ..options.clone()
+    };
+    Settings::new(base, &options)
+}
+
+/// Checks the values of a grid axis named `name`: at least one, all finite.
+pub(crate) fn check_axis(name: &str, values: &[f64]) -> Result<(), String> {
+    if values.is_empty() {
+        return Err(format!("{name}: no values"));
+    }
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(format!("{name} = {v}: the values must be finite")),
+        None => Ok(()),
+    }
+}
+
+/// The attractor one run reached.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Run {
+    /// The initial state `[u.., v..]` (m, m/s).
+    pub start: Vec<f64>,
+    /// Period of the attractor in forcing periods: the smallest p, at most
+    /// half the recorded periods, with s_{k+p} = s_k (to the cluster
+    /// tolerance) for every pair of recorded Poincaré samples; null when
+    /// they do not repeat (quasi-periodic, chaotic, or not settled).
+    pub period: Option<usize>,
+    /// Impacts (all contacts) per forcing period.
+    pub impacts_per_period: f64,
+    /// Largest |u_i| over the bodies and the recorded periods (m).
+    pub max_displacement: f64,
+    /// The largest Lyapunov exponent (1/s), if requested.
+    pub lyapunov: Option<f64>,
+    /// The failure, if any.
+    pub error: Option<String>,
+}
+
+impl Run {
+    /// A run that failed with `error`.
+    pub(crate) fn failed(start: Vec<f64>, error: String) -> Self {
+        Self {
+            start,
+            period: None,
+            impacts_per_period: f64::NAN,
+            max_displacement: f64::NAN,
+            lyapunov: None,
+            error: Some(error),
+        }
+    }
+}
+
+/// A run's Poincaré samples and the scales of their displacements (largest
+/// |u| over the window) and velocities (that times the forcing frequency).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Recorded {
+    pub(crate) samples: Vec<Vec<f64>>,
+    pub(crate) scale: (f64, f64),
+}
+
+/// Simulates `model` (parameter value `x`, for the sweep's bookkeeping) from
+/// `state` (`[u.., v..]` at forcing phase 0) and classifies the attractor.
+pub(crate) fn run_from(
+    model: &Model,
+    x: f64,
+    state: Vec<f64>,
+    settings: &Settings,
+) -> (Run, Recorded) {
+    let n = model.bodies().len();
+    let start = Start {
+        u: state[..n].to_vec(),
+        v: state[n..].to_vec(),
+        phase: 0,
+    };
+    let (point, _) = run_value(model, x, Direction::None, Some(start), settings);
+    let omega = model.forcing_frequency().unwrap_or(1.0);
+    classify(state, point, omega, settings.cluster_tolerance)
+}
+
+/// A run's summary from its sweep point, with its samples.
+fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, Recorded) {
+    if let Some(e) = point.error {
+        return (Run::failed(start, e), Recorded::default());
+    }
+    let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
+    let scale = (max_u, max_u * omega);
+    let s = &point.sections;
+    // Periodic: every sample equals the one p periods later (a slowly
+    // settling orbit, whose samples drift, is not: its greedy clusters
+    // could number a few).
+    let period = (1..=s.len() / 2)
+        .find(|&p| (0..s.len() - p).all(|k| same_sample(&s[k], &s[k + p], tol, scale)))
+        .filter(|&p| p == 1 || !settling(s, scale));
+    let run = Run {
+        start,
+        period,
+        impacts_per_period: point.impacts_per_period,
+        max_displacement: max_u,
+        lyapunov: point.lyapunov.and_then(|l| l.first().copied()),
+        error: None,
+    };
+    let recorded = Recorded {
+        samples: point.sections,
+        scale,
+    };
+    (run, recorded)
+}
+
+/// Whether the samples still spiral into a fixed point: the steps between
+/// consecutive samples shrink by more than half from the first quarter of
+/// the window to the last. A lightly damped free oscillation sampled once
+/// per forcing period turns by 2π ω0/Ω a sample, so a residual near the
+/// cluster tolerance repeats every few samples (R2 N = 2 at Ω = 10 rad/s
+/// after 100 periods: "period 4"); a period-p orbit's steps repeat with
+/// period p and do not shrink.
+fn settling(s: &[Vec<f64>], scale: (f64, f64)) -> bool {
+    let n = s[0].len() / 2;
+    let step = |k: usize| {
+        (0..2 * n).fold(0.0f64, |m, i| {
+            let sc = if i < n { scale.0 } else { scale.1 };
+            m.max((s[k + 1][i] - s[k][i]).abs() / sc.max(f64::MIN_POSITIVE))
+        })
+    };
+    let q = ((s.len() - 1) / 4).max(1);
+    let mean = |ks: std::ops::Range<usize>| ks.clone().map(step).sum::<f64>() / ks.len() as f64;
+    mean(s.len() - 1 - q..s.len() - 1) < 0.5 * mean(0..q)
+}
+
+/// Whether two Poincaré samples are equal: every displacement within
+/// `tol` times the displacement scale, every velocity within `tol` times
+/// the velocity scale.
+fn same_sample(a: &[f64], b: &[f64], tol: f64, scale: (f64, f64)) -> bool {
+    let n = a.len() / 2;
+    (0..2 * n).all(|i| {
+        let s = if i < n { scale.0 } else { scale.1 };
+        (a[i] - b[i]).abs() <= tol * s
+    })
+}
+
+/// Whether two periodic runs reached the same attractor: every sample of
+/// the last cycle of each lies on the last cycle of the other (to `tol` of
+/// the larger scales). A run still spiralling into a fixed point with a
+/// third of a turn per period repeats every 3 periods while every sample
+/// lies on the fixed point: the same attractor as the settled run.
+/// Non-periodic and failed runs are never the same as anything here.
+pub(crate) fn same_attractor(a: (&Run, &Recorded), b: (&Run, &Recorded), tol: f64) -> bool {
+    let (Some(p), Some(q)) = (a.0.period, b.0.period) else {
+        return false;
+    };
+    let (s, o) = (&a.1.samples, &b.1.samples);
+    if s.len() < p || o.len() < q {
+        return false;
+    }
+    let scale = (a.1.scale.0.max(b.1.scale.0), a.1.scale.1.max(b.1.scale.1));
+    let on = |x: &[f64], cycle: &[Vec<f64>]| cycle.iter().any(|y| same_sample(x, y, tol, scale));
+    let (ca, cb) = (&s[s.len() - p..], &o[o.len() - q..]);
+    ca.iter().all(|x| on(x, cb)) && cb.iter().all(|y| on(y, ca))
+}
+
+/// The attractor of every run: an index into the list of distinct
+/// attractors (the representative run of each is returned too: of the
+/// shortest period among its runs). The periodic ones come first, in
+/// order of first appearance; a run that is
+/// not periodic over its window but whose last sample lies on one of them
+/// (a slowly settling transient) belongs to it; the other non-periodic
+/// runs share one index, last; failed runs get none.
+pub(crate) fn identify(
+    runs: &[Run],
+    recorded: &[Recorded],
+    tol: f64,
+) -> (Vec<Option<usize>>, Vec<usize>) {
+    let mut reps: Vec<usize> = Vec::new();
+    let mut ids: Vec<Option<usize>> = vec![None; runs.len()];
+    for (i, run) in runs.iter().enumerate() {
+        if run.error.is_some() || run.period.is_none() {
+            continue;
+        }
+        let found = reps
+            .iter()
+            .position(|&j| same_attractor((&runs[j], &recorded[j]), (run, &recorded[i]), tol));
+        ids[i] = Some(match found {
+            // The run of the shortest period represents the attractor.
+            Some(k) => {
+                if run.period < runs[reps[k]].period {
+                    reps[k] = i;
+                }
+                k
+            }
+            None => {
+                reps.push(i);
+                reps.len() - 1
+            }
+        });
+    }
+    let periodic = reps.len();
+    for (i, run) in runs.iter().enumerate() {
+        if run.error.is_some() || run.period.is_some() {
+            continue;
+        }
+        let last = recorded[i].samples.last();
+        let on = (0..periodic).find(|&k| {
+            let (rep, rec) = (&runs[reps[k]], &recorded[reps[k]]);
+            let p = rep.period.unwrap_or(1);
+            let scale = (
+                rec.scale.0.max(recorded[i].scale.0),
+                rec.scale.1.max(recorded[i].scale.1),
+            );
+            last.is_some_and(|l| {
+                rec.samples[rec.samples.len() - p..]
+                    .iter()
+                    .any(|q| same_sample(l, q, tol, scale))
+            })
+        });
+        ids[i] = Some(on.unwrap_or_else(|| {
+            if reps.len() == periodic {
+                reps.push(i);
+            }
+            periodic
+        }));
+    }
+    (ids, reps)
+}
+
+/// Distinct attractors among runs (see [`identify`]).
+pub(crate) fn count_attractors(runs: &[Run], recorded: &[Recorded], tol: f64) -> usize {
+    identify(runs, recorded, tol).1.len()
+}

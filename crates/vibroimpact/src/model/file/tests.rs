@@ -1,0 +1,196 @@
+//! Tests of the model-file schema.
+use super::*;
+
+fn parse(text: &str) -> Result<LoadedModel, ModelFileError> {
+    ModelDocument::from_toml(text, "m.toml")?.build()
+}
+
+const ROW: &str = r#"
+[row]
+count = 3
+mass = 0.227
+natural_frequency = 7.41
+damping_ratio = 0.013
+clearance = 0.001
+contact = { law = "exponential", a_over_b = 1.2, alpha = 1.3e5, a = 1.0 }
+
+[excitation]
+type = "harmonic-base"
+amplitude = 0.05
+frequency = 7.0395
+"#;
+
+const EXPLICIT: &str = r#"
+[[body]]
+name = "a"
+mass = 1.0
+stiffness = 100.0
+[[body]]
+name = "b"
+mass = 2.0
+natural_frequency = 5.0
+damping_ratio = 0.02
+initial_velocity = 0.1
+[[spring]]
+between = ["a", "b"]
+stiffness = 10.0
+[[contact]]
+between = ["wall", "a"]
+clearance = 0.002
+law = { law = "hertz", stiffness = 1e9 }
+[[contact]]
+between = ["a", "b"]
+clearance = 0.001
+law = { law = "kelvin-voigt", stiffness = 1e6, damping = 10.0, form = "non-negative" }
+[[force]]
+body = "b"
+amplitude = 1.0
+frequency = 3.0
+"#;
+
+#[test]
+fn row_form() {
+    let m = parse(ROW).unwrap().model;
+    assert_eq!(m.bodies().len(), 3);
+    assert_eq!(m.contacts().len(), 4);
+    assert!((m.bodies()[0].stiffness - 0.227 * 7.41 * 7.41).abs() < 1e-12);
+    assert!((m.bodies()[0].damping - 2.0 * 0.013 * 0.227 * 7.41).abs() < 1e-14);
+    assert_eq!(m.forcing_frequency(), Some(7.0395));
+}
+
+#[test]
+fn explicit_form() {
+    let text = EXPLICIT;
+    let m = parse(text).unwrap().model;
+    assert_eq!(m.couplings().len(), 1);
+    assert_eq!(m.contact_name(0), "wall|a");
+    assert_eq!(m.contacts()[1].law.form(), ForceForm::NonNegative);
+    assert_eq!(m.initial_velocity(), &[0.0, 0.1]);
+    assert_eq!(m.forcing_frequency(), Some(3.0));
+}
+
+fn err(text: &str) -> String {
+    parse(text).expect_err("should fail").to_string()
+}
+
+#[test]
+fn errors_name_line_and_key() {
+    let e = err(&ROW.replace("mass = 0.227", "mass = 0.227\nmasss = 1"));
+    assert!(e.starts_with("m.toml:") && e.contains("masss"), "{e}");
+    // A value of the wrong type names its table and key (a Python dict's
+    // TOML text has no lines the user wrote).
+    let e = err(&ROW.replace("mass = 0.227", "mass = \"0.2\""));
+    assert!(
+        e.starts_with("m.toml:4: key `row.mass`: invalid type: string \"0.2\""),
+        "{e}"
+    );
+    let e = err(&ROW.replace("clearance = 0.001\n", ""));
+    assert!(e.contains("clearance"), "{e}");
+    let e = err(&ROW.replace("mass = 0.227", "mass = -1"));
+    assert!(e.starts_with("m.toml:2:") && e.contains("mass = -1"), "{e}");
+    let e = err(&ROW.replace("alpha = 1.3e5", "alpha = 0"));
+    assert!(e.contains("alpha"), "{e}");
+    let e = err(&ROW.replace("clearance = 0.001", "clearance = -0.001"));
+    assert!(e.contains("clearance"), "{e}");
+    let e = err("[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"wall\", \"b\"]\nclearance = 0.0\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+    assert!(
+        e.contains("m.toml:5") && e.contains("exactly two names") && e.contains("got 3"),
+        "{e}"
+    );
+    let e = err(&ROW.replace("count = 3", "count = 3 # \u{1} x"));
+    assert!(e.contains("control character U+0001"), "{e}");
+    let line = ROW
+        .lines()
+        .position(|l| l.starts_with("count = 3"))
+        .unwrap()
+        + 1;
+    assert!(e.starts_with(&format!("m.toml:{line}: ")), "{e}");
+    let e = err("[[body]]\nname = \"a\"\nmass = 1.0\n[[contact]]\nbetween = [\"a\", \"zz\"]\nclearance = 0.0\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+    assert!(
+        e.starts_with("m.toml:4:") && e.contains("unknown body `zz`"),
+        "{e}"
+    );
+    let e = err("[[body]]\nname = \"a\"\nmass = 1.0\ninitial_displacement = 0.01\n[[contact]]\nbetween = [\"a\", \"wall\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1.0 }\n");
+    assert!(e.contains("overlap"), "{e}");
+    let e = err(&ROW.replace("type = \"harmonic-base\"", "type = \"quake\""));
+    assert!(e.contains("quake"), "{e}");
+    let e = err(&ROW.replace("law = \"exponential\"", "law = \"magic\""));
+    assert!(e.contains("magic"), "{e}");
+}
+
+#[test]
+fn accelerograms_from_text_and_inline() {
+    let a = parse_accelerogram_csv("time,acceleration\n0,0\n0.5,1\n1.0,0\n", "ok.csv").unwrap();
+    assert_eq!((a.times.len(), a.acceleration[1]), (3, 1.0));
+    let e = parse_accelerogram_csv("0,0\n0.5,1\n0.4,0\n", "bad.csv")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.csv:3:") && e.contains("increase"), "{e}");
+    let text = "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n[excitation]\ntype = \"accelerogram\"\nfile = \"ok.csv\"\nscale = 0.5\n";
+    let doc = ModelDocument::parse(text, "m.toml", &mut |f, _| {
+        assert_eq!(f, "ok.csv");
+        Ok(a.clone())
+    })
+    .unwrap();
+    let m = doc.build().unwrap().model;
+    let BaseExcitation::Record(r) = m.base() else {
+        panic!("a record")
+    };
+    assert_eq!(r.at(0.25), 0.25);
+    // Written back with the record inline, it reads without the file.
+    let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+    assert_eq!(again.build().unwrap().model, m);
+    let e = ModelDocument::from_toml(text, "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ok.csv") && e.contains("inline"), "{e}");
+}
+
+#[test]
+fn inline_records_and_settings_are_checked() {
+    let base = "[row]\ncount = 1\nmass = 1.0\nstiffness = 1.0\nclearance = 0.01\ncontact = { law = \"hertz\", stiffness = 1e6 }\n";
+    let e = err(&format!(
+            "{base}[excitation]\ntype = \"accelerogram\"\ntime = [0.0, 1.0, 2.0]\nacceleration = [0.0, 1.0]\n"
+        ));
+    assert!(
+        e.starts_with("m.toml:7:") && e.contains("`time` has 3 values, `acceleration` 2"),
+        "{e}"
+    );
+    let e = err(&format!("{base}[simulation]\natol = -1e-9\n"));
+    assert!(
+        e.contains("[simulation] atol = -0.000000001: must be finite and > 0"),
+        "{e}"
+    );
+    let e = err(&format!("{base}[simulation]\nrtol = nan\n"));
+    assert!(e.contains("[simulation] rtol = NaN"), "{e}");
+}
+
+/// Every example form survives the round trip through `to_toml`.
+#[test]
+fn round_trip() {
+    for text in [ROW, EXPLICIT] {
+        let doc = ModelDocument::from_toml(text, "m.toml").unwrap();
+        let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+        assert_eq!(again.build().unwrap().model, doc.build().unwrap().model);
+    }
+}
+
+/// `[initial]` by body name: the named bodies' values, the others at rest;
+/// an unknown name is an error with its line; the form survives the round
+/// trip; a dotted parameter into it does not exist.
+#[test]
+fn initial_state_by_body_name() {
+    let text = include_str!("../../../../../examples/granular-chain.toml");
+    let doc = ModelDocument::from_toml(text, "chain.toml").unwrap();
+    let m = doc.build().unwrap().model;
+    assert_eq!(m.initial_velocity()[0], 1.0);
+    assert!(m.initial_velocity()[1..].iter().all(|&v| v == 0.0));
+    assert!(m.initial_displacement().iter().all(|&u| u == 0.0));
+    let again = ModelDocument::from_toml(&doc.to_toml(), "again").unwrap();
+    assert_eq!(again.build().unwrap().model, m);
+    let bad = text.replace("{ p1 = 1.0 }", "{ p1 = 1.0, q7 = 2.0 }");
+    let e = err(&bad);
+    assert!(e.contains("chain.toml:") || e.contains(":2"), "{e}");
+    assert!(e.contains("no body named \"q7\""), "{e}");
+    assert!(doc.parameter("initial.velocity.1").is_err());
+}

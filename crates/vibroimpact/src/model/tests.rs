@@ -1,0 +1,146 @@
+//! Tests of the model (`mod.rs`).
+
+use super::*;
+
+use crate::model::reference::seed_law as law;
+
+#[test]
+fn row_layout_and_names() {
+    let m = Model::row(
+        3,
+        0.227,
+        12.0,
+        0.04,
+        1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::None,
+    )
+    .unwrap();
+    assert_eq!(m.contacts().len(), 4);
+    assert_eq!(m.contact_name(0), "wall|p1");
+    assert_eq!(m.contact_name(1), "p1|p2");
+    assert_eq!(m.contact_name(3), "p3|wall");
+    let u = [1e-4, -2e-4, 5e-4];
+    assert!((m.approach(0, &u) - (-1e-4 - 1e-3)).abs() < 1e-18);
+    assert!((m.approach(1, &u) - (3e-4 - 1e-3)).abs() < 1e-18);
+    assert!((m.approach(3, &u) - (5e-4 - 1e-3)).abs() < 1e-18);
+}
+
+#[test]
+fn invalid_models_are_named() {
+    let e = Model::row(
+        2,
+        -1.0,
+        1.0,
+        0.0,
+        1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::None,
+    )
+    .unwrap_err();
+    assert!(e.message.contains("mass = -1"), "{e}");
+    assert_eq!(
+        (e.kind, e.key.as_str()),
+        (ModelErrorKind::InvalidValue, "body.1.mass")
+    );
+    let e = Model::row(
+        2,
+        1.0,
+        1.0,
+        0.0,
+        -1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::None,
+    )
+    .unwrap_err();
+    assert!(e.message.contains("clearance"), "{e}");
+    let m = Model::row(
+        2,
+        1.0,
+        1.0,
+        0.0,
+        1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::None,
+    )
+    .unwrap();
+    let e = m.with_initial_state(vec![2e-3, 0.0], vec![]).unwrap_err();
+    assert!(e.message.contains("overlap"), "{e}");
+    assert_eq!(e.kind, ModelErrorKind::Overlap);
+}
+
+#[test]
+fn accelerogram_interpolates_and_validates() {
+    let r = Accelerogram::new(vec![0.0, 1.0, 3.0], vec![0.0, 2.0, -2.0], 0.5).unwrap();
+    assert_eq!(r.at(0.5), 0.5);
+    assert_eq!(r.at(2.0), 0.0);
+    assert_eq!(r.at(3.0), -1.0);
+    assert_eq!(r.at(3.5), 0.0);
+    assert_eq!(r.at(-1.0), 0.0);
+    assert!(Accelerogram::new(vec![0.0, 1.0, 1.0], vec![0.0; 3], 1.0).is_err());
+    assert_eq!(r.peak(), 1.0);
+}
+
+#[test]
+fn accelerogram_segment_is_the_bisections() {
+    // A uniform record with rounding in its times, a record with a
+    // slow stretch (long walks fall back to bisection) and one with
+    // only two samples; every sample time, the midpoints and the ends.
+    let uniform: Vec<f64> = (0..2001).map(|k| k as f64 * 0.005).collect();
+    let mut uneven: Vec<f64> = (0..200).map(|k| k as f64 * 0.01).collect();
+    uneven.extend((1..50).map(|k| 1.99 + k as f64 * 0.2));
+    for times in [uniform, uneven, vec![-1.0, 2.0]] {
+        let n = times.len();
+        let r = Accelerogram::new(times.clone(), vec![0.0; n], 1.0).unwrap();
+        let mut probes = times.clone();
+        probes.extend(times.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+        probes.extend(times.iter().map(|t| t - 1e-12));
+        for t in probes.into_iter().filter(|t| *t >= times[0]) {
+            let bisection = times.partition_point(|&x| x <= t).clamp(1, n - 1);
+            assert_eq!(r.segment(t), bisection, "t = {t}");
+        }
+    }
+}
+
+#[test]
+fn mirror_symmetry() {
+    let base = BaseExcitation::Harmonic {
+        amplitude: 0.05,
+        frequency: 7.0,
+        phase: 0.3,
+    };
+    let row = |walls| Model::row(3, 1.0, 1.0, 0.1, 1e-3, law(), walls, base.clone()).unwrap();
+    assert!(row((true, true)).is_mirror_symmetric());
+    assert!(row((false, false)).is_mirror_symmetric());
+    // One wall only: not symmetric.
+    assert!(!row((true, false)).is_mirror_symmetric());
+    // No periodic forcing: no spatio-temporal symmetry.
+    assert!(!row((true, true))
+        .with_base(BaseExcitation::None)
+        .is_mirror_symmetric());
+    // A heavier end body breaks it.
+    let mut m = row((true, true));
+    m.bodies[0].mass = 1.1;
+    assert!(!m.is_mirror_symmetric());
+    // A different clearance at one wall breaks it.
+    let mut m = row((true, true));
+    m.contacts[0].clearance = 2e-3;
+    assert!(!m.is_mirror_symmetric());
+}
+
+#[test]
+fn forcing_frequency() {
+    let base = BaseExcitation::Harmonic {
+        amplitude: 0.05,
+        frequency: 7.0,
+        phase: 0.0,
+    };
+    let m = Model::row(1, 1.0, 1.0, 0.0, 1e-3, law(), (true, true), base).unwrap();
+    assert_eq!(m.forcing_frequency(), Some(7.0));
+    let m = m.with_base(BaseExcitation::None);
+    assert_eq!(m.forcing_frequency(), None);
+}

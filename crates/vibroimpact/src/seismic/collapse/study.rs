@@ -1,0 +1,165 @@
+//! A collapse study as every face runs it: per record its IDA and its
+//! spectral acceleration at the period (one task per record for a
+//! cluster), then the summary over the records; and their documents (the
+//! CLI's JSON is the schema, Python returns the same).
+
+use serde_json::{json, Value};
+
+use super::{median_collapse, record_ida, Criterion, IdaSettings, RecordIda, Verdict};
+use crate::model::record::Record;
+use crate::seismic::pounding::{PoundingError, Row, RunSettings};
+
+/// The settings of a collapse study.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CollapseStudy {
+    /// When a run collapses.
+    pub criterion: Criterion,
+    /// The scales visited.
+    pub ida: IdaSettings,
+    /// How each run is computed.
+    pub run: RunSettings,
+    /// The period T of the intensity S_T (s): the records' spectral
+    /// acceleration at it, 5 % damped unless `damping` says otherwise.
+    pub period: Option<f64>,
+    /// The damping ratio of that spectral acceleration.
+    pub damping: f64,
+}
+
+/// One record's part of a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordCollapse {
+    /// Its IDA.
+    pub ida: RecordIda,
+    /// Its pseudo-spectral acceleration at the period, unscaled (m/s²).
+    pub sa: Option<f64>,
+}
+
+impl CollapseStudy {
+    /// One record's IDA and spectral acceleration (the task of one
+    /// record).
+    pub fn record(&self, row: &Row, record: &Record) -> Result<RecordCollapse, PoundingError> {
+        let sa = self
+            .period
+            .map(|t| {
+                crate::seismic::spectrum::response_spectrum(record, 1.0, self.damping, &[t])
+                    .map(|p| p[0].pseudo_acceleration)
+            })
+            .transpose()?;
+        let ida = record_ida(row, record, &self.criterion, &self.ida, &self.run)?;
+        Ok(RecordCollapse { ida, sa })
+    }
+}
+
+/// A verdict as a document: `kind` (standing, drift, capacity, diverged)
+/// and its details.
+fn verdict_document(v: &Verdict) -> Value {
+    match v {
+        Verdict::Standing => json!({ "kind": "standing" }),
+        Verdict::Drift {
+            building,
+            storey,
+            drift,
+            time,
+        } => {
+            json!({ "kind": "drift", "building": building, "storey": storey, "drift": drift, "time": time })
+        }
+        Verdict::Capacity {
+            building,
+            displacement,
+        } => json!({ "kind": "capacity", "building": building, "displacement": displacement }),
+        Verdict::Diverged { message } => json!({ "kind": "diverged", "message": message }),
+    }
+}
+
+/// One record's document: its source, spectral acceleration, the runs
+/// (`scale`, `max_drift`, `verdict`) in the order made, the bracket
+/// (`survived`, `collapse`), whether it is censored and, then, the note
+/// "no collapse up to scale X".
+pub fn record_document(r: &RecordCollapse) -> Value {
+    let points: Vec<Value> = r
+        .ida
+        .points
+        .iter()
+        .map(|p| json!({ "scale": p.scale, "max_drift": p.max_drift, "verdict": verdict_document(&p.verdict) }))
+        .collect();
+    json!({
+        "source": r.ida.source,
+        "sa": r.sa,
+        "runs": points,
+        "survived": r.ida.survived,
+        "collapse": r.ida.collapse,
+        "censored": r.ida.collapse.is_none(),
+        "note": r.ida.collapse.is_none().then(|| format!("no collapse up to scale {}", r.ida.survived)),
+    })
+}
+
+/// The summary over the records' parts: the median collapse scale (null
+/// where censored records leave it undetermined, with a note naming
+/// them); with spectral accelerations, the set's median S_T at the period
+/// (their geometric mean, as FEMA P695's S_NRT) and the median collapse
+/// intensity Ŝ_CT = median scale × S_T; with
+/// `smt` the collapse margin ratio CMR = Ŝ_CT / S_MT, and with `ssf` also
+/// ACMR = SSF × CMR.
+pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Option<f64>) -> Value {
+    let idas: Vec<RecordIda> = records.iter().map(|r| r.ida.clone()).collect();
+    let median = median_collapse(&idas);
+    let sas: Option<Vec<f64>> = records.iter().map(|r| r.sa).collect();
+    // The set's median as FEMA P695 tabulates it (S_NRT, Table A-3): the
+    // geometric mean, the median of the lognormal fit.
+    let s_t = sas
+        .as_deref()
+        .filter(|v| !v.is_empty())
+        .map(|v| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp());
+    let s_ct = median.zip(s_t).map(|(m, s)| m * s);
+    let cmr = s_ct.zip(smt).map(|(c, m)| c / m);
+    let censored: Vec<String> = idas
+        .iter()
+        .filter(|r| r.collapse.is_none())
+        .map(|r| format!("{}: no collapse up to scale {}", r.source, r.survived))
+        .collect();
+    json!({
+        "records": records.len(),
+        "collapsed": records.len() - censored.len(),
+        "median_collapse_scale": median,
+        "s_t": s_t,
+        "s_ct": s_ct,
+        "smt": smt,
+        "cmr": cmr,
+        "ssf": ssf,
+        "acmr": cmr.zip(ssf).map(|(c, s)| c * s),
+        "censored": censored,
+        "note": median.is_none().then(|| format!(
+            "the median collapse scale is not determined: {} of {} records did not collapse; raise the largest scale",
+            censored.len(),
+            records.len()
+        )),
+    })
+}
+
+/// The study's document: the row, the settings, every record's document
+/// ([`record_document`]) and the summary ([`summary_document`]).
+pub fn study_document(
+    row: &Row,
+    study: &CollapseStudy,
+    records: Vec<Value>,
+    summary: Value,
+) -> Value {
+    json!({
+        "row": crate::seismic::pounding::documents::row_document(row),
+        "criterion": {
+            "drift_limit": study.criterion.drift,
+            "capacity": study.criterion.capacity,
+            "contacts": study.criterion.contacts,
+        },
+        "ida": {
+            "first": study.ida.first,
+            "growth": study.ida.growth,
+            "max_scale": study.ida.max_scale,
+            "tolerance": study.ida.tolerance,
+        },
+        "period": study.period,
+        "damping": study.damping,
+        "records": records,
+        "summary": summary,
+    })
+}

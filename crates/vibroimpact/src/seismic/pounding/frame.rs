@@ -1,0 +1,127 @@
+//! A shear frame (docs/earthquakes.md): floor masses, storey stiffnesses
+//! and laws, Rayleigh damping on the initial stiffnesses, its modes.
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::model::hysteresis::{StoreyLaw, StoreySpec};
+
+/// A shear frame: floors from the ground up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShearFrame {
+    /// Floor masses (kg), from the first floor up.
+    pub masses: Vec<f64>,
+    /// Storey stiffnesses (N/m): storey i joins floor i − 1 (the ground for
+    /// i = 1) to floor i.
+    pub stiffnesses: Vec<f64>,
+    /// Rayleigh damping ratio in the first two modes (on the initial
+    /// stiffnesses).
+    pub damping_ratio: f64,
+    /// The storeys' laws, from the ground up (empty: all elastic; a law's
+    /// elastic stiffness is the storey's in `stiffnesses`).
+    pub storeys: Vec<StoreySpec>,
+}
+
+impl ShearFrame {
+    /// Checks the frame: as many storeys as floors, masses and stiffnesses
+    /// positive and finite, a damping ratio in [0, 1).
+    pub fn check(&self, name: &str) -> Result<(), String> {
+        if self.masses.is_empty() || self.masses.len() != self.stiffnesses.len() {
+            return Err(format!(
+                "{name}: {} masses and {} storey stiffnesses; give one of each per floor",
+                self.masses.len(),
+                self.stiffnesses.len()
+            ));
+        }
+        for (i, (m, k)) in self.masses.iter().zip(&self.stiffnesses).enumerate() {
+            if !(m.is_finite() && *m > 0.0 && k.is_finite() && *k > 0.0) {
+                return Err(format!(
+                    "{name}: floor {}: mass {m} and stiffness {k} must be positive and finite",
+                    i + 1
+                ));
+            }
+        }
+        if !(self.damping_ratio.is_finite() && (0.0..1.0).contains(&self.damping_ratio)) {
+            return Err(format!(
+                "{name}: damping ratio {}: give a value in [0, 1)",
+                self.damping_ratio
+            ));
+        }
+        if !self.storeys.is_empty() && self.storeys.len() != self.masses.len() {
+            return Err(format!(
+                "{name}: {} storey laws for {} storeys; give one per storey (or none: elastic)",
+                self.storeys.len(),
+                self.masses.len()
+            ));
+        }
+        self.laws().map(|_| ()).map_err(|e| format!("{name}: {e}"))
+    }
+
+    /// The storeys' laws with their elastic stiffnesses (all elastic
+    /// without `storeys`); an error names the storey and the key.
+    pub fn laws(&self) -> Result<Vec<StoreyLaw>, String> {
+        (0..self.masses.len())
+            .map(|i| {
+                let spec = self.storeys.get(i).copied().unwrap_or(StoreySpec::Elastic);
+                spec.law(self.stiffnesses[i])
+                    .map_err(|e| format!("storey {}: {e}", i + 1))
+            })
+            .collect()
+    }
+
+    /// Whether any storey yields (is not elastic).
+    pub fn inelastic(&self) -> bool {
+        self.storeys.iter().any(|s| *s != StoreySpec::Elastic)
+    }
+
+    /// The stiffness matrix K (tridiagonal).
+    pub(super) fn stiffness_matrix(&self) -> DMatrix<f64> {
+        let n = self.masses.len();
+        let k = &self.stiffnesses;
+        DMatrix::from_fn(n, n, |r, c| {
+            if r == c {
+                k[r] + k.get(r + 1).copied().unwrap_or(0.0)
+            } else if r + 1 == c {
+                -k[c]
+            } else if c + 1 == r {
+                -k[r]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The natural circular frequencies (rad/s), lowest first: the
+    /// eigenvalues of M^{-1/2} K M^{-1/2}.
+    pub fn natural_frequencies(&self) -> Vec<f64> {
+        let k = self.stiffness_matrix();
+        let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
+        let n = s.len();
+        let a = DMatrix::from_fn(n, n, |r, c| s[r] * k[(r, c)] * s[c]);
+        let mut w: Vec<f64> = SymmetricEigen::new(a)
+            .eigenvalues
+            .iter()
+            .map(|l| l.max(0.0).sqrt())
+            .collect();
+        w.sort_by(f64::total_cmp);
+        w
+    }
+
+    /// The fundamental period T1 (s).
+    pub fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.natural_frequencies()[0]
+    }
+
+    /// Rayleigh's (α, β) with ζ in modes 1 and 2 (one storey: β = 0, α = 2ζω).
+    pub fn rayleigh(&self) -> (f64, f64) {
+        let w = self.natural_frequencies();
+        let z = self.damping_ratio;
+        match w.as_slice() {
+            [w1] => (2.0 * z * w1, 0.0),
+            [w1, w2, ..] => {
+                let alpha = 2.0 * z * w1 * w2 / (w1 + w2);
+                (alpha, 2.0 * z / (w1 + w2))
+            }
+            [] => (0.0, 0.0),
+        }
+    }
+}

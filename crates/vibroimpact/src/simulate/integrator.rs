@@ -1,0 +1,84 @@
+//! Which integrator runs a simulation: the global one, the local one
+//! (docs/theory.md §10), or the one of the two that pays for the model.
+
+use super::OptionsError;
+use crate::model::{BaseExcitation, Model};
+
+/// How a simulation advances the state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Integrator {
+    /// The local integrator where it pays, the global one elsewhere (see
+    /// [`Integrator::resolve`]).
+    #[default]
+    Auto,
+    /// Every body integrated at every step by the step driver.
+    Global,
+    /// Exact motion between contacts; only bodies whose contacts are
+    /// active are integrated ([`super::local::LocalStats`] counts the work).
+    Local,
+}
+
+/// Groups of bodies (joined by springs) from which [`Integrator::Auto`]
+/// runs the local integrator (docs/decisions.md D24: at 16 bodies of R2
+/// near resonance, where every body impacts, the local run takes 6 % more
+/// time; at 0.5 ω0, 2× less; below, the global integrator is as fast or
+/// faster).
+pub const AUTO_LOCAL_GROUPS: usize = 16;
+
+impl Integrator {
+    /// `auto`, `global` or `local`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Auto => "auto",
+            Integrator::Global => "global",
+            Integrator::Local => "local",
+        }
+    }
+
+    /// The integrator that runs `model`: [`Integrator::Auto`] is local for
+    /// a model of at least [`AUTO_LOCAL_GROUPS`] groups whose free motion
+    /// has a bounded steady state under its forcing (no undamped group
+    /// under harmonic forcing) and no recorded base motion, global
+    /// otherwise; the others are themselves. (A record moves every group
+    /// and the global integrator steps at its samples anyway: rows of 16
+    /// and 64 buildings ran 3.9–6.6× slower locally, docs/decisions.md D26.)
+    pub fn resolve(self, model: &Model) -> Integrator {
+        match self {
+            Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {
+                Integrator::Global
+            }
+            Integrator::Auto => {
+                let (place, members) = crate::simulate::local::free_motion::spring_groups(model);
+                // Per group: damped (by a body's or a coupling's damper).
+                let mut damped = vec![false; members.len()];
+                for (i, b) in model.bodies().iter().enumerate() {
+                    damped[place[i].0] |= b.damping != 0.0;
+                }
+                for c in model.couplings() {
+                    damped[place[c.a].0] |= c.damping != 0.0;
+                }
+                let harmonic = model.forcing_frequency().is_some();
+                if members.len() >= AUTO_LOCAL_GROUPS && !(harmonic && damped.contains(&false)) {
+                    Integrator::Local
+                } else {
+                    Integrator::Global
+                }
+            }
+            other => other,
+        }
+    }
+}
+
+impl std::str::FromStr for Integrator {
+    type Err = OptionsError;
+    fn from_str(s: &str) -> Result<Self, OptionsError> {
+        match s {
+            "auto" => Ok(Integrator::Auto),
+            "global" => Ok(Integrator::Global),
+            "local" => Ok(Integrator::Local),
+            _ => Err(OptionsError(format!(
+                "integrator = {s:?}: must be auto, global or local"
+            ))),
+        }
+    }
+}

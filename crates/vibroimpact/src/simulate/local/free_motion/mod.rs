@@ -1,0 +1,627 @@
+//! Exact motion between contacts (docs/theory.md §10).
+//!
+//! Files: `mod.rs` (groups and their exact motion), `modal.rs` (complex
+//! modes), `bounds.rs` (bounds on the motion ahead), `tests.rs`.
+//!
+//! With every contact open, a model's equations are linear with
+//! time-dependent forcing:
+//!
+//! ```text
+//! ẋ = A x + Σ_j b_j sin(Ω_j t + φ_j) − e z̈_rec(t)
+//! ```
+//!
+//! per group of bodies joined by springs and dampers (a body without
+//! couplings is a group of one); `x` is the group's interleaved state
+//! `[u_1, v_1, …]`, `e` has a 1 in every velocity row, and the harmonic
+//! terms are the base's and the forces'. The state is propagated exactly:
+//!
+//! * harmonic forcing by its steady state `x_p(t) = Σ_j Im(X_j e^{i(Ω_j t +
+//!   φ_j)})`, `(iΩ_j − A) X_j = b_j`, and the homogeneous rest by `e^{Aτ}`:
+//!   `x(t₀ + τ) = x_p(t₀ + τ) + e^{Aτ}(x(t₀) − x_p(t₀))`;
+//! * a recorded accelerogram (linear between samples, zero outside the
+//!   record) sample by sample under first-order hold:
+//!   `x(b) = e^{Aτ}x(a) + Γ₁ e f(a) + Γ₂ e f'` with `Γ₁ = ∫₀^τ e^{As} ds`,
+//!   `Γ₂ = ∫₀^τ e^{A(τ−s)} s ds`, read off the exponential of the augmented
+//!   matrix `[[A, e, 0], [0, 0, 1], [0, 0, 0]] τ` (Van Loan);
+//! * for a single body `e^{Aτ}` in closed form (under-, critically and
+//!   over-damped, and free bodies with ω0 = 0), for a group by
+//!   nalgebra's matrix exponential.
+//!
+//! A hysteretic storey on a linear branch (docs/theory.md §11: an elastic
+//! branch of a bilinear storey, `F = k d + F₀`) is a spring of its initial
+//! stiffness `k` with a constant force `F₀`: the group moves about its
+//! static rest state `x_s` (`K u_s = f₀`, zero velocities), `x(t) = x_s +`
+//! the motion above of `x − x_s` ([`FreeMotion::set_rest`]).
+//!
+//! It also bounds the motion ahead, for the contact scheduler
+//! (`bounds.rs`).
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use crate::model::{Accelerogram, BaseExcitation, Model};
+
+use modal::Modal;
+
+/// Why a model's free motion has no exact propagator.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FreeMotionError {
+    /// An undamped group has a natural frequency equal to a forcing
+    /// frequency: its steady state grows without bound.
+    #[error("the free motion of {bodies} is undamped and resonant at the forcing frequency {frequency} rad/s: it has no bounded steady state; use the global integrator")]
+    Resonant {
+        /// The group's body names.
+        bodies: String,
+        /// The forcing frequency (rad/s).
+        frequency: f64,
+    },
+}
+
+/// How a group's `e^{Aτ}` is computed.
+#[derive(Clone, Debug)]
+enum Propagator {
+    /// One body: `ü = −w2 u − c2 u̇` in closed form.
+    Single { w2: f64, c2: f64 },
+    /// A group: the matrix exponential of `A`.
+    Group(DMatrix<f64>),
+}
+
+/// One spring-coupled group of bodies and its exact propagator.
+#[derive(Clone, Debug)]
+pub struct Group {
+    bodies: Vec<usize>,
+    propagator: Propagator,
+    /// Steady states of the harmonic terms: (Ω, φ, Re X, Im X).
+    harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    /// Couplings inside the group: (local a, local b, k, c).
+    couplings: Vec<(usize, usize, f64, f64)>,
+    /// Sum of the harmonic forces' amplitudes on each body (N).
+    force_amplitude: Vec<f64>,
+    /// Harmonic forces: (body in the group, P, Ω, φ).
+    forces: Vec<(usize, f64, f64, f64)>,
+    /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
+    rate: f64,
+    /// The complex modes, where they can be trusted (not for a single
+    /// body under harmonic forcing: closed form).
+    modal: Option<Modal>,
+    /// Without modes, under a uniform record: the matrix form of a whole
+    /// sample step, computed once.
+    hold_step: Option<HoldStep>,
+    /// The static rest state of its storeys' constant forces
+    /// (interleaved; zero without storeys), and those forces.
+    rest: Vec<f64>,
+    rest_forces: Vec<f64>,
+}
+
+/// The first-order-hold step of one record sample interval `τ`: `x(b) =
+/// Φ x(a) + γ₀ f(a) + γ₁ f'` (the columns of the augmented exponential).
+#[derive(Clone, Debug)]
+struct HoldStep {
+    tau: f64,
+    phi: DMatrix<f64>,
+    g0: Vec<f64>,
+    g1: Vec<f64>,
+}
+
+/// The exact free motion of every group of a model.
+#[derive(Clone, Debug)]
+pub struct FreeMotion {
+    groups: Vec<Group>,
+    /// (group, index in the group) of every body.
+    place: Vec<(usize, usize)>,
+    base: BaseExcitation,
+    /// The base's |z̈| over stretches of time, for the bounds.
+    peaks: bounds::Peaks,
+}
+
+/// Calls `step(τ, f(a), f')` for every interval `[a, a + τ]` between
+/// `t0`, the record's samples and `t1`: the forcing `f = −z̈` (zero
+/// outside the record) is linear over each. A sample within 1e-12 of a
+/// record step of `t0` or `t1` (rounding of the same time) is not a
+/// breakpoint: the sliver would cost a step of its own for a change of
+/// the state far below any tolerance.
+fn record_intervals(rec: &Accelerogram, t0: f64, t1: f64, mut step: impl FnMut(f64, f64, f64)) {
+    let times = rec.times();
+    let (first, last) = (times[0], times[times.len() - 1]);
+    let sliver = 1e-12 * (last - first) / (times.len().max(2) - 1) as f64;
+    let mut ta = t0;
+    let mut k = times.partition_point(|&s| s <= t0 + sliver);
+    while ta < t1 {
+        let tb = match times.get(k) {
+            Some(&s) if s < t1 - sliver => s,
+            _ => t1,
+        };
+        let mid = 0.5 * (ta + tb);
+        let (fa, fb) = if mid > first && mid < last {
+            (-rec.at(ta), -rec.at(tb))
+        } else {
+            (0.0, 0.0)
+        };
+        let tau = tb - ta;
+        step(tau, fa, (fb - fa) / tau);
+        ta = tb;
+        k += 1;
+    }
+}
+
+/// The sample step of `times` if uniform (to 1e-9 of it, as a record's
+/// `dt`).
+fn uniform_step(times: &[f64]) -> Option<f64> {
+    let steps = times.windows(2).map(|w| w[1] - w[0]);
+    let (lo, hi) = steps.fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
+        (lo.min(d), hi.max(d))
+    });
+    (times.len() >= 2 && hi - lo <= 1e-9 * hi).then_some(times[1] - times[0])
+}
+
+/// `e^{Aτ}` of `ü = −w2 u − c2 u̇` as `[[p00, p01], [p10, p11]]`:
+/// `e^{μτ}[C I + S (A − μ I)]` with `μ = −c2/2`, `δ = μ² − w2`, `C, S` the
+/// cosine and sine (hyperbolic for δ > 0) of `√|δ| τ` (S divided by
+/// `√|δ|`), by their series where `|δ| τ²` is small.
+fn single_exp(w2: f64, c2: f64, tau: f64) -> [f64; 4] {
+    let mu = -0.5 * c2;
+    let delta = mu * mu - w2;
+    let x = delta * tau * tau;
+    let (ec, es) = if x.abs() < 1e-4 {
+        let e = (mu * tau).exp();
+        (
+            e * (1.0 + x / 2.0 + x * x / 24.0),
+            e * tau * (1.0 + x / 6.0 + x * x / 120.0),
+        )
+    } else if delta < 0.0 {
+        let wd = (-delta).sqrt();
+        let e = (mu * tau).exp();
+        (e * (wd * tau).cos(), e * (wd * tau).sin() / wd)
+    } else {
+        // e^{μτ} cosh(rτ) and e^{μτ} sinh(rτ)/r from the two decaying
+        // exponentials (μ + r <= 0: no overflow).
+        let r = delta.sqrt();
+        let (ep, em) = (((mu + r) * tau).exp(), ((mu - r) * tau).exp());
+        (0.5 * (ep + em), 0.5 * (ep - em) / r)
+    };
+    [ec - mu * es, es, -w2 * es, ec + mu * es]
+}
+
+/// The groups of `model`: the connected components of its couplings and
+/// storeys (union–find), as each body's (group, index in the group) and each
+/// group's bodies (ascending), groups in the order of their first body.
+pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usize>>) {
+    let n = model.bodies().len();
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    let storeys = model
+        .storeys()
+        .iter()
+        .filter_map(|s| Some((s.below?, s.above)));
+    for (p, q) in model.couplings().iter().map(|c| (c.a, c.b)).chain(storeys) {
+        let (a, b) = (find(&mut root, p), find(&mut root, q));
+        root[a.max(b)] = a.min(b);
+    }
+    let mut place = vec![(usize::MAX, 0); n];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for i in 0..n {
+        let r = find(&mut root, i);
+        if place[r].0 == usize::MAX {
+            place[r] = (members.len(), 0);
+            members.push(Vec::new());
+        }
+        let g = place[r].0;
+        place[i] = (g, members[g].len());
+        members[g].push(i);
+    }
+    (place, members)
+}
+
+impl FreeMotion {
+    /// The groups of `model` and their propagators. Errors for an undamped
+    /// group in resonance with a harmonic forcing term.
+    pub fn new(model: &Model) -> Result<Self, FreeMotionError> {
+        let (place, members) = spring_groups(model);
+        let mut groups = Vec::with_capacity(members.len());
+        for bodies in members {
+            groups.push(Self::group(model, &place, bodies)?);
+        }
+        let record_step = match model.base() {
+            BaseExcitation::Record(rec) => Some(uniform_step(rec.times())),
+            _ => None,
+        };
+        for g in &mut groups {
+            if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
+                g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
+            }
+            if let (None, Some(Some(tau))) = (&g.modal, record_step) {
+                let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(g), tau);
+                g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
+            }
+        }
+        Ok(Self {
+            groups,
+            place,
+            base: model.base().clone(),
+            peaks: bounds::Peaks::new(model.base()),
+        })
+    }
+
+    fn group(
+        model: &Model,
+        place: &[(usize, usize)],
+        bodies: Vec<usize>,
+    ) -> Result<Group, FreeMotionError> {
+        let m = bodies.len();
+        let all = model.bodies();
+        let mass: Vec<f64> = bodies.iter().map(|&i| all[i].mass).collect();
+        let mut stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let damping: Vec<f64> = bodies.iter().map(|&i| all[i].damping).collect();
+        let here = place[bodies[0]].0;
+        let mut couplings: Vec<(usize, usize, f64, f64)> = model
+            .couplings()
+            .iter()
+            .filter(|c| place[c.a].0 == here)
+            .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
+            .collect();
+        // A storey is a spring of its initial stiffness (its constant
+        // force is the rest state's, `set_rest`).
+        for s in model.storeys().iter().filter(|s| place[s.above].0 == here) {
+            let k = s.law.initial_stiffness();
+            match s.below {
+                None => stiffness[place[s.above].1] += k,
+                Some(b) => couplings.push((place[b].1, place[s.above].1, k, 0.0)),
+            }
+        }
+        let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
+        for j in 0..m {
+            a[(2 * j, 2 * j + 1)] = 1.0;
+            a[(2 * j + 1, 2 * j)] = -stiffness[j] / mass[j];
+            a[(2 * j + 1, 2 * j + 1)] = -damping[j] / mass[j];
+        }
+        for &(p, q, k, c) in &couplings {
+            for (i, j) in [(p, q), (q, p)] {
+                a[(2 * i + 1, 2 * i)] -= k / mass[i];
+                a[(2 * i + 1, 2 * j)] += k / mass[i];
+                a[(2 * i + 1, 2 * i + 1)] -= c / mass[i];
+                a[(2 * i + 1, 2 * j + 1)] += c / mass[i];
+            }
+        }
+        // Harmonic terms b sin(Ω t + φ) (per unit mass, velocity rows).
+        let mut terms: Vec<(f64, f64, Vec<f64>)> = Vec::new();
+        if let BaseExcitation::Harmonic {
+            amplitude,
+            frequency,
+            phase,
+        } = *model.base()
+        {
+            let mut b = vec![0.0; 2 * m];
+            for j in 0..m {
+                b[2 * j + 1] = -amplitude;
+            }
+            terms.push((frequency, phase, b));
+        }
+        let mut force_amplitude = vec![0.0; m];
+        let mut forces = Vec::new();
+        for f in model.forces() {
+            if place[f.body].0 != place[bodies[0]].0 {
+                continue;
+            }
+            let j = place[f.body].1;
+            let mut b = vec![0.0; 2 * m];
+            b[2 * j + 1] = f.amplitude / mass[j];
+            force_amplitude[j] += f.amplitude.abs();
+            forces.push((j, f.amplitude, f.frequency, f.phase));
+            terms.push((f.frequency, f.phase, b));
+        }
+        let names = || {
+            bodies
+                .iter()
+                .map(|&i| all[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut harmonic = Vec::with_capacity(terms.len());
+        let mut rate = 0.0f64;
+        for (w, phi, b) in terms {
+            rate = rate.max(w);
+            let mut lhs = DMatrix::<Complex<f64>>::from_fn(2 * m, 2 * m, |i, j| {
+                Complex::new(-a[(i, j)], 0.0)
+            });
+            for i in 0..2 * m {
+                lhs[(i, i)] += Complex::new(0.0, w);
+            }
+            let rhs = DVector::<Complex<f64>>::from_fn(2 * m, |i, _| Complex::new(b[i], 0.0));
+            let scale = a.amax() + w;
+            let x = lhs
+                .lu()
+                .solve(&rhs)
+                .filter(|x| x.iter().all(|z| z.re.is_finite() && z.im.is_finite()))
+                // An exactly singular pivot may still solve to huge values:
+                // resonance shows as a response far beyond any physical one.
+                .filter(|x| {
+                    let bmax = b.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                    x.iter()
+                        .all(|z| z.norm() * scale * 1e-12 <= bmax.max(1e-300))
+                })
+                .ok_or_else(|| FreeMotionError::Resonant {
+                    bodies: names(),
+                    frequency: w,
+                })?;
+            harmonic.push((
+                w,
+                phi,
+                x.iter().map(|z| z.re).collect(),
+                x.iter().map(|z| z.im).collect(),
+            ));
+        }
+        for j in 0..m {
+            rate = rate.max((-a[(2 * j + 1, 2 * j)]).sqrt());
+        }
+        let propagator = if m == 1 {
+            Propagator::Single {
+                w2: stiffness[0] / mass[0],
+                c2: damping[0] / mass[0],
+            }
+        } else {
+            Propagator::Group(a)
+        };
+        Ok(Group {
+            bodies,
+            propagator,
+            harmonic,
+            mass,
+            stiffness,
+            damping,
+            couplings,
+            force_amplitude,
+            forces,
+            rate,
+            modal: None,
+            hold_step: None,
+            rest: vec![0.0; 2 * m],
+            rest_forces: vec![0.0; m],
+        })
+    }
+
+    /// The groups.
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
+    }
+
+    /// (group, index within the group) of body `i`.
+    pub fn place(&self, i: usize) -> (usize, usize) {
+        self.place[i]
+    }
+
+    /// Sets group `g`'s rest state to the static displacement under the
+    /// constant forces `f` on its bodies (N, the group's order): `K u_s =
+    /// f` (solved again only if `f` changed). A group without ground springs is solved in the least-squares
+    /// sense (its storeys' forces act in pairs, within the range of `K`).
+    /// Errors with the residual if `f` is not balanced by the springs.
+    pub fn set_rest(&mut self, g: usize, f: &[f64]) -> Result<(), f64> {
+        let group = &mut self.groups[g];
+        let m = group.bodies.len();
+        if f == group.rest_forces.as_slice() {
+            return Ok(());
+        }
+        if f.iter().all(|&x| x == 0.0) {
+            group.rest.fill(0.0);
+            group.rest_forces.fill(0.0);
+            return Ok(());
+        }
+        let mut k = DMatrix::<f64>::zeros(m, m);
+        for j in 0..m {
+            k[(j, j)] = group.stiffness[j];
+        }
+        for &(a, b, kc, _) in &group.couplings {
+            k[(a, a)] += kc;
+            k[(b, b)] += kc;
+            k[(a, b)] -= kc;
+            k[(b, a)] -= kc;
+        }
+        let rhs = DVector::from_column_slice(f);
+        let eps = 1e-13 * k.amax();
+        let u = k
+            .clone()
+            .svd(true, true)
+            .solve(&rhs, eps)
+            .unwrap_or_else(|_| DVector::from_element(m, f64::NAN));
+        let residual = (&k * &u - &rhs).amax();
+        let scale = rhs.amax();
+        if residual.is_nan() || residual > 1e-9 * scale {
+            return Err(residual / scale);
+        }
+        for j in 0..m {
+            group.rest[2 * j] = u[j];
+            group.rest[2 * j + 1] = 0.0;
+        }
+        group.rest_forces.copy_from_slice(f);
+        Ok(())
+    }
+
+    /// Adds the particular motion of group `g` at time `t` (its rest state
+    /// and harmonic steady state), times `sign`, to `x`.
+    fn add_particular(&self, g: &Group, t: f64, sign: f64, x: &mut [f64]) {
+        for (xi, r) in x.iter_mut().zip(&g.rest) {
+            *xi += sign * r;
+        }
+        for (w, phi, re, im) in &g.harmonic {
+            let (s, c) = (w * t + phi).sin_cos();
+            for (xi, (r, i)) in x.iter_mut().zip(re.iter().zip(im)) {
+                *xi += sign * (r * s + i * c);
+            }
+        }
+    }
+
+    /// `x ← e^{Aτ} x` for group `g`.
+    fn homogeneous(g: &Group, tau: f64, x: &mut [f64]) {
+        match &g.propagator {
+            Propagator::Single { w2, c2 } => {
+                let p = single_exp(*w2, *c2, tau);
+                let (u, v) = (x[0], x[1]);
+                x[0] = p[0] * u + p[1] * v;
+                x[1] = p[2] * u + p[3] * v;
+            }
+            Propagator::Group(a) => {
+                let phi = (a * tau).exp();
+                let y = &phi * DVector::from_column_slice(x);
+                x.copy_from_slice(y.as_slice());
+            }
+        }
+    }
+
+    /// `Φ = e^{Aτ}`, `γ₀` and `γ₁` of the first-order hold over `τ`: the
+    /// exponential of the augmented matrix (Van Loan).
+    fn hold_matrices(a: &DMatrix<f64>, tau: f64) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
+        let d = a.nrows();
+        let mut big = DMatrix::<f64>::zeros(d + 2, d + 2);
+        big.view_mut((0, 0), (d, d)).copy_from(&(a * tau));
+        for j in 0..d / 2 {
+            big[(2 * j + 1, d)] = tau;
+        }
+        big[(d, d + 1)] = tau;
+        let e = big.exp();
+        (
+            e.view((0, 0), (d, d)).into_owned(),
+            (0..d).map(|i| e[(i, d)]).collect(),
+            (0..d).map(|i| e[(i, d + 1)]).collect(),
+        )
+    }
+
+    /// `x ← Φ x + γ₀ fa + γ₁ slope`: `x(b)` from `x = x(a)` under the
+    /// forcing `f(t) = fa + slope (t − a)` in every velocity row (the
+    /// harmonic part already removed); `y` is scratch of `x`'s length.
+    fn hold(
+        step: (&DMatrix<f64>, &[f64], &[f64]),
+        fa: f64,
+        slope: f64,
+        x: &mut [f64],
+        y: &mut [f64],
+    ) {
+        let (phi, g0, g1) = step;
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = g0[i] * fa + g1[i] * slope;
+            for (j, xj) in x.iter().enumerate() {
+                *yi += phi[(i, j)] * xj;
+            }
+        }
+        x.copy_from_slice(y);
+    }
+
+    /// Propagates group `g`'s interleaved state `x` from `t0` to `t1 >= t0`
+    /// exactly (in place).
+    pub fn propagate(&self, g: usize, t0: f64, t1: f64, x: &mut [f64]) {
+        let group = &self.groups[g];
+        if t1 == t0 {
+            return;
+        }
+        self.add_particular(group, t0, -1.0, x);
+        match (&self.base, &group.modal) {
+            (BaseExcitation::Record(rec), Some(modal)) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                record_intervals(rec, t0, t1, |tau, fa, slope| {
+                    modal.hold(tau, fa, slope, &mut z)
+                });
+                modal.to_state(&z, x);
+            }
+            (BaseExcitation::Record(rec), None) => {
+                let mut y = vec![0.0; x.len()];
+                record_intervals(rec, t0, t1, |tau, fa, slope| match &group.hold_step {
+                    // A whole sample step (to rounding of the sample times:
+                    // 1e-12 of a step moves the state by far less than any
+                    // tolerance).
+                    Some(h) if (tau - h.tau).abs() <= 1e-12 * h.tau => {
+                        Self::hold((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
+                    }
+                    _ => {
+                        let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(group), tau);
+                        Self::hold((&phi, &g0, &g1), fa, slope, x, &mut y)
+                    }
+                });
+            }
+            (_, Some(modal)) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                modal.free(t1 - t0, &mut z);
+                modal.to_state(&z, x);
+            }
+            (_, None) => Self::homogeneous(group, t1 - t0, x),
+        }
+        self.add_particular(group, t1, 1.0, x);
+    }
+
+    /// Acceleration of body `j` of group `g` (index in the group) in the
+    /// group's interleaved state `x` at `t`: springs, dampers, couplings,
+    /// forces and the base (m/s², relative to the base).
+    pub fn acceleration(&self, g: usize, t: f64, x: &[f64], j: usize) -> f64 {
+        let group = &self.groups[g];
+        // Springs act on the displacement from rest (the storeys' constant
+        // forces balance there).
+        let u = |i: usize| x[2 * i] - group.rest[2 * i];
+        let mut f = -group.stiffness[j] * u(j) - group.damping[j] * x[2 * j + 1];
+        for &(a, b, k, c) in &group.couplings {
+            let other = match (a == j, b == j) {
+                (true, _) => b,
+                (_, true) => a,
+                _ => continue,
+            };
+            f += k * (u(other) - u(j)) + c * (x[2 * other + 1] - x[2 * j + 1]);
+        }
+        for &(i, p, w, phi) in &group.forces {
+            if i == j {
+                f += p * (w * t + phi).sin();
+            }
+        }
+        f / group.mass[j] - self.base.at(t)
+    }
+
+    /// `x ← e^{Aτ} x` for group `g`: a tangent vector of the free motion
+    /// (the forcing does not enter the variational equations).
+    pub fn propagate_homogeneous(&self, g: usize, tau: f64, x: &mut [f64]) {
+        let group = &self.groups[g];
+        if tau == 0.0 {
+            return;
+        }
+        match &group.modal {
+            Some(modal) => {
+                let mut z = Vec::with_capacity(x.len());
+                modal.to_modes(x, &mut z);
+                modal.free(tau, &mut z);
+                modal.to_state(&z, x);
+            }
+            None => Self::homogeneous(group, tau, x),
+        }
+    }
+
+    /// The group's system matrix `A` (interleaved).
+    fn matrix(g: &Group) -> DMatrix<f64> {
+        match &g.propagator {
+            Propagator::Group(a) => a.clone(),
+            Propagator::Single { w2, c2 } => DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w2, -c2]),
+        }
+    }
+}
+
+impl Group {
+    /// The bodies, in order along the line.
+    pub fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+
+    /// Fastest natural frequency or forcing frequency of the group (rad/s;
+    /// 0 for free bodies without forcing).
+    pub fn rate(&self) -> f64 {
+        self.rate
+    }
+}
+
+mod bounds;
+mod modal;
+
+#[cfg(test)]
+mod tests;

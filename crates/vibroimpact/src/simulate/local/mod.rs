@@ -1,0 +1,511 @@
+//! The local integrator (docs/theory.md §10): exact motion between
+//! contacts, the step driver only where bodies touch.
+//!
+//! ## Files
+//! - `mod.rs` — the active set and the local run's state;
+//! - `driver.rs` — the event loop;
+//! - `activation.rs`, `membership.rs`, `rebuild.rs` — when a contact
+//!   matters, the set's edge, rebuilding the set;
+//! - `free_motion/` — exact motion between contacts;
+//! - `storeys.rs` — hysteretic storeys under the local integrator;
+//! - `extrema.rs`, `energy.rs`, `tape.rs` — exact extrema, the energy
+//!   audit, the tangent tape;
+//! - `tests/` — against the global integrator (`mod.rs`) and with storeys
+//!   (`storeys.rs`).
+//!
+//! Every group of bodies joined by springs ([`FreeMotion`]) moves exactly
+//! while none of its contacts is active. A contact becomes active where its
+//! force stops being negligible at the run's tolerance (`s_act`, see
+//! `Activation`); the groups it joins are then integrated, with every
+//! other group that is integrated at that time, as one system of those
+//! bodies alone (the *active set*, its own [`Stepper`] with the error norm
+//! per body). A group leaves the set when all its contacts have separated
+//! beyond `s_act` with a margin, and moves exactly again from the set's
+//! state.
+//!
+//! Contacts between two exactly moving groups (or a group and a wall) are
+//! never evaluated: each carries the time until which its gap provably
+//! stays below `s_act` — from the gap, its rate and a bound on the sides'
+//! accelerations over a horizon ([`crate::simulate::local::free_motion::Group`]'s energy
+//! bound), `s(t₀ + τ) <= s₀ + ṡ₀ τ + C τ²` — and is checked again then
+//! (an event queue in time order, ties by contact index). A grazing contact
+//! cannot be missed: the bound holds over the whole interval. Contacts
+//! between the set and an exactly moving group are followed on every step
+//! of the set over its dense output; one that reaches `s_act` inside a
+//! step sends the set back to the step's start, to be integrated to that
+//! time exactly and the group joined there.
+//!
+//! Hysteretic storeys (`storeys.rs`): a storey on a linear branch is
+//! a spring with a constant force, so its group moves exactly about its
+//! rest state; a bilinear storey's approach to yield is checked like a
+//! contact's (its drift against the branch's window), and its group is
+//! integrated, its branches switched at located events, from within
+//! [`storeys::YIELD_APPROACH`] of yield until it is elastic and safely
+//! below yield again. A Bouc–Wen storey's group is integrated throughout.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use super::switches::{apply_event, Event, Switches, Verdict};
+use super::*;
+use crate::contact::LawKind;
+use crate::dynamics::variational::Variational;
+use crate::dynamics::{Chain, SetSystem, StoreyTerms};
+use crate::integrate::Recorder;
+use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce, Storey};
+use crate::simulate::local::free_motion::FreeMotion;
+
+mod activation;
+mod driver;
+mod energy;
+mod extrema;
+pub mod free_motion;
+mod membership;
+mod rebuild;
+mod storeys;
+mod tape;
+
+use activation::{first_step, Activation};
+pub(super) use driver::{run, Tangents};
+use energy::LocalEnergy;
+use extrema::LocalExtrema;
+use membership::Crossing;
+pub use tape::LocalTape;
+use tape::TapeRecord;
+
+/// Work of the local integrator, beside the integrator's counters.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LocalStats {
+    /// Bound checks of contacts between exactly moving bodies (and of
+    /// storeys' approach to yield).
+    pub contact_checks: u64,
+    /// Times the active set was formed or changed.
+    pub set_changes: u64,
+    /// Largest number of bodies integrated at once.
+    pub largest_set: usize,
+    /// Right-hand-side evaluations of each body (0: the body moved exactly
+    /// for the whole run and was never evaluated).
+    pub body_evaluations: Vec<u64>,
+}
+
+impl LocalStats {
+    /// Number of bodies that were integrated at some time.
+    pub fn bodies_integrated(&self) -> usize {
+        self.body_evaluations.iter().filter(|&&e| e > 0).count()
+    }
+}
+
+/// How far ahead a set looks before it lets a group move exactly again,
+/// as a part of its fastest period (radians of its fastest rate).
+const RELEASE_PERIOD_FRACTION: f64 = 0.05;
+
+/// Total order on check times for the event queue.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Time(f64);
+impl Eq for Time {}
+impl PartialOrd for Time {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Time {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+/// The integrated bodies and their system.
+struct ActiveSet {
+    /// Groups in the set, ascending.
+    groups: Vec<usize>,
+    /// Bodies, ascending (the set's body j is model body `bodies[j]`).
+    bodies: Vec<usize>,
+    /// Model contacts joining the set to an exactly moving group: (contact,
+    /// whether its left side is in the set).
+    boundary: Vec<usize>,
+    /// The set's row, with the tangent columns when they are carried.
+    sys: SetSystem,
+    st: Stepper,
+    scan: StepScan,
+    /// The set's state at the start of its last step.
+    saved: (f64, Vec<f64>),
+    /// The fastest natural or forcing rate of its groups (rad/s).
+    rate: f64,
+    /// The extrema of its steps, when asked for.
+    extrema: Option<ExtremaScan>,
+    /// Model indices of its storeys (the set's storey k is `storeys[k]`).
+    storeys: Vec<usize>,
+    /// Its storeys' branch switches and its contacts' onsets.
+    switches: Option<Switches>,
+    /// The event its last kept step ended at, applied once the step's
+    /// samples are taken.
+    event: Option<Event>,
+}
+
+/// The local integrator's run.
+struct Run<'a> {
+    model: &'a Model,
+    opts: &'a SimulationOptions,
+    method: Method,
+    free: FreeMotion,
+    /// Per group: time and interleaved state of its exact motion.
+    exact: Vec<(f64, Vec<f64>)>,
+    /// Per group: in the active set.
+    in_set: Vec<bool>,
+    /// Per group: when it last joined the set.
+    joined: Vec<f64>,
+    /// While the set steps: checks do not move exact groups' reference
+    /// states (samples and a step taken back still need earlier times);
+    /// the moves wait in `deferred` (group, time, state).
+    defer: bool,
+    deferred: Vec<(usize, f64, Vec<f64>)>,
+    /// Per body: index in the active set.
+    slot: Vec<Option<usize>>,
+    activation: Vec<Activation>,
+    /// Per group: its contacts, couplings, harmonic forces and checked
+    /// (bilinear and Bouc–Wen) storeys (model indices, ascending).
+    group_contacts: Vec<Vec<usize>>,
+    group_storeys: Vec<Vec<usize>>,
+    group_couplings: Vec<Vec<usize>>,
+    group_forces: Vec<Vec<usize>>,
+    /// Per check (contacts, then storeys: check `nc + s` is storey s's):
+    /// the generation of its scheduled check (older queue entries are
+    /// stale).
+    generation: Vec<u64>,
+    queue: BinaryHeap<Reverse<(Time, usize, u64)>>,
+    set: Option<ActiveSet>,
+    /// Per contact: the impact under way (index into `impacts`) and the
+    /// onset velocity, while the contact is not in the set.
+    impacts: Vec<ImpactRecord>,
+    onset: Vec<(Option<usize>, f64)>,
+    stats: Stats,
+    contact_evaluations: u64,
+    local: LocalStats,
+    /// Per check (contacts, then storeys): the checks made (which one
+    /// crawls).
+    checks_per_contact: Vec<u64>,
+    /// The storeys' memory for the whole model: the branches of those
+    /// moving exactly (the set's own are in its system until it is taken
+    /// apart, [`Run::sync_storeys`]), and `hysteretic`, the Bouc–Wen
+    /// states after the interleaved state (`storeys` reads them at index
+    /// 2N on).
+    storeys: StoreyTerms,
+    hysteretic: Vec<f64>,
+    /// The extrema over the window, when asked for.
+    extrema: Option<LocalExtrema>,
+    /// Tangent columns carried (0: none).
+    columns: usize,
+    /// Per group: time and tangent columns (each of the group's
+    /// interleaved rows, one after the other) of its exact motion; the
+    /// set's are in its state.
+    tangents: Vec<(f64, Vec<f64>)>,
+    breakpoints: Vec<f64>,
+    /// The record of the run's linearisation, when a tape is asked for.
+    tape: Option<TapeRecord>,
+    /// Per contact between two bodies that move alike (see
+    /// [`alike`]): their ω² = k/m.
+    alike: Vec<Option<f64>>,
+    /// The energy audit's sums, when asked for.
+    energy: Option<LocalEnergy>,
+}
+
+/// ω² of the two bodies of contact `c` if they move alike: each a group
+/// of its own (no coupling), the same k/m > 0 and c/m, and no harmonic
+/// force or storey on either. Then the base drives both alike and their difference
+/// `Δ = u_l − u_r` is a free damped oscillator: its energy
+/// `Δ̇² + ω²Δ²` never grows, so `|Δ| <= sqrt(E)/ω` for all time.
+fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
+    let (l, r) = (c.pair.left()?, c.pair.right()?);
+    let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
+    let forced = |i: usize| {
+        model.forces().iter().any(|f| f.body == i)
+            || model
+                .storeys()
+                .iter()
+                .any(|s| s.above == i || s.below == Some(i))
+    };
+    if !single(l) || !single(r) || forced(l) || forced(r) {
+        return None;
+    }
+    let (a, b) = (&model.bodies()[l], &model.bodies()[r]);
+    let w2 = a.stiffness / a.mass;
+    (w2 > 0.0 && w2 == b.stiffness / b.mass && a.damping / a.mass == b.damping / b.mass)
+        .then_some(w2)
+}
+
+/// The first time a quantity that starts `d` below its limit, at rate `b`
+/// and with |second derivative| <= 2 `cq`, can reach it: the root of `b τ +
+/// cq τ² = d` (infinite if it never does); None if it is there already,
+/// or within rounding of `size` and closing.
+fn reach_time(d: f64, b: f64, cq: f64, size: f64) -> Option<f64> {
+    Some(if d < 0.0 || (d <= 8.0 * f64::EPSILON * size && b > 0.0) {
+        return None;
+    } else if cq == 0.0 {
+        if b <= 0.0 {
+            f64::INFINITY
+        } else {
+            d / b
+        }
+    } else {
+        let root = (b * b + 4.0 * cq * d).sqrt();
+        if b > 0.0 {
+            2.0 * d / (b + root)
+        } else {
+            (root - b) / (2.0 * cq)
+        }
+    })
+}
+
+/// The rows `[u, v]` of `bodies` in an interleaved state `v` of the whole
+/// model.
+fn rows_of(bodies: &[usize], v: &[f64]) -> Vec<f64> {
+    bodies
+        .iter()
+        .flat_map(|&i| [v[2 * i], v[2 * i + 1]])
+        .collect()
+}
+
+/// Writes the rows `x` of `bodies` into an interleaved state `out` of the
+/// whole model.
+fn put_rows(bodies: &[usize], x: &[f64], out: &mut [f64]) {
+    for (j, &i) in bodies.iter().enumerate() {
+        out[2 * i] = x[2 * j];
+        out[2 * i + 1] = x[2 * j + 1];
+    }
+}
+
+/// Group of a contact's side, if a body.
+fn side_groups(free: &FreeMotion, c: &Contact) -> [Option<usize>; 2] {
+    [
+        c.pair.left().map(|i| free.place(i).0),
+        c.pair.right().map(|i| free.place(i).0),
+    ]
+}
+
+impl Run<'_> {
+    /// State (u, v) of body `i` moving exactly, at `t` (not before its
+    /// group's reference time).
+    fn exact_body(&self, i: usize, t: f64) -> (f64, f64) {
+        let (g, j) = self.free.place(i);
+        let (t0, x) = &self.exact[g];
+        let mut x = x.clone();
+        self.free.propagate(g, *t0, t, &mut x);
+        (x[2 * j], x[2 * j + 1])
+    }
+
+    /// The time until which check k (a contact with both sides moving
+    /// exactly, or a storey moving exactly) surely stays inactive, from
+    /// `t`; None: active now (or so soon that the bound cannot tell).
+    fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
+        self.local.contact_checks += 1;
+        self.checks_per_contact[k] += 1;
+        // The sides' groups at t. Inside a step of the set they only go into
+        // `deferred`: samples and a step taken back still ask for earlier
+        // times of these groups, and exact motion never runs backward.
+        let mut at: Vec<(usize, Vec<f64>)> = Vec::with_capacity(2);
+        for i in self.sides(k).into_iter().flatten() {
+            let g = self.free.place(i).0;
+            if at.iter().any(|(h, _)| *h == g) {
+                continue;
+            }
+            let (t0, x) = &self.exact[g];
+            let mut x = x.clone();
+            self.free.propagate(g, *t0, t, &mut x);
+            at.push((g, x));
+        }
+        let until = {
+            let at = &at;
+            let exact = &self.exact;
+            self.bound(k, t, move |g| {
+                at.iter()
+                    .find(|(h, _)| *h == g)
+                    .map_or(exact[g].1.as_slice(), |(_, x)| x.as_slice())
+            })
+        };
+        for (g, x) in at {
+            if self.defer {
+                self.deferred.push((g, t, x));
+            } else {
+                self.before_move(g, t);
+                self.exact[g] = (t, x);
+            }
+        }
+        until
+    }
+
+    /// Moves the exact groups' reference states deferred during a step of
+    /// the set up to `t` (the time everything has been sampled to).
+    fn apply_deferred(&mut self, t: f64) {
+        let mut later = Vec::new();
+        for (g, tc, x) in std::mem::take(&mut self.deferred) {
+            if tc > t {
+                later.push((g, tc, x));
+            } else if !self.in_set[g] && tc > self.exact[g].0 {
+                self.before_move(g, tc);
+                self.exact[g] = (tc, x);
+            }
+        }
+        self.deferred = later;
+    }
+
+    /// [`safe_until`](Self::safe_until) from the groups' interleaved states
+    /// at `t` (`state(g)`), as if they moved exactly from there.
+    fn bound<'s>(&self, k: usize, t: f64, state: impl Fn(usize) -> &'s [f64]) -> Option<f64> {
+        if let Some(c) = self.model.contacts().get(k) {
+            if let Some(until) = self.alike_bound(c, k, &state) {
+                return Some(until);
+            }
+        }
+        let remaining = self.opts.t_end - t;
+        let rate = self
+            .sides(k)
+            .iter()
+            .flatten()
+            .map(|&i| self.free.groups()[self.free.place(i).0].rate())
+            .fold(0.0f64, f64::max);
+        // The bound is tightest over a short horizon (the energy may grow
+        // with it): start at a quarter of the fastest period and double it
+        // while the bound lasts the whole horizon (a stiff body whose
+        // motion is tiny is safe for far longer than its period).
+        let mut horizon = if rate > 0.0 {
+            remaining.min(0.5 * std::f64::consts::PI / rate)
+        } else {
+            remaining
+        };
+        let floor = 1e-10 * horizon;
+        loop {
+            let zdd = self.free.base_peak(t, t + horizon);
+            let tau = match self.model.contacts().get(k) {
+                Some(c) => self.bound_over(c, k, (horizon, zdd), &state)?,
+                None => {
+                    let s = k - self.model.contacts().len();
+                    self.storey_bound_over(s, (horizon, zdd), &state)?
+                }
+            };
+            if tau < horizon || horizon >= remaining {
+                return (tau > floor && t + tau > t).then_some(t + tau);
+            }
+            horizon = remaining.min(2.0 * horizon);
+        }
+    }
+
+    /// For a contact between bodies that move alike: the run's end, if
+    /// their difference's energy keeps the gap below activation for all
+    /// time.
+    fn alike_bound<'s>(
+        &self,
+        c: &Contact,
+        k: usize,
+        state: &impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
+        if let (Some(w2), Some(l), Some(r)) = (self.alike[k], c.pair.left(), c.pair.right()) {
+            // Bodies that move alike: the gap's bound for all time.
+            let (xl, xr) = (state(self.free.place(l).0), state(self.free.place(r).0));
+            let (d, dv) = (xl[0] - xr[0], xl[1] - xr[1]);
+            let energy = dv * dv + w2 * d * d;
+            let reach = (energy / w2).sqrt();
+            let size = c.clearance + xl[0].abs() + xr[0].abs();
+            let gap = self.activation[k].gap(energy.sqrt());
+            // Safe to the end while both move exactly: no check is queued,
+            // so every path that changes either body's motion must lapse
+            // or reschedule this contact (`join` does, and `release`
+            // schedules the contacts it frees).
+            if reach - c.clearance + 1e-12 * size < gap {
+                return Some(self.opts.t_end);
+            }
+        }
+        None
+    }
+
+    /// The time within `horizon` until which contact `c` (index `k`) stays
+    /// inactive by the bound from the sides' states, the base's |z̈| below
+    /// `zdd` over the horizon; None: active now.
+    fn bound_over<'s>(
+        &self,
+        c: &Contact,
+        k: usize,
+        (horizon, zdd): (f64, f64),
+        state: &impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
+        let (mut s0, mut sd0, mut acc) = (-c.clearance, 0.0, 0.0);
+        // The rounding of s: a gap that close to activation and closing is
+        // active (else checks would hover there at rounding-sized steps).
+        let mut size = c.clearance;
+        for (side, sign) in [c.pair.left(), c.pair.right()].into_iter().zip([1.0, -1.0]) {
+            let Some(i) = side else { continue };
+            let (g, j) = self.free.place(i);
+            let x = state(g);
+            size += x[2 * j].abs();
+            s0 += sign * x[2 * j];
+            sd0 += sign * x[2 * j + 1];
+            let group = &self.free.groups()[g];
+            acc += group.acceleration_bound(j, group.energy_ahead(x, horizon, zdd), zdd);
+        }
+        if !(s0.is_finite() && sd0.is_finite() && acc.is_finite()) {
+            return None;
+        }
+        let speed = sd0.abs() + acc * horizon;
+        let d = self.activation[k].gap(speed) - s0;
+        Some(reach_time(d, sd0, 0.5 * acc, size)?.min(horizon))
+    }
+
+    /// Schedules contact k's next check (both sides exact) from `t`, or
+    /// returns true if it is active now.
+    fn schedule(&mut self, k: usize, t: f64) -> bool {
+        self.generation[k] += 1;
+        match self.safe_until(k, t) {
+            None => true,
+            Some(until) => {
+                if until < self.opts.t_end {
+                    self.queue
+                        .push(Reverse((Time(until), k, self.generation[k])));
+                }
+                false
+            }
+        }
+    }
+
+    /// The next valid check, without removing it.
+    fn next_check(&mut self) -> Option<(f64, usize)> {
+        while let Some(&Reverse((Time(t), k, gen))) = self.queue.peek() {
+            if gen == self.generation[k] {
+                return Some((t, k));
+            }
+            self.queue.pop();
+        }
+        None
+    }
+
+    /// Whether check k (a contact or a storey) has a side in the active
+    /// set.
+    fn touches_set(&self, k: usize) -> bool {
+        self.sides(k)
+            .into_iter()
+            .flatten()
+            .any(|i| self.slot[i].is_some())
+    }
+}
+
+impl Run<'_> {
+    /// Before group `g`'s reference state moves to `t` (or it joins the
+    /// set there): its exact motion up to `t` is scanned for extrema and
+    /// enters the energy audit.
+    fn before_move(&mut self, g: usize, t: f64) {
+        self.scan_group_to(g, t);
+        self.energy_to(g, t);
+    }
+
+    /// Adds the set's integrator work since its last absorption to the
+    /// run's counters (and to each of its bodies).
+    fn absorb(&mut self, set: &mut ActiveSet) {
+        let st = set.st.stats();
+        self.stats = self.stats + st;
+        for &i in &set.bodies {
+            self.local.body_evaluations[i] += st.rhs_evaluations;
+        }
+        set.st.reset_stats();
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,240 @@
+//! Hysteretic storeys under the local integrator: the global integrator's
+//! runs, exact motion about a storey's rest state after it yielded, the
+//! Bouc–Wen groups integrated throughout, rows and isolated buildings.
+
+use super::*;
+use crate::seismic::pounding::tests::record;
+use crate::seismic::pounding::{parse_row, Response, Row, RunSettings};
+
+const HERTZ: &str = "law = { law = \"hertz\", stiffness = 1e9, exponent = 1.5 }\n";
+const BILINEAR: &str = "{ law = \"bilinear\", yield_drift = YD, post_yield_ratio = 0.05 }";
+const BOUC_WEN: &str =
+    "{ law = \"bouc-wen\", yield_drift = 0.002, post_yield_ratio = 0.05, exponent = 2 }";
+
+/// A two-storey frame of storeys `law` (yield drift `yd`) beside a
+/// one-storey elastic one across `gap`, pounding at floor 1.
+fn pair(law: &str, yd: f64, gap: f64) -> Row {
+    let text = format!(
+        "gap = {gap}\nfloors = [1]\n{HERTZ}\
+         [left]\nmasses = [1e5, 1e5]\nstiffnesses = [4e7, 3e7]\ndamping_ratio = 0.05\n\
+         storeys = [{law}, {law}]\n\
+         [right]\nmasses = [1e5]\nstiffnesses = [2e7]\ndamping_ratio = 0.05\n"
+    )
+    .replace("YD", &yd.to_string());
+    parse_row(&text, "pair.toml").unwrap()
+}
+
+fn model(row: &Row) -> Model {
+    row.model(&record(), 1.0, true).unwrap().model
+}
+
+/// Both integrators over the record at `rtol` (atol 1e-6 rtol).
+fn both(model: &Model, rtol: f64) -> (Simulation, Simulation) {
+    let run = |integrator| {
+        let opts = SimulationOptions {
+            t_end: 12.0,
+            rtol,
+            atol: rtol * 1e-6,
+            integrator,
+            ..Default::default()
+        };
+        let sim = simulate(model, &opts).unwrap();
+        assert!(sim.error.is_none(), "{integrator:?}: {:?}", sim.error);
+        sim
+    };
+    (run(Integrator::Global), run(Integrator::Local))
+}
+
+/// A yielding frame pounding an elastic one: the local integrator logs
+/// the global one's impacts (count, start times to 1e-7 s, peak forces to
+/// 1e-6), dissipates the same hysteretic energy per storey (1e-8) and
+/// ends in the same state (1e-6 of its size; measured 2e-7); the elastic
+/// frame moves exactly between poundings (integrated a fraction of the
+/// time), and the yielding one leaves the set again after its last yield.
+#[test]
+fn a_yielding_pair_as_the_global_integrator_runs_it() {
+    let (g, l) = both(&model(&pair(BILINEAR, 0.002, 0.01)), 1e-10);
+    assert!(g.impacts.len() >= 4, "{} impacts", g.impacts.len());
+    assert_eq!(g.impacts.len(), l.impacts.len());
+    for (a, b) in g.impacts.iter().zip(&l.impacts) {
+        assert_eq!(a.contact, b.contact);
+        assert!((a.start_time - b.start_time).abs() < 1e-7, "{a:?} {b:?}");
+        assert!((a.peak_force - b.peak_force).abs() < 1e-6 * a.peak_force);
+    }
+    for (a, b) in g.hysteretic_energy.iter().zip(&l.hysteretic_energy) {
+        assert!(*a > 0.0 && (a - b).abs() < 1e-8 * a, "{a} vs {b}");
+    }
+    let d = difference(&g, &l);
+    assert!(d < 1e-6, "{d:e}");
+    let stats = l.local.unwrap();
+    let e = &stats.body_evaluations;
+    assert!(e[2] < e[0] / 2, "{e:?}");
+    assert!(stats.set_changes >= 4, "{stats:?}");
+}
+
+/// A frame that yields and does not pound (the gap 1 m): after the
+/// record's strong part it is elastic about a residual drift, leaves the
+/// set and moves exactly about its new rest state (the storeys' constant
+/// forces balanced by its springs), to the global integrator's state to
+/// 1e-9 of its size at the end. A frame that never yields is never
+/// integrated.
+#[test]
+fn exact_motion_about_a_residual_drift() {
+    let (g, l) = both(&model(&pair(BILINEAR, 0.01, 1.0)), 1e-10);
+    // A residual drift of about 9 mm in the second storey.
+    let drift = g.final_displacement[1] - g.final_displacement[0];
+    assert!(drift.abs() > 5e-3, "{drift}");
+    let d = difference(&g, &l);
+    assert!(d < 1e-9, "{d:e}");
+    let stats = l.local.unwrap();
+    assert_eq!(stats.set_changes, 2, "{stats:?}");
+    assert!(stats.body_evaluations[0] < g.stats.rhs_evaluations);
+    let (g, l) = both(&model(&pair(BILINEAR, 1.0, 1.0)), 1e-10);
+    assert!(difference(&g, &l) < 1e-9);
+    assert_eq!(l.local.unwrap().body_evaluations, [0, 0, 0]);
+}
+
+/// A Bouc–Wen frame is integrated throughout (its z never follows the
+/// drift linearly), its neighbour exactly between poundings: the global
+/// integrator's impacts, hysteretic energies (1e-8) and final state
+/// (1e-6).
+#[test]
+fn bouc_wen_groups_are_integrated_throughout() {
+    let (g, l) = both(&model(&pair(BOUC_WEN, 0.002, 0.01)), 1e-10);
+    assert!(!g.impacts.is_empty());
+    assert_eq!(g.impacts.len(), l.impacts.len());
+    for (a, b) in g.hysteretic_energy.iter().zip(&l.hysteretic_energy) {
+        assert!(*a > 0.0 && (a - b).abs() < 1e-8 * a, "{a} vs {b}");
+    }
+    assert!(difference(&g, &l) < 1e-6);
+    let stats = l.local.unwrap();
+    let e = &stats.body_evaluations;
+    assert!(
+        e[0] == e[1] && e[0] == l.stats.rhs_evaluations && e[2] < e[0],
+        "{e:?}"
+    );
+}
+
+/// Rows by the pounding study's own runs: a yielding pair, three
+/// buildings in a row with yielding storeys (chain pounding), and an
+/// isolated building (bilinear bearings, yielding superstructure) striking
+/// its moat wall: every peak (drift, residual drift, floor acceleration,
+/// displacement, hysteretic energy, impacts and force, isolator) equals
+/// the global integrator's to 1e-6.
+#[test]
+fn rows_and_isolated_buildings_as_the_global_integrator_runs_them() {
+    let frame = |masses: &str, k: &str, yd: &str| {
+        let n = masses.matches(',').count() + 1;
+        let yielding = BILINEAR.replace("YD", yd);
+        format!(
+            "masses = {masses}\nstiffnesses = {k}\ndamping_ratio = 0.05\nstoreys = [{}]\n",
+            vec![yielding.as_str(); n].join(", ")
+        )
+    };
+    let row = format!(
+        "{HERTZ}[[building]]\nname = \"A\"\n{}[[building]]\nname = \"B\"\ngap = 0.006\nfloors = [1, 2]\n{}\
+         [[building]]\nname = \"C\"\ngap = 0.006\nfloors = [1, 2]\n{}",
+        frame("[2e5, 2e5, 2e5]", "[5e7, 5e7, 5e7]", "0.003"),
+        frame("[3e5, 3e5]", "[2e8, 2e8]", "0.003"),
+        frame("[2e5, 2e5, 2e5, 2e5]", "[6e7, 6e7, 6e7, 6e7]", "0.003"),
+    );
+    let isolated = format!(
+        "{HERTZ}[[building]]\nname = \"iso\"\n{}\
+         [building.isolation]\nmass = 3e5\ncapacity = 0.3\n\
+         bearing = {{ law = \"bilinear\", stiffness = 6e7, yield_drift = 0.01, post_yield_ratio = 0.1 }}\n\
+         moat = {{ gap = 0.03, law = {{ law = \"hertz\", stiffness = 5e9, exponent = 1.5 }} }}\n",
+        frame("[3e5, 3e5, 3e5]", "[4e8, 4e8, 4e8]", "0.0015"),
+    );
+    let rows = [
+        pair(BILINEAR, 0.002, 0.01),
+        parse_row(&row, "row.toml").unwrap(),
+        parse_row(&isolated, "iso.toml").unwrap(),
+    ];
+    let global = RunSettings::new(0.005, 1e-9);
+    let local = RunSettings {
+        integrator: Integrator::Local,
+        ..global
+    };
+    for (r, row) in rows.iter().enumerate() {
+        let g = row.respond(&record(), 1.0, true, &global).unwrap();
+        let l = row.respond(&record(), 1.0, true, &local).unwrap();
+        assert_eq!(g.impacts, l.impacts, "row {r}");
+        assert!(
+            g.hysteretic_energy.iter().flatten().any(|e| *e > 0.0),
+            "row {r}: {:?}",
+            g.drift
+        );
+        let worst = worst_difference(&g, &l);
+        assert!(worst < 1e-6, "row {r}: {worst:e}");
+        let moat = g
+            .isolators
+            .iter()
+            .flatten()
+            .map(|i| i.moat_impacts)
+            .sum::<usize>();
+        assert!(g.impacts + moat > 0, "row {r}");
+    }
+}
+
+/// The largest difference over two responses' peaks, relative to each
+/// quantity's largest value in the building (residual drifts to 2 mm).
+fn worst_difference(g: &Response, l: &Response) -> f64 {
+    let rel = |a: f64, b: f64, scale: f64| (a - b).abs() / scale.max(1e-300);
+    let mut worst = rel(
+        g.peak_impact_force,
+        l.peak_impact_force,
+        g.peak_impact_force,
+    );
+    for (a, b) in [
+        (&g.drift, &l.drift),
+        (&g.acceleration, &l.acceleration),
+        (&g.displacement, &l.displacement),
+        (&g.hysteretic_energy, &l.hysteretic_energy),
+    ] {
+        for (x, y) in a.iter().zip(b) {
+            let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (p, q) in x.iter().zip(y) {
+                worst = worst.max(rel(*p, *q, scale));
+            }
+        }
+    }
+    for (x, y) in g
+        .residual_drift
+        .iter()
+        .flatten()
+        .zip(l.residual_drift.iter().flatten())
+    {
+        worst = worst.max(rel(*x, *y, 0.002));
+    }
+    for (a, b) in g.isolators.iter().zip(&l.isolators) {
+        if let (Some(a), Some(b)) = (a, b) {
+            assert_eq!(a.moat_impacts, b.moat_impacts);
+            worst = worst
+                .max(rel(
+                    a.peak_displacement,
+                    b.peak_displacement,
+                    a.peak_displacement,
+                ))
+                .max(rel(a.moat_peak_force, b.moat_peak_force, a.moat_peak_force));
+        }
+    }
+    worst
+}
+
+/// Tangent columns do not cross a storey's branch switch: refused by
+/// name.
+#[test]
+fn tangents_with_storeys_are_refused() {
+    let m = model(&pair(BILINEAR, 0.002, 0.01));
+    let opts = SimulationOptions {
+        t_end: 1.0,
+        integrator: Integrator::Local,
+        ..Default::default()
+    };
+    let y0 = vec![0.0; 2 * m.bodies().len()];
+    let columns = vec![0.0; y0.len()];
+    let Err(e) = crate::simulate::local_flow(&m, &opts, &y0, (&columns, 1), false) else {
+        panic!("tangents with storeys ran");
+    };
+    assert!(e.0.contains("hysteretic storeys"), "{e}");
+}

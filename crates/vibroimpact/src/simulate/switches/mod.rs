@@ -1,0 +1,236 @@
+//! The events that change a run's right-hand side inside a step, located
+//! on the step's dense output: the branch switches of bilinear storeys
+//! (docs/theory.md §11: within a step a bilinear storey's force is linear
+//! in its drift; its switch function is yield or unloading), and the onset
+//! of a contact whose law needs its impact velocity (Lankarani–Nikravesh:
+//! the step that crosses the onset must not be taken with the previous
+//! impact's velocity). Where one happens inside a step, the step is taken
+//! again up to that time, and the event is applied there.
+//!
+//! Files: `mod.rs` (the switches), `tests.rs` (exact piecewise motion of
+//! bilinear storeys).
+
+use super::ChainDynamics;
+use crate::dynamics::Chain;
+use crate::integrate::{IntegrationError, Stepper};
+use crate::numeric::brent;
+
+/// An event that changes the right-hand side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Event {
+    /// Bilinear storey k's branch switch.
+    Storey(usize),
+    /// Contact k reaches its onset approach: its impact velocity is set
+    /// there.
+    Onset(usize),
+}
+
+/// What a step's check found.
+pub(super) enum Verdict {
+    /// No event in the step.
+    Clear,
+    /// An event inside the step: the stepper is back at the step's start,
+    /// and the next steps end at the event ([`Switches::before_step`]).
+    Retake,
+    /// The step ended at this event.
+    Switch(Event),
+}
+
+/// The events of a run: its bilinear storeys and the onsets of its
+/// contacts whose laws need the impact velocity.
+pub(super) struct Switches {
+    events: Vec<Event>,
+    /// Per event, whether it can fire: an onset fires once per impact
+    /// (disarmed when applied, armed again once its contact is open at a
+    /// step's end).
+    armed: Vec<bool>,
+    /// Per contact, its onset approach s_on.
+    s_on: Vec<f64>,
+    t_prev: f64,
+    y_prev: Vec<f64>,
+    buf: Vec<f64>,
+    /// The states at the three inside points of the last step.
+    inside: [Vec<f64>; 3],
+    /// The next event's time, once located.
+    pending: Option<(f64, Event)>,
+}
+
+impl Switches {
+    /// None for a model without such events; `s_on` per contact.
+    pub(super) fn new(sys: &ChainDynamics, dim: usize, s_on: Vec<f64>) -> Option<Self> {
+        let onsets = (0..s_on.len())
+            .filter(|&k| sys.contact_law(k).needs_impact_velocity())
+            .map(Event::Onset);
+        let events: Vec<Event> = sys
+            .storeys()
+            .bilinear()
+            .map(Event::Storey)
+            .chain(onsets)
+            .collect();
+        (!events.is_empty()).then(|| Self {
+            armed: vec![true; events.len()],
+            events,
+            s_on,
+            t_prev: 0.0,
+            y_prev: vec![0.0; dim],
+            buf: vec![0.0; dim],
+            inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
+            pending: None,
+        })
+    }
+
+    /// Keeps the state a step starts from; the step's `bound`, shortened to
+    /// a located event; or the event itself where it is located at the
+    /// step's start (rounding: apply it there, no step).
+    pub(super) fn before_step(&mut self, st: &Stepper, bound: f64) -> Result<f64, Event> {
+        self.t_prev = st.t();
+        self.y_prev.copy_from_slice(st.y());
+        match self.pending {
+            Some((t, e)) if t <= st.t() => {
+                self.pending = None;
+                self.disarm(e);
+                Err(e)
+            }
+            Some((t, _)) => Ok(bound.min(t)),
+            None => Ok(bound),
+        }
+    }
+
+    /// Arms again every onset whose contact is open at the end of a step
+    /// that is kept (not one about to be taken again).
+    fn rearm(&mut self, sys: &ChainDynamics, y: &[f64]) {
+        for i in 0..self.events.len() {
+            if !self.armed[i] && self.value(sys, self.events[i], y) > 0.0 {
+                self.armed[i] = true;
+            }
+        }
+    }
+
+    /// Marks `e` applied: an onset waits for its contact to open again.
+    fn disarm(&mut self, e: Event) {
+        if let (Event::Onset(_), Some(i)) = (e, self.events.iter().position(|x| *x == e)) {
+            self.armed[i] = false;
+        }
+    }
+
+    /// The event's function in the state `y`: positive before it, zero at
+    /// it (a contact's: s_on − s, positive while the contact is open).
+    fn value(&self, sys: &ChainDynamics, e: Event, y: &[f64]) -> f64 {
+        match e {
+            Event::Storey(k) => sys.storeys().switch_value(k, y),
+            Event::Onset(k) => self.s_on[k] - sys.approach(k, y).0,
+        }
+    }
+
+    /// Checks the step just taken for events (at its end and at three
+    /// points inside on the dense output, located by Brent).
+    pub(super) fn after_step<S: Chain>(
+        &mut self,
+        st: &mut Stepper,
+        sys: &mut S,
+    ) -> Result<Verdict, IntegrationError> {
+        let (t0, t1) = (self.t_prev, st.t());
+        if let Some((t, e)) = self.pending {
+            if t1 >= t {
+                self.pending = None;
+                self.disarm(e);
+                return Ok(Verdict::Switch(e));
+            }
+        }
+        // The three inside points' states, taken once for all the events
+        // (a dense output may cost stages of its own), and only if an
+        // event is live.
+        let live: Vec<usize> = (0..self.events.len())
+            .filter(|&i| {
+                self.armed[i] && self.value(sys.chain(), self.events[i], &self.y_prev) > 0.0
+            })
+            .collect();
+        if live.is_empty() {
+            self.rearm(sys.chain(), st.y());
+            return Ok(Verdict::Clear);
+        }
+        let times: [f64; 4] = [1.0, 2.0, 3.0, 4.0].map(|j| {
+            if j == 4.0 {
+                t1
+            } else {
+                t0 + (t1 - t0) * j / 4.0
+            }
+        });
+        for (k, t) in times[..3].iter().enumerate() {
+            st.dense_output(sys, *t, &mut self.inside[k]);
+        }
+        let mut first: Option<(f64, Event)> = None;
+        for i in live {
+            let e = self.events[i];
+            let (mut ta, mut ga) = (t0, self.value(sys.chain(), e, &self.y_prev));
+            for (j, &tb) in times.iter().enumerate() {
+                let gb = self.value(
+                    sys.chain(),
+                    e,
+                    if j == 3 { st.y() } else { &self.inside[j] },
+                );
+                if gb <= 0.0 {
+                    let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
+                    let mut buf = std::mem::take(&mut self.buf);
+                    let root = brent(
+                        |t| {
+                            st.dense_output(sys, t, &mut buf);
+                            self.value(sys.chain(), e, &buf)
+                        },
+                        ta,
+                        tb,
+                        ga,
+                        gb,
+                        xtol,
+                        200,
+                    );
+                    self.buf = buf;
+                    let t = root.unwrap_or(tb);
+                    if first.is_none_or(|(tf, _)| t < tf) {
+                        first = Some((t, e));
+                    }
+                    break;
+                }
+                (ta, ga) = (tb, gb);
+            }
+        }
+        match first {
+            None => {
+                self.rearm(sys.chain(), st.y());
+                Ok(Verdict::Clear)
+            }
+            Some((t, e)) if t >= t1 => {
+                self.disarm(e);
+                Ok(Verdict::Switch(e))
+            }
+            Some(found) => {
+                self.pending = Some(found);
+                st.reset(sys, t0, &self.y_prev)?;
+                Ok(Verdict::Retake)
+            }
+        }
+    }
+}
+
+/// Applies `event` at the stepper's point (a storey's branch switch, or a
+/// contact's impact velocity) and restarts the stepper there (the
+/// right-hand side changed).
+pub(super) fn apply_event<S: Chain>(
+    st: &mut Stepper,
+    sys: &mut S,
+    event: Event,
+) -> Result<(), IntegrationError> {
+    let (t, y) = (st.t(), st.y().to_vec());
+    let chain = sys.chain_mut();
+    match event {
+        Event::Storey(k) => chain.storeys_mut().switch(k, &y),
+        Event::Onset(k) => {
+            let (_, sd) = chain.approach(k, &y);
+            chain.set_onset_velocity(k, sd);
+        }
+    }
+    st.reset(sys, t, &y)
+}
+
+#[cfg(test)]
+mod tests;
