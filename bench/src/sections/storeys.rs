@@ -15,14 +15,19 @@
 //!    more than the global steps they spare; why `auto` runs such rows
 //!    globally.
 
-use super::*;
+use std::time::Instant;
+
+use serde_json::json;
 use vibroimpact::contact::ContactLaw;
 use vibroimpact::integrate::Method;
 use vibroimpact::model::hysteresis::{Bilinear, StoreyLaw};
 use vibroimpact::model::record::{parse_record, Units};
-use vibroimpact::model::{BaseExcitation, Body, Contact, ContactPair, Storey};
+use vibroimpact::model::{BaseExcitation, Body, Contact, ContactPair, Model, Storey};
 use vibroimpact::seismic::pounding::parse_row;
-use vibroimpact::simulate::Simulation;
+use vibroimpact::simulate::{Integrator, Simulation, SimulationOptions};
+
+use super::Entries;
+use crate::common::Peers;
 
 /// The struck row of `n` frames (bodies frame by frame, floors up).
 fn struck_row(n: usize) -> Model {
@@ -138,7 +143,7 @@ fn row_text(k: usize) -> String {
     text
 }
 
-pub(super) fn run(quick: bool) -> Value {
+pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
     let repeats = if quick { 1 } else { 3 };
     println!("\n== storeys: a struck row of yielding frames, 3 s, rtol 1e-8 ==");
     let options = |integrator, rtol: f64| SimulationOptions {
@@ -184,7 +189,7 @@ pub(super) fn run(quick: bool) -> Value {
     println!(
         "\n== storeys: rows of yielding buildings under the synthetic record, DOPRI5 rtol 1e-4 =="
     );
-    let text = include_str!("../../examples/synthetic-quake.csv");
+    let text = include_str!("../../../examples/synthetic-quake.csv");
     let record = parse_record(text, "synthetic-quake.csv", Some(Units::MetersPerSecond2))
         .expect("the example record");
     let mut rows = Vec::new();
@@ -225,5 +230,8 @@ pub(super) fn run(quick: bool) -> Value {
             );
         }
     }
-    json!({"struck_row": struck, "rows_under_a_record": rows})
+    vec![(
+        "storeys",
+        json!({"struck_row": struck, "rows_under_a_record": rows}),
+    )]
 }

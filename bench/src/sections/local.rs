@@ -16,7 +16,15 @@
 //!    exponents, global and local: the values one after the other (one
 //!    thread), timed, with the largest exponents side by side.
 
-use super::*;
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use vibroimpact::model::reference;
+use vibroimpact::model::Model;
+use vibroimpact::simulate::Integrator;
+
+use super::Entries;
+use crate::common::{error, ours_with, peer_or_exit, r2, robust_to, t_end, Peers, Run, Sweep};
 
 /// The struck chain of `n` beads, bead 1 at 1 m/s.
 fn chain(n: usize) -> Model {
@@ -29,22 +37,23 @@ fn peak(run: &Run) -> f64 {
     run.state[n..].iter().fold(0.0f64, |m, v| m.max(*v))
 }
 
-pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
+pub fn run(peers: Option<&Peers>, quick: bool) -> Entries {
     let repeats = if quick { 2 } else { 5 };
     let mut out = serde_json::Map::new();
-    // 1. R2 N = 1000, 3 periods.
+    out.insert("r2_n1000_3_periods".into(), r2_n1000(peers, repeats));
+    out.insert("struck_chain".into(), struck_chain(quick, repeats));
+    out.insert("small_rows".into(), small_rows(repeats));
+    out.insert("sweeps".into(), sweeps(quick));
+    vec![("local", Value::Object(out))]
+}
+
+/// Section 1: R2 N = 1000, 3 periods, every solver's robust setting.
+fn r2_n1000(peers: Option<&Peers>, repeats: usize) -> Value {
     println!("\n== local integrator: R2, N = 1000, 3 periods, error <= 1e-5 against ARKODE Verner 8 at rtol 1e-11 ==");
     let model = r2(1000);
     let t = t_end(3.0);
     let reference = match peers {
-        Some(p) => {
-            p.run("arkode-verner8", 1000, 3.0, 1e-11, 1e-14, 1)
-                .unwrap_or_else(|e| {
-                    eprintln!("error: {e}");
-                    std::process::exit(1)
-                })
-                .state
-        }
+        Some(p) => peer_or_exit(p.run("arkode-verner8", 1000, 3.0, 1e-11, 1e-14, 1)).state,
         None => ours_with(&model, t, 1e-12, 1e-15, 1, Integrator::Global).state,
     };
     let rtols: Vec<f64> = (6..=11).map(|k| 10f64.powi(-k)).collect();
@@ -53,7 +62,7 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
         ("vibroimpact-local", Integrator::Local),
         ("vibroimpact-global", Integrator::Global),
     ] {
-        let sweep: Vec<(f64, f64, Run)> = rtols
+        let sweep: Sweep = rtols
             .iter()
             .map(|&rtol| {
                 let run = ours_with(&model, t, rtol, rtol * 1e-3, repeats, integrator);
@@ -118,13 +127,12 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
         "fastest SUNDIALS / local = {:.1}",
         fastest_sundials / local_time
     );
-    out.insert(
-        "r2_n1000_3_periods".into(),
-        json!({"robust": rows.iter().map(|r| json!({"solver": r.0, "rtol": r.1, "error": r.2, "seconds": r.3, "rhs_evaluations": r.4})).collect::<Vec<_>>(),
-               "fastest_sundials_over_local": fastest_sundials / local_time}),
-    );
+    json!({"robust": rows.iter().map(|r| json!({"solver": r.0, "rtol": r.1, "error": r.2, "seconds": r.3, "rhs_evaluations": r.4})).collect::<Vec<_>>(),
+           "fastest_sundials_over_local": fastest_sundials / local_time})
+}
 
-    // 2. The struck chain.
+/// Section 2: the struck chain, local from 10³ beads up, global to 10⁴.
+fn struck_chain(quick: bool, repeats: usize) -> Value {
     println!("\n== local integrator: struck Hertzian chain, 0.02 s, default settings (rtol 1e-8, atol 1e-12) ==");
     let duration = 0.02;
     let converged = peak(&ours_with(
@@ -182,12 +190,11 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
         "local time(N = 10⁴) / time(N = 10³) = {:.2}",
         time(10_000) / time(1000)
     );
-    out.insert(
-        "struck_chain".into(),
-        json!({"converged_peak_velocity": converged, "rows": chain_rows}),
-    );
+    json!({"converged_peak_velocity": converged, "rows": chain_rows})
+}
 
-    // 3. Small rows.
+/// Section 3: R2, N = 2 and 3, 20 periods, global and local.
+fn small_rows(repeats: usize) -> Value {
     println!("\n== local integrator: R2, 20 periods, error <= 1e-6 against rtol 1e-13 ==");
     let mut small = Vec::new();
     for n in [2usize, 3] {
@@ -196,7 +203,7 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
         let reference = ours_with(&model, t, 1e-13, 1e-16, 1, Integrator::Global).state;
         let mut picks = Vec::new();
         for (name, integrator) in [("global", Integrator::Global), ("local", Integrator::Local)] {
-            let sweep: Vec<(f64, f64, Run)> = (6..=12)
+            let sweep: Sweep = (6..=12)
                 .map(|k| {
                     let rtol = 10f64.powi(-k);
                     let run = ours_with(&model, t, rtol, rtol * 1e-3, repeats * 4, integrator);
@@ -223,9 +230,7 @@ pub(super) fn run(peers: Option<&Peers>, quick: bool) -> Value {
             println!("N = {n}: global / local = {:.2}", g / l);
         }
     }
-    out.insert("small_rows".into(), Value::Array(small));
-    out.insert("sweeps".into(), sweeps(quick));
-    Value::Object(out)
+    Value::Array(small)
 }
 
 /// A sweep of section 4: bodies, values, transient and recorded periods,
@@ -250,7 +255,7 @@ fn sweeps(quick: bool) -> Value {
     };
     let mut rows = Vec::new();
     for &(n, values, transient, record, lyapunov) in cases {
-        let text = include_str!("../../examples/fujita-row-n2.toml")
+        let text = include_str!("../../../examples/fujita-row-n2.toml")
             .replace("count = 2", &format!("count = {n}"));
         let doc = ModelDocument::from_toml(&text, "row").expect("the example row");
         let family = ParameterizedModel::new(doc, "frequency").expect("a frequency");
