@@ -198,7 +198,9 @@ pub fn chart_figure(chart: &Chart) -> Figure {
 
 /// A continued curve of special points over a chart, by kind: black folds
 /// (solid) and branch points (dashed), vermillion period doublings
-/// (dashed) and Neimark–Sacker points (solid), blue grazings.
+/// (dashed) and Neimark–Sacker points (solid), purple grazings; over a
+/// white halo, so that it stays visible over cells of every colour (black
+/// chaotic ones included).
 pub fn curve_series(kind: &str, label: String, points: Vec<(f64, f64)>) -> Series {
     match kind {
         "fold" => Series::line(label, points).with_color(6),
@@ -207,6 +209,7 @@ pub fn curve_series(kind: &str, label: String, points: Vec<(f64, f64)>) -> Serie
         "grazing" => Series::line(label, points).with_color(4),
         _ => Series::dashed(label, points).with_color(1),
     }
+    .with_halo()
 }
 
 /// Legend text of attractor `k`.
@@ -317,12 +320,7 @@ pub fn diagram_figure(summary: &SweepSummary) -> Figure {
             .flat_map(|p| p.sections.iter().map(move |s| (p.parameter, 1e3 * s[0])))
             .collect();
         let label = if summary.up_down { d.name() } else { "" };
-        let marker = if *d == Direction::Down {
-            Marker::Triangle
-        } else {
-            Marker::Circle
-        };
-        fig.push(Series::markers(label, pts, marker).with_color(c));
+        fig.push(Series::markers(label, pts, Marker::Dot).with_color(c));
     }
     fig
 }

@@ -95,20 +95,29 @@ impl Canvas {
         area.draw(&PathElement::new(pts, style)).map_err(de)
     }
 
+    /// Draws `marker` at `(x, y)`, its size grown by `grow` (a halo).
     pub(super) fn marker<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         marker: Marker,
         (x, y): (f64, f64),
         color: RGBColor,
+        grow: f64,
     ) -> DrawResult {
-        let s = MARKER_SIZE;
+        let s = MARKER_SIZE + grow;
         match marker {
             Marker::Circle => area
                 .draw(&Circle::new(self.pt((x, y)), self.px(s), color.filled()))
                 .map_err(de),
+            Marker::Dot => area
+                .draw(&Circle::new(
+                    self.pt((x, y)),
+                    self.px(DOT_SIZE + grow).max(1),
+                    color.filled(),
+                ))
+                .map_err(de),
             Marker::Square => {
-                let h = 0.85 * s;
+                let h = 0.85 * MARKER_SIZE + grow;
                 area.draw(&Rectangle::new(
                     [self.pt((x - h, y - h)), self.pt((x + h, y + h))],
                     color.filled(),
@@ -116,7 +125,7 @@ impl Canvas {
                 .map_err(de)
             }
             Marker::Triangle => {
-                let r = 1.3 * s;
+                let r = 1.3 * MARKER_SIZE + 2.0 * grow;
                 let c = 0.866 * r;
                 let pts = vec![
                     self.pt((x, y - r)),
@@ -199,6 +208,12 @@ fn draw_series<DB: DrawingBackend>(
                 continue;
             }
         };
+        if s.halo {
+            let halo = cv.stroke(HALO, LINE_WIDTH + 2.0 * HALO_WIDTH);
+            for line in &lines {
+                cv.line(area, line, halo)?;
+            }
+        }
         for line in &lines {
             cv.line(area, line, style)?;
         }
@@ -208,17 +223,21 @@ fn draw_series<DB: DrawingBackend>(
             .filter_map(|&p| plan.data_px(p))
             .filter(|&p| plan.inside(p))
             .collect();
-        match series_markers(s.style) {
-            Some(m) => {
+        let marker = match series_markers(s.style) {
+            Some(m) => Some(m),
+            // A line through a single point would be invisible: show a dot.
+            None if lines.is_empty() && visible.len() == 1 => Some(Marker::Circle),
+            None => None,
+        };
+        if let Some(m) = marker {
+            if s.halo {
                 for &p in &visible {
-                    cv.marker(area, m, p, color)?;
+                    cv.marker(area, m, p, HALO, HALO_WIDTH)?;
                 }
             }
-            // A line through a single point would be invisible: show a dot.
-            None if lines.is_empty() && visible.len() == 1 => {
-                cv.marker(area, Marker::Circle, visible[0], color)?;
+            for &p in &visible {
+                cv.marker(area, m, p, color, 0.0)?;
             }
-            None => {}
         }
     }
 
@@ -413,7 +432,9 @@ pub(super) fn draw_legend<DB: DrawingBackend>(
             Style::Markers(_) | Style::Rectangles => {}
         }
         if let Some(m) = series_markers(s.style) {
-            cv.marker(area, m, (0.5 * (sx0 + sx1), yc), *color)?;
+            // A dot is too small to read in a legend: a full marker there.
+            let m = if m == Marker::Dot { Marker::Circle } else { m };
+            cv.marker(area, m, (0.5 * (sx0 + sx1), yc), *color, 0.0)?;
         }
         let baseline = yc + 0.5 * CAP * em;
         cv.text(area, label, em, sx1 + gap, baseline, HPos::Left, false)?;

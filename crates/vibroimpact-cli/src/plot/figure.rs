@@ -19,6 +19,9 @@ pub enum Marker {
     Square,
     /// Filled upward triangle.
     Triangle,
+    /// A small filled circle, for dense scatter (an orbit diagram's
+    /// thousands of samples).
+    Dot,
 }
 
 /// How a series is drawn.
@@ -65,6 +68,9 @@ pub struct Series {
     pub style: Style,
     /// Palette index (wraps around); `None` takes the next unused palette colour.
     pub color: Option<usize>,
+    /// Drawn over a light halo, so that it stays visible over filled cells
+    /// of any colour.
+    pub halo: bool,
 }
 
 impl Series {
@@ -80,6 +86,7 @@ impl Series {
             points: points.into_iter().collect(),
             style,
             color: None,
+            halo: false,
         }
     }
 
@@ -117,6 +124,13 @@ impl Series {
     /// Sets the palette index of the series colour.
     pub fn with_color(mut self, palette_index: usize) -> Self {
         self.color = Some(palette_index);
+        self
+    }
+
+    /// Draws the series over a light halo (lines and markers outlined in
+    /// white), for series drawn over a chart's cells.
+    pub fn with_halo(mut self) -> Self {
+        self.halo = true;
         self
     }
 }

@@ -34,6 +34,11 @@ pub(super) const LINE_WIDTH: f64 = 2.0;
 pub(super) const FRAME_WIDTH: f64 = 1.25;
 pub(super) const GRID_WIDTH: f64 = 1.0;
 pub(super) const MARKER_SIZE: f64 = 4.5;
+/// Radius of a [`Marker::Dot`](super::Marker::Dot).
+pub(super) const DOT_SIZE: f64 = 1.3;
+/// Width of a halo on each side of a line or marker, and its colour.
+pub(super) const HALO_WIDTH: f64 = 1.5;
+pub(super) const HALO: RGBColor = RGBColor(255, 255, 255);
 pub(super) const DASH: (f64, f64) = (9.0, 5.0);
 
 pub(super) const TEXT: RGBColor = RGBColor(20, 20, 20);

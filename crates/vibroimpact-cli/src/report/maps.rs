@@ -84,46 +84,99 @@ fn runs(transient: usize, record: usize, stop: &Interrupt) -> SweepOptions {
     }
 }
 
-/// Runs every study of the section; `stop` interrupts them.
+/// Frequencies of the N = 2 orbit diagram (and its Lyapunov exponents).
+const DIAGRAM_POINTS: usize = 301;
+
+/// Runs every study of the section; `stop` interrupts them. The charts
+/// take every core; then the curves are continued on this thread while
+/// the brute-force runs (diagram, basins) take one other thread, the core
+/// the continuation leaves idle. Every result is the same whatever the
+/// threads (each run is deterministic on its own).
 pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
-    let mut rows = Vec::new();
-    for (n, nx, ny, transient) in GRIDS {
-        let doc = document(n)?;
-        let t0 = Instant::now();
-        let options = ChartOptions {
-            sweep: SweepOptions {
-                lyapunov: Some(1),
-                ..runs(transient, 20, stop)
-            },
-            starts: 1,
-        };
-        let chart = chart(
-            &doc,
-            ("frequency", &grid(FREQUENCY, nx)),
-            ("amplitude", &grid(AMPLITUDE, ny)),
-            &options,
-            &|| {},
-        )
-        .map_err(|e| CliError::new(e.to_string()))?;
-        let t1 = Instant::now();
-        let (branch, curves) = branch_and_curves(&doc, stop)?;
-        eprintln!(
-            "R2 N = {n}: chart of {} cells in {:.1} s, {} curves in {:.1} s",
-            chart.cells.len(),
-            (t1 - t0).as_secs_f64(),
-            curves.followed.len(),
-            t1.elapsed().as_secs_f64()
-        );
-        rows.push(RowMap {
-            n,
-            chart,
-            branch,
-            curves,
-        });
-    }
+    let charts = GRIDS
+        .iter()
+        .map(|&grid| chart_of(grid, stop))
+        .collect::<Result<Vec<_>, _>>()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| CliError::new(format!("the brute-force runs' thread: {e}")))?;
+    let (rows, brute) = std::thread::scope(|s| {
+        let brute = s.spawn(|| pool.install(|| brute_force(stop)));
+        let rows = charts
+            .into_iter()
+            .map(|(n, doc, chart)| with_curves(n, &doc, chart, stop))
+            .collect::<Result<Vec<_>, _>>();
+        (rows, brute.join())
+    });
+    let (sweep, basins) =
+        brute.map_err(|_| CliError::new("the brute-force runs stopped unexpectedly"))??;
+    Ok(Maps {
+        rows: rows?,
+        sweep,
+        basins,
+    })
+}
+
+/// The chart of one row size (`n`, cells `nx × ny`, `transient` periods).
+fn chart_of(
+    (n, nx, ny, transient): (usize, usize, usize, usize),
+    stop: &Interrupt,
+) -> Result<(usize, ModelDocument, Chart), CliError> {
+    let doc = document(n)?;
+    let t0 = Instant::now();
+    let options = ChartOptions {
+        sweep: SweepOptions {
+            lyapunov: Some(1),
+            ..runs(transient, 20, stop)
+        },
+        starts: 1,
+    };
+    let chart = chart(
+        &doc,
+        ("frequency", &grid(FREQUENCY, nx)),
+        ("amplitude", &grid(AMPLITUDE, ny)),
+        &options,
+        &|| {},
+    )
+    .map_err(|e| CliError::new(e.to_string()))?;
+    eprintln!(
+        "R2 N = {n}: chart of {} cells in {:.1} s",
+        chart.cells.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok((n, doc, chart))
+}
+
+/// The chart of `n` bodies with the curves of its branch.
+fn with_curves(
+    n: usize,
+    doc: &ModelDocument,
+    chart: Chart,
+    stop: &Interrupt,
+) -> Result<RowMap, CliError> {
+    let t0 = Instant::now();
+    let (branch, curves) = branch_and_curves(doc, stop)?;
+    eprintln!(
+        "R2 N = {n}: {} curves in {:.1} s",
+        curves.followed.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(RowMap {
+        n,
+        chart,
+        branch,
+        curves,
+    })
+}
+
+/// R2 N = 2 by brute force: the orbit diagram with λ1 over
+/// [`DIAGRAM_POINTS`] frequencies, and the basins at 1.1 ω0.
+fn brute_force(stop: &Interrupt) -> Result<(SweepSummary, Basins), CliError> {
+    let t0 = Instant::now();
     let doc = document(2)?;
     let family = ParameterizedModel::new(doc.clone(), "frequency")?;
-    let values = grid(FREQUENCY, 61);
+    let values = grid(FREQUENCY, DIAGRAM_POINTS);
     let sweep = sweep(
         &family,
         &values,
@@ -147,11 +200,13 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Maps, CliError> {
         &|| {},
     )
     .map_err(|e| CliError::new(e.to_string()))?;
-    Ok(Maps {
-        rows,
-        sweep,
-        basins,
-    })
+    eprintln!(
+        "R2 N = 2: orbit diagram at {} frequencies and basins of {} states in {:.1} s",
+        values.len(),
+        u.len() * v.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok((sweep, basins))
 }
 
 /// The branch in frequency at the model's amplitude from its orbit at
@@ -223,7 +278,11 @@ fn chart_with_curves(row: &RowMap) -> Figure {
         })
         .collect();
     if !codim2.is_empty() {
-        fig.push(Series::markers("codimension two", codim2, Marker::Square).with_color(6));
+        fig.push(
+            Series::markers("codimension two", codim2, Marker::Square)
+                .with_color(6)
+                .with_halo(),
+        );
     }
     fig
 }
