@@ -83,7 +83,7 @@ pub struct RowRunArgs {
 
 impl RowRunArgs {
     /// The library's settings (a sample step that is not positive and
-    /// finite is refused by name).
+    /// finite is refused by name); Ctrl-C stops every run.
     pub fn settings(&self) -> Result<vibroimpact::seismic::pounding::RunSettings, CliError> {
         if !(self.sample.is_finite() && self.sample > 0.0) {
             return Err(CliError::new(format!(
@@ -96,6 +96,7 @@ impl RowRunArgs {
             rtol: self.rtol,
             method: self.method.method(),
             integrator: self.integrator.integrator(),
+            interrupt: Some(crate::interrupt::on_ctrl_c()),
         })
     }
 }

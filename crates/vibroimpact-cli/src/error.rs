@@ -62,6 +62,9 @@ pub fn option_error(e: &vibroimpact::field_error::FieldError) -> CliError {
 pub fn pounding_error(e: vibroimpact::seismic::pounding::PoundingError) -> CliError {
     match e {
         vibroimpact::seismic::pounding::PoundingError::Field(f) => option_error(&f),
+        vibroimpact::seismic::pounding::PoundingError::Interrupted => {
+            CliError::new("interrupted (Ctrl-C): nothing written")
+        }
         other => CliError::new(other.to_string()),
     }
 }

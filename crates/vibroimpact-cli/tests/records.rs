@@ -444,6 +444,24 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
         (vec!["--growth", "1"], "--growth 1"),
         (vec!["--tolerance", "1.5"], "--tolerance 1.5"),
         (vec!["--smt", "2"], "--period"),
+        // W2: a negative S_MT printed a negative CMR; refused before the runs.
+        (
+            vec!["--period", "1", "--smt", "-2"],
+            "--smt -2: give the positive MCE spectral acceleration S_MT",
+        ),
+        (
+            vec!["--period", "1", "--smt", "2", "--ssf", "0"],
+            "--ssf 0:",
+        ),
+        // --period 0 was answered about the spectrum's `--periods`.
+        (
+            vec!["--period", "0"],
+            "--period 0: give the positive period (s) of the spectral acceleration",
+        ),
+        (
+            vec!["--damping", "1"],
+            "--damping 1: give a damping ratio in [0, 1)",
+        ),
     ] {
         let a = args(&extra);
         let a: Vec<&str> = a.iter().map(String::as_str).collect();

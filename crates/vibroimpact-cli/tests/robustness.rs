@@ -56,6 +56,37 @@ fn interrupted_sweep_keeps_complete_outputs() {
     assert_no_temporary_files(&dir);
 }
 
+/// Ctrl-C in `pounding` stops every run at its next step: the command
+/// exits non-zero at once saying so, and writes nothing (a study is
+/// written whole). Before, the runs never looked at the request.
+#[cfg(unix)]
+#[test]
+fn interrupted_pounding_writes_nothing() {
+    let dir = temp_dir("pounding-interrupted");
+    let quake = dir.join("long.csv");
+    let mut text = String::from("time,acceleration\n");
+    for k in 0..=60_000 {
+        let t = k as f64 * 0.01;
+        text += &format!("{t},{}\n", 3.0 * (std::f64::consts::TAU * 1.5 * t).sin());
+    }
+    std::fs::write(&quake, text).unwrap();
+    let mut cmd = bin();
+    cmd.args(["pounding", &repo_file("examples/pounding-frames.toml")])
+        .arg(&quake)
+        .args(["--units", "m/s2", "--sample", "2e-5", "--out"])
+        .arg(dir.join("out"));
+    let start = std::time::Instant::now();
+    let out = interrupt_after(cmd, 1000);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(start.elapsed().as_secs_f64() < 6.0, "{stderr}");
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("interrupted (Ctrl-C): nothing written"),
+        "{stderr}"
+    );
+    assert!(!dir.join("out").join("pounding.json").exists());
+}
+
 /// Ctrl-C in `simulate --out` keeps a complete, valid history up to the
 /// time reached (every row whole), the impact log and the summary, and no
 /// temporary file; the exit status says it was interrupted.

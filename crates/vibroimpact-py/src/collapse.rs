@@ -6,11 +6,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
 use vibroimpact::seismic::collapse::{
-    record_document, study_document, summary_document, CollapseStudy, Criterion, IdaSettings,
-    RecordCollapse, RecordIda,
+    check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
+    IdaSettings, RecordCollapse, RecordIda,
 };
 
 use crate::convert::{to_python, value_error};
+use crate::monitor::{self, Progress};
 use crate::records::{pair_and_run, pounding_error, record_of, RecordInput};
 
 /// The study's settings as Python hands them over: (drift limit,
@@ -56,6 +57,10 @@ fn study(
             damping,
         },
     ))
+    .and_then(|(row, study)| {
+        study.check().map_err(pounding_error)?;
+        Ok((row, study))
+    })
 }
 
 /// One record's part of the collapse study of the row in `pair_text`:
@@ -69,11 +74,14 @@ pub fn collapse_record<'py>(
     record: RecordInput<'py>,
     settings: Settings,
 ) -> PyResult<String> {
-    let (row, study) = study(pair_text, source, settings)?;
+    let (row, mut study) = study(pair_text, source, settings)?;
     let record = record_of(&record)?;
-    let part = py
-        .detach(|| study.record(&row, &record))
-        .map_err(pounding_error)?;
+    // Monitored: Ctrl-C stops the IDA at its next step (KeyboardInterrupt).
+    let part = monitor::run(py, None, move |p: &Progress| {
+        study.run.interrupt = Some(p.interrupt.clone());
+        study.record(&row, &record)
+    })?
+    .map_err(pounding_error)?;
     serde_json::to_string(&record_document(&part)).map_err(value_error)
 }
 
@@ -106,6 +114,7 @@ pub fn collapse_document<'py>(
     ssf: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (row, study) = study(pair_text, source, settings)?;
+    check_margins(smt, ssf).map_err(value_error)?;
     let docs: Vec<Value> = records
         .iter()
         .map(|t| serde_json::from_str(t).map_err(value_error))

@@ -11,6 +11,7 @@ use vibroimpact::seismic::pounding::{documents, PoundingError, Row, RunSettings,
 use vibroimpact::seismic::spectrum::response_spectrum as spectrum;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};
+use crate::monitor::{self, Progress};
 
 /// A record from the text of a file (`source` names it): `source`,
 /// `header`, `units` (of the file), `dt` (None if not uniform), `times`
@@ -100,6 +101,7 @@ pub fn response_spectrum<'py>(
 pub(crate) fn pounding_error(e: PoundingError) -> PyErr {
     match e {
         PoundingError::Run { .. } | PoundingError::Diverged { .. } => numerical_error(e),
+        PoundingError::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string()),
         other => value_error(other),
     }
 }
@@ -116,6 +118,7 @@ pub(crate) fn pair_and_run(
         rtol,
         method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
+        interrupt: None,
     };
     let pair =
         vibroimpact::seismic::pounding::parse_row(pair_text, source).map_err(pounding_error)?;
@@ -193,13 +196,17 @@ pub fn pounding<'py>(
         (_, _, Some(gaps)) => Study::Moat { gaps },
         _ => Study::Runs { free },
     };
-    let doc = py
-        .detach(|| {
-            study
-                .run(&row, &runs, &run)
-                .map(|outcome| documents::study_document(&row, &runs, &outcome))
-        })
-        .map_err(pounding_error)?;
+    // Monitored: Ctrl-C stops every run at its next step (KeyboardInterrupt).
+    let doc = monitor::run(py, None, move |p: &Progress| {
+        let run = RunSettings {
+            interrupt: Some(p.interrupt.clone()),
+            ..run
+        };
+        study
+            .run(&row, &runs, &run)
+            .map(|outcome| documents::study_document(&row, &runs, &outcome))
+    })?
+    .map_err(pounding_error)?;
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)
 }
 
@@ -251,9 +258,15 @@ pub fn pounding_history<'py>(
         (&times, &acceleration),
         (sample, rtol, method, integrator),
     )?;
-    let h = py
-        .detach(|| row.history(&record, scale, &run))
-        .map_err(pounding_error)?;
+    let shared = row.clone();
+    let h = monitor::run(py, None, move |p: &Progress| {
+        let run = RunSettings {
+            interrupt: Some(p.interrupt.clone()),
+            ..run
+        };
+        shared.history(&record, scale, &run)
+    })?
+    .map_err(pounding_error)?;
     let rm = &h.model;
     let n = rm.model.bodies().len();
     let series = |i: usize| -> Vec<f64> { h.displacement.chunks(n).map(|s| s[i]).collect() };

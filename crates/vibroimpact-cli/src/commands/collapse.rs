@@ -11,11 +11,12 @@ use clap::Args;
 use rayon::prelude::*;
 use serde_json::Value;
 use vibroimpact::seismic::collapse::{
-    record_document, study_document, summary_document, CollapseStudy, Criterion, IdaSettings,
+    check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
+    IdaSettings,
 };
 
 use crate::args::RowRunArgs;
-use crate::error::{pounding_error, CliError};
+use crate::error::{option_error, pounding_error, CliError};
 use crate::format::Format;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
@@ -129,6 +130,8 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
         period: args.period,
         damping: args.damping,
     };
+    study.check().map_err(pounding_error)?;
+    check_margins(args.smt, args.ssf).map_err(|e| option_error(&e))?;
     let recs = args
         .records
         .iter()

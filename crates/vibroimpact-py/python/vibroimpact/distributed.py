@@ -316,6 +316,18 @@ def fragility(intensity: Any, exceeded: Any) -> Result:
         raise ValueError("intensity: positive finite values")
     if np.any((y < 0) | (y > 1)):
         raise ValueError("exceeded: booleans or fractions in [0, 1]")
+    if not 0.0 < float(y.sum()) < y.size:
+        what = "no run exceeded" if y.sum() == 0 else "every run exceeded"
+        raise ValueError(
+            f"exceeded: {what}; the fragility's median and dispersion are not determined "
+            "(extend the intensities)"
+        )
+    partial = (y > 0) & (y < 1)
+    if not partial.any() and x[y == 0].max() < x[y == 1].min():
+        raise ValueError(
+            "exceeded: every exceedance lies above every non-exceedance; the likelihood "
+            "grows without bound as beta -> 0, so the dispersion is not determined"
+        )
     lx = np.log(x)
 
     def loglik(lt, b):

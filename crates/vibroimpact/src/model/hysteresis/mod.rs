@@ -454,7 +454,8 @@ impl StoreySpec {
 
 /// A drift history from text (`source` names it in errors): one drift a
 /// line (m), blank lines and `#` comments skipped, text before the first
-/// number a header; every drift finite, at least one.
+/// number a header; a line that starts with a number is data, never taken
+/// for a header; every drift finite, at least one.
 pub fn parse_drifts(text: &str, source: &str) -> Result<Vec<f64>, RecordError> {
     let mut drifts = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -471,13 +472,18 @@ pub fn parse_drifts(text: &str, source: &str) -> Result<Vec<f64>, RecordError> {
                     format!("`{l}` is not finite"),
                 ))
             }
-            Err(_) if drifts.is_empty() => continue,
+            Err(_) if drifts.is_empty() && !starts_with_number(l) => continue,
             Err(_) => {
+                let hint = if starts_with_number(l) {
+                    " (one drift a line)"
+                } else {
+                    ""
+                };
                 return Err(RecordError::at(
                     source,
                     i + 1,
-                    format!("`{l}` is not a drift"),
-                ))
+                    format!("`{l}` is not a drift{hint}"),
+                ));
             }
         }
     }
@@ -485,6 +491,14 @@ pub fn parse_drifts(text: &str, source: &str) -> Result<Vec<f64>, RecordError> {
         return Err(RecordError::whole(source, "no drifts"));
     }
     Ok(drifts)
+}
+
+/// Whether the first field of `line` (split at whitespace, `,` or `;`)
+/// reads as a number: then the line is data, not a header.
+fn starts_with_number(line: &str) -> bool {
+    line.split(|c: char| c.is_whitespace() || c == ',' || c == ';')
+        .next()
+        .is_some_and(|f| f.parse::<f64>().is_ok())
 }
 
 /// The most samples a cyclic protocol may have (800 MB of drifts).

@@ -196,4 +196,18 @@ fn drift_files_are_read_with_their_lines() {
         parse_drifts("drift\n", "d.txt").unwrap_err().to_string(),
         "d.txt: no drifts"
     );
+    // A first line of numbers is data, never a header (it was dropped as
+    // one, silently).
+    assert_eq!(
+        parse_drifts("0.01 0.02\n0.03\n", "d.txt")
+            .unwrap_err()
+            .to_string(),
+        "d.txt:1: `0.01 0.02` is not a drift (one drift a line)"
+    );
+    assert_eq!(
+        parse_drifts("0.01,0.02\n", "d.txt").unwrap_err().line,
+        Some(1)
+    );
+    let d = parse_drifts("drift\nunits: m\n0.01\n", "d.txt").unwrap();
+    assert_eq!(d, vec![0.01]);
 }

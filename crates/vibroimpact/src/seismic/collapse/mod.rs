@@ -310,7 +310,9 @@ pub fn median_collapse(records: &[RecordIda]) -> Option<f64> {
 }
 
 mod study;
-pub use study::{record_document, study_document, summary_document, CollapseStudy, RecordCollapse};
+pub use study::{
+    check_margins, record_document, study_document, summary_document, CollapseStudy, RecordCollapse,
+};
 
 #[cfg(test)]
 mod tests;

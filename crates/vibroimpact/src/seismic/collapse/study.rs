@@ -6,11 +6,12 @@
 use serde_json::{json, Value};
 
 use super::{median_collapse, record_ida, Criterion, IdaSettings, RecordIda, Verdict};
+use crate::field_error::FieldError;
 use crate::model::record::Record;
 use crate::seismic::pounding::{PoundingError, Row, RunSettings};
 
 /// The settings of a collapse study.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CollapseStudy {
     /// When a run collapses.
     pub criterion: Criterion,
@@ -35,9 +36,29 @@ pub struct RecordCollapse {
 }
 
 impl CollapseStudy {
+    /// Refuses, before any run, a criterion or IDA setting out of range, a
+    /// period of the intensity that is not positive and finite, and a
+    /// damping ratio outside [0, 1).
+    pub fn check(&self) -> Result<(), PoundingError> {
+        self.criterion.check()?;
+        self.ida.check()?;
+        if let Some(t) = self.period {
+            if !(t.is_finite() && t > 0.0) {
+                let m = "give the positive period (s) of the spectral acceleration";
+                return Err(FieldError::new("period", t, m).into());
+            }
+        }
+        if !(0.0..1.0).contains(&self.damping) {
+            let m = "give a damping ratio in [0, 1)";
+            return Err(FieldError::new("damping", self.damping, m).into());
+        }
+        Ok(())
+    }
+
     /// One record's IDA and spectral acceleration (the task of one
     /// record).
     pub fn record(&self, row: &Row, record: &Record) -> Result<RecordCollapse, PoundingError> {
+        self.check()?;
         let sa = self
             .period
             .map(|t| {
@@ -91,6 +112,24 @@ pub fn record_document(r: &RecordCollapse) -> Value {
         "censored": r.ida.collapse.is_none(),
         "note": r.ida.collapse.is_none().then(|| format!("no collapse up to scale {}", r.ida.survived)),
     })
+}
+
+/// Refuses an S_MT or SSF that is not positive and finite (a negative
+/// S_MT gave a negative CMR): checked before any run.
+pub fn check_margins(smt: Option<f64>, ssf: Option<f64>) -> Result<(), FieldError> {
+    for (field, v, what) in [
+        (
+            "smt",
+            smt,
+            "give the positive MCE spectral acceleration S_MT",
+        ),
+        ("ssf", ssf, "give the positive spectral shape factor"),
+    ] {
+        if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(FieldError::new(field, v, what));
+        }
+    }
+    Ok(())
 }
 
 /// The summary over the records' parts: the median collapse scale (null

@@ -43,6 +43,9 @@ pub enum PoundingError {
         /// Why.
         message: String,
     },
+    /// The study was asked to stop (Ctrl-C): no result.
+    #[error("interrupted: the study stopped before its end, no result")]
+    Interrupted,
     /// A run under a record could not start or failed: the record and why.
     #[error("{record}: {message}")]
     Run {

