@@ -293,6 +293,10 @@ fn hysteresis_loop_and_bad_input() {
             &["--yield-drift", "0.01", "--points", "10"][..],
             "--points 10: give a positive multiple of 4",
         ),
+        (
+            &["--law", "elastic", "--yield-drift", "0.01"][..],
+            "--yield-drift: an elastic storey has no yield drift",
+        ),
     ] {
         assert_clean_error(&[&base[..], extra].concat(), needle);
     }

@@ -24,7 +24,10 @@ fn spec(
     let (exponent, beta, gamma) = (*exponent, *beta, *gamma);
     let (a, nu, eta) = (*a, *nu, *eta);
     Ok(match name.as_str() {
-        "elastic" => StoreySpec::Elastic,
+        "elastic" if yield_drift.is_some() => return Err(value_error(
+            "yield_drift: an elastic storey has no yield drift (give law='bilinear' or 'bouc-wen')",
+        )),
+        "elastic" => StoreySpec::Elastic {},
         "bilinear" => StoreySpec::Bilinear {
             yield_drift: uy()?,
             post_yield_ratio,

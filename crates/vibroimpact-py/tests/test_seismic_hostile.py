@@ -99,3 +99,26 @@ def test_h1_ctrl_c_stops_a_long_pounding_and_collapse_study():
             assert time.perf_counter() - start < 5.0
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def test_unclear_record_inputs_get_clear_messages(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    three = tmp_path / "three.txt"
+    three.write_text("0 1 2\n0.01 2 3\n")
+    junk = tmp_path / "junk.txt"
+    junk.write_text("garbage here\nmore garbage\n")
+    for path, needle in ((empty, "empty: no samples"),
+                         (three, r"three.txt:1: expected two numbers \(time, acceleration\)"),
+                         (junk, "no line holds two numbers")):
+        with pytest.raises(ValueError, match=needle):
+            vi.read_record(path, units="m/s2")
+    with pytest.raises(ValueError, match="is not a regular file"):
+        vi.read_record(tmp_path, units="m/s2")
+    with pytest.raises(TypeError, match="^records: expected a file name"):
+        vi.pounding(PAIR, None)
+
+
+def test_a_yield_drift_on_an_elastic_storey_is_refused():
+    with pytest.raises(ValueError, match="^yield_drift: an elastic storey has no yield drift"):
+        vi.hysteresis(stiffness=1e6, law="elastic", yield_drift=0.01, amplitudes=[0.01])

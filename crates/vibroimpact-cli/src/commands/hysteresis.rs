@@ -95,7 +95,12 @@ impl HysteresisArgs {
                 .ok_or_else(|| CliError::new("--yield-drift: give the yield drift (m)"))
         };
         Ok(match self.law {
-            LawName::Elastic => StoreySpec::Elastic,
+            LawName::Elastic if self.yield_drift.is_some() => {
+                return Err(CliError::new(
+                    "--yield-drift: an elastic storey has no yield drift (give --law bilinear or bouc-wen)",
+                ))
+            }
+            LawName::Elastic => StoreySpec::Elastic {},
             LawName::Bilinear => StoreySpec::Bilinear {
                 yield_drift: uy()?,
                 post_yield_ratio: self.post_yield_ratio,

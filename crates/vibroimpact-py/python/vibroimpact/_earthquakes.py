@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+import stat
+from collections.abc import Iterable, Mapping
 from typing import Any, Optional, Union
 
 import numpy as np
@@ -40,9 +41,15 @@ def read_record(path: Union[str, "os.PathLike[str]"], *, units: Optional[str] = 
     if units is not None and not isinstance(units, str):
         raise TypeError("units: expected 'g', 'm/s2' or 'gal'")
     try:
-        size = os.stat(path).st_size
+        st = os.stat(path)
     except OSError as e:
         raise OSError(f"{path}: cannot read: {e.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise ValueError(
+            f"path: {path} is not a regular file (a directory, FIFO or device "
+            "cannot be read as a record)"
+        )
+    size = st.st_size
     if size > 1 << 30:
         raise ValueError(f"path: {path} has {size} bytes, more than the input limit of 1 GiB")
     with open(path, encoding="utf-8", errors="replace") as f:
@@ -134,6 +141,11 @@ def _record_inputs(records: Any, units: Optional[str]) -> list:
     of one record or a list of them (file names or :func:`read_record`
     results)."""
     one = isinstance(records, (str, os.PathLike, Mapping))
+    if not one and not isinstance(records, Iterable):
+        raise TypeError(
+            "records: expected a file name, a read_record result or a list of them, "
+            f"got {type(records).__name__}"
+        )
     out = []
     for k, r in enumerate([records] if one else list(records)):
         if isinstance(r, (str, os.PathLike)):

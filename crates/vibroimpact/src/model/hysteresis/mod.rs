@@ -381,8 +381,9 @@ pub fn under_drift(
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "law", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum StoreySpec {
-    /// Linear.
-    Elastic,
+    /// Linear (no other key: a `yield_drift` given to an elastic storey is
+    /// refused, not ignored).
+    Elastic {},
     /// Bilinear with kinematic hardening.
     Bilinear {
         /// Yield drift u_y (m).
@@ -415,7 +416,7 @@ impl StoreySpec {
     /// The law with the storey's elastic `stiffness`, checked.
     pub fn law(&self, stiffness: f64) -> Result<StoreyLaw, LawError> {
         let law = match *self {
-            StoreySpec::Elastic => StoreyLaw::Elastic { stiffness },
+            StoreySpec::Elastic {} => StoreyLaw::Elastic { stiffness },
             StoreySpec::Bilinear {
                 yield_drift,
                 post_yield_ratio,

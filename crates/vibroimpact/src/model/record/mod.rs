@@ -397,7 +397,10 @@ pub fn parse_columns(
             _ => None,
         };
         let Some((t, a)) = pair else {
-            if times.is_empty() {
+            // A line that starts with a number is data (three columns, a
+            // bad number), never taken for a header.
+            let data = cells.first().is_some_and(|c| c.parse::<f64>().is_ok());
+            if times.is_empty() && !data {
                 header.push(l.to_string());
                 continue;
             }
@@ -422,6 +425,14 @@ pub fn parse_columns(
         times.push(t);
         values.push(a);
         lines.push(i + 1);
+    }
+    if times.is_empty() {
+        let what = if text.trim().is_empty() {
+            "empty: no samples"
+        } else {
+            "no samples: no line holds two numbers (time, acceleration)"
+        };
+        return Err(RecordError::whole(source, what));
     }
     let units = units
         .or_else(|| header.iter().find_map(|h| units_in(h)))

@@ -108,6 +108,18 @@ fn bad_records_name_the_line() {
             "x:5: a gap",
         ),
         ("t a (g)\n0 1\n".into(), "at least two"),
+        // An empty file was answered about units; three columns and
+        // garbage with "0 samples".
+        ("".into(), "x: empty: no samples"),
+        ("\n  \n".into(), "x: empty: no samples"),
+        (
+            "0 1 2\n0.01 2 3\n".into(),
+            "x:1: expected two numbers (time, acceleration), found `0 1 2`",
+        ),
+        (
+            "garbage here\nmore garbage\n".into(),
+            "x: no samples: no line holds two numbers",
+        ),
     ];
     for (text, needle) in cases {
         let e = parse_record(&text, "x", None).unwrap_err();

@@ -146,8 +146,12 @@ impl Bearing {
                 if !(radius.is_finite() && radius > 0.0) {
                     return Err(bad("radius", radius, "must be finite and > 0"));
                 }
-                if !(friction.is_finite() && friction >= 0.0) {
-                    return Err(bad("friction", friction, "must be finite and >= 0"));
+                if !(friction.is_finite() && (0.0..1.0).contains(&friction)) {
+                    return Err(bad(
+                        "friction",
+                        friction,
+                        "must be in [0, 1) (a sliding bearing's coefficient is about 0.02 to 0.2)",
+                    ));
                 }
                 let pendulum = weight / radius;
                 if friction == 0.0 {

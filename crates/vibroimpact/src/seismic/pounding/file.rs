@@ -264,6 +264,15 @@ fn row_of(spec: RowSpec) -> Result<Row, PoundingError> {
     let mut joints = Vec::new();
     for (k, b) in spec.building.into_iter().enumerate() {
         let name = b.name.clone().unwrap_or_else(|| format!("B{}", k + 1));
+        if name.trim().is_empty() {
+            return missing(
+                "name",
+                &format!(
+                    "building {}: the name is empty (results are keyed by it)",
+                    k + 1
+                ),
+            );
+        }
         let what = format!("building {name}");
         if k == 0 {
             if b.has_joint() {

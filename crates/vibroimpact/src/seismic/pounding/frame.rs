@@ -61,7 +61,11 @@ impl ShearFrame {
     pub fn laws(&self) -> Result<Vec<StoreyLaw>, String> {
         (0..self.masses.len())
             .map(|i| {
-                let spec = self.storeys.get(i).copied().unwrap_or(StoreySpec::Elastic);
+                let spec = self
+                    .storeys
+                    .get(i)
+                    .copied()
+                    .unwrap_or(StoreySpec::Elastic {});
                 spec.law(self.stiffnesses[i])
                     .map_err(|e| format!("storey {}: {e}", i + 1))
             })
@@ -70,7 +74,7 @@ impl ShearFrame {
 
     /// Whether any storey yields (is not elastic).
     pub fn inelastic(&self) -> bool {
-        self.storeys.iter().any(|s| *s != StoreySpec::Elastic)
+        self.storeys.iter().any(|s| *s != StoreySpec::Elastic {})
     }
 
     /// The stiffness matrix K (tridiagonal).

@@ -143,7 +143,8 @@ fn friction_pendulum_bearings() {
         rigid.period()
     );
     for (radius, friction, needle) in [
-        (r, -0.1, "friction = -0.1: must be finite and >= 0"),
+        (r, -0.1, "friction = -0.1: must be in [0, 1)"),
+        (r, 1.0, "friction = 1: must be in [0, 1)"),
         (0.0, mu, "radius = 0: must be finite and > 0"),
     ] {
         let bad = Bearing::FrictionPendulum {
@@ -239,7 +240,24 @@ fn bad_rows_are_refused() {
         (
             "bearing = { law = \"bilinear\", stiffness = 6e7, yield_drift = 0.01,",
             "bearing = { law = \"friction-pendulum\", radius = 2.0, friction = -0.1 }\n#",
-            "iso.toml: building iso: isolation: friction = -0.1: must be finite and >= 0",
+            "iso.toml: building iso: isolation: friction = -0.1: must be in [0, 1)",
+        ),
+        // Accepted without a word before: a friction coefficient of 5, an
+        // empty name, an elastic storey with a yield drift.
+        (
+            "bearing = { law = \"bilinear\", stiffness = 6e7, yield_drift = 0.01,",
+            "bearing = { law = \"friction-pendulum\", radius = 2.0, friction = 5 }\n#",
+            "iso.toml: building iso: isolation: friction = 5: must be in [0, 1)",
+        ),
+        (
+            "name = \"next\"",
+            "name = \"\"",
+            "building 2: the name is empty",
+        ),
+        (
+            "damping_ratio = 0.05\n",
+            "damping_ratio = 0.05\nstoreys = [{ law = \"elastic\", yield_drift = 0.01 }]\n",
+            "unknown field `yield_drift`",
         ),
         (
             "post_yield_ratio = 0.1 }",
