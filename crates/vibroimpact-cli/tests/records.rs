@@ -213,18 +213,35 @@ fn pounding_of_two_frames() {
             ],
             "--ratios",
         ),
-        (
-            vec![
-                "pounding", &pair, &quake, "--units", "m/s2", "--format", "csv",
-            ],
-            "--format csv",
-        ),
     ] {
         let out = common::run(&args);
         assert!(!out.status.success(), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "{args:?}: {err}");
     }
+    // `--format csv` of the runs was offered, then refused: it is the
+    // runs' peaks, a row per record, building and storey, the JSON's
+    // numbers to the last bit.
+    let out = common::run(&[
+        "pounding", &pair, &quake, "--units", "m/s2", "--format", "csv",
+    ]);
+    assert!(out.status.success());
+    let csv = String::from_utf8(out.stdout).unwrap();
+    let doc = json(&[
+        "pounding", &pair, &quake, "--units", "m/s2", "--format", "json",
+    ]);
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0][3], "peak_drift_m");
+    assert_eq!(rows.len(), 1 + 3 + 2, "{csv}");
+    let right_2 = &rows[5];
+    assert_eq!((right_2[1], right_2[2]), ("right", "2"));
+    let drift: f64 = right_2[3].parse().unwrap();
+    assert_eq!(
+        drift,
+        doc["runs"][0]["pounding"]["peak_drift"]["right"][1]
+            .as_f64()
+            .unwrap()
+    );
 }
 
 /// `hysteresis`: a bilinear storey's loop over a cyclic protocol (the
@@ -343,6 +360,30 @@ fn moat_gap_study_of_an_isolated_building() {
     ] {
         assert!(dir.join(f).is_file(), "{f}");
     }
+    // The table prints the cells (it printed no results before): a row
+    // for the run without contacts and one per gap, the JSON's medians.
+    let out = run(&[
+        "pounding",
+        &building,
+        &quake,
+        "--units",
+        "m/s2",
+        "--scale",
+        "2",
+        "--moat-gaps",
+        "0.05:1.5:2",
+    ]);
+    let table = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = table
+        .lines()
+        .filter(|l| l.contains("e-") || l.contains("e0"))
+        .collect();
+    assert_eq!(lines.len(), 3, "{table}");
+    assert!(lines[0].trim_start().starts_with("free"), "{table}");
+    assert!(
+        lines[1].contains(&format!("{reach:.4e}")) || lines[0].contains(&format!("{reach:.4e}")),
+        "{table}"
+    );
     // The runs themselves draw each yielding building's loops.
     let runs = temp_dir("moat-runs");
     json(&[

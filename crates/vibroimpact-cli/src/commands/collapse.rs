@@ -17,7 +17,7 @@ use vibroimpact::seismic::collapse::{
 
 use crate::args::RowRunArgs;
 use crate::error::{option_error, pounding_error, CliError};
-use crate::format::Format;
+use crate::format::SummaryFormat;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use crate::records;
@@ -73,8 +73,8 @@ pub struct CollapseArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Format on standard output.
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
+    format: SummaryFormat,
 }
 
 /// The IDA curves: per record the largest drift against the scale, the
@@ -157,13 +157,8 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
         render(&ida_figure(&doc, args.drift_limit), &dir.join("ida"))?;
     }
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
-        Format::Csv => {
-            return Err(CliError::new(
-                "--format csv: the collapse study has no table; give json or table",
-            ))
-        }
-        Format::Table => print_table(&doc),
+        SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
+        SummaryFormat::Table => print_table(&doc),
     }
     Ok(())
 }

@@ -56,7 +56,8 @@ pub struct PoundingArgs {
     /// and the same without contacts.
     #[arg(long, conflicts_with = "gaps")]
     moat_gaps: Option<String>,
-    /// Output folder for pounding.json (with hysteretic storeys, the
+    /// Output folder for pounding.json and, for the runs, runs.csv (a row
+    /// per record, building and storey; with hysteretic storeys, the
     /// loops of each record's run, loops-RECORD-BUILDING.svg/.png; for a
     /// spectrum, spectrum.csv and the figure spectrum.svg/.png; for a
     /// moat-gap study, moat.csv and the figures moat-drift and
@@ -114,6 +115,50 @@ fn spectrum_csv(cells: &[SpectrumCell]) -> Result<String, CliError> {
             format!("{:e}", quantile(&c.drift_amplification, 0.84)),
             format!("{:e}", quantile(&c.required_gap, 0.5)),
         ])?;
+    }
+    w.finish()
+}
+
+/// The runs' peaks as CSV, a row per record, building and storey (from the
+/// study's document): peak and residual drift, peak absolute floor
+/// acceleration and displacement with pounding, and the peak drift of the
+/// building apart (empty with `--free false`).
+fn runs_csv(doc: &Value) -> Result<String, CliError> {
+    let mut w = CsvText::new();
+    w.row([
+        "record",
+        "building",
+        "storey",
+        "peak_drift_m",
+        "residual_drift_m",
+        "peak_floor_acceleration_m_s2",
+        "peak_displacement_m",
+        "free_peak_drift_m",
+    ])?;
+    let cell = |v: &Value| v.as_f64().map_or(String::new(), |x| format!("{x:e}"));
+    let names: Vec<&str> = doc["row"]["buildings"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|b| b["name"].as_str())
+        .collect();
+    for r in doc["runs"].as_array().into_iter().flatten() {
+        let (p, f) = (&r["pounding"], &r["free"]);
+        for name in &names {
+            let drifts = p["peak_drift"][name].as_array().map_or(0, Vec::len);
+            for i in 0..drifts {
+                w.row([
+                    r["record"]["source"].as_str().unwrap_or("").to_string(),
+                    name.to_string(),
+                    (i + 1).to_string(),
+                    cell(&p["peak_drift"][name][i]),
+                    cell(&p["residual_drift"][name][i]),
+                    cell(&p["peak_floor_acceleration"][name][i]),
+                    cell(&p["peak_displacement"][name][i]),
+                    cell(&f["peak_drift"][name][i]),
+                ])?;
+            }
+        }
     }
     w.finish()
 }
@@ -263,7 +308,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     let (csv, name) = match &outcome {
         Outcome::Spectrum(cells) => (Some(spectrum_csv(cells)?), "spectrum"),
         Outcome::Moat(cells) => (Some(moat_csv(cells)?), "moat"),
-        Outcome::Runs { .. } => (None, ""),
+        Outcome::Runs { .. } => (Some(runs_csv(&doc)?), "runs"),
     };
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
@@ -318,14 +363,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
-        Format::Csv => {
-            match &csv {
-                Some(c) => print!("{c}"),
-                None => return Err(CliError::new(
-                    "--format csv: the CSV is the pounding spectrum's (give --gaps and --ratios) or the moat-gap study's (--moat-gaps)",
-                )),
-            }
-        }
+        Format::Csv => print!("{}", csv.unwrap_or_default()),
         Format::Table => print_table(&doc),
     }
     Ok(())
@@ -364,6 +402,19 @@ fn print_table(doc: &Value) {
                 .as_f64()
                 .unwrap_or(f64::NAN),
         );
+        for j in r["pounding"]["joint_impacts"]
+            .as_array()
+            .into_iter()
+            .flatten()
+        {
+            println!(
+                "  joint {}–{}: {} impacts, peak force {:.4e} N",
+                j["between"][0].as_str().unwrap_or("?"),
+                j["between"][1].as_str().unwrap_or("?"),
+                j["impacts"],
+                j["peak_impact_force"].as_f64().unwrap_or(f64::NAN),
+            );
+        }
         for j in r["joints"].as_array().into_iter().flatten() {
             println!(
                 "  joint {}–{}: required gap {:.4e} m (ABS {:.4e}, SRSS {:.4e}, DDC {:.4e})",
@@ -391,6 +442,27 @@ fn print_table(doc: &Value) {
                 i["moat_peak_force"].as_f64().unwrap_or(f64::NAN),
             );
         }
+    }
+    if let Some(cells) = doc["moat_cells"].as_array() {
+        println!(
+            "{:>10} {:>14} {:>16} {:>14} {:>14} {:>10}",
+            "moat gap", "drift [m]", "floor acc [m/s2]", "isolator [m]", "moat F [N]", "capacity"
+        );
+        for c in cells {
+            let median = |key: &str| c[key]["median"].as_f64().unwrap_or(f64::NAN);
+            let gap = c["gap"]
+                .as_f64()
+                .map_or("free".to_string(), |g| format!("{g:.4}"));
+            println!(
+                "{gap:>10} {:>14.4e} {:>16.4e} {:>14.4e} {:>14.4e} {:>10}",
+                median("peak_drift"),
+                median("peak_floor_acceleration"),
+                median("isolator_displacement"),
+                median("moat_peak_force"),
+                c["beyond_capacity"],
+            );
+        }
+        println!("(medians over the records; capacity: records beyond an isolator's capacity)");
     }
     if let Some(cells) = doc["cells"].as_array() {
         println!(

@@ -73,7 +73,8 @@ fn yield_drift(law: &StoreyLaw) -> Option<f64> {
 /// drifts, ductility demands (peak over yield drift; null for an elastic
 /// storey), hysteretic energies, floor accelerations and displacements;
 /// the isolators' response (isolated buildings); the peak impact force
-/// and impact count between buildings and each joint's closings.
+/// and impact count between buildings, each joint's closings, and per
+/// joint its impacts and peak impact force (`joint_impacts`).
 pub fn response_document(row: &Row, r: &Response) -> Value {
     let ductility = row.buildings.iter().zip(&r.drift).map(|(b, drift)| {
         let laws = b.frame.laws().unwrap_or_default();
@@ -93,6 +94,11 @@ pub fn response_document(row: &Row, r: &Response) -> Value {
         "peak_impact_force": r.peak_impact_force,
         "impacts": r.impacts,
         "closing": r.closing,
+        "joint_impacts": r.joint_impacts.iter().enumerate().map(|(j, &(n, f))| json!({
+            "between": [row.buildings[j].name, row.buildings[j + 1].name],
+            "impacts": n,
+            "peak_impact_force": f,
+        })).collect::<Vec<_>>(),
     });
     let isolators: Map<String, Value> = row
         .buildings

@@ -120,6 +120,8 @@ pub struct Response {
     pub peak_impact_force: f64,
     /// Impacts between buildings.
     pub impacts: usize,
+    /// Per joint, its impacts and their largest force (N; 0 without).
+    pub joint_impacts: Vec<(usize, f64)>,
     /// Per joint, per pounding floor, the largest closing
     /// max (u_left − u_right) (m).
     pub closing: Vec<Vec<f64>>,

@@ -192,6 +192,17 @@ impl Peaks {
             isolators,
             peak_impact_force: between.clone().fold(0.0, |m, i| m.max(i.peak_force)),
             impacts: between.count(),
+            joint_impacts: rm
+                .joints
+                .iter()
+                .map(|contacts| {
+                    let at = sim.impacts.iter().filter(|i| contacts.contains(&i.contact));
+                    (
+                        at.clone().count(),
+                        at.fold(0.0f64, |m, i| m.max(i.peak_force)),
+                    )
+                })
+                .collect(),
             closing: self
                 .closing
                 .into_iter()

@@ -82,6 +82,26 @@ fn chain_pounding_in_a_row_of_three() {
     };
     assert!(at(0) > 0 && at(1) > 0, "impacts {} and {}", at(0), at(1));
     assert_eq!(at(0) + at(1), res.pounding.impacts);
+    // Per joint in the response (docs/cli.md promised them; the documents
+    // had row totals only): the history's counts and the impact log's
+    // largest force at each joint.
+    let peak = |joint: usize| {
+        h.impacts
+            .iter()
+            .filter(|i| h.model.joints[joint].contains(&i.contact))
+            .fold(0.0f64, |m, i| m.max(i.peak_force))
+    };
+    assert_eq!(
+        res.pounding.joint_impacts,
+        vec![(at(0), peak(0)), (at(1), peak(1))]
+    );
+    assert_eq!(peak(0).max(peak(1)), res.pounding.peak_impact_force);
+    let doc = super::super::documents::response_document(&row, &res.pounding);
+    assert_eq!(
+        doc["joint_impacts"][1]["between"],
+        serde_json::json!(["B", "C"])
+    );
+    assert_eq!(doc["joint_impacts"][0]["impacts"], at(0));
     // The left joint far apart: building A is free.
     let apart = parse_row(&text(1.0), "row.toml").unwrap();
     let p = apart.respond(&record(), 1.0, true, &run).unwrap();
