@@ -33,10 +33,12 @@ pub fn status() -> ProgressBar {
 /// Says up front, on standard error, that a run will take long (its
 /// estimated steps and time), if it will; the run goes on.
 pub fn announce_long(work: Option<vibroimpact::simulate::WorkEstimate>) {
+    announce_long_as(work, "Ctrl-C stops it and keeps what is complete");
+}
+
+/// [`announce_long`] with what Ctrl-C does to this command's results.
+pub fn announce_long_as(work: Option<vibroimpact::simulate::WorkEstimate>, on_stop: &str) {
     if let Some(work) = work.filter(|w| w.is_long()) {
-        eprintln!(
-            "note: {}; Ctrl-C stops it and keeps what is complete",
-            work.describe()
-        );
+        eprintln!("note: {}; {on_stop}", work.describe());
     }
 }

@@ -56,9 +56,10 @@ fn interrupted_sweep_keeps_complete_outputs() {
     assert_no_temporary_files(&dir);
 }
 
-/// Ctrl-C in `pounding` stops every run at its next step: the command
-/// exits non-zero at once saying so, and writes nothing (a study is
-/// written whole). Before, the runs never looked at the request.
+/// A long `pounding` says so before any work, and Ctrl-C stops every run
+/// at its next step: the command exits non-zero at once saying so, and
+/// writes nothing (a study is written whole). Before, the runs never
+/// looked at the request, and only `simulate` announced a long run.
 #[cfg(unix)]
 #[test]
 fn interrupted_pounding_writes_nothing() {
@@ -73,7 +74,7 @@ fn interrupted_pounding_writes_nothing() {
     let mut cmd = bin();
     cmd.args(["pounding", &repo_file("examples/pounding-frames.toml")])
         .arg(&quake)
-        .args(["--units", "m/s2", "--sample", "2e-5", "--out"])
+        .args(["--units", "m/s2", "--sample", "1e-6", "--out"])
         .arg(dir.join("out"));
     let start = std::time::Instant::now();
     let out = interrupt_after(cmd, 1000);
@@ -82,6 +83,11 @@ fn interrupted_pounding_writes_nothing() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(
         stderr.contains("interrupted (Ctrl-C): nothing written"),
+        "{stderr}"
+    );
+    // Announced before any work (6e8 samples: about a minute).
+    assert!(
+        stderr.starts_with("note: a long run:") && stderr.contains("nothing is written"),
         "{stderr}"
     );
     assert!(!dir.join("out").join("pounding.json").exists());

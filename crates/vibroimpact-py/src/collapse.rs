@@ -76,6 +76,7 @@ pub fn collapse_record<'py>(
 ) -> PyResult<String> {
     let (row, mut study) = study(pair_text, source, settings)?;
     let record = record_of(&record)?;
+    crate::simulate::warn_if_long(py, study.estimate(&row, &record).map_err(pounding_error)?)?;
     // Monitored: Ctrl-C stops the IDA at its next step (KeyboardInterrupt).
     let part = monitor::run(py, None, move |p: &Progress| {
         study.run.interrupt = Some(p.interrupt.clone());

@@ -196,6 +196,10 @@ pub fn pounding<'py>(
         (_, _, Some(gaps)) => Study::Moat { gaps },
         _ => Study::Runs { free },
     };
+    crate::simulate::warn_if_long(
+        py,
+        study.estimate(&row, &runs, &run).map_err(pounding_error)?,
+    )?;
     // Monitored: Ctrl-C stops every run at its next step (KeyboardInterrupt).
     let doc = monitor::run(py, None, move |p: &Progress| {
         let run = RunSettings {

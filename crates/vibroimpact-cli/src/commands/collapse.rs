@@ -14,6 +14,7 @@ use vibroimpact::seismic::collapse::{
     check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
     IdaSettings,
 };
+use vibroimpact::simulate::WorkEstimate;
 
 use crate::args::RowRunArgs;
 use crate::error::{option_error, pounding_error, CliError};
@@ -137,6 +138,15 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
         .iter()
         .map(|p| records::read(p, units))
         .collect::<Result<Vec<_>, _>>()?;
+    let estimates = recs
+        .iter()
+        .map(|r| study.estimate(&row, r))
+        .collect::<Result<Option<Vec<_>>, _>>()
+        .map_err(pounding_error)?;
+    crate::progress::announce_long_as(
+        estimates.and_then(|w| w.into_iter().reduce(WorkEstimate::then)),
+        "Ctrl-C stops it (nothing is written)",
+    );
     let parts = recs
         .par_iter()
         .map(|r| study.record(&row, r))

@@ -303,6 +303,10 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         },
         _ => Study::Runs { free: args.free },
     };
+    crate::progress::announce_long_as(
+        study.estimate(&row, &runs, &run).map_err(pounding_error)?,
+        "Ctrl-C stops it (nothing is written)",
+    );
     let outcome = study.run(&row, &runs, &run).map_err(pounding_error)?;
     let doc = documents::study_document(&row, &runs, &outcome);
     let (csv, name) = match &outcome {

@@ -9,6 +9,7 @@ use super::{median_collapse, record_ida, Criterion, IdaSettings, RecordIda, Verd
 use crate::field_error::FieldError;
 use crate::model::record::Record;
 use crate::seismic::pounding::{PoundingError, Row, RunSettings};
+use crate::simulate::WorkEstimate;
 
 /// The settings of a collapse study.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +54,26 @@ impl CollapseStudy {
             return Err(FieldError::new("damping", self.damping, m).into());
         }
         Ok(())
+    }
+
+    /// The work of one record's IDA, estimated before it starts: its run
+    /// at the first scale times the runs the IDA can make (the scales up
+    /// to the largest, then the bisection to the tolerance). None where a
+    /// run's checks refuse it (the run itself says why).
+    pub fn estimate(
+        &self,
+        row: &Row,
+        record: &Record,
+    ) -> Result<Option<WorkEstimate>, PoundingError> {
+        self.check()?;
+        let ida = &self.ida;
+        let climbs = ((ida.max_scale / ida.first).ln() / ida.growth.ln()).ceil() + 1.0;
+        let halvings = (ida.growth.ln() / (1.0 + ida.tolerance).ln())
+            .log2()
+            .ceil()
+            .max(0.0);
+        let one = row.estimate(record, ida.first, self.criterion.contacts, &self.run)?;
+        Ok(one.map(|w| w.times(climbs + halvings)))
     }
 
     /// One record's IDA and spectral acceleration (the task of one

@@ -32,7 +32,9 @@ use crate::field_error::FieldError;
 use crate::integrate::{IntegrationError, Interrupt, Method};
 use crate::model::record::Record;
 use crate::model::{Accelerogram, BaseExcitation, Contact, ContactPair, Model};
-use crate::simulate::{simulate_streaming, Integrator, SimulationOptions};
+use crate::simulate::{
+    estimate_work, simulate_streaming, Integrator, SimulationOptions, WorkEstimate,
+};
 
 /// The free-vibration tail after the record for a row with yielding
 /// storeys or hysteretic bearings, in fundamental periods of its
@@ -525,6 +527,26 @@ impl Row {
                 message,
             }),
         }
+    }
+
+    /// The work of one run under `record` × `scale` (with or without the
+    /// contacts), estimated before it starts as a simulation's is
+    /// ([`estimate_work`]): a long run says so up front. None where the
+    /// run's checks refuse it (the run itself says why).
+    pub fn estimate(
+        &self,
+        record: &Record,
+        scale: f64,
+        contacts: bool,
+        run: &RunSettings,
+    ) -> Result<Option<WorkEstimate>, PoundingError> {
+        let rm = self.model(record, scale, contacts)?;
+        let opts = SimulationOptions {
+            accelerations: true,
+            storey_forces: true,
+            ..self.options(record, run)?
+        };
+        Ok(estimate_work(&rm.model, &opts))
     }
 
     /// [`Row::respond`], stopped as soon as a storey drift passes `limit`

@@ -9,6 +9,7 @@ use super::{
     SpectrumCell, StoreyLoop,
 };
 use crate::model::record::Record;
+use crate::simulate::WorkEstimate;
 
 /// Which study.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,6 +51,32 @@ pub enum Outcome {
 }
 
 impl Study {
+    /// The study's work, estimated before it starts: each record's run
+    /// with the contacts, times the runs the study makes of it (apart
+    /// too; per spectrum or moat cell). None where a run's checks refuse
+    /// it (the study itself says why).
+    pub fn estimate(
+        &self,
+        row: &Row,
+        records: &[(Record, f64)],
+        run: &RunSettings,
+    ) -> Result<Option<WorkEstimate>, PoundingError> {
+        let runs = match self {
+            Study::Runs { free } => 1.0 + f64::from(u8::from(*free)),
+            Study::Spectrum { gaps, ratios } => (gaps.len() * ratios.len()) as f64,
+            Study::Moat { gaps } => 1.0 + gaps.len() as f64,
+        };
+        let mut total: Option<WorkEstimate> = None;
+        for (r, s) in records {
+            let Some(one) = row.estimate(r, *s, true, run)? else {
+                return Ok(None);
+            };
+            let one = one.times(runs);
+            total = Some(total.map_or(one, |t| t.then(one)));
+        }
+        Ok(total)
+    }
+
     /// Runs the study of `row` under `records` (each with its scale).
     pub fn run(
         &self,
