@@ -314,6 +314,19 @@ fn hysteresis_loop_and_bad_input() {
             &["--law", "elastic", "--yield-drift", "0.01"][..],
             "--yield-drift: an elastic storey has no yield drift",
         ),
+        // H3: a document of 2e7 row objects (30 GB) is refused up
+        // front; the table of as many samples needs no document.
+        (
+            &[
+                "--yield-drift",
+                "0.01",
+                "--points",
+                "10000000",
+                "--format",
+                "json",
+            ][..],
+            "20000000 drift samples: the JSON document (--format json, --out) would hold about 30 GB",
+        ),
     ] {
         assert_clean_error(&[&base[..], extra].concat(), needle);
     }

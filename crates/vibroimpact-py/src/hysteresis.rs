@@ -5,9 +5,10 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibroimpact::model::hysteresis::{
-    cyclic_protocol, parse_drifts as parse, under_drift, StoreySpec,
+    cyclic_protocol, parse_drifts as parse, seconds_per_drift, under_drift, StoreySpec,
 };
-use vibroimpact::results::hysteresis_document;
+use vibroimpact::results::hysteresis_summary;
+use vibroimpact::simulate::LONG_RUN;
 
 use crate::convert::{array1, floats, numerical_error, to_python, value_error};
 
@@ -70,12 +71,20 @@ pub fn hysteresis<'py>(
         Some(d) => floats(&d, "drift")?,
         None => cyclic_protocol(&amplitudes, cycles, points).map_err(value_error)?,
     };
+    let seconds = drifts.len() as f64 * seconds_per_drift(&storey);
+    if seconds > LONG_RUN {
+        let text = format!(
+            "a long run: {} drift samples, about {seconds:.0} s on one core",
+            drifts.len()
+        );
+        let text = std::ffi::CString::new(text).map_err(value_error)?;
+        PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 2)?;
+    }
     let rows = py
         .detach(|| under_drift(&storey, &drifts, rtol))
         .map_err(numerical_error)?;
-    let doc =
-        to_python(py, &hysteresis_document(&storey, &drifts, &rows))?.cast_into::<PyDict>()?;
-    doc.del_item("rows")?;
+    // The arrays, not a row object per sample (1.5 kB each).
+    let doc = to_python(py, &hysteresis_summary(&storey, &rows))?.cast_into::<PyDict>()?;
     doc.set_item("force", array1(py, rows.iter().map(|r| r.0).collect()))?;
     doc.set_item("dissipated", array1(py, rows.iter().map(|r| r.1).collect()))?;
     doc.set_item("drift", array1(py, drifts))?;

@@ -123,3 +123,15 @@ def test_unclear_record_inputs_get_clear_messages(tmp_path):
 def test_a_yield_drift_on_an_elastic_storey_is_refused():
     with pytest.raises(ValueError, match="^yield_drift: an elastic storey has no yield drift"):
         vi.hysteresis(stiffness=1e6, law="elastic", yield_drift=0.01, amplitudes=[0.01])
+
+
+def test_h3_a_long_hysteresis_warns_before_it_starts():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", vi.LongRunWarning)
+        start = time.perf_counter()
+        with pytest.raises(vi.LongRunWarning, match="20000000 drift samples, about 60 s"):
+            vi.hysteresis(stiffness=1e6, law="bouc-wen", yield_drift=0.01,
+                          amplitudes=[0.02], cycles=10, points=2_000_000)
+        assert time.perf_counter() - start < 5.0

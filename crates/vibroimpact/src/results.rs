@@ -411,23 +411,32 @@ pub fn storey_law_document(law: &crate::model::hysteresis::StoreyLaw) -> Value {
     }
 }
 
-/// The `hysteresis` document: the law, the units, a row per drift
-/// (force, dissipated energy), the peak force and the total dissipated
-/// energy.
-pub fn hysteresis_document(
-    law: &crate::model::hysteresis::StoreyLaw,
-    drifts: &[f64],
-    rows: &[(f64, f64)],
-) -> Value {
+/// The `hysteresis` summary: the law, the units, the peak force and the
+/// energy dissipated over `rows` (force, dissipated so far) — the
+/// document without its rows.
+pub fn hysteresis_summary(law: &crate::model::hysteresis::StoreyLaw, rows: &[(f64, f64)]) -> Value {
     json!({
         "law": storey_law_document(law),
         "units": { "drift": "m", "force": "N", "dissipated": "J" },
         "peak_force": rows.iter().fold(0.0f64, |m, r| m.max(r.0.abs())),
         "total_dissipated": rows.last().map_or(0.0, |r| r.1),
-        "rows": drifts.iter().zip(rows).map(|(d, (f, e))| json!({
-            "drift": d, "force": f, "dissipated": e,
-        })).collect::<Vec<_>>(),
     })
+}
+
+/// The `hysteresis` document: [`hysteresis_summary`] and a row per drift
+/// (drift, force, dissipated so far).
+pub fn hysteresis_document(
+    law: &crate::model::hysteresis::StoreyLaw,
+    drifts: &[f64],
+    rows: &[(f64, f64)],
+) -> Value {
+    let mut doc = hysteresis_summary(law, rows);
+    doc["rows"] = drifts
+        .iter()
+        .zip(rows)
+        .map(|(d, (f, e))| json!({ "drift": d, "force": f, "dissipated": e }))
+        .collect();
+    doc
 }
 
 /// The `spectrum` document: the record (scaled by `scale`), the damping,

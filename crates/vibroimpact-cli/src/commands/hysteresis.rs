@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use vibroimpact::model::hysteresis::{
-    cyclic_protocol, parse_drifts, under_drift, LawError, StoreySpec,
+    cyclic_protocol, parse_drifts, seconds_per_drift, under_drift, LawError, StoreyLaw, StoreySpec,
 };
-use vibroimpact::results::hysteresis_document;
+use vibroimpact::results::{hysteresis_document, hysteresis_summary};
+use vibroimpact::simulate::LONG_RUN;
 
 use crate::error::CliError;
 use crate::format::{CsvText, Format};
@@ -161,7 +162,34 @@ pub fn run(args: &HysteresisArgs) -> Result<(), CliError> {
             ))
         }
     };
+    // The JSON document holds a row object per sample (about 1.5 kB):
+    // refused where it would not fit, announced where it takes long.
+    let samples = drifts.len() as f64;
+    let document = args.out.is_some() || args.format == Format::Json;
+    if document && samples * DOCUMENT_BYTES_PER_SAMPLE > MAX_DOCUMENT_BYTES {
+        return Err(CliError::new(format!(
+            "{} drift samples: the JSON document (--format json, --out) would hold about {:.0} GB; give fewer samples (--points, --cycles) or --format table or csv",
+            drifts.len(),
+            samples * DOCUMENT_BYTES_PER_SAMPLE / 1e9
+        )));
+    }
+    let seconds = samples
+        * (seconds_per_drift(&law)
+            + if document {
+                DOCUMENT_SECONDS_PER_SAMPLE
+            } else {
+                0.0
+            });
+    if seconds > LONG_RUN {
+        eprintln!(
+            "note: a long run: {} drift samples, about {seconds:.0} s on one core; Ctrl-C quits (nothing is written)",
+            drifts.len()
+        );
+    }
     let rows = under_drift(&law, &drifts, args.rtol)?;
+    if !document {
+        return print_summary(&law, &drifts, &rows, args.format);
+    }
     let doc = hysteresis_document(&law, &drifts, &rows);
     if let Some(dir) = &args.out {
         ensure_dir(dir)?;
@@ -181,15 +209,40 @@ pub fn run(args: &HysteresisArgs) -> Result<(), CliError> {
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
         Format::Csv => print!("{}", csv(&drifts, &rows)?),
-        Format::Table => println!(
-            "{}: {} drifts, peak force {:.6e} N, dissipated {:.6e} J",
-            doc["law"]["law"].as_str().unwrap_or(""),
-            drifts.len(),
-            doc["peak_force"].as_f64().unwrap_or(f64::NAN),
-            doc["total_dissipated"].as_f64().unwrap_or(f64::NAN),
-        ),
+        Format::Table => print_table(&doc, drifts.len()),
     }
     Ok(())
+}
+
+/// Bytes and seconds per sample of the JSON document (measured: 1.5 GB
+/// and 1.6 s for 1e6 samples), and the most it may hold.
+const DOCUMENT_BYTES_PER_SAMPLE: f64 = 1.5e3;
+const DOCUMENT_SECONDS_PER_SAMPLE: f64 = 1.6e-6;
+const MAX_DOCUMENT_BYTES: f64 = 8e9;
+
+/// The table or CSV without the JSON document (a row object per sample
+/// is not needed to print them).
+fn print_summary(
+    law: &StoreyLaw,
+    drifts: &[f64],
+    rows: &[(f64, f64)],
+    format: Format,
+) -> Result<(), CliError> {
+    match format {
+        Format::Csv => print!("{}", csv(drifts, rows)?),
+        _ => print_table(&hysteresis_summary(law, rows), drifts.len()),
+    }
+    Ok(())
+}
+
+/// The one-line table of a summary or document over `samples` drifts.
+fn print_table(doc: &serde_json::Value, samples: usize) {
+    println!(
+        "{}: {samples} drifts, peak force {:.6e} N, dissipated {:.6e} J",
+        doc["law"]["law"].as_str().unwrap_or(""),
+        doc["peak_force"].as_f64().unwrap_or(f64::NAN),
+        doc["total_dissipated"].as_f64().unwrap_or(f64::NAN),
+    );
 }
 
 fn csv(drifts: &[f64], rows: &[(f64, f64)]) -> Result<String, CliError> {

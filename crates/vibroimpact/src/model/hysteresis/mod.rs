@@ -502,6 +502,15 @@ fn starts_with_number(line: &str) -> bool {
         .is_some_and(|f| f.parse::<f64>().is_ok())
 }
 
+/// Seconds per drift sample of [`under_drift`] (measured: Bouc–Wen
+/// integrated between samples 3 µs, the piecewise-linear laws 0.2 µs).
+pub fn seconds_per_drift(law: &StoreyLaw) -> f64 {
+    match law {
+        StoreyLaw::BoucWen(_) => 3e-6,
+        _ => 0.2e-6,
+    }
+}
+
 /// The most samples a cyclic protocol may have (800 MB of drifts).
 pub const MAX_PROTOCOL_SAMPLES: f64 = 1e8;
 
