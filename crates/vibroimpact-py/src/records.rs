@@ -208,7 +208,7 @@ pub fn pounding<'py>(
         };
         study
             .run(&row, &runs, &run)
-            .map(|outcome| documents::study_document(&row, &runs, &outcome))
+            .map(|outcome| documents::study_document(&row, &runs, &outcome, &run))
     })?
     .map_err(pounding_error)?;
     Ok(to_python(py, &doc)?.cast_into::<PyDict>()?)

@@ -308,7 +308,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
         "Ctrl-C stops it (nothing is written)",
     );
     let outcome = study.run(&row, &runs, &run).map_err(pounding_error)?;
-    let doc = documents::study_document(&row, &runs, &outcome);
+    let doc = documents::study_document(&row, &runs, &outcome, &run);
     let (csv, name) = match &outcome {
         Outcome::Spectrum(cells) => (Some(spectrum_csv(cells)?), "spectrum"),
         Outcome::Moat(cells) => (Some(moat_csv(cells)?), "moat"),

@@ -20,6 +20,19 @@ pub enum Method {
     Auto,
 }
 
+impl Method {
+    /// The method's name as the faces spell it (`dop853`, `dopri5`,
+    /// `rodas`, `auto`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Dop853 => "dop853",
+            Method::Dopri5 => "dopri5",
+            Method::Rodas => "rodas",
+            Method::Auto => "auto",
+        }
+    }
+}
+
 /// The drivers a [`Stepper`] holds. (One stepper serves a whole
 /// integration, so the size difference of the variants does not matter.)
 #[derive(Clone, Debug)]

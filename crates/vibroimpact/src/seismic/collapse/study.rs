@@ -219,6 +219,8 @@ pub fn study_document(
         },
         "period": study.period,
         "damping": study.damping,
+        "settings": crate::seismic::pounding::documents::settings_document(&study.run),
+        "units": crate::seismic::pounding::documents::units_document(),
         "records": records,
         "summary": summary,
     })

@@ -22,6 +22,7 @@ fn epp() -> Row {
                     yield_drift: UY,
                     post_yield_ratio: 0.0,
                 }],
+                heights: Vec::new(),
             },
             isolation: None,
         }],

@@ -347,6 +347,7 @@ impl Building {
             stiffnesses,
             damping_ratio: self.frame.damping_ratio,
             storeys: Vec::new(),
+            heights: Vec::new(),
         }
         .natural_frequencies()[0]
     }

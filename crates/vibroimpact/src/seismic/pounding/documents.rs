@@ -6,7 +6,9 @@
 
 use serde_json::{json, Map, Value};
 
-use super::{quantile, MoatCell, Outcome, PoundingResult, Response, Row, SpectrumCell};
+use super::{
+    quantile, MoatCell, Outcome, PoundingResult, Response, Row, RunSettings, SpectrumCell,
+};
 use crate::model::hysteresis::StoreyLaw;
 use crate::model::record::Record;
 
@@ -84,9 +86,20 @@ pub fn response_document(row: &Row, r: &Response) -> Value {
             .map(|(d, uy)| uy.map(|uy| d / uy))
             .collect::<Vec<_>>()
     });
+    let ratios = |d: &[Vec<f64>]| {
+        let per: Vec<Option<Vec<f64>>> = row
+            .buildings
+            .iter()
+            .zip(d)
+            .map(|(b, d)| b.frame.drift_ratios(d))
+            .collect();
+        by_building(row, per)
+    };
     let mut doc = json!({
         "peak_drift": by_building(row, &r.drift),
+        "peak_drift_ratio": ratios(&r.drift),
         "residual_drift": by_building(row, &r.residual_drift),
+        "residual_drift_ratio": ratios(&r.residual_drift),
         "ductility": by_building(row, ductility),
         "hysteretic_energy": by_building(row, &r.hysteretic_energy),
         "peak_floor_acceleration": by_building(row, &r.acceleration),
@@ -216,10 +229,46 @@ pub fn moat_cell_document(c: &MoatCell) -> Value {
     })
 }
 
-/// The study's document: the row, and its runs, or (with the records) the
-/// cells of the pounding spectrum or of the moat-gap study.
-pub fn study_document(row: &Row, records: &[(Record, f64)], outcome: &Outcome) -> Value {
-    let mut doc = json!({ "row": row_document(row) });
+/// How the runs were computed: the sampling step, the tolerance, the
+/// method and the integrator.
+pub fn settings_document(run: &RunSettings) -> Value {
+    json!({
+        "sample": run.sample,
+        "rtol": run.rtol,
+        "method": run.method.name(),
+        "integrator": run.integrator.name(),
+    })
+}
+
+/// The units of every quantity of the seismic documents.
+pub fn units_document() -> Value {
+    json!({
+        "drift": "m",
+        "drift_ratio": "m/m",
+        "displacement": "m",
+        "floor_acceleration": "m/s2",
+        "force": "N",
+        "energy": "J",
+        "period": "s",
+        "gap": "m",
+        "spectral_acceleration": "m/s2",
+    })
+}
+
+/// The study's document: the row, the settings and units, and its runs,
+/// or (with the records) the cells of the pounding spectrum or of the
+/// moat-gap study.
+pub fn study_document(
+    row: &Row,
+    records: &[(Record, f64)],
+    outcome: &Outcome,
+    run: &RunSettings,
+) -> Value {
+    let mut doc = json!({
+        "row": row_document(row),
+        "settings": settings_document(run),
+        "units": units_document(),
+    });
     let metadata = || -> Value { records.iter().map(|(r, s)| json!(r.metadata(*s))).collect() };
     match outcome {
         Outcome::Runs { documents, .. } => doc["runs"] = Value::Array(documents.clone()),

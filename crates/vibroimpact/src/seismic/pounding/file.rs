@@ -130,6 +130,8 @@ struct BuildingSpec {
     damping_ratio: f64,
     #[serde(default)]
     storeys: Vec<StoreySpec>,
+    #[serde(default)]
+    heights: Vec<f64>,
     isolation: Option<IsolationSpec>,
     gap: Option<f64>,
     floors: Option<Vec<usize>>,
@@ -195,6 +197,7 @@ fn building(name: String, f: BuildingSpec, what: &str) -> Result<Building, Pound
             stiffnesses: f.stiffnesses,
             damping_ratio: f.damping_ratio,
             storeys: f.storeys,
+            heights: f.heights,
         },
         isolation,
     })

@@ -19,6 +19,9 @@ pub struct ShearFrame {
     /// The storeys' laws, from the ground up (empty: all elastic; a law's
     /// elastic stiffness is the storey's in `stiffnesses`).
     pub storeys: Vec<StoreySpec>,
+    /// The storeys' heights (m), from the ground up (empty: not given, and
+    /// no drift ratios).
+    pub heights: Vec<f64>,
 }
 
 impl ShearFrame {
@@ -53,7 +56,37 @@ impl ShearFrame {
                 self.masses.len()
             ));
         }
+        if !self.heights.is_empty() && self.heights.len() != self.masses.len() {
+            return Err(format!(
+                "{name}: heights: {} heights for {} storeys; give one per storey",
+                self.heights.len(),
+                self.masses.len()
+            ));
+        }
+        if let Some((i, h)) = self
+            .heights
+            .iter()
+            .enumerate()
+            .find(|(_, h)| !(h.is_finite() && **h > 0.0))
+        {
+            return Err(format!(
+                "{name}: heights: storey {}: height {h} m must be positive and finite",
+                i + 1
+            ));
+        }
         self.laws().map(|_| ()).map_err(|e| format!("{name}: {e}"))
+    }
+
+    /// The storey drift ratios of `drifts` (m, one per storey): each over
+    /// its storey's height; None without heights.
+    pub fn drift_ratios(&self, drifts: &[f64]) -> Option<Vec<f64>> {
+        (!self.heights.is_empty()).then(|| {
+            drifts
+                .iter()
+                .zip(&self.heights)
+                .map(|(d, h)| d / h)
+                .collect()
+        })
     }
 
     /// The storeys' laws with their elastic stiffnesses (all elastic

@@ -12,6 +12,7 @@ fn frame(n: usize, m: f64, k: f64) -> ShearFrame {
         stiffnesses: vec![k; n],
         damping_ratio: 0.05,
         storeys: Vec::new(),
+        heights: Vec::new(),
     }
 }
 
@@ -48,6 +49,7 @@ fn frame_frequencies_and_rayleigh_damping() {
         stiffnesses: vec![1.2e8, 1.0e8, 0.7e8],
         damping_ratio: 0.04,
         storeys: Vec::new(),
+        heights: Vec::new(),
     };
     let (alpha, beta) = f3.rayleigh();
     let k = f3.stiffness_matrix();

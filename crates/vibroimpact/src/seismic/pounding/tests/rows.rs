@@ -112,6 +112,49 @@ fn chain_pounding_in_a_row_of_three() {
     assert!((p.drift[2][0] - res.free.drift[2][0]).abs() > 1e-3 * res.free.drift[2][0]);
 }
 
+/// Storey heights give drift ratios, peak and residual, per storey (each
+/// drift over its storey's height, bit for bit); a building without
+/// heights has none (null); the documents state their units and the
+/// settings of their runs. Heights that do not fit are refused by name.
+#[test]
+fn storey_heights_give_drift_ratios() {
+    let text = format!(
+        "{LAW}[[building]]\nname = \"A\"\n{}heights = [4.0, 3.5, 3.5]\n[[building]]\nname = \"B\"\ngap = 0.004\nfloors = [1, 2]\n{}",
+        frame("[2e5, 2e5, 2e5]", "[5e7, 5e7, 5e7]"),
+        frame("[3e5, 3e5]", "[2e8, 2e8]"),
+    );
+    let row = parse_row(&text, "row.toml").unwrap();
+    let run = RunSettings::new(0.005, 1e-8);
+    let res = row.respond(&record(), 1.0, true, &run).unwrap();
+    let doc = super::super::documents::response_document(&row, &res);
+    for (i, h) in [4.0, 3.5, 3.5].iter().enumerate() {
+        assert_eq!(doc["peak_drift_ratio"]["A"][i], res.drift[0][i] / h);
+        assert_eq!(
+            doc["residual_drift_ratio"]["A"][i],
+            res.residual_drift[0][i] / h
+        );
+    }
+    assert!(doc["peak_drift_ratio"]["B"].is_null());
+    let study = super::super::Study::Runs { free: false };
+    let runs = [(record(), 1.0)];
+    let outcome = study.run(&row, &runs, &run).unwrap();
+    let full = super::super::documents::study_document(&row, &runs, &outcome, &run);
+    assert_eq!(full["units"]["drift_ratio"], "m/m");
+    assert_eq!(full["settings"]["rtol"], 1e-8);
+    assert_eq!(full["settings"]["method"], "dop853");
+    for (heights, needle) in [
+        ("[4.0, 3.5]", "building A: heights: 2 heights for 3 storeys"),
+        (
+            "[4.0, 0.0, 3.5]",
+            "building A: heights: storey 2: height 0 m must be positive",
+        ),
+    ] {
+        let bad = text.replace("[4.0, 3.5, 3.5]", heights);
+        let e = parse_row(&bad, "row.toml").unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+    }
+}
+
 /// A friction pendulum is W/R d + μ W z/u_y: far along a monotonic slide
 /// its force is W/R d + μ W to 1e-9 of μ W; without friction it is the
 /// pendulum's spring, and the period of a (near) rigid superstructure on
@@ -147,6 +190,7 @@ fn friction_pendulum_bearings() {
             stiffnesses: vec![1e15],
             damping_ratio: 0.05,
             storeys: Vec::new(),
+            heights: Vec::new(),
         },
         isolation: Some(Isolation {
             mass: 1e5,
