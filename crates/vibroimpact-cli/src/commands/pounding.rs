@@ -388,6 +388,9 @@ fn print_table(doc: &Value) {
             }
         );
     }
+    for n in row["notes"].as_array().into_iter().flatten() {
+        println!("note: {}", n.as_str().unwrap_or(""));
+    }
     for j in row["joints"].as_array().into_iter().flatten() {
         println!(
             "joint {}–{}: gap {} m at floors {}",

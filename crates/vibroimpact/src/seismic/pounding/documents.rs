@@ -15,7 +15,7 @@ use crate::model::record::Record;
 /// The row: each building's name, fundamental period, floors, whether it
 /// is isolated and its Rayleigh damping (ratio, α, β, on the initial
 /// stiffness in the fixed-base modes 1 and 2); each joint's two
-/// buildings, gap and pounding floors.
+/// buildings, gap and pounding floors; the row's notes ([`Row::notes`]).
 pub fn row_document(row: &Row) -> Value {
     let buildings: Vec<Value> = row
         .buildings
@@ -48,7 +48,7 @@ pub fn row_document(row: &Row) -> Value {
             })
         })
         .collect();
-    json!({ "buildings": buildings, "joints": joints })
+    json!({ "buildings": buildings, "joints": joints, "notes": row.notes() })
 }
 
 /// `{name: value}` over the row's buildings.

@@ -282,6 +282,25 @@ impl Row {
         }
     }
 
+    /// What is legal but worth a word: an isolated building whose bearings'
+    /// capacity is below its moat gap (the bearings pass their capacity
+    /// before the slab can reach the wall).
+    pub fn notes(&self) -> Vec<String> {
+        self.buildings
+            .iter()
+            .filter_map(|b| {
+                let iso = b.isolation.as_ref()?;
+                let (c, gap) = (iso.capacity?, iso.moat.as_ref()?.gap);
+                (c < gap).then(|| {
+                    format!(
+                        "building {}: the bearings' capacity {c} m is below the moat gap {gap} m: they pass it before the slab can reach the wall",
+                        b.name
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// Checks the row: at least one building (one alone: an isolated
     /// building and its moat wall), distinct names, each checked; a joint
     /// between each two neighbours with a finite gap ≥ 0 and floors of

@@ -300,6 +300,20 @@ fn isolated_building_and_its_moat_wall() {
 #[test]
 fn bad_rows_are_refused() {
     let good = isolated("0.2", "");
+    // Legal, but worth a word: the capacity 0.1 m below the moat gap.
+    let row = parse_row(&good, "iso.toml").unwrap();
+    assert_eq!(
+        row.notes(),
+        vec!["building iso: the bearings' capacity 0.1 m is below the moat gap 0.2 m: they pass it before the slab can reach the wall"]
+    );
+    assert_eq!(
+        super::super::documents::row_document(&row)["notes"][0],
+        row.notes()[0]
+    );
+    assert!(parse_row(&isolated("0.05", ""), "iso.toml")
+        .unwrap()
+        .notes()
+        .is_empty());
     for (from, to, needle) in [
         (
             "bearing = { law = \"bilinear\", stiffness = 6e7, yield_drift = 0.01,",
