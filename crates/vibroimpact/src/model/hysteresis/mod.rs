@@ -121,11 +121,21 @@ fn need(key: &'static str, v: f64, ok: bool, message: &'static str) -> Result<()
     }
 }
 
-/// The checks every hysteretic law shares: stiffness and yield drift
-/// positive, post-yield ratio in [0, 1).
+/// The smallest yield drift (m): below a nanometre a storey switches
+/// branch at every step of a run (a fuzzed 5e-324 m hung a pounding run).
+pub const MIN_YIELD_DRIFT: f64 = 1e-9;
+
+/// The checks every hysteretic law shares: stiffness positive, yield
+/// drift at least [`MIN_YIELD_DRIFT`], post-yield ratio in [0, 1).
 fn check_common(k: f64, uy: f64, b: f64) -> Result<(), LawError> {
     need("stiffness", k, k > 0.0, "must be finite and > 0")?;
     need("yield_drift", uy, uy > 0.0, "must be finite and > 0")?;
+    need(
+        "yield_drift",
+        uy,
+        uy >= MIN_YIELD_DRIFT,
+        "must be at least 1e-9 m (a smaller one switches branch at every step)",
+    )?;
     need(
         "post_yield_ratio",
         b,

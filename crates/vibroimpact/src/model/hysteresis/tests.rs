@@ -211,3 +211,22 @@ fn drift_files_are_read_with_their_lines() {
     let d = parse_drifts("drift\nunits: m\n0.01\n", "d.txt").unwrap();
     assert_eq!(d, vec![0.01]);
 }
+
+/// Found by the fuzzer: a yield drift of 5e-324 m was accepted and hung a
+/// pounding run (a branch switch at every step); below a nanometre it is
+/// refused by name.
+#[test]
+fn a_vanishing_yield_drift_is_refused() {
+    let spec = StoreySpec::Bilinear {
+        yield_drift: 5e-324,
+        post_yield_ratio: 0.03,
+    };
+    let e = spec.law(1e8).unwrap_err();
+    assert_eq!(e.key, "yield_drift");
+    assert!(e.to_string().contains("at least 1e-9 m"), "{e}");
+    let ok = StoreySpec::Bilinear {
+        yield_drift: 1e-9,
+        post_yield_ratio: 0.03,
+    };
+    assert!(ok.law(1e8).is_ok());
+}

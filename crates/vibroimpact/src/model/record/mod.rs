@@ -234,13 +234,26 @@ impl Record {
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(*s), b.max(*s)));
         let dt = (hi - lo <= 1e-9 * hi).then_some(times[1] - times[0]);
+        let acceleration: Vec<f64> = values.iter().map(|v| v * units.to_si()).collect();
+        // A finite value in g or gal can overflow in m/s² (1e308 g).
+        if let Some(k) = acceleration.iter().position(|a| !a.is_finite()) {
+            return Err(RecordError::whole(
+                source,
+                format!(
+                    "sample {} (t = {}): {:e} is not finite in m/s2",
+                    k + 1,
+                    times[k],
+                    values[k]
+                ),
+            ));
+        }
         Ok(Record {
             source: source.to_string(),
             header,
             units,
             dt,
             times,
-            acceleration: values.iter().map(|v| v * units.to_si()).collect(),
+            acceleration,
         })
     }
 }

@@ -120,6 +120,11 @@ fn bad_records_name_the_line() {
             "garbage here\nmore garbage\n".into(),
             "x: no samples: no line holds two numbers",
         ),
+        // Found by the fuzzer: finite in g, infinite in m/s².
+        (
+            "t a (g)\n0 0\n0.01 -1e308\n".into(),
+            "x: sample 2 (t = 0.01): -1e308 is not finite in m/s2",
+        ),
     ];
     for (text, needle) in cases {
         let e = parse_record(&text, "x", None).unwrap_err();
