@@ -470,6 +470,8 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
         low <= 1.9 && 1.9 <= high && high / low <= 1.02,
         "[{low}, {high}]"
     );
+    // How it collapsed (the EPP storey passes the drift limit).
+    assert_eq!(r["collapse_mode"], "drift limit");
     let s = &doc["summary"];
     assert_eq!(s["median_collapse_scale"].as_f64().unwrap(), high);
     let (s_t, cmr) = (s["s_t"].as_f64().unwrap(), s["cmr"].as_f64().unwrap());
@@ -478,6 +480,7 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
     let short = args(&["--max-scale", "1.5"]);
     let doc = json(&short.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(doc["records"][0]["note"], "no collapse up to scale 1.5");
+    assert!(doc["records"][0]["collapse_mode"].is_null());
     assert!(doc["summary"]["median_collapse_scale"].is_null());
     assert!(doc["summary"]["note"]
         .as_str()

@@ -178,8 +178,9 @@ fn print_table(doc: &Value) {
         let runs = r["runs"].as_array().map_or(0, Vec::len);
         match r["collapse"].as_f64() {
             Some(c) => println!(
-                "{}: collapse between scales {:.4} and {:.4} ({runs} runs)",
+                "{}: collapse ({}) between scales {:.4} and {:.4} ({runs} runs)",
                 r["source"].as_str().unwrap_or("?"),
+                r["collapse_mode"].as_str().unwrap_or("?"),
                 r["survived"].as_f64().unwrap_or(f64::NAN),
                 c
             ),

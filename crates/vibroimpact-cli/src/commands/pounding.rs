@@ -13,6 +13,7 @@ use clap::Args;
 use serde_json::Value;
 use vibroimpact::seismic::pounding::{
     documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, StoreyLoop, Study,
+    GRAVITY,
 };
 
 use crate::args::RowRunArgs;
@@ -409,6 +410,27 @@ fn print_table(doc: &Value) {
                 .as_f64()
                 .unwrap_or(f64::NAN),
         );
+        let p = &r["pounding"];
+        let largest = |v: &Value| {
+            v.as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(Value::as_f64)
+                .fold(f64::NAN, f64::max)
+        };
+        for (name, drifts) in p["peak_drift"].as_object().into_iter().flatten() {
+            let ratio = largest(&p["peak_drift_ratio"][name]);
+            let ratio = if ratio.is_nan() {
+                String::new()
+            } else {
+                format!(" (ratio {:.3} %)", 100.0 * ratio)
+            };
+            println!(
+                "  {name}: peak drift {:.4e} m{ratio}, peak floor acceleration {:.3} g",
+                largest(drifts),
+                largest(&p["peak_floor_acceleration"][name]) / GRAVITY,
+            );
+        }
         for j in r["pounding"]["joint_impacts"]
             .as_array()
             .into_iter()

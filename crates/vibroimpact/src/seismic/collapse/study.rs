@@ -124,12 +124,23 @@ pub fn record_document(r: &RecordCollapse) -> Value {
         .iter()
         .map(|p| json!({ "scale": p.scale, "max_drift": p.max_drift, "verdict": verdict_document(&p.verdict) }))
         .collect();
+    // How it collapsed: the verdict of the run at the collapse scale.
+    let mode = r.ida.collapse.and_then(|c| {
+        let run = r.ida.points.iter().find(|p| p.scale == c)?;
+        Some(match run.verdict {
+            Verdict::Drift { .. } => "drift limit",
+            Verdict::Capacity { .. } => "isolator capacity",
+            Verdict::Diverged { .. } => "numerical failure",
+            Verdict::Standing => return None,
+        })
+    });
     json!({
         "source": r.ida.source,
         "sa": r.sa,
         "runs": points,
         "survived": r.ida.survived,
         "collapse": r.ida.collapse,
+        "collapse_mode": mode,
         "censored": r.ida.collapse.is_none(),
         "note": r.ida.collapse.is_none().then(|| format!("no collapse up to scale {}", r.ida.survived)),
     })
