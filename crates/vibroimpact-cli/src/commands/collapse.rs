@@ -14,6 +14,7 @@ use vibroimpact::seismic::collapse::{
     check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
     IdaSettings,
 };
+use vibroimpact::seismic::pounding::GRAVITY;
 use vibroimpact::simulate::WorkEstimate;
 
 use crate::args::RowRunArgs;
@@ -78,27 +79,45 @@ pub struct CollapseArgs {
     format: SummaryFormat,
 }
 
-/// The IDA curves: per record the largest drift against the scale, the
-/// collapses marked, the drift limit as a line.
+/// The IDA curves (Vamvatsikos–Cornell): per record the largest storey
+/// drift against the intensity, Sa(T1) in g where the study has a period
+/// (the record's spectral acceleration times the scale), else the scale;
+/// the collapses marked by their mode; the drift limit as a line.
 fn ida_figure(doc: &Value, limit: f64) -> Figure {
+    let in_g = doc["period"].as_f64().is_some();
+    let y_label = match doc["period"].as_f64() {
+        Some(t) => format!("Sa(T1 = {t} s)  [g]"),
+        None => "scale".to_string(),
+    };
     let mut fig = Figure::new(
         "Incremental dynamic analysis",
         "largest storey drift  [m]",
-        "scale",
+        y_label,
     )
     .legend_at(LegendPosition::LowerRight);
-    let mut fallen = Vec::new();
+    let modes = [
+        ("drift", "collapse: drift limit", Marker::Triangle),
+        ("capacity", "collapse: isolator capacity", Marker::Square),
+        ("diverged", "collapse: numerical failure", Marker::Circle),
+    ];
+    let mut fallen: Vec<Vec<(f64, f64)>> = vec![Vec::new(); modes.len()];
     let mut top = 0.0f64;
     for r in doc["records"].as_array().into_iter().flatten() {
+        let per_scale = if in_g {
+            r["sa"].as_f64().unwrap_or(f64::NAN) / GRAVITY
+        } else {
+            1.0
+        };
         let mut pts: Vec<(f64, f64)> = r["runs"]
             .as_array()
             .into_iter()
             .flatten()
             .filter_map(|p| {
-                let (s, d) = (p["scale"].as_f64()?, p["max_drift"].as_f64()?);
+                let (s, d) = (p["scale"].as_f64()? * per_scale, p["max_drift"].as_f64()?);
                 top = top.max(s);
-                if p["verdict"]["kind"] != "standing" {
-                    fallen.push((d.min(limit), s));
+                let kind = &p["verdict"]["kind"];
+                if let Some(m) = modes.iter().position(|(k, _, _)| kind == k) {
+                    fallen[m].push((d.min(limit), s));
                 }
                 Some((d.min(limit), s))
             })
@@ -106,7 +125,11 @@ fn ida_figure(doc: &Value, limit: f64) -> Figure {
         pts.sort_by(|a, b| a.1.total_cmp(&b.1));
         fig.push(Series::line("", pts).with_color(0));
     }
-    fig.push(Series::markers("collapse", fallen, Marker::Triangle).with_color(3));
+    for ((_, label, marker), pts) in modes.iter().zip(fallen) {
+        if !pts.is_empty() {
+            fig.push(Series::markers(*label, pts, *marker).with_color(3));
+        }
+    }
     fig.push(Series::dashed("drift limit", [(limit, 0.0), (limit, top)]).with_color(1));
     fig
 }
@@ -205,5 +228,30 @@ fn print_table(doc: &Value) {
     );
     if let Some(n) = s["note"].as_str() {
         println!("note: {n}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// Sa(T1) in g on the intensity axis where the study has a period (the
+    /// record's Sa × the scale / g), the scale without one; a collapse
+    /// marked by its mode.
+    #[test]
+    fn the_ida_is_drawn_in_sa_of_t1_with_collapses_by_mode() {
+        let run = |scale: f64, kind: &str| json!({"scale": scale, "max_drift": 0.01 * scale, "verdict": {"kind": kind}});
+        let record =
+            json!({"sa": 2.0 * GRAVITY, "runs": [run(0.5, "standing"), run(1.0, "capacity")]});
+        let fig = ida_figure(&json!({"period": 1.0, "records": [record.clone()]}), 0.05);
+        assert_eq!(fig.y_label, "Sa(T1 = 1 s)  [g]");
+        assert_eq!(fig.series[0].points, vec![(0.005, 1.0), (0.01, 2.0)]);
+        let marked = &fig.series[1];
+        assert_eq!(marked.label.as_deref(), Some("collapse: isolator capacity"));
+        assert_eq!(marked.points, vec![(0.01, 2.0)]);
+        let bare = ida_figure(&json!({"period": null, "records": [record]}), 0.05);
+        assert_eq!(bare.y_label, "scale");
+        assert_eq!(bare.series[0].points, vec![(0.005, 0.5), (0.01, 1.0)]);
     }
 }
