@@ -38,29 +38,24 @@ fn study(
     ) = settings;
     let (sample, rtol, method, integrator) = run;
     let (row, run) = pair_and_run(pair_text, source, (sample, rtol, &method, &integrator))?;
-    Ok((
-        row,
-        CollapseStudy {
-            criterion: Criterion {
-                drift,
-                capacity,
-                contacts,
-            },
-            ida: IdaSettings {
-                first,
-                growth,
-                max_scale,
-                tolerance,
-            },
-            run,
-            period,
-            damping,
+    let study = CollapseStudy {
+        criterion: Criterion {
+            drift,
+            capacity,
+            contacts,
         },
-    ))
-    .and_then(|(row, study)| {
-        study.check().map_err(pounding_error)?;
-        Ok((row, study))
-    })
+        ida: IdaSettings {
+            first,
+            growth,
+            max_scale,
+            tolerance,
+        },
+        run,
+        period,
+        damping,
+    };
+    study.check().map_err(pounding_error)?;
+    Ok((row, study))
 }
 
 /// One record's part of the collapse study of the row in `pair_text`:
