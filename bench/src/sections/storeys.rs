@@ -58,6 +58,7 @@ fn struck_row(n: usize) -> Model {
                     yield_drift: 0.005,
                     post_yield_ratio: 0.05,
                 }),
+                p_delta: 0.0,
             });
             if f + 1 < n {
                 contacts.push(Contact {

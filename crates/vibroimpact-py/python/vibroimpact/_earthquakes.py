@@ -230,7 +230,8 @@ def pounding(
     (docs/earthquakes.md), or its text; ``records`` one record or a list,
     each a :func:`read_record` result or a file name (read with ``units``
     when its header does not state them), scaled by ``scale``. ``sample``
-    (s): the sampling of drifts and floor accelerations. ``method``:
+    (s): the sampling of the hysteresis loops; peaks and residual drifts are
+    exact on the dense output whatever it is. ``method``:
     "dop853", or "dopri5", the faster at ``rtol`` 1e-3 to 1e-5 (the
     record's samples limit the step; peaks within 1 % there,
     docs/earthquakes.md). ``integrator="local"``: each frame moves exactly

@@ -380,6 +380,11 @@ impl ChainDynamics {
         &self.contacts[k].law
     }
 
+    /// The ground's acceleration z̈(t) (m/s²).
+    pub fn base_acceleration(&self, t: f64) -> f64 {
+        self.base.at(t)
+    }
+
     /// The part of the right-hand side that depends on time alone (the
     /// base acceleration and the harmonic forces, per unit mass) at `t`,
     /// in the interleaved state layout of the 2N mechanical components:

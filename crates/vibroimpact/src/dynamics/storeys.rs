@@ -49,6 +49,8 @@ struct Term {
     below: Option<usize>,
     above: usize,
     law: StoreyLaw,
+    /// The P-Δ geometric stiffness P/h (N/m).
+    p_delta: f64,
     /// The branch of a bilinear storey.
     branch: Branch,
     /// Where a Bouc–Wen storey's (z, e) sit in the state.
@@ -80,6 +82,7 @@ impl StoreyTerms {
                     below: s.below,
                     above: s.above,
                     law: s.law,
+                    p_delta: s.p_delta,
                     branch: Branch::Elastic {
                         d0,
                         z0: 0.0,
@@ -159,20 +162,23 @@ impl StoreyTerms {
         }
     }
 
-    /// Storey k's force F(d, z) in the state `y` (N).
+    /// Storey k's force F(d, z) in the state `y` (N): its law's, without
+    /// the P-Δ shear.
     pub fn force(&self, k: usize, y: &[f64]) -> f64 {
         let (d, _) = self.drift(k, y);
         self.terms[k].law.force(d, self.hysteretic(k, d, y))
     }
 
     /// The energy the storeys store in `y`: ½ b k d² + ½ (1 − b) k z² each
-    /// (½ k d² for an elastic one).
+    /// (½ k d² for an elastic one), less the P-Δ loads' ½ (P/h) d² (the
+    /// work the gravity loads did as the storey drifted).
     pub fn stored_energy(&self, y: &[f64]) -> f64 {
         (0..self.terms.len())
             .map(|k| {
                 let (d, _) = self.drift(k, y);
                 let s = self.hysteretic(k, d, y);
-                self.terms[k].law.stored(d, s)
+                let t = &self.terms[k];
+                t.law.stored(d, s) - 0.5 * t.p_delta * d * d
             })
             .sum()
     }
@@ -190,7 +196,7 @@ impl StoreyTerms {
         for (k, t) in self.terms.iter().enumerate() {
             let (d, dd) = self.drift(k, y);
             let s = self.hysteretic(k, d, y);
-            let f = t.law.force(d, s);
+            let f = t.law.force(d, s) - t.p_delta * d;
             force[t.above] -= f;
             if let Some(b) = t.below {
                 force[b] += f;
@@ -269,8 +275,13 @@ impl StoreyTerms {
         (self.terms[k].below, self.terms[k].above)
     }
 
+    /// Storey k's P-Δ geometric stiffness P/h (N/m; 0: none).
+    pub fn p_delta(&self, k: usize) -> f64 {
+        self.terms[k].p_delta
+    }
+
     /// Storey k on a linear branch: F = k d + F₀ with its initial stiffness
-    /// k; returns F₀ (an elastic law's is 0; a bilinear storey's elastic
+    /// k (the P-Δ shear −(P/h) d beside it); returns F₀ (an elastic law's is 0; a bilinear storey's elastic
     /// branch gives (1 − b) k (z₀ − d₀)). None on a plastic branch or for
     /// Bouc–Wen, whose force is not linear in the drift.
     pub fn linear_force(&self, k: usize) -> Option<f64> {

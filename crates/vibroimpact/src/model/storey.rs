@@ -2,6 +2,10 @@
 //! storey follows the storey's drift and its history. Such a storey's
 //! elastic stiffness is its law's, not a body spring or a coupling; its
 //! dampers (Rayleigh on the initial stiffness) stay linear couplings.
+//!
+//! P-Δ (docs/theory.md §11): the gravity load P above a storey of height h
+//! acts through its drift as a shear −(P/h)·d, a negative geometric
+//! stiffness beside the law's force, on every branch.
 
 use super::{Model, ModelError, ModelErrorKind};
 use crate::model::hysteresis::StoreyLaw;
@@ -17,6 +21,9 @@ pub struct Storey {
     pub above: usize,
     /// The law.
     pub law: StoreyLaw,
+    /// The P-Δ geometric stiffness P/h (N/m, ≥ 0; 0: none): the storey's
+    /// shear is F(d, z) − (P/h)·d.
+    pub p_delta: f64,
 }
 
 impl Model {
@@ -31,6 +38,18 @@ impl Model {
                     ModelErrorKind::UnknownBody,
                     format!("storey.{}", k + 1),
                     format!("storey {}: must join two different existing bodies, or a body and the ground", k + 1),
+                ));
+            }
+            let k0 = s.law.initial_stiffness();
+            if !(s.p_delta >= 0.0 && s.p_delta.is_finite()) || s.p_delta >= k0 {
+                return Err(ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    format!("storey.{}.p_delta", k + 1),
+                    format!(
+                        "storey {}: P-Δ stiffness P/h = {} N/m: must be finite, ≥ 0 and below the law's elastic stiffness {k0} N/m (else the storey is unstable at zero drift)",
+                        k + 1,
+                        s.p_delta
+                    ),
                 ));
             }
             s.law.check().map_err(|e| {

@@ -9,7 +9,10 @@
 //!   peaks and documents, pounding spectra and moat-gap studies.
 //! - `collapse/` — incremental dynamic analysis to collapse per record and
 //!   the FEMA P695 margins.
+//! - `pushover/` — a shear frame's static pushover and what FEMA P695
+//!   reads from it (V_max, δ_y,eff, δ_u, μ_T).
 
 pub mod collapse;
 pub mod pounding;
+pub mod pushover;
 pub mod spectrum;

@@ -1,6 +1,7 @@
 //! Exact extrema over a window on the integrator's dense output
 //! (docs/theory.md §10 for the local integrator's exact motion).
 
+use super::gauges::{Gauge, GaugeReading, GaugeScan};
 use super::*;
 
 /// Largest |u_i| and |v_i| of every body over a time window, located on the
@@ -21,6 +22,8 @@ pub struct Extrema {
     /// crosses zero where an impact grazes into or out of existence).
     /// Interior maxima where ṡ changes sign are located like those of |u_i|.
     pub impact_margin: Vec<f64>,
+    /// What each of the options' gauges read, in their order.
+    pub gauges: Vec<GaugeReading>,
 }
 
 /// Dense-output values of two components at time t.
@@ -31,6 +34,45 @@ pub(super) fn dense_pair<S: Chain>(
     t: f64,
 ) -> (f64, f64) {
     (st.dense_component(sys, i, t), st.dense_component(sys, j, t))
+}
+
+/// The gauge's reading on `[a, b]` within the step ending at `st.t()`, on
+/// the dense output: a separation's rate is the bodies' relative velocity;
+/// an acceleration is the dense velocity's slope plus the ground's, its
+/// rate a difference of the acceleration within the step (where a record
+/// is linear).
+fn gauge_step<S: Chain>(gauge: &mut GaugeScan, st: &mut Stepper, sys: &mut S, a: f64, b: f64) {
+    match gauge.gauge {
+        Gauge::Separation { left, right, .. } => {
+            let mut side = |i: Option<usize>, t: f64| {
+                i.map_or((0.0, 0.0), |i| dense_pair(st, sys, (2 * i, 2 * i + 1), t))
+            };
+            gauge.scan(a, b, |t| {
+                let (l, r) = (side(left, t), side(right, t));
+                (l.0 - r.0, l.1 - r.1)
+            });
+        }
+        Gauge::AbsoluteAcceleration { body } => {
+            let (t0, t1) = (st.t_prev(), st.t());
+            if t1 <= t0 {
+                return;
+            }
+            let h = 1e-4 * (t1 - t0);
+            // The slope of the velocity's polynomial (smooth past the
+            // step's ends); the ground's at t itself.
+            let mut acceleration = |t: f64| {
+                let slope = (st.dense_component(sys, 2 * body + 1, t + h)
+                    - st.dense_component(sys, 2 * body + 1, t - h))
+                    / (2.0 * h);
+                slope + sys.chain().base_acceleration(t)
+            };
+            gauge.scan(a, b, |t| {
+                let (lo, hi) = ((t - h).max(t0), (t + h).min(t1));
+                let x = acceleration(t);
+                (x, (acceleration(hi) - acceleration(lo)) / (hi - lo))
+            });
+        }
+    }
 }
 
 /// Running state of the extrema search: the window start and the previous
@@ -44,13 +86,17 @@ pub(super) struct ExtremaScan {
     /// The impact threshold s_on of every contact.
     pub(super) s_on: Vec<f64>,
     pub(super) found: Extrema,
+    /// The gauges being read.
+    pub(super) gauges: Vec<GaugeScan>,
 }
 
 impl ExtremaScan {
+    /// The scan from the stepper's point over `(from, to)`: every body,
+    /// the contacts with thresholds `s_on`, and `gauges`.
     pub(super) fn new(
         (from, to): (f64, f64),
         bodies: usize,
-        s_on: Vec<f64>,
+        (s_on, gauges): (Vec<f64>, &[Gauge]),
         st: &Stepper,
         sys: &ChainDynamics,
     ) -> Self {
@@ -64,8 +110,10 @@ impl ExtremaScan {
                 max_displacement: vec![0.0; bodies],
                 max_velocity: vec![0.0; bodies],
                 impact_margin: vec![f64::NEG_INFINITY; s_on.len()],
+                gauges: Vec::new(),
             },
             s_on,
+            gauges: gauges.iter().cloned().map(GaugeScan::new).collect(),
         };
         if from <= scan.t && scan.t <= to {
             for i in 0..bodies {
@@ -106,6 +154,12 @@ impl ExtremaScan {
         }
     }
 
+    /// What the scan found.
+    pub(super) fn finish(mut self) -> Extrema {
+        self.found.gauges = self.gauges.iter().map(GaugeScan::reading).collect();
+        self.found
+    }
+
     /// Processes the accepted step from the previous end to `st.t()`.
     pub(super) fn step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
         let t1 = st.t();
@@ -140,6 +194,9 @@ impl ExtremaScan {
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
             self.contact_step(st, sys, a, b);
+            for gauge in &mut self.gauges {
+                gauge_step(gauge, st, sys, a, b);
+            }
         }
         self.t = t1;
         self.y.copy_from_slice(st.y());

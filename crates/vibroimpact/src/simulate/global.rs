@@ -53,7 +53,13 @@ pub fn simulate_streaming(
     let mut extrema = match (opts.extrema_window, &error) {
         (Some(window), None) => {
             let s_on = scan.trackers.iter().map(|tr| tr.s_on).collect();
-            Some(ExtremaScan::new(window, n2 / 2, s_on, &st, &sys))
+            Some(ExtremaScan::new(
+                window,
+                n2 / 2,
+                (s_on, &opts.gauges),
+                &st,
+                &sys,
+            ))
         }
         _ => None,
     };
@@ -149,7 +155,7 @@ pub fn simulate_streaming(
     if let (None, Some(t)) = (&error, sink_stopped) {
         error = Some(IntegrationError::Interrupted { t });
     }
-    let extrema = extrema.map(|x| x.found);
+    let extrema = extrema.map(ExtremaScan::finish);
     Ok(global_result(
         model,
         opts,
@@ -204,6 +210,9 @@ pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), O
                 opts.t_end
             )));
         }
+    }
+    for gauge in &opts.gauges {
+        gauge.check(model.bodies().len()).map_err(OptionsError)?;
     }
     if let BaseExcitation::Record(r) = model.base() {
         let end = r.times().last().copied().unwrap_or(0.0);

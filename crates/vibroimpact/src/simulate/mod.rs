@@ -5,7 +5,8 @@
 //! - `global.rs` — the global run, streamed sample by sample;
 //! - `events.rs`, `switches/` — impact onsets and ends; events that change
 //!   the right-hand side inside a step (storey branches, onsets);
-//! - `extrema.rs` — exact extrema on the dense output;
+//! - `extrema.rs`, `gauges.rs` — exact extrema on the dense output, of
+//!   the bodies and of the gauges (drifts, closings, accelerations);
 //! - `integrator.rs`, `estimate.rs` — which integrator runs; the work of a
 //!   run, estimated before it starts;
 //! - `local/` — the local integrator, exact motion between contacts;
@@ -81,6 +82,9 @@ pub struct SimulationOptions {
     /// Locate the exact extrema of every |u_i| and |v_i| over this time
     /// window (see [`Extrema`]).
     pub extrema_window: Option<(f64, f64)>,
+    /// Further quantities whose extrema (and means) are located over the
+    /// extrema window: drifts, closings, absolute accelerations.
+    pub gauges: Vec<Gauge>,
     /// Stop request checked at every step (see [`Interrupt`]): the
     /// simulation then ends early with [`IntegrationError::Interrupted`] as
     /// its error, keeping what was computed.
@@ -114,6 +118,7 @@ impl Default for SimulationOptions {
             start: None,
             method: Method::Dop853,
             extrema_window: None,
+            gauges: Vec::new(),
             interrupt: None,
             integrator: Integrator::Auto,
             accelerations: false,
@@ -551,6 +556,7 @@ fn simulate_local(
 mod estimate;
 mod events;
 mod extrema;
+mod gauges;
 mod global;
 mod integrator;
 pub mod local;
@@ -560,6 +566,7 @@ pub use estimate::{estimate_work, WorkEstimate, LONG_RUN};
 use events::{contact_at, contact_end, StepScan, Tracker};
 pub use extrema::Extrema;
 use extrema::ExtremaScan;
+pub use gauges::{Gauge, GaugeReading};
 pub use global::simulate_streaming;
 pub use integrator::{Integrator, AUTO_LOCAL_GROUPS};
 

@@ -79,10 +79,12 @@ pub enum Verdict {
         building: String,
         /// The storey (1-based).
         storey: usize,
-        /// Its drift when the run stopped (m).
+        /// Its peak drift, exact on the dense output (m).
         drift: f64,
-        /// When it passed the limit (s).
-        time: f64,
+        /// The sample at which the run stopped past the limit (s); None
+        /// where the limit was passed only between samples (the run then
+        /// went on to its end).
+        time: Option<f64>,
     },
     /// An isolator passed its capacity.
     Capacity {
@@ -194,7 +196,13 @@ impl Criterion {
                 building: name(worst.1),
                 storey: worst.2 + 1,
                 drift: worst.0,
-                time,
+                time: Some(time),
+            },
+            (Stop::End, _) if worst.0 > self.drift => Verdict::Drift {
+                building: name(worst.1),
+                storey: worst.2 + 1,
+                drift: worst.0,
+                time: None,
             },
             (Stop::End, Some((k, i))) if self.capacity => Verdict::Capacity {
                 building: name(k),

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::model::hysteresis::StoreySpec;
-use crate::seismic::pounding::{Building, ShearFrame};
+use crate::seismic::pounding::{Building, Gravity, ShearFrame};
 
 const M: f64 = 1.0e5;
 const K: f64 = 4.0e6;
@@ -23,6 +23,7 @@ fn epp() -> Row {
                     post_yield_ratio: 0.0,
                 }],
                 heights: Vec::new(),
+                gravity: Gravity::default(),
             },
             isolation: None,
         }],

@@ -14,13 +14,15 @@
 
 use serde::Deserialize;
 
+use super::frame::Gravity;
 use super::ShearFrame;
 use crate::contact::ContactLaw;
 use crate::model::hysteresis::{BoucWen, Degradation, LawError, StoreyLaw, StoreySpec};
 use crate::model::{Body, Contact, ContactPair, Coupling, Storey};
 
-/// Standard gravity (m/s²), for a friction pendulum's weight.
-pub const GRAVITY: f64 = 9.80665;
+/// Standard gravity (m/s²): a friction pendulum's weight, P-Δ loads,
+/// accelerations in g.
+pub use crate::model::record::STANDARD_GRAVITY as GRAVITY;
 
 /// One building of a row.
 #[derive(Clone, Debug, PartialEq)]
@@ -341,13 +343,22 @@ impl Building {
         let mut masses = vec![iso.mass];
         masses.extend(&self.frame.masses);
         let mut stiffnesses = vec![iso.bearing.period_stiffness(self.weight())];
-        stiffnesses.extend(&self.frame.stiffnesses);
+        // The storeys' P-Δ (none in the bearings) in their stiffnesses.
+        let geometric = self.frame.geometric_stiffnesses();
+        stiffnesses.extend(
+            self.frame
+                .stiffnesses
+                .iter()
+                .zip(geometric)
+                .map(|(k, g)| k - g),
+        );
         ShearFrame {
             masses,
             stiffnesses,
             damping_ratio: self.frame.damping_ratio,
             storeys: Vec::new(),
             heights: Vec::new(),
+            gravity: Gravity::default(),
         }
         .natural_frequencies()[0]
     }
@@ -379,7 +390,7 @@ impl Building {
         if let (Some(i), Some(law)) = (iso, self.bearing_law()?) {
             placement.base = Some(parts.bodies.len());
             let spring = Self::spring_or_storey(
-                law,
+                (law, 0.0),
                 (None, parts.bodies.len()),
                 None,
                 parts,
@@ -428,18 +439,25 @@ impl Building {
     /// The spring of an elastic law; a hysteretic one becomes a storey
     /// between `(below, above)` (`storey`: the building's storey from 0,
     /// None for the bearings) and its spring is 0.
+    /// `p_delta` is the storey's P-Δ stiffness P/h: an elastic storey's
+    /// spring is k − P/h, a hysteretic one carries it.
     fn spring_or_storey(
-        law: StoreyLaw,
+        (law, p_delta): (StoreyLaw, f64),
         (below, above): (Option<usize>, usize),
         storey: Option<usize>,
         parts: &mut Parts,
         placement: &mut Placement,
     ) -> f64 {
         match law {
-            StoreyLaw::Elastic { stiffness } => stiffness,
+            StoreyLaw::Elastic { stiffness } => stiffness - p_delta,
             law => {
                 placement.storeys.push((parts.storeys.len(), storey));
-                parts.storeys.push(Storey { below, above, law });
+                parts.storeys.push(Storey {
+                    below,
+                    above,
+                    law,
+                    p_delta,
+                });
                 0.0
             }
         }
@@ -458,6 +476,7 @@ impl Building {
     ) -> Result<(), String> {
         let (alpha, beta) = self.frame.rayleigh();
         let laws = self.frame.laws()?;
+        let geometric = self.frame.geometric_stiffnesses();
         let first = parts.bodies.len();
         placement.first_floor = first;
         let to_ground = placement.base.is_none();
@@ -473,8 +492,13 @@ impl Building {
             } else {
                 Some(first + i - 1)
             };
-            let spring =
-                Self::spring_or_storey(laws[i], (below, first + i), Some(i), parts, placement);
+            let spring = Self::spring_or_storey(
+                (laws[i], geometric[i]),
+                (below, first + i),
+                Some(i),
+                parts,
+                placement,
+            );
             parts.bodies.push(Body {
                 name: format!("{tag}{}", i + 1),
                 mass: m,

@@ -2,7 +2,7 @@
 //! pounding study: the file's line and key, a setting's field, a run's
 //! record.
 
-use super::{Bearing, Building, Isolation, Joint, Moat, Row, ShearFrame, Wall};
+use super::{Bearing, Building, Gravity, Isolation, Joint, Moat, Row, ShearFrame, Wall};
 use crate::contact::ContactLaw;
 use crate::field_error::FieldError;
 use crate::model::file::LawSpec;
@@ -132,6 +132,10 @@ struct BuildingSpec {
     storeys: Vec<StoreySpec>,
     #[serde(default)]
     heights: Vec<f64>,
+    #[serde(default)]
+    p_delta: bool,
+    #[serde(default)]
+    leaning_loads: Vec<f64>,
     isolation: Option<IsolationSpec>,
     gap: Option<f64>,
     floors: Option<Vec<usize>>,
@@ -198,6 +202,10 @@ fn building(name: String, f: BuildingSpec, what: &str) -> Result<Building, Pound
             damping_ratio: f.damping_ratio,
             storeys: f.storeys,
             heights: f.heights,
+            gravity: Gravity {
+                p_delta: f.p_delta,
+                leaning_loads: f.leaning_loads,
+            },
         },
         isolation,
     })

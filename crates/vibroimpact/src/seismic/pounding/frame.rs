@@ -4,6 +4,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::model::hysteresis::{StoreyLaw, StoreySpec};
+use crate::model::record::STANDARD_GRAVITY;
 
 /// A shear frame: floors from the ground up.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +23,20 @@ pub struct ShearFrame {
     /// The storeys' heights (m), from the ground up (empty: not given, and
     /// no drift ratios).
     pub heights: Vec<f64>,
+    /// The gravity loads acting through the drifts (P-Δ), if any.
+    pub gravity: Gravity,
+}
+
+/// P-Δ: the gravity load above each storey, P_i = Σ_{j ≥ i} (m_j g + L_j)
+/// with L_j a leaning column's load at floor j, acts through its drift as
+/// the shear −(P_i/h_i)·d_i (docs/theory.md §11).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Gravity {
+    /// Whether P-Δ acts (it needs the storeys' heights).
+    pub p_delta: bool,
+    /// A leaning column's gravity load per floor (N; empty: none), from
+    /// the first floor up.
+    pub leaning_loads: Vec<f64>,
 }
 
 impl ShearFrame {
@@ -74,7 +89,87 @@ impl ShearFrame {
                 i + 1
             ));
         }
+        self.check_gravity(name)?;
         self.laws().map(|_| ()).map_err(|e| format!("{name}: {e}"))
+    }
+
+    /// P-Δ needs heights; leaning loads need P-Δ, one per floor, finite and
+    /// ≥ 0; each storey's P/h must stay below its elastic stiffness (else
+    /// it is unstable at zero drift).
+    fn check_gravity(&self, name: &str) -> Result<(), String> {
+        let g = &self.gravity;
+        if !g.leaning_loads.is_empty() && !g.p_delta {
+            return Err(format!(
+                "{name}: leaning_loads: given without p_delta = true; set it (the loads act only through P-Δ)"
+            ));
+        }
+        if !g.p_delta {
+            return Ok(());
+        }
+        if self.heights.is_empty() {
+            return Err(format!(
+                "{name}: p_delta: needs the storeys' heights (heights = [...], m)"
+            ));
+        }
+        if !g.leaning_loads.is_empty() && g.leaning_loads.len() != self.masses.len() {
+            return Err(format!(
+                "{name}: leaning_loads: {} loads for {} floors; give one per floor (N)",
+                g.leaning_loads.len(),
+                self.masses.len()
+            ));
+        }
+        if let Some((i, l)) = g
+            .leaning_loads
+            .iter()
+            .enumerate()
+            .find(|(_, l)| !(l.is_finite() && **l >= 0.0))
+        {
+            return Err(format!(
+                "{name}: leaning_loads: floor {}: load {l} N must be finite and ≥ 0",
+                i + 1
+            ));
+        }
+        for (i, (kg, k)) in self
+            .geometric_stiffnesses()
+            .iter()
+            .zip(&self.stiffnesses)
+            .enumerate()
+        {
+            if kg >= k {
+                return Err(format!(
+                    "{name}: p_delta: storey {}: P/h = {kg:.6e} N/m is not below its stiffness {k:.6e} N/m: the storey is unstable under its gravity load at zero drift",
+                    i + 1
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Each storey's gravity load P_i (N): the weights of the floors at and
+    /// above it and their leaning loads; zeros without P-Δ.
+    pub fn gravity_loads(&self) -> Vec<f64> {
+        let n = self.masses.len();
+        if !self.gravity.p_delta {
+            return vec![0.0; n];
+        }
+        let mut p = vec![0.0; n];
+        let mut above = 0.0;
+        for i in (0..n).rev() {
+            above += self.masses[i] * STANDARD_GRAVITY
+                + self.gravity.leaning_loads.get(i).copied().unwrap_or(0.0);
+            p[i] = above;
+        }
+        p
+    }
+
+    /// Each storey's P-Δ geometric stiffness P_i/h_i (N/m); zeros without
+    /// P-Δ.
+    pub fn geometric_stiffnesses(&self) -> Vec<f64> {
+        self.gravity_loads()
+            .iter()
+            .enumerate()
+            .map(|(i, p)| self.heights.get(i).map_or(0.0, |h| p / h))
+            .collect()
     }
 
     /// The storey drift ratios of `drifts` (m, one per storey): each over
@@ -110,10 +205,16 @@ impl ShearFrame {
         self.storeys.iter().any(|s| *s != StoreySpec::Elastic {})
     }
 
-    /// The stiffness matrix K (tridiagonal).
+    /// The stiffness matrix K (tridiagonal), each storey's stiffness less
+    /// its P-Δ stiffness.
     pub(super) fn stiffness_matrix(&self) -> DMatrix<f64> {
         let n = self.masses.len();
-        let k = &self.stiffnesses;
+        let k: Vec<f64> = self
+            .stiffnesses
+            .iter()
+            .zip(self.geometric_stiffnesses())
+            .map(|(k, g)| k - g)
+            .collect();
         DMatrix::from_fn(n, n, |r, c| {
             if r == c {
                 k[r] + k.get(r + 1).copied().unwrap_or(0.0)
@@ -141,6 +242,24 @@ impl ShearFrame {
             .collect();
         w.sort_by(f64::total_cmp);
         w
+    }
+
+    /// The fundamental mode shape φ₁ (floor displacements, the roof's 1),
+    /// of the stiffnesses less their P-Δ.
+    pub fn first_mode(&self) -> Vec<f64> {
+        let k = self.stiffness_matrix();
+        let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
+        let n = s.len();
+        let a = DMatrix::from_fn(n, n, |r, c| s[r] * k[(r, c)] * s[c]);
+        let eig = SymmetricEigen::new(a);
+        let lowest = (0..n)
+            .min_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]))
+            .unwrap_or(0);
+        let phi: Vec<f64> = (0..n)
+            .map(|r| s[r] * eig.eigenvectors[(r, lowest)])
+            .collect();
+        let roof = phi[n - 1];
+        phi.iter().map(|p| p / roof).collect()
     }
 
     /// The fundamental period T1 (s).

@@ -583,16 +583,18 @@ impl Row {
         limit: Option<f64>,
     ) -> Result<(Response, Stop), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
-        let opts = SimulationOptions {
+        let mut opts = SimulationOptions {
             accelerations: true,
             storey_forces: true,
             ..self.options(record, run)?
         };
         let mut peaks = Peaks::new(self, &rm, opts.t_end);
+        opts.gauges = peaks.gauges();
+        opts.extrema_window = Some((0.0, opts.t_end));
         let model = &rm.model;
         let mut passed = None;
         let sim = simulate_streaming(model, &opts, |t, row| {
-            let worst = peaks.sample(t, row, model.base().at(t));
+            let worst = peaks.sample(row);
             if limit.is_some_and(|l| worst > l) {
                 passed = Some(t);
             }
@@ -638,7 +640,7 @@ impl Row {
         let sim = simulate_streaming(model, &opts, |t, row| {
             times.push(t);
             displacement.extend_from_slice(&row[..n]);
-            peaks.sample(t, row, model.base().at(t));
+            peaks.sample(row);
             true
         })
         .map_err(|e| PoundingError::run(record, e.0))?;
@@ -749,7 +751,7 @@ mod study;
 use building::Parts;
 pub use building::{Bearing, Building, Isolation, Moat, Placement, Wall, GRAVITY};
 pub use file::{parse_row, PoundingError};
-pub use frame::ShearFrame;
+pub use frame::{Gravity, ShearFrame};
 pub use moat::{moat_study, MoatCell};
 use peaks::Peaks;
 pub use spectrum::{pounding_spectrum, quantile, value_range, with_period_ratio, SpectrumCell};

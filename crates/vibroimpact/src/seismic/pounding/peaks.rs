@@ -1,27 +1,28 @@
-//! The peaks of a row's run, taken as its samples stream by (nothing
-//! stored): drifts, residual drifts, floor accelerations and displacements
-//! per building, closings per joint floor, the isolators' displacements;
-//! then the impact log and the storeys' hysteretic energy at the end.
+//! The peaks of a row's run, exact on the dense output (the run's gauges
+//! and extrema, whatever the sampling): drifts, residual drifts, floor
+//! accelerations and displacements per building, closings per joint floor,
+//! the isolators' displacements; the impact log and the storeys'
+//! hysteretic energy at the end; the hysteresis loops at the samples.
 
 use super::{IsolatorResponse, Response, Row, RowModel, StoreyLoop};
-use crate::simulate::Simulation;
+use crate::simulate::{Gauge, GaugeReading, Simulation};
 
-/// Running peaks of one run.
+/// The peaks of one run: the gauges it asks the simulation for, where
+/// each peak is read, and the hysteresis loops at the samples.
 pub(super) struct Peaks {
     /// Per building: where its floors start, its slab, how many floors.
     layout: Vec<(usize, Option<usize>, usize)>,
-    /// Per building, the time its residual window opens (its last
-    /// fundamental period).
-    windows: Vec<f64>,
-    drift: Vec<Vec<f64>>,
-    acceleration: Vec<Vec<f64>>,
-    displacement: Vec<Vec<f64>>,
-    /// Per building, the drift sums over its window and their count.
-    residual: Vec<(Vec<f64>, usize)>,
-    /// Per building with a slab: peak |u| and its sum over the window.
-    slab: Vec<(f64, f64)>,
-    /// Per joint, per floor: (left body, right body, largest closing).
-    closing: Vec<Vec<(usize, usize, f64)>>,
+    /// The gauges, in order: per building, per floor, its storey's drift
+    /// (with its mean over the building's last fundamental period) and its
+    /// absolute acceleration, then its slab's displacement (with its mean)
+    /// if isolated; then per joint, per floor, its closing.
+    gauges: Vec<Gauge>,
+    /// Per building, its first gauge.
+    building_gauges: Vec<usize>,
+    /// Per building, the index of its slab's gauge, if isolated.
+    slab_gauges: Vec<Option<usize>>,
+    /// Per joint, its first closing gauge and how many.
+    joint_gauges: Vec<(usize, usize)>,
     /// Per hysteretic storey of the model (its order).
     loops: Vec<Tracked>,
 }
@@ -31,7 +32,7 @@ pub(super) struct Peaks {
 type Tracked = (Option<usize>, usize, StoreyLoop);
 
 impl Peaks {
-    /// Empty peaks of `row` run as `rm` up to `t_end`.
+    /// The peaks of `row` run as `rm` up to `t_end`.
     pub(super) fn new(row: &Row, rm: &RowModel, t_end: f64) -> Self {
         let layout: Vec<_> = rm
             .placements
@@ -39,26 +40,42 @@ impl Peaks {
             .zip(&row.buildings)
             .map(|(p, b)| (p.first_floor, p.base, b.floors()))
             .collect();
-        let zeros: Vec<Vec<f64>> = layout.iter().map(|l| vec![0.0; l.2]).collect();
-        let closing = row
-            .joints
-            .iter()
-            .enumerate()
-            .map(|(j, joint)| {
-                let (a, b) = (&rm.placements[j], &rm.placements[j + 1]);
-                joint
-                    .floors
-                    .iter()
-                    .map(|&f| {
-                        (
-                            a.first_floor + f - 1,
-                            b.first_floor + f - 1,
-                            f64::NEG_INFINITY,
-                        )
-                    })
-                    .collect()
-            })
-            .collect();
+        let (mut gauges, mut building_gauges, mut slab_gauges) =
+            (Vec::new(), Vec::new(), Vec::new());
+        for (&(first, base, floors), b) in layout.iter().zip(&row.buildings) {
+            // The residual window: the building's last fundamental period.
+            let mean_from = Some(t_end - b.period());
+            building_gauges.push(gauges.len());
+            for i in 0..floors {
+                let right = if i == 0 { base } else { Some(first + i - 1) };
+                gauges.push(Gauge::Separation {
+                    left: Some(first + i),
+                    right,
+                    mean_from,
+                });
+                gauges.push(Gauge::AbsoluteAcceleration { body: first + i });
+            }
+            slab_gauges.push(base.map(|slab| {
+                gauges.push(Gauge::Separation {
+                    left: Some(slab),
+                    right: None,
+                    mean_from,
+                });
+                gauges.len() - 1
+            }));
+        }
+        let mut joint_gauges = Vec::new();
+        for (j, joint) in row.joints.iter().enumerate() {
+            let (a, b) = (&rm.placements[j], &rm.placements[j + 1]);
+            joint_gauges.push((gauges.len(), joint.floors.len()));
+            for &f in &joint.floors {
+                gauges.push(Gauge::Separation {
+                    left: Some(a.first_floor + f - 1),
+                    right: Some(b.first_floor + f - 1),
+                    mean_from: None,
+                });
+            }
+        }
         let mut loops: Vec<(usize, Tracked)> = Vec::new();
         for (k, p) in rm.placements.iter().enumerate() {
             for &(s, storey) in &p.storeys {
@@ -79,51 +96,37 @@ impl Peaks {
         loops.sort_by_key(|l| l.0);
         Self {
             loops: loops.into_iter().map(|l| l.1).collect(),
-            windows: row.buildings.iter().map(|b| t_end - b.period()).collect(),
-            drift: zeros.clone(),
-            acceleration: zeros.clone(),
-            displacement: zeros.clone(),
-            residual: zeros.into_iter().map(|z| (z, 0)).collect(),
-            slab: vec![(0.0, 0.0); layout.len()],
+            gauges,
+            building_gauges,
+            slab_gauges,
+            joint_gauges,
             layout,
-            closing,
         }
     }
 
+    /// The gauges the run reads for these peaks.
+    pub(super) fn gauges(&self) -> Vec<Gauge> {
+        self.gauges.clone()
+    }
+
     /// Takes the sample `row` = [u.., v.., a.., storey forces..] at `t`
-    /// with ground acceleration `ag`; returns the largest storey drift in
-    /// it.
-    pub(super) fn sample(&mut self, t: f64, row: &[f64], ag: f64) -> f64 {
-        let mut worst = 0.0f64;
+    /// into the loops; returns the largest storey drift in it.
+    pub(super) fn sample(&mut self, row: &[f64]) -> f64 {
         let n = (row.len() - self.loops.len()) / 3;
-        let (u, a, forces) = (&row[..n], &row[2 * n..3 * n], &row[3 * n..]);
+        let (u, forces) = (&row[..n], &row[3 * n..]);
         for ((below, above, l), &f) in self.loops.iter_mut().zip(forces) {
             l.drift.push(u[*above] - below.map_or(0.0, |b| u[b]));
             l.force.push(f);
         }
-        for (k, &(first, base, floors)) in self.layout.iter().enumerate() {
-            let late = t >= self.windows[k];
-            let slab = base.map_or(0.0, |b| u[b]);
+        let mut worst = 0.0f64;
+        for &(first, base, floors) in &self.layout {
             for i in 0..floors {
-                let below = if i == 0 { slab } else { u[first + i - 1] };
-                let d = u[first + i] - below;
-                worst = worst.max(d.abs());
-                self.drift[k][i] = self.drift[k][i].max(d.abs());
-                self.displacement[k][i] = self.displacement[k][i].max(u[first + i].abs());
-                self.acceleration[k][i] = self.acceleration[k][i].max((a[first + i] + ag).abs());
-                if late {
-                    self.residual[k].0[i] += d;
-                }
-            }
-            self.residual[k].1 += usize::from(late);
-            self.slab[k].0 = self.slab[k].0.max(slab.abs());
-            if late {
-                self.slab[k].1 += slab;
-            }
-        }
-        for joint in &mut self.closing {
-            for (l, r, c) in joint.iter_mut() {
-                *c = c.max(u[*l] - u[*r]);
+                let below = match (i, base) {
+                    (0, None) => 0.0,
+                    (0, Some(b)) => u[b],
+                    _ => u[first + i - 1],
+                };
+                worst = worst.max((u[first + i] - below).abs());
             }
         }
         worst
@@ -146,20 +149,30 @@ impl Peaks {
         }
         let in_joints = |c: usize| rm.joints.iter().any(|j| j.contains(&c));
         let between = sim.impacts.iter().filter(|i| in_joints(i.contact));
+        // The run's readings; a run with no step has read nothing.
+        let empty = GaugeReading {
+            min: 0.0,
+            max: 0.0,
+            mean: None,
+        };
+        let readings = sim.extrema.as_ref().map(|e| e.gauges.as_slice());
+        let read = |w: usize| readings.and_then(|r| r.get(w)).unwrap_or(&empty);
         // A run stopped before a building's window opened (a collapse
         // study's drift limit) has no residual: NaN (null in documents).
-        let mean = |sum: f64, count: usize| {
-            if count == 0 {
-                f64::NAN
-            } else {
-                sum / count as f64
-            }
+        let mean = |w: usize| read(w).mean.unwrap_or(f64::NAN);
+        let displaced = |i: usize| sim.extrema.as_ref().map_or(0.0, |e| e.max_displacement[i]);
+        let per_floor = |f: &dyn Fn(usize, usize) -> f64| -> Vec<Vec<f64>> {
+            self.layout
+                .iter()
+                .enumerate()
+                .map(|(k, l)| (0..l.2).map(|i| f(k, i)).collect())
+                .collect()
         };
-        let residual: Vec<Vec<f64>> = self
-            .residual
-            .iter()
-            .map(|(sum, count)| sum.iter().map(|s| mean(*s, *count)).collect())
-            .collect();
+        let drift_gauge = |k: usize, i: usize| self.building_gauges[k] + 2 * i;
+        let drift = per_floor(&|k, i| read(drift_gauge(k, i)).peak());
+        let residual = per_floor(&|k, i| mean(drift_gauge(k, i)));
+        let acceleration = per_floor(&|k, i| read(drift_gauge(k, i) + 1).peak());
+        let displacement = per_floor(&|k, i| displaced(self.layout[k].0 + i));
         let isolators = rm
             .placements
             .iter()
@@ -172,10 +185,11 @@ impl Peaks {
                     .iter()
                     .filter(|i| p.moat.contains(&i.contact))
                     .collect();
-                let (peak, sum) = self.slab[k];
+                let w = self.slab_gauges[k]?;
+                let peak = read(w).peak();
                 Some(IsolatorResponse {
                     peak_displacement: peak,
-                    residual_displacement: mean(sum, self.residual[k].1),
+                    residual_displacement: mean(w),
                     hysteretic_energy: bearing_energy[k],
                     beyond_capacity: iso.capacity.is_some_and(|c| peak > c),
                     moat_impacts: moat.len(),
@@ -184,10 +198,10 @@ impl Peaks {
             })
             .collect();
         Response {
-            drift: self.drift,
+            drift,
             residual_drift: residual,
-            acceleration: self.acceleration,
-            displacement: self.displacement,
+            acceleration,
+            displacement,
             hysteretic_energy,
             isolators,
             peak_impact_force: between.clone().fold(0.0, |m, i| m.max(i.peak_force)),
@@ -204,9 +218,9 @@ impl Peaks {
                 })
                 .collect(),
             closing: self
-                .closing
-                .into_iter()
-                .map(|j| j.into_iter().map(|(_, _, c)| c).collect())
+                .joint_gauges
+                .iter()
+                .map(|&(first, n)| (first..first + n).map(|w| read(w).max).collect())
                 .collect(),
             loops: self.loops.into_iter().map(|(_, _, l)| l).collect(),
         }

@@ -687,7 +687,12 @@ impl<'a> Run<'a> {
                 .iter()
                 .map(|c| c.law.onset_approach(opts.impact_force_threshold))
                 .collect();
-            run.extrema = Some(LocalExtrema::new(window, model, &run.free, s_on));
+            run.extrema = Some(LocalExtrema::new(
+                window,
+                model,
+                &run.free,
+                (s_on, &opts.gauges),
+            ));
         }
         Ok(run)
     }

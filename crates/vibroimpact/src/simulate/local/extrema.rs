@@ -12,6 +12,7 @@
 //! intervals no longer than its steps over free flight.
 
 use super::*;
+use crate::simulate::gauges::{Gauge, GaugeScan};
 
 /// Extrema over the window, and how far each group and contact has been
 /// scanned.
@@ -28,6 +29,11 @@ pub(super) struct LocalExtrema {
     /// The impact threshold of every contact.
     s_on: Vec<f64>,
     found: Extrema,
+    /// The options' gauges, each scanned up to a time like a contact.
+    gauges: Vec<GaugeScan>,
+    gauge_scanned: Vec<f64>,
+    /// Per group: the gauges that read one of its bodies.
+    group_gauges: Vec<Vec<usize>>,
 }
 
 impl LocalExtrema {
@@ -36,8 +42,17 @@ impl LocalExtrema {
         window: (f64, f64),
         model: &Model,
         free: &FreeMotion,
-        s_on: Vec<f64>,
+        (s_on, gauges): (Vec<f64>, &[Gauge]),
     ) -> Self {
+        let mut group_gauges = vec![Vec::new(); free.groups().len()];
+        for (w, gauge) in gauges.iter().enumerate() {
+            for i in gauge.sides().into_iter().flatten() {
+                let g = free.place(i).0;
+                if group_gauges[g].last() != Some(&w) {
+                    group_gauges[g].push(w);
+                }
+            }
+        }
         let record_step = match model.base() {
             BaseExcitation::Record(r) => {
                 let t = r.times();
@@ -66,13 +81,18 @@ impl LocalExtrema {
                 max_displacement: vec![0.0; model.bodies().len()],
                 max_velocity: vec![0.0; model.bodies().len()],
                 impact_margin: vec![f64::NEG_INFINITY; s_on.len()],
+                gauges: Vec::new(),
             },
             s_on,
+            gauges: gauges.iter().cloned().map(GaugeScan::new).collect(),
+            gauge_scanned: vec![f64::NEG_INFINITY; gauges.len()],
+            group_gauges,
         }
     }
 
     /// The extrema found.
-    pub(super) fn into_found(self) -> Extrema {
+    pub(super) fn into_found(mut self) -> Extrema {
+        self.found.gauges = self.gauges.iter().map(GaugeScan::reading).collect();
         self.found
     }
 
@@ -97,7 +117,8 @@ impl LocalExtrema {
         sys: &SetSystem,
     ) -> ExtremaScan {
         let s_on = ids.iter().map(|&k| self.s_on[k]).collect();
-        ExtremaScan::new(self.window, bodies, s_on, st, sys.chain())
+        // (The gauges are read by the run, on the set's steps.)
+        ExtremaScan::new(self.window, bodies, (s_on, &[]), st, sys.chain())
     }
 
     /// The part of `[from, t]` inside the window, if any (a point counts).
@@ -159,7 +180,28 @@ impl Run<'_> {
             }
             ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
         }
+        for c in 0..ex.group_gauges[g].len() {
+            let w = ex.group_gauges[g][c];
+            if self.gauge_in_set(&ex, w) {
+                continue;
+            }
+            self.gauge_to(&mut ex, w, t);
+        }
         self.extrema = Some(ex);
+    }
+
+    /// Whether gauge `w` reads a body in the set.
+    fn gauge_in_set(&self, ex: &LocalExtrema, w: usize) -> bool {
+        let sides = ex.gauges[w].gauge.sides();
+        sides.into_iter().flatten().any(|i| self.slot[i].is_some())
+    }
+
+    /// Gauge `w` scanned from where it was up to `t`.
+    fn gauge_to(&mut self, ex: &mut LocalExtrema, w: usize, t: f64) {
+        if let Some((a, b)) = ex.span(ex.gauge_scanned[w], t) {
+            self.scan_gauge(ex, w, a, b);
+        }
+        ex.gauge_scanned[w] = ex.gauge_scanned[w].max(t);
     }
 
     /// A group leaves the set at `t`: its exact motion, and its contacts,
@@ -169,6 +211,9 @@ impl Run<'_> {
             ex.group_scanned[g] = t;
             for &k in &self.group_contacts[g] {
                 ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
+            }
+            for &w in &ex.group_gauges[g] {
+                ex.gauge_scanned[w] = ex.gauge_scanned[w].max(t);
             }
         }
     }
@@ -191,8 +236,85 @@ impl Run<'_> {
                 }
                 ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
             }
+            for w in 0..ex.gauges.len() {
+                if self.gauge_in_set(&ex, w) {
+                    self.gauge_to(&mut ex, w, t);
+                }
+            }
         }
         self.extrema = Some(ex);
+    }
+
+    /// Gauge `w` on `[a, b]`: over the grid of its exact sides (one piece
+    /// within a step of the set), as [`GaugeScan::scan`] reads a piece.
+    fn scan_gauge(&mut self, ex: &mut LocalExtrema, w: usize, a: f64, b: f64) {
+        let gauge = ex.gauges[w].gauge.clone();
+        let step = gauge
+            .sides()
+            .into_iter()
+            .flatten()
+            .filter(|&i| self.slot[i].is_none())
+            .map(|i| ex.grid[self.free.place(i).0])
+            .fold(f64::INFINITY, f64::min);
+        let mut ta = a;
+        for tb in grid(a, b, step) {
+            let reading = &mut ex.gauges[w];
+            match gauge {
+                Gauge::Separation { left, right, .. } => reading.scan(ta, tb, |t| {
+                    let (l, r) = (self.side_at(left, t), self.side_at(right, t));
+                    (l.0 - r.0, l.1 - r.1)
+                }),
+                Gauge::AbsoluteAcceleration { body } => {
+                    let h = 1e-4 * (tb - ta);
+                    reading.scan(ta, tb, |t| {
+                        let (lo, hi) = ((t - h).max(ta), (t + h).min(tb));
+                        let x = self.absolute_acceleration(body, t);
+                        let rate = (self.absolute_acceleration(body, hi)
+                            - self.absolute_acceleration(body, lo))
+                            / (hi - lo);
+                        (x, rate)
+                    });
+                }
+            }
+            ta = tb;
+        }
+    }
+
+    /// A body's (u, v) at `t` (None: the ground): exact from its group's
+    /// reference state, or the set's dense output.
+    fn side_at(&mut self, side: Option<usize>, t: f64) -> (f64, f64) {
+        let Some(i) = side else {
+            return (0.0, 0.0);
+        };
+        match (self.slot[i], self.set.as_mut()) {
+            (Some(j), Some(set)) => (
+                set.st.dense_component(&mut set.sys, 2 * j, t),
+                set.st.dense_component(&mut set.sys, 2 * j + 1, t),
+            ),
+            (Some(_), None) => (f64::NAN, f64::NAN),
+            (None, _) => self.exact_body(i, t),
+        }
+    }
+
+    /// Body i's absolute acceleration at `t`: its exact motion's, or the
+    /// slope of the set's dense velocity, plus the ground's.
+    fn absolute_acceleration(&mut self, i: usize, t: f64) -> f64 {
+        let ground = self.model.base().at(t);
+        match (self.slot[i], self.set.as_mut()) {
+            (Some(j), Some(set)) => {
+                let h = 1e-4 * set.st.h_last();
+                let mut v = |t| set.st.dense_component(&mut set.sys, 2 * j + 1, t);
+                (v(t + h) - v(t - h)) / (2.0 * h) + ground
+            }
+            (Some(_), None) => f64::NAN,
+            (None, _) => {
+                let (g, j) = self.free.place(i);
+                let (t0, x0) = &self.exact[g];
+                let mut x = x0.clone();
+                self.free.propagate(g, *t0, t, &mut x);
+                self.free.acceleration(g, t, &x, j) + ground
+            }
+        }
     }
 
     /// |u|, |v| of group `g`'s bodies on `[a, b]` (its exact motion).
@@ -267,21 +389,8 @@ impl Run<'_> {
     fn approach(&mut self, k: usize, t: f64) -> (f64, f64) {
         let c = &self.model.contacts()[k];
         let clearance = c.clearance;
-        let mut uv = [(0.0, 0.0); 2];
-        for (slot, side) in uv.iter_mut().zip([c.pair.left(), c.pair.right()]) {
-            let Some(i) = side else { continue };
-            *slot = match self.slot[i] {
-                None => self.exact_body(i, t),
-                // (A body has a slot only while the set exists.)
-                Some(j) => match self.set.as_mut() {
-                    Some(set) => (
-                        set.st.dense_component(&mut set.sys, 2 * j, t),
-                        set.st.dense_component(&mut set.sys, 2 * j + 1, t),
-                    ),
-                    None => (f64::NAN, f64::NAN),
-                },
-            };
-        }
-        (uv[0].0 - uv[1].0 - clearance, uv[0].1 - uv[1].1)
+        let (l, r) = (c.pair.left(), c.pair.right());
+        let (l, r) = (self.side_at(l, t), self.side_at(r, t));
+        (l.0 - r.0 - clearance, l.1 - r.1)
     }
 }

@@ -385,6 +385,7 @@ impl Run<'_> {
                     below: s.below.map(slot).transpose()?,
                     above: slot(s.above)?,
                     law: s.law,
+                    p_delta: s.p_delta,
                 })
             })
             .collect::<Result<Vec<_>, IntegrationError>>()?;

@@ -41,6 +41,7 @@ fn sdof(uy: f64) -> Model {
                 yield_drift: uy,
                 post_yield_ratio: B,
             }),
+            p_delta: 0.0,
         }])
         .unwrap()
 }
@@ -248,6 +249,7 @@ fn bouc_wen_storey_matches_its_equations() {
         below: None,
         above: 0,
         law: StoreyLaw::BoucWen(w),
+        p_delta: 0.0,
     }])
     .unwrap();
     let opts = SimulationOptions {
@@ -348,16 +350,19 @@ fn energy_balances_with_yielding_storeys_and_impacts() {
             below: None,
             above: 0,
             law: bilinear,
+            p_delta: 0.0,
         },
         Storey {
             below: Some(0),
             above: 1,
             law: bilinear,
+            p_delta: 0.0,
         },
         Storey {
             below: None,
             above: 2,
             law: bouc_wen,
+            p_delta: 0.0,
         },
     ])
     .unwrap();

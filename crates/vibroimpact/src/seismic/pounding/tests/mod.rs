@@ -13,6 +13,7 @@ fn frame(n: usize, m: f64, k: f64) -> ShearFrame {
         damping_ratio: 0.05,
         storeys: Vec::new(),
         heights: Vec::new(),
+        gravity: Gravity::default(),
     }
 }
 
@@ -50,6 +51,7 @@ fn frame_frequencies_and_rayleigh_damping() {
         damping_ratio: 0.04,
         storeys: Vec::new(),
         heights: Vec::new(),
+        gravity: Gravity::default(),
     };
     let (alpha, beta) = f3.rayleigh();
     let k = f3.stiffness_matrix();
@@ -115,8 +117,8 @@ fn required_gap_and_code_rules() {
         .unwrap();
     assert_eq!(above.pounding.impacts, 0);
     // The history of the pounding run: the same impacts and peak force,
-    // its largest sampled drift the response's (same samples), a sample
-    // every 2.5 ms over the record.
+    // its largest sampled drift below the response's exact one and within
+    // 1e-3 of it, a sample every 2.5 ms over the record.
     let h = pair(0.98 * need)
         .history(&rec, 1.0, &RunSettings::new(0.0025, 1e-9))
         .unwrap();
@@ -128,7 +130,11 @@ fn required_gap_and_code_rules() {
     let top_drift = (0..h.times.len())
         .map(|j| (h.displacement[j * 5 + 2] - h.displacement[j * 5 + 1]).abs())
         .fold(0.0, f64::max);
-    assert_eq!(top_drift, below.pounding.drift[0][2]);
+    let exact = below.pounding.drift[0][2];
+    assert!(
+        top_drift <= exact * (1.0 + 1e-12) && top_drift >= exact * (1.0 - 1e-3),
+        "{top_drift} against {exact}"
+    );
     let g = far.joints[0].code_gaps;
     assert!(g.double_difference <= g.srss && g.srss <= g.absolute_sum);
     assert!(need <= g.absolute_sum);
@@ -207,13 +213,83 @@ fn the_local_integrator_matches_the_global_one() {
         let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
         let mut worst = rel(l.peak_impact_force, g.peak_impact_force);
         for side in 0..2 {
-            for (a, b) in [(&l.drift, &g.drift), (&l.acceleration, &g.acceleration)] {
+            for (a, b) in [
+                (&l.drift, &g.drift),
+                (&l.acceleration, &g.acceleration),
+                (&l.displacement, &g.displacement),
+            ] {
                 for (x, y) in a[side].iter().zip(&b[side]) {
                     worst = worst.max(rel(*x, *y));
                 }
             }
+            for (x, y) in l.residual_drift[side].iter().zip(&g.residual_drift[side]) {
+                worst = worst.max((x - y).abs() / g.drift[side][0]);
+            }
+        }
+        for (a, b) in l.closing.iter().flatten().zip(g.closing.iter().flatten()) {
+            worst = worst.max(rel(*a, *b));
         }
         assert!(worst < 1e-6, "contacts {contacts}: {worst:e}");
+    }
+}
+
+/// W1: the peaks are read on the dense output, so they do not depend on
+/// the output sampling (a 100 s sample gave zero drifts and gaps before),
+/// and a sampled history never exceeds them.
+#[test]
+fn peaks_do_not_depend_on_the_sampling() {
+    let pair = storeys_3_and_2();
+    let rec = record();
+    let at = |sample: f64| {
+        pair.analyse(&rec, 1.0, &RunSettings::new(sample, 1e-9))
+            .unwrap()
+    };
+    let (fine, coarse) = (at(0.0025), at(100.0));
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+    let mut worst = rel(coarse.joints[0].required_gap, fine.joints[0].required_gap);
+    for (c, f) in [
+        (&coarse.pounding, &fine.pounding),
+        (&coarse.free, &fine.free),
+    ] {
+        for side in 0..2 {
+            for (a, b) in [
+                (&c.drift, &f.drift),
+                (&c.acceleration, &f.acceleration),
+                (&c.displacement, &f.displacement),
+            ] {
+                for (x, y) in a[side].iter().zip(&b[side]) {
+                    assert!(*y > 0.0);
+                    worst = worst.max(rel(*x, *y));
+                }
+            }
+            for (x, y) in c.residual_drift[side].iter().zip(&f.residual_drift[side]) {
+                worst = worst.max((x - y).abs() / f.drift[side][0]);
+            }
+        }
+    }
+    assert!(worst < 1e-9, "{worst:e}");
+    assert!(fine.joints[0].required_gap > 0.0);
+    // A history sampled every 0.2 ms stays below every exact peak drift,
+    // within 1e-5 of it.
+    let h = pair
+        .history(&rec, 1.0, &RunSettings::new(2e-4, 1e-9))
+        .unwrap();
+    let n = 5;
+    for (k, first, floors) in [(0, 0, 3), (1, 3, 2)] {
+        for i in 0..floors {
+            let sampled = (0..h.times.len())
+                .map(|j| {
+                    let u = &h.displacement[j * n..(j + 1) * n];
+                    let below = if i == 0 { 0.0 } else { u[first + i - 1] };
+                    (u[first + i] - below).abs()
+                })
+                .fold(0.0, f64::max);
+            let exact = fine.pounding.drift[k][i];
+            assert!(
+                sampled <= exact * (1.0 + 1e-12) && sampled >= exact * (1.0 - 1e-5),
+                "building {k} storey {i}: {sampled} against {exact}"
+            );
+        }
     }
 }
 

@@ -191,6 +191,7 @@ fn friction_pendulum_bearings() {
             damping_ratio: 0.05,
             storeys: Vec::new(),
             heights: Vec::new(),
+            gravity: Gravity::default(),
         },
         isolation: Some(Isolation {
             mass: 1e5,

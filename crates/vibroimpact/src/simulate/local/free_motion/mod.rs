@@ -267,10 +267,10 @@ impl FreeMotion {
             .filter(|c| place[c.a].0 == here)
             .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
             .collect();
-        // A storey is a spring of its initial stiffness (its constant
-        // force is the rest state's, `set_rest`).
+        // A storey is a spring of its initial stiffness less its P-Δ
+        // stiffness (its constant force is the rest state's, `set_rest`).
         for s in model.storeys().iter().filter(|s| place[s.above].0 == here) {
-            let k = s.law.initial_stiffness();
+            let k = s.law.initial_stiffness() - s.p_delta;
             match s.below {
                 None => stiffness[place[s.above].1] += k,
                 Some(b) => couplings.push((place[b].1, place[s.above].1, k, 0.0)),

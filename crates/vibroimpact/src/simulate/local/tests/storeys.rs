@@ -3,8 +3,9 @@
 //! Bouc–Wen groups integrated throughout, rows and isolated buildings.
 
 use super::*;
+use crate::model::hysteresis::{Bilinear, StoreyLaw};
 use crate::seismic::pounding::tests::record;
-use crate::seismic::pounding::{parse_row, Response, Row, RunSettings};
+use crate::seismic::pounding::{parse_row, Gravity, Response, Row, RunSettings};
 
 const HERTZ: &str = "law = { law = \"hertz\", stiffness = 1e9, exponent = 1.5 }\n";
 const BILINEAR: &str = "{ law = \"bilinear\", yield_drift = YD, post_yield_ratio = 0.05 }";
@@ -145,10 +146,19 @@ fn rows_and_isolated_buildings_as_the_global_integrator_runs_them() {
          moat = {{ gap = 0.03, law = {{ law = \"hertz\", stiffness = 5e9, exponent = 1.5 }} }}\n",
         frame("[3e5, 3e5, 3e5]", "[4e8, 4e8, 4e8]", "0.0015"),
     );
+    // The pair again with P-Δ in its yielding frame: storeys 3.5 m high
+    // under their floors' weights and a leaning column's 2 MN a floor.
+    let mut p_delta = pair(BILINEAR, 0.002, 0.01);
+    p_delta.buildings[0].frame.heights = vec![3.5, 3.5];
+    p_delta.buildings[0].frame.gravity = Gravity {
+        p_delta: true,
+        leaning_loads: vec![2e6, 2e6],
+    };
     let rows = [
         pair(BILINEAR, 0.002, 0.01),
         parse_row(&row, "row.toml").unwrap(),
         parse_row(&isolated, "iso.toml").unwrap(),
+        p_delta,
     ];
     let global = RunSettings::new(0.005, 1e-9);
     let local = RunSettings {
@@ -219,6 +229,69 @@ fn worst_difference(g: &Response, l: &Response) -> f64 {
         }
     }
     worst
+}
+
+/// P-Δ lowers a storey's stiffness by P/h on every branch: an undamped
+/// bilinear storey on its elastic branch swings at ω² = (k − P/h)/m
+/// (its closed form u₀ cos ωt to 1e-8 of u₀ over 20 periods, both
+/// integrators), and a P/h at or above k is refused by name.
+#[test]
+fn p_delta_lowers_the_storey_stiffness_exactly() {
+    let (m, k, g, u0) = (1e5, 4e7, 1.5e7, 0.001);
+    let storey = |p_delta| Storey {
+        below: None,
+        above: 0,
+        law: StoreyLaw::Bilinear(Bilinear {
+            stiffness: k,
+            yield_drift: 0.01,
+            post_yield_ratio: 0.05,
+        }),
+        p_delta,
+    };
+    let body = Body {
+        name: "floor".into(),
+        mass: m,
+        stiffness: 0.0,
+        damping: 0.0,
+    };
+    let model = |p_delta| {
+        Model::new(
+            vec![body.clone()],
+            vec![],
+            vec![],
+            BaseExcitation::None,
+            vec![],
+            vec![],
+            vec![],
+        )
+        .unwrap()
+        .with_storeys(vec![storey(p_delta)])
+    };
+    let w = ((k - g) / m).sqrt();
+    let t_end = 20.0 * 2.0 * std::f64::consts::PI / w + 0.123;
+    for integrator in [Integrator::Global, Integrator::Local] {
+        let opts = SimulationOptions {
+            t_end,
+            rtol: 1e-12,
+            atol: 1e-16,
+            start: Some(vec![u0, 0.0]),
+            integrator,
+            ..Default::default()
+        };
+        let sim = simulate(&model(g).unwrap(), &opts).unwrap();
+        let exact = u0 * (w * t_end).cos();
+        let err = (sim.final_displacement[0] - exact).abs() / u0;
+        assert!(err < 1e-8, "{integrator:?}: {err:e}");
+    }
+    for bad in [k, 2.0 * k, -1.0, f64::NAN] {
+        let e = model(bad).unwrap_err();
+        assert_eq!(e.key, "storey.1.p_delta");
+        assert!(
+            e.message.contains("unstable at zero drift"),
+            "{}",
+            e.message
+        );
+    }
 }
 
 /// Tangent columns do not cross a storey's branch switch: refused by
