@@ -7,18 +7,18 @@ use pyo3::types::PyDict;
 use serde_json::Value;
 use vibroimpact::seismic::collapse::{
     check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
-    IdaSettings, RecordCollapse, RecordIda,
+    DriftLimit, IdaSettings, RecordCollapse, RecordIda,
 };
 
 use crate::convert::{to_python, value_error};
 use crate::monitor::{self, Progress};
 use crate::records::{pair_and_run, pounding_error, record_of, RecordInput};
 
-/// The study's settings as Python hands them over: (drift limit,
-/// capacity, contacts), (first, growth, max scale, tolerance), (period,
+/// The study's settings as Python hands them over: (drift limit (m),
+/// drift-ratio limit (one of the two), capacity, contacts), (first, growth, max scale, tolerance), (period,
 /// damping), (sample, rtol, method, integrator).
 type Settings = (
-    (f64, bool, bool),
+    (Option<f64>, Option<f64>, bool, bool),
     (f64, f64, f64, f64),
     (Option<f64>, f64),
     (f64, f64, String, String),
@@ -31,7 +31,7 @@ fn study(
     settings: Settings,
 ) -> PyResult<(vibroimpact::seismic::pounding::Row, CollapseStudy)> {
     let (
-        (drift, capacity, contacts),
+        (drift, ratio, capacity, contacts),
         (first, growth, max_scale, tolerance),
         (period, damping),
         run,
@@ -40,7 +40,11 @@ fn study(
     let (row, run) = pair_and_run(pair_text, source, (sample, rtol, &method, &integrator))?;
     let study = CollapseStudy {
         criterion: Criterion {
-            drift,
+            drift: match (drift, ratio) {
+                (Some(d), _) => DriftLimit::Drift(d),
+                (None, Some(r)) => DriftLimit::Ratio(r),
+                (None, None) => DriftLimit::FEMA,
+            },
             capacity,
             contacts,
         },

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 use vibroimpact::seismic::collapse::{
     check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
-    IdaSettings,
+    DriftLimit, IdaSettings,
 };
 use vibroimpact::seismic::pounding::GRAVITY;
 use vibroimpact::simulate::WorkEstimate;
@@ -33,10 +33,15 @@ pub struct CollapseArgs {
     /// asks (FEMA P695: by PGV); one IDA each.
     #[arg(required = true)]
     records: Vec<PathBuf>,
-    /// The storey drift at collapse (m): the storey height times the
-    /// collapse drift ratio.
+    /// The storey drift at collapse (m), every storey; instead of
+    /// --drift-ratio-limit.
+    #[arg(long, conflicts_with = "drift_ratio_limit")]
+    drift_limit: Option<f64>,
+    /// The storey drift ratio at collapse, each storey's height times it
+    /// (the buildings need `heights`); the default 0.10 is FEMA P695
+    /// practice's cap on sidesway, beyond its archetypes' collapse.
     #[arg(long)]
-    drift_limit: f64,
+    drift_ratio_limit: Option<f64>,
     /// The period T (s) of the intensity S_T (the records' median spectral
     /// acceleration there, as FEMA P695's S_NRT: their geometric mean).
     #[arg(long)]
@@ -80,23 +85,34 @@ pub struct CollapseArgs {
 }
 
 /// The IDA curves (Vamvatsikos–Cornell): per record the largest storey
-/// drift against the intensity, Sa(T1) in g where the study has a period
-/// (the record's spectral acceleration times the scale), else the scale;
-/// the collapses marked by their mode; the drift limit as a line.
-fn ida_figure(doc: &Value, limit: f64) -> Figure {
+/// drift ratio (the drift where the limit is in metres) against the
+/// intensity, Sa(T1) in g where the study has a period (the record's
+/// spectral acceleration times the scale), else the scale; the collapses
+/// marked by their mode; the limit as a line.
+fn ida_figure(doc: &Value) -> Figure {
     let in_g = doc["period"].as_f64().is_some();
+    let criterion = &doc["criterion"];
+    let (limit, key, x_label) = match criterion["drift_ratio_limit"].as_f64() {
+        Some(r) => (r, "max_drift_ratio", "largest storey drift ratio"),
+        None => (
+            criterion["drift_limit"].as_f64().unwrap_or(f64::NAN),
+            "max_drift",
+            "largest storey drift  [m]",
+        ),
+    };
     let y_label = match doc["period"].as_f64() {
         Some(t) => format!("Sa(T1 = {t} s)  [g]"),
         None => "scale".to_string(),
     };
-    let mut fig = Figure::new(
-        "Incremental dynamic analysis",
-        "largest storey drift  [m]",
-        y_label,
-    )
-    .legend_at(LegendPosition::LowerRight);
+    let mut fig = Figure::new("Incremental dynamic analysis", x_label, y_label)
+        .legend_at(LegendPosition::LowerRight);
     let modes = [
         ("drift", "collapse: drift limit", Marker::Triangle),
+        (
+            "instability",
+            "collapse: dynamic instability",
+            Marker::Diamond,
+        ),
         ("capacity", "collapse: isolator capacity", Marker::Square),
         ("diverged", "collapse: numerical failure", Marker::Circle),
     ];
@@ -113,7 +129,7 @@ fn ida_figure(doc: &Value, limit: f64) -> Figure {
             .into_iter()
             .flatten()
             .filter_map(|p| {
-                let (s, d) = (p["scale"].as_f64()? * per_scale, p["max_drift"].as_f64()?);
+                let (s, d) = (p["scale"].as_f64()? * per_scale, p[key].as_f64()?);
                 top = top.max(s);
                 let kind = &p["verdict"]["kind"];
                 if let Some(m) = modes.iter().position(|(k, _, _)| kind == k) {
@@ -140,7 +156,11 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
     let row = records::row(&args.pair)?;
     let study = CollapseStudy {
         criterion: Criterion {
-            drift: args.drift_limit,
+            drift: match (args.drift_limit, args.drift_ratio_limit) {
+                (Some(d), _) => DriftLimit::Drift(d),
+                (None, Some(r)) => DriftLimit::Ratio(r),
+                (None, None) => DriftLimit::FEMA,
+            },
             capacity: args.capacity,
             contacts: args.contacts,
         },
@@ -187,7 +207,7 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
             &dir.join("collapse.json"),
             serde_json::to_string_pretty(&doc)?.as_bytes(),
         )?;
-        render(&ida_figure(&doc, args.drift_limit), &dir.join("ida"))?;
+        render(&ida_figure(&doc), &dir.join("ida"))?;
     }
     match args.format {
         SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
@@ -237,21 +257,40 @@ mod tests {
     use serde_json::json;
 
     /// Sa(T1) in g on the intensity axis where the study has a period (the
-    /// record's Sa × the scale / g), the scale without one; a collapse
-    /// marked by its mode.
+    /// record's Sa × the scale / g), the scale without one; the drift
+    /// ratio on the other where the limit is a ratio, else the drift; a
+    /// collapse marked by its mode.
     #[test]
     fn the_ida_is_drawn_in_sa_of_t1_with_collapses_by_mode() {
-        let run = |scale: f64, kind: &str| json!({"scale": scale, "max_drift": 0.01 * scale, "verdict": {"kind": kind}});
-        let record =
-            json!({"sa": 2.0 * GRAVITY, "runs": [run(0.5, "standing"), run(1.0, "capacity")]});
-        let fig = ida_figure(&json!({"period": 1.0, "records": [record.clone()]}), 0.05);
+        let run = |scale: f64, kind: &str| json!({"scale": scale, "max_drift": 0.01 * scale, "max_drift_ratio": 0.003 * scale, "verdict": {"kind": kind}});
+        let record = json!({"sa": 2.0 * GRAVITY, "runs": [run(0.5, "standing"), run(1.0, "capacity"), run(1.2, "instability")]});
+        let metres = json!({"drift_limit": 0.05, "drift_ratio_limit": null});
+        let fig =
+            ida_figure(&json!({"period": 1.0, "criterion": metres, "records": [record.clone()]}));
         assert_eq!(fig.y_label, "Sa(T1 = 1 s)  [g]");
-        assert_eq!(fig.series[0].points, vec![(0.005, 1.0), (0.01, 2.0)]);
-        let marked = &fig.series[1];
-        assert_eq!(marked.label.as_deref(), Some("collapse: isolator capacity"));
-        assert_eq!(marked.points, vec![(0.01, 2.0)]);
-        let bare = ida_figure(&json!({"period": null, "records": [record]}), 0.05);
+        assert_eq!(fig.x_label, "largest storey drift  [m]");
+        assert_eq!(
+            fig.series[0].points,
+            vec![(0.005, 1.0), (0.01, 2.0), (0.012, 2.4)]
+        );
+        let marked: Vec<_> = fig.series[1..]
+            .iter()
+            .filter_map(|s| s.label.as_deref())
+            .collect();
+        assert_eq!(
+            marked[..2],
+            [
+                "collapse: dynamic instability",
+                "collapse: isolator capacity"
+            ]
+        );
+        let ratio = json!({"drift_limit": null, "drift_ratio_limit": 0.1});
+        let bare = ida_figure(&json!({"period": null, "criterion": ratio, "records": [record]}));
         assert_eq!(bare.y_label, "scale");
-        assert_eq!(bare.series[0].points, vec![(0.005, 0.5), (0.01, 1.0)]);
+        assert_eq!(bare.x_label, "largest storey drift ratio");
+        assert_eq!(
+            bare.series[0].points,
+            vec![(0.0015, 0.5), (0.003, 1.0), (0.0036, 1.2)]
+        );
     }
 }

@@ -134,6 +134,16 @@ impl Canvas {
                 ];
                 area.draw(&Polygon::new(pts, color.filled())).map_err(de)
             }
+            Marker::Diamond => {
+                let r = 1.3 * MARKER_SIZE + 2.0 * grow;
+                let pts = vec![
+                    self.pt((x, y - r)),
+                    self.pt((x + r, y)),
+                    self.pt((x, y + r)),
+                    self.pt((x - r, y)),
+                ];
+                area.draw(&Polygon::new(pts, color.filled())).map_err(de)
+            }
         }
     }
 }

@@ -19,6 +19,8 @@ pub enum Marker {
     Square,
     /// Filled upward triangle.
     Triangle,
+    /// Filled diamond.
+    Diamond,
     /// A small filled circle, for dense scatter (an orbit diagram's
     /// thousands of samples).
     Dot,

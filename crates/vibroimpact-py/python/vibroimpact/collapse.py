@@ -202,7 +202,8 @@ def collapse_study(
     pair: Any,
     records: Any,
     *,
-    drift_limit: float,
+    drift_limit: Any = None,
+    drift_ratio_limit: Any = None,
     period: Any = None,
     damping: float = 0.05,
     first: float = 0.25,
@@ -230,8 +231,13 @@ def collapse_study(
     docs/earthquakes.md): per record (a file name or a
     :func:`vibroimpact.read_record`-like result, normalized as the record
     set asks, e.g. ``vibroimpact.records.fema_p695(normalized=True)``) an
-    IDA to collapse: a storey drift past ``drift_limit`` (m), an isolator
-    past its capacity (``capacity``) or a run that fails to integrate;
+    IDA to collapse: a storey drift ratio past ``drift_ratio_limit`` (each
+    storey's height times it; default 0.10, FEMA P695 practice's cap on
+    sidesway; the buildings need ``heights``) or a storey drift past
+    ``drift_limit`` (m) instead, an isolator past its capacity
+    (``capacity``) or a run that fails to integrate; a storey past its
+    limit where its tangent stiffness with P-Δ is negative is a "dynamic
+    instability";
     scales from ``first`` by ``growth`` up to ``max_scale``, the collapse
     bracketed to ``tolerance``; with the row's contacts or without them
     (``contacts``). ``sample``, ``rtol``, ``method``, ``integrator`` as
@@ -258,7 +264,11 @@ def collapse_study(
 
     source, text = _pair_text(pair)
     _pounding_settings(1.0, sample, rtol, method, integrator)
-    for name, v in (("drift_limit", drift_limit), ("damping", damping), ("first", first),
+    if drift_limit is not None and drift_ratio_limit is not None:
+        raise ValueError("drift_limit, drift_ratio_limit: give one or the other")
+    limits = [("drift_limit", drift_limit)] if drift_limit is not None else [
+        ("drift_ratio_limit", 0.10 if drift_ratio_limit is None else drift_ratio_limit)]
+    for name, v in (*limits, ("damping", damping), ("first", first),
                     ("growth", growth), ("max_scale", max_scale), ("tolerance", tolerance)):
         if isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not math.isfinite(v):
             raise ValueError(f"{name}: expected a finite number, got {v!r}")
@@ -289,7 +299,8 @@ def collapse_study(
     if smt is not None and period is None:
         raise ValueError("smt: give it with period")
     settings = (
-        (float(drift_limit), capacity, contacts),
+        (None if drift_limit is None else float(drift_limit),
+         float(limits[0][1]) if drift_limit is None else None, capacity, contacts),
         (float(first), float(growth), float(max_scale), float(tolerance)),
         (None if period is None else float(period), float(damping)),
         (float(sample), float(rtol), method, integrator),

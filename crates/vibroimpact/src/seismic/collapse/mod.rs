@@ -28,13 +28,29 @@
 
 use crate::model::record::Record;
 use crate::seismic::pounding::{PoundingError, Row, RunSettings, Stop};
+use crate::seismic::pushover::storey_tangent;
+
+/// The storey drift at which a run counts as a collapse.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DriftLimit {
+    /// A storey drift (m), every storey.
+    Drift(f64),
+    /// A storey drift ratio: each storey's height times it (every building
+    /// needs heights). FEMA P695 practice caps sidesway at a drift ratio
+    /// beyond the collapse of its archetypes: [`DriftLimit::FEMA`].
+    Ratio(f64),
+}
+
+impl DriftLimit {
+    /// The default: a drift ratio of 0.10.
+    pub const FEMA: Self = Self::Ratio(0.10);
+}
 
 /// When a run counts as a collapse.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Criterion {
-    /// The storey drift limit (m): a storey's height times the collapse
-    /// drift ratio.
-    pub drift: f64,
+    /// The storey drift limit.
+    pub drift: DriftLimit,
     /// Whether an isolator displacement past its stated capacity is a
     /// collapse.
     pub capacity: bool,
@@ -73,7 +89,8 @@ impl Default for IdaSettings {
 pub enum Verdict {
     /// Standing at the end.
     Standing,
-    /// A storey drift passed the limit.
+    /// A storey drift passed the limit on a rising curve (the storey
+    /// still stiffened as it drifted).
     Drift {
         /// The building.
         building: String,
@@ -84,6 +101,20 @@ pub enum Verdict {
         /// The sample at which the run stopped past the limit (s); None
         /// where the limit was passed only between samples (the run then
         /// went on to its end).
+        time: Option<f64>,
+    },
+    /// Dynamic instability: a storey drift passed the limit where the
+    /// storey's tangent stiffness with P-Δ (its monotonic curve's) was
+    /// negative, so nothing stopped it drifting (sidesway).
+    Instability {
+        /// The building.
+        building: String,
+        /// The storey (1-based).
+        storey: usize,
+        /// Its peak drift, exact on the dense output (m).
+        drift: f64,
+        /// The sample at which the run stopped past the limit (s); None
+        /// where only the dense output saw it pass.
         time: Option<f64>,
     },
     /// An isolator passed its capacity.
@@ -115,6 +146,8 @@ pub struct IdaPoint {
     /// The largest storey drift over the buildings (m; up to the stop, or
     /// up to where a run that did not converge ended).
     pub max_drift: f64,
+    /// The largest storey drift ratio (None: a building has no heights).
+    pub max_drift_ratio: Option<f64>,
     /// The verdict.
     pub verdict: Verdict,
 }
@@ -159,12 +192,35 @@ impl IdaSettings {
 impl Criterion {
     /// Refuses a drift limit that is not positive and finite.
     pub fn check(&self) -> Result<(), PoundingError> {
-        if self.drift.is_finite() && self.drift > 0.0 {
+        let (key, v, m) = match self.drift {
+            DriftLimit::Drift(d) => ("drift_limit", d, "give a positive storey drift (m)"),
+            DriftLimit::Ratio(r) => ("drift_ratio_limit", r, "give a positive drift ratio"),
+        };
+        if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            let m = "give a positive storey drift (m)";
-            Err(crate::field_error::FieldError::new("drift_limit", self.drift, m).into())
+            Err(crate::field_error::FieldError::new(key, v, m).into())
         }
+    }
+
+    /// Every storey's drift limit (m) per building; a ratio needs every
+    /// building's heights.
+    pub fn limits(&self, row: &Row) -> Result<Vec<Vec<f64>>, PoundingError> {
+        row.buildings
+            .iter()
+            .map(|b| match self.drift {
+                DriftLimit::Drift(d) => Ok(vec![d; b.floors()]),
+                DriftLimit::Ratio(r) if b.frame.heights.is_empty() => {
+                    Err(crate::field_error::FieldError::new(
+                        "drift_ratio_limit",
+                        r,
+                        format!("building {:?} has no storey heights: give its heights, or a drift limit in metres", b.name),
+                    )
+                    .into())
+                }
+                DriftLimit::Ratio(r) => Ok(b.frame.heights.iter().map(|h| r * h).collect()),
+            })
+            .collect()
     }
 
     /// One run of `row` under `record` × `scale`.
@@ -175,16 +231,52 @@ impl Criterion {
         scale: f64,
         run: &RunSettings,
     ) -> Result<IdaPoint, PoundingError> {
-        let (r, stop) = row.respond_until(record, scale, self.contacts, run, Some(self.drift))?;
-        let mut worst = (0.0f64, 0, 0);
+        let limits = self.limits(row)?;
+        let (r, stop) = row.respond_until(record, scale, self.contacts, run, Some(&limits))?;
+        // The storey nearest its limit (drift over limit), and the largest
+        // drift and drift ratio.
+        let (mut worst, mut max_drift, mut max_ratio) = ((0.0f64, 0, 0), 0.0f64, Some(0.0f64));
         for (k, drifts) in r.drift.iter().enumerate() {
+            let heights = &row.buildings[k].frame.heights;
+            if heights.is_empty() {
+                max_ratio = None;
+            }
             for (i, &d) in drifts.iter().enumerate() {
-                if d > worst.0 {
-                    worst = (d, k, i);
+                if d / limits[k][i] > worst.0 {
+                    worst = (d / limits[k][i], k, i);
                 }
+                max_drift = max_drift.max(d);
+                max_ratio = max_ratio.map(|m| m.max(d / heights.get(i).copied().unwrap_or(1.0)));
             }
         }
+        let (passed, k, i) = worst;
+        let drift = r
+            .drift
+            .get(k)
+            .and_then(|d| d.get(i))
+            .copied()
+            .unwrap_or(0.0);
         let name = |k: usize| row.buildings[k].name.clone();
+        let past = |time| -> Result<Verdict, PoundingError> {
+            let tangent = storey_tangent(&row.buildings[k].frame, i, drift)
+                .map_err(|m| PoundingError::pair("storeys", m))?;
+            let (building, storey) = (name(k), i + 1);
+            Ok(if tangent < 0.0 {
+                Verdict::Instability {
+                    building,
+                    storey,
+                    drift,
+                    time,
+                }
+            } else {
+                Verdict::Drift {
+                    building,
+                    storey,
+                    drift,
+                    time,
+                }
+            })
+        };
         let beyond = r
             .isolators
             .iter()
@@ -192,18 +284,8 @@ impl Criterion {
             .find_map(|(k, i)| i.filter(|i| i.beyond_capacity).map(|i| (k, i)));
         let verdict = match (stop, beyond) {
             (Stop::Diverged { message }, _) => Verdict::Diverged { message },
-            (Stop::Limit { time }, _) => Verdict::Drift {
-                building: name(worst.1),
-                storey: worst.2 + 1,
-                drift: worst.0,
-                time: Some(time),
-            },
-            (Stop::End, _) if worst.0 > self.drift => Verdict::Drift {
-                building: name(worst.1),
-                storey: worst.2 + 1,
-                drift: worst.0,
-                time: None,
-            },
+            (Stop::Limit { time }, _) => past(Some(time))?,
+            (Stop::End, _) if passed > 1.0 => past(None)?,
             (Stop::End, Some((k, i))) if self.capacity => Verdict::Capacity {
                 building: name(k),
                 displacement: i.peak_displacement,
@@ -212,7 +294,8 @@ impl Criterion {
         };
         Ok(IdaPoint {
             scale,
-            max_drift: worst.0,
+            max_drift,
+            max_drift_ratio: max_ratio,
             verdict,
         })
     }

@@ -5,7 +5,7 @@
 
 use serde_json::{json, Value};
 
-use super::{median_collapse, record_ida, Criterion, IdaSettings, RecordIda, Verdict};
+use super::{median_collapse, record_ida, Criterion, DriftLimit, IdaSettings, RecordIda, Verdict};
 use crate::field_error::FieldError;
 use crate::model::record::Record;
 use crate::seismic::pounding::{PoundingError, Row, RunSettings};
@@ -72,6 +72,9 @@ impl CollapseStudy {
             .log2()
             .ceil()
             .max(0.0);
+        // (A drift-ratio limit needs the heights: refused here, before any
+        // run.)
+        self.criterion.limits(row)?;
         let one = row.estimate(record, ida.first, self.criterion.contacts, &self.run)?;
         Ok(one.map(|w| w.times(climbs + halvings)))
     }
@@ -105,6 +108,14 @@ fn verdict_document(v: &Verdict) -> Value {
         } => {
             json!({ "kind": "drift", "building": building, "storey": storey, "drift": drift, "time": time })
         }
+        Verdict::Instability {
+            building,
+            storey,
+            drift,
+            time,
+        } => {
+            json!({ "kind": "instability", "building": building, "storey": storey, "drift": drift, "time": time })
+        }
         Verdict::Capacity {
             building,
             displacement,
@@ -122,13 +133,14 @@ pub fn record_document(r: &RecordCollapse) -> Value {
         .ida
         .points
         .iter()
-        .map(|p| json!({ "scale": p.scale, "max_drift": p.max_drift, "verdict": verdict_document(&p.verdict) }))
+        .map(|p| json!({ "scale": p.scale, "max_drift": p.max_drift, "max_drift_ratio": p.max_drift_ratio, "verdict": verdict_document(&p.verdict) }))
         .collect();
     // How it collapsed: the verdict of the run at the collapse scale.
     let mode = r.ida.collapse.and_then(|c| {
         let run = r.ida.points.iter().find(|p| p.scale == c)?;
         Some(match run.verdict {
             Verdict::Drift { .. } => "drift limit",
+            Verdict::Instability { .. } => "dynamic instability",
             Verdict::Capacity { .. } => "isolator capacity",
             Verdict::Diverged { .. } => "numerical failure",
             Verdict::Standing => return None,
@@ -218,7 +230,14 @@ pub fn study_document(
     json!({
         "row": crate::seismic::pounding::documents::row_document(row),
         "criterion": {
-            "drift_limit": study.criterion.drift,
+            "drift_limit": match study.criterion.drift {
+                DriftLimit::Drift(d) => json!(d),
+                DriftLimit::Ratio(_) => Value::Null,
+            },
+            "drift_ratio_limit": match study.criterion.drift {
+                DriftLimit::Ratio(r) => json!(r),
+                DriftLimit::Drift(_) => Value::Null,
+            },
             "capacity": study.criterion.capacity,
             "contacts": study.criterion.contacts,
         },

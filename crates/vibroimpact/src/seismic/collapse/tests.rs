@@ -37,7 +37,7 @@ fn epp() -> Row {
 /// `rtol`.
 fn epp_ida(ida: IdaSettings, rtol: f64) -> RecordIda {
     let criterion = Criterion {
-        drift: LIMIT,
+        drift: DriftLimit::Drift(LIMIT),
         capacity: true,
         contacts: true,
     };
@@ -94,7 +94,7 @@ fn an_elastic_perfectly_plastic_storey_collapses_at_its_strength() {
 #[test]
 fn censored_records_and_the_median() {
     let criterion = Criterion {
-        drift: LIMIT,
+        drift: DriftLimit::Drift(LIMIT),
         capacity: true,
         contacts: true,
     };
@@ -127,7 +127,7 @@ fn censored_records_and_the_median() {
         &epp(),
         &step(),
         &Criterion {
-            drift: 0.0,
+            drift: DriftLimit::Drift(0.0),
             ..criterion
         },
         &ida,
@@ -164,4 +164,62 @@ fn a_first_scale_that_collapses_goes_down() {
         "{r:?}"
     );
     assert!(r.points[0].verdict.collapsed() && r.points[0].scale == 10.0);
+}
+
+/// The EPP storey 3.5 m high under P-Δ (P/h = g = 0.2 k): past yield its
+/// resistance k u_y − g d falls, so under a step A it stops only if the
+/// work left, ((k − g) u_y − m A)²/(2g), covers the kinetic energy at
+/// yield, m A u_y − ½ (k − g) u_y²; equality gives the collapse step A_c,
+/// the smaller root of x² − 2((k − g) u_y + g u_y) x + ((k − g) u_y)² +
+/// g u_y (k − g) u_y = 0 in x = m A. The IDA brackets it, and the collapse
+/// is a dynamic instability at the 0.10 drift-ratio limit (0.35 m).
+#[test]
+fn p_delta_brings_an_epp_storey_down_by_instability() {
+    let g = 0.2 * K;
+    let h = 3.5;
+    let mut row = epp();
+    let frame = &mut row.buildings[0].frame;
+    frame.heights = vec![h];
+    frame.gravity = Gravity {
+        p_delta: true,
+        leaning_loads: vec![g * h - M * crate::model::record::STANDARD_GRAVITY],
+    };
+    assert!((frame.geometric_stiffnesses()[0] / g - 1.0).abs() < 1e-12);
+    let a = (K - g) * UY;
+    let (b, c) = (2.0 * (a + g * UY), a * a + g * UY * a);
+    let a_c = (b - (b * b - 4.0 * c).sqrt()) / 2.0 / M;
+    assert!((a_c - 1.1056).abs() < 1e-4, "{a_c}");
+    let criterion = Criterion {
+        drift: DriftLimit::FEMA,
+        capacity: true,
+        contacts: true,
+    };
+    let ida = IdaSettings {
+        first: 0.5,
+        ..IdaSettings::default()
+    };
+    let run = RunSettings::new(0.002, 1e-10);
+    let r = record_ida(&row, &step(), &criterion, &ida, &run).unwrap();
+    let c = r.collapse.unwrap();
+    assert!(
+        r.survived <= a_c * (1.0 + 1e-6) && c >= a_c * (1.0 - 1e-6) && c / r.survived <= 1.02,
+        "[{}, {c}] against {a_c}",
+        r.survived
+    );
+    for p in &r.points {
+        let ratio = p.max_drift_ratio.unwrap();
+        assert!((ratio - p.max_drift / h).abs() < 1e-15);
+        match &p.verdict {
+            Verdict::Instability { storey, drift, .. } => {
+                assert_eq!(*storey, 1);
+                assert!(*drift > 0.1 * h && p.scale >= c);
+            }
+            Verdict::Standing => assert!(p.scale < c && ratio < 0.1),
+            v => panic!("{v:?}"),
+        }
+    }
+    // The same storey without heights: a drift-ratio limit is refused by
+    // name.
+    let e = record_ida(&epp(), &step(), &criterion, &ida, &run).unwrap_err();
+    assert!(e.to_string().contains("drift_ratio_limit"), "{e}");
 }

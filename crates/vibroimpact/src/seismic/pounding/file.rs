@@ -67,7 +67,7 @@ fn pair_text(file: Option<&str>, line: Option<usize>, message: &str) -> String {
 
 impl PoundingError {
     /// The row refused at `key`.
-    pub(super) fn pair(key: &'static str, message: String) -> Self {
+    pub(crate) fn pair(key: &'static str, message: String) -> Self {
         PoundingError::Pair {
             file: None,
             line: None,

@@ -568,8 +568,9 @@ impl Row {
         Ok(estimate_work(&rm.model, &opts))
     }
 
-    /// [`Row::respond`], stopped as soon as a storey drift passes `limit`
-    /// (if given), and kept (not an error) where the run does not
+    /// [`Row::respond`], stopped as soon as a sampled storey drift passes
+    /// its limit in `limits` (m, per building and storey, if given), and
+    /// kept (not an error) where the run does not
     /// converge: the response up to the stop, and why it stopped. Not
     /// converging is a step size that underflows or the step limit; the
     /// other early ends (an explicit method's stiffness, no progress) depend
@@ -580,7 +581,7 @@ impl Row {
         scale: f64,
         contacts: bool,
         run: &RunSettings,
-        limit: Option<f64>,
+        limits: Option<&[Vec<f64>]>,
     ) -> Result<(Response, Stop), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let mut opts = SimulationOptions {
@@ -594,8 +595,8 @@ impl Row {
         let model = &rm.model;
         let mut passed = None;
         let sim = simulate_streaming(model, &opts, |t, row| {
-            let worst = peaks.sample(row);
-            if limit.is_some_and(|l| worst > l) {
+            let worst = peaks.sample(row, limits);
+            if worst > 1.0 {
                 passed = Some(t);
             }
             passed.is_none()
@@ -640,7 +641,7 @@ impl Row {
         let sim = simulate_streaming(model, &opts, |t, row| {
             times.push(t);
             displacement.extend_from_slice(&row[..n]);
-            peaks.sample(row);
+            peaks.sample(row, None);
             true
         })
         .map_err(|e| PoundingError::run(record, e.0))?;

@@ -110,23 +110,27 @@ impl Peaks {
     }
 
     /// Takes the sample `row` = [u.., v.., a.., storey forces..] at `t`
-    /// into the loops; returns the largest storey drift in it.
-    pub(super) fn sample(&mut self, row: &[f64]) -> f64 {
+    /// into the loops; returns the largest storey drift in it over its
+    /// limit in `limits` (per building and storey; 0 without).
+    pub(super) fn sample(&mut self, row: &[f64], limits: Option<&[Vec<f64>]>) -> f64 {
         let n = (row.len() - self.loops.len()) / 3;
         let (u, forces) = (&row[..n], &row[3 * n..]);
         for ((below, above, l), &f) in self.loops.iter_mut().zip(forces) {
             l.drift.push(u[*above] - below.map_or(0.0, |b| u[b]));
             l.force.push(f);
         }
+        let Some(limits) = limits else {
+            return 0.0;
+        };
         let mut worst = 0.0f64;
-        for &(first, base, floors) in &self.layout {
+        for (&(first, base, floors), limit) in self.layout.iter().zip(limits) {
             for i in 0..floors {
                 let below = match (i, base) {
                     (0, None) => 0.0,
                     (0, Some(b)) => u[b],
                     _ => u[first + i - 1],
                 };
-                worst = worst.max((u[first + i] - below).abs());
+                worst = worst.max((u[first + i] - below).abs() / limit[i]);
             }
         }
         worst

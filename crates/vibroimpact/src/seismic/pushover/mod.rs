@@ -158,6 +158,21 @@ fn peak(f: impl Fn(f64) -> Result<f64, String>, top: f64, n: usize) -> Result<(f
     Ok(if v > best.1 { (d, v) } else { best })
 }
 
+/// Storey `i`'s tangent stiffness past the drift |`d`| on its monotonic
+/// curve, P-Δ included (N/m): negative where the storey softens (a
+/// forward difference of 1e-6 |d|).
+pub fn storey_tangent(frame: &ShearFrame, i: usize, d: f64) -> Result<f64, String> {
+    let laws = frame.laws()?;
+    let s = Storey {
+        law: laws[i],
+        geometric: frame.geometric_stiffnesses()[i],
+        share: 1.0,
+        limit: f64::INFINITY,
+    };
+    let (d, h) = (d.abs(), 1e-6 * d.abs().max(f64::MIN_POSITIVE));
+    Ok((s.resistance(d + h)? - s.resistance(d)?) / h)
+}
+
 /// The pushover of `frame` (it needs the storeys' heights); errors name
 /// the option or storey.
 pub fn pushover(frame: &ShearFrame, opts: &PushoverOptions) -> Result<Pushover, String> {
