@@ -36,21 +36,65 @@ pub(super) fn dense_pair<S: Chain>(
     (st.dense_component(sys, i, t), st.dense_component(sys, j, t))
 }
 
+/// A gauge's values and rates at the step's ends from the states and
+/// rates there (`start`, `end`), where the scan covers the `whole` step: a
+/// separation's from the bodies' (u, v); an acceleration's from the
+/// rates, the ground's (z̈ at the ends) and the jerks. None where they are
+/// to be read on the dense output.
+fn gauge_ends(
+    gauge: Gauge,
+    whole: bool,
+    (y0, f0): (&[f64], &[f64]),
+    (y1, f1): (&[f64], &[f64]),
+    jerk: Option<(&Jerk, (f64, f64))>,
+) -> Option<((f64, f64), (f64, f64))> {
+    if !whole {
+        return None;
+    }
+    let side = |y: &[f64], i: Option<usize>| i.map_or((0.0, 0.0), |i| (y[2 * i], y[2 * i + 1]));
+    match (gauge, jerk) {
+        (Gauge::Separation { left, right, .. }, _) => {
+            let (la, ra) = (side(y0, left), side(y0, right));
+            let (lb, rb) = (side(y1, left), side(y1, right));
+            Some(((la.0 - ra.0, la.1 - ra.1), (lb.0 - rb.0, lb.1 - rb.1)))
+        }
+        (Gauge::AbsoluteAcceleration { body }, Some((jerk, (za, zb)))) => {
+            let iv = 2 * body + 1;
+            let ja = jerk.at_start[body];
+            ja.is_finite()
+                .then(|| ((f0[iv] + za, ja), (f1[iv] + zb, jerk.at_end[body])))
+        }
+        _ => None,
+    }
+}
+
 /// The gauge's reading on `[a, b]` within the step ending at `st.t()`, on
 /// the dense output: a separation's rate is the bodies' relative velocity;
 /// an acceleration is the dense velocity's slope plus the ground's, its
 /// rate a difference of the acceleration within the step (where a record
 /// is linear).
-fn gauge_step<S: Chain>(gauge: &mut GaugeScan, st: &mut Stepper, sys: &mut S, a: f64, b: f64) {
+/// `ends`: an acceleration's values and rates at the step's ends, where
+/// known exactly (else read on the dense output).
+fn gauge_step_with<S: Chain>(
+    gauge: &mut GaugeScan,
+    st: &mut Stepper,
+    sys: &mut S,
+    (a, b): (f64, f64),
+    ends: Option<((f64, f64), (f64, f64))>,
+) {
     match gauge.gauge {
         Gauge::Separation { left, right, .. } => {
             let mut side = |i: Option<usize>, t: f64| {
                 i.map_or((0.0, 0.0), |i| dense_pair(st, sys, (2 * i, 2 * i + 1), t))
             };
-            gauge.scan(a, b, |t| {
+            let at = |t| {
                 let (l, r) = (side(left, t), side(right, t));
                 (l.0 - r.0, l.1 - r.1)
-            });
+            };
+            match ends {
+                Some(ends) => gauge.scan_ends((a, b), ends, at),
+                None => gauge.scan(a, b, at),
+            }
         }
         Gauge::AbsoluteAcceleration { body } => {
             let (t0, t1) = (st.t_prev(), st.t());
@@ -66,11 +110,15 @@ fn gauge_step<S: Chain>(gauge: &mut GaugeScan, st: &mut Stepper, sys: &mut S, a:
                     / (2.0 * h);
                 slope + sys.chain().base_acceleration(t)
             };
-            gauge.scan(a, b, |t| {
+            let at = |t: f64| {
                 let (lo, hi) = ((t - h).max(t0), (t + h).min(t1));
                 let x = acceleration(t);
                 (x, (acceleration(hi) - acceleration(lo)) / (hi - lo))
-            });
+            };
+            match ends {
+                Some(ends) => gauge.scan_ends((a, b), ends, at),
+                None => gauge.scan(a, b, at),
+            }
         }
     }
 }
@@ -88,6 +136,40 @@ pub(super) struct ExtremaScan {
     pub(super) found: Extrema,
     /// The gauges being read.
     pub(super) gauges: Vec<GaugeScan>,
+    /// With acceleration gauges: every body's absolute jerk at the last
+    /// step's end, and scratch for the right-hand side that gives it.
+    jerk: Option<Jerk>,
+}
+
+/// The bodies' absolute jerk at a step's end: one evaluation of the
+/// right-hand side a hair back along the step's tangent.
+struct Jerk {
+    /// At the step's start (the step before's end).
+    at_start: Vec<f64>,
+    at_end: Vec<f64>,
+    probe: Vec<f64>,
+    rates: Vec<f64>,
+}
+
+impl Jerk {
+    /// The jerk at the step's end `st.t()` into `at_end`: the acceleration
+    /// f_v + z̈ there less its value at t − ε on the tangent y − ε f, over ε
+    /// (ε a millionth of the step; the jerk is continuous where a record
+    /// kinks, the acceleration relative to the ground is not).
+    fn update<S: Chain>(&mut self, st: &Stepper, sys: &mut S) {
+        std::mem::swap(&mut self.at_start, &mut self.at_end);
+        let (t, y, f) = (st.t(), st.y(), st.dydt());
+        let eps = 1e-6 * st.h_last();
+        for ((p, y), f) in self.probe.iter_mut().zip(y).zip(f) {
+            *p = y - eps * f;
+        }
+        crate::integrate::OdeSystem::rhs(sys, t - eps, &self.probe, &mut self.rates);
+        let ground = |t| sys.chain().base_acceleration(t);
+        let dz = ground(t) - ground(t - eps);
+        for (i, j) in self.at_end.iter_mut().enumerate() {
+            *j = (f[2 * i + 1] - self.rates[2 * i + 1] + dz) / eps;
+        }
+    }
 }
 
 impl ExtremaScan {
@@ -113,7 +195,16 @@ impl ExtremaScan {
                 gauges: Vec::new(),
             },
             s_on,
-            gauges: gauges.iter().cloned().map(GaugeScan::new).collect(),
+            gauges: gauges.iter().copied().map(GaugeScan::new).collect(),
+            jerk: gauges
+                .iter()
+                .any(|g| matches!(g, Gauge::AbsoluteAcceleration { .. }))
+                .then(|| Jerk {
+                    at_start: vec![f64::NAN; bodies],
+                    at_end: vec![f64::NAN; bodies],
+                    probe: vec![0.0; st.y().len()],
+                    rates: vec![0.0; st.y().len()],
+                }),
         };
         if from <= scan.t && scan.t <= to {
             for i in 0..bodies {
@@ -194,9 +285,28 @@ impl ExtremaScan {
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
             self.contact_step(st, sys, a, b);
-            for gauge in &mut self.gauges {
-                gauge_step(gauge, st, sys, a, b);
+            // The bodies' accelerations and jerks at the step's ends, where
+            // the scan's ends are the step's.
+            let whole = a == self.t && b == t1 && self.t == st.t_prev();
+            if let Some(jerk) = self.jerk.as_mut() {
+                jerk.update(st, sys);
             }
+            let ground = self.jerk.as_ref().map(|_| {
+                let z = |t| sys.chain().base_acceleration(t);
+                (z(a), z(b))
+            });
+            for gauge in self.gauges.iter_mut() {
+                let ends = gauge_ends(
+                    gauge.gauge,
+                    whole,
+                    (&self.y, &self.dydt),
+                    (st.y(), st.dydt()),
+                    self.jerk.as_ref().zip(ground),
+                );
+                gauge_step_with(gauge, st, sys, (a, b), ends);
+            }
+        } else if let Some(jerk) = self.jerk.as_mut() {
+            jerk.update(st, sys);
         }
         self.t = t1;
         self.y.copy_from_slice(st.y());

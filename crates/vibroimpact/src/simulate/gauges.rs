@@ -3,10 +3,8 @@
 //! with the [`Extrema`](super::Extrema): a storey's drift, a joint's
 //! closing, a floor's absolute acceleration.
 
-use crate::integrate::events::EventLocator;
-
 /// A quantity of the motion watched over the extrema window.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Gauge {
     /// u_left − u_right (m; None: the ground, from which displacements are
     /// measured): a storey's drift, a joint's closing. Its interior extrema
@@ -90,6 +88,38 @@ impl GaugeReading {
     }
 }
 
+/// Where the cubic Hermite interpolant of a piece, values `xa`, `xb` and
+/// rates `ra`, `rb` (of opposite signs) at its ends, is stationary: the
+/// root in (a, b) of its quadratic rate, by bisection. The piece is short
+/// (an integrator's step, a sixteenth of a period), so the cubic places the
+/// extremum to O(h⁴) and the value read there on the motion itself is off
+/// the true extremum by the square of that (a relative 1e-10 at a record's
+/// 0.01 s and 30 rad/s).
+pub(super) fn hermite_stationary(
+    (a, b): (f64, f64),
+    (xa, ra): (f64, f64),
+    (xb, rb): (f64, f64),
+) -> f64 {
+    let h = b - a;
+    // The rate times h in s = (t − a)/h: q(s) = c2 s² + c1 s + c0, with
+    // q(0) = h ra and q(1) = h rb.
+    let c2 = 6.0 * (xa - xb) + 3.0 * h * (ra + rb);
+    let c1 = 6.0 * (xb - xa) - h * (4.0 * ra + 2.0 * rb);
+    let c0 = h * ra;
+    let q = |s: f64| (c2 * s + c1) * s + c0;
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let rising = c0 < 0.0;
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if (q(mid) < 0.0) == rising {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    a + 0.5 * (lo + hi) * h
+}
+
 /// Gauss–Legendre nodes and weights on [−1, 1], 4 points: exact for the
 /// 7th-degree dense output of DOP853.
 const GAUSS4: [(f64, f64); 4] = [
@@ -142,13 +172,31 @@ impl GaugeScan {
     /// and its rate: the ends, an interior extremum where the rate changes
     /// sign (Brent on the rate), and the mean's part by Gauss–Legendre.
     pub(super) fn scan(&mut self, a: f64, b: f64, mut at: impl FnMut(f64) -> (f64, f64)) {
-        let (xa, ra) = at(a);
-        let (xb, rb) = at(b);
+        let ends = (at(a), at(b));
+        self.scan_ends((a, b), ends, at);
+    }
+
+    /// [`GaugeScan::scan`] with the values and rates at the ends given.
+    pub(super) fn scan_ends(
+        &mut self,
+        (a, b): (f64, f64),
+        ((xa, ra), (xb, rb)): ((f64, f64), (f64, f64)),
+        mut at: impl FnMut(f64) -> (f64, f64),
+    ) {
         self.note(xa);
         self.note(xb);
         if ra * rb < 0.0 {
-            if let Ok(t) = EventLocator::FINE.locate(|t| at(t).1, (a, ra), (b, rb)) {
-                self.note(at(t).0);
+            // The cubic's stationary point, then one secant step on the
+            // rate from the side of the bracket it leaves.
+            let t1 = hermite_stationary((a, b), (xa, ra), (xb, rb));
+            let (x1, r1) = at(t1);
+            self.note(x1);
+            let (tc, rc) = if r1 * ra < 0.0 { (a, ra) } else { (b, rb) };
+            if r1 != 0.0 && r1 != rc {
+                let t2 = t1 - r1 * (t1 - tc) / (r1 - rc);
+                if t2 > a && t2 < b {
+                    self.note(at(t2).0);
+                }
             }
         }
         if let Some(from) = self.gauge.mean_from() {

@@ -34,6 +34,8 @@ pub(super) struct LocalExtrema {
     gauge_scanned: Vec<f64>,
     /// Per group: the gauges that read one of its bodies.
     group_gauges: Vec<Vec<usize>>,
+    /// Per gauge: whether it reads one group alone (with the ground).
+    within: Vec<bool>,
 }
 
 impl LocalExtrema {
@@ -45,6 +47,14 @@ impl LocalExtrema {
         (s_on, gauges): (Vec<f64>, &[Gauge]),
     ) -> Self {
         let mut group_gauges = vec![Vec::new(); free.groups().len()];
+        let within = gauges
+            .iter()
+            .map(|gauge| {
+                let mut groups = gauge.sides().into_iter().flatten().map(|i| free.place(i).0);
+                let first = groups.next();
+                groups.all(|g| Some(g) == first)
+            })
+            .collect();
         for (w, gauge) in gauges.iter().enumerate() {
             for i in gauge.sides().into_iter().flatten() {
                 let g = free.place(i).0;
@@ -87,6 +97,7 @@ impl LocalExtrema {
             gauges: gauges.iter().cloned().map(GaugeScan::new).collect(),
             gauge_scanned: vec![f64::NEG_INFINITY; gauges.len()],
             group_gauges,
+            within,
         }
     }
 
@@ -139,6 +150,33 @@ impl LocalExtrema {
     }
 }
 
+/// An exact side's group state, carried along a scan.
+struct Carried {
+    g: usize,
+    /// The side's place in its group.
+    j: usize,
+    t: f64,
+    x: Vec<f64>,
+}
+
+impl Carried {
+    /// The state moved on to `t`.
+    fn advance(&mut self, free: &FreeMotion, t: f64) {
+        free.propagate(self.g, self.t, t, &mut self.x);
+        self.t = t;
+    }
+
+    /// The side's (u, v) at `t` (from the carried state).
+    fn at(&self, free: &FreeMotion, t: f64) -> (f64, f64) {
+        if t == self.t {
+            return (self.x[2 * self.j], self.x[2 * self.j + 1]);
+        }
+        let mut y = self.x.clone();
+        free.propagate(self.g, self.t, t, &mut y);
+        (y[2 * self.j], y[2 * self.j + 1])
+    }
+}
+
 /// The ends of the equal pieces of `[a, b]` no longer than `step` (at
 /// least one; the last exactly `b`; none that does not advance).
 fn grid(a: f64, b: f64, step: f64) -> impl Iterator<Item = f64> {
@@ -180,14 +218,92 @@ impl Run<'_> {
             }
             ex.contact_scanned[k] = ex.contact_scanned[k].max(t);
         }
-        for c in 0..ex.group_gauges[g].len() {
-            let w = ex.group_gauges[g][c];
-            if self.gauge_in_set(&ex, w) {
-                continue;
+        // The group's own gauges in one pass over its motion, the others
+        // (reading another exact group too) each on its own.
+        let (mut own, mut across) = (Vec::new(), Vec::new());
+        for &w in &ex.group_gauges[g] {
+            if !self.gauge_in_set(&ex, w) {
+                if ex.within[w] {
+                    own.push(w);
+                } else {
+                    across.push(w);
+                }
             }
+        }
+        if let Some(&first) = own.first() {
+            if let Some((a, b)) = ex.span(ex.gauge_scanned[first], t) {
+                self.scan_group_gauges(&mut ex, g, &own, a, b);
+            }
+            for &w in &own {
+                ex.gauge_scanned[w] = ex.gauge_scanned[w].max(t);
+            }
+        }
+        for w in across {
             self.gauge_to(&mut ex, w, t);
         }
         self.extrema = Some(ex);
+    }
+
+    /// Group `g`'s own gauges `ws` (scanned up to the same time) on
+    /// `[a, b]` of its exact motion: per piece of its grid the state at
+    /// the ends once, the values and rates exact (a separation's relative
+    /// velocity, an acceleration's jerk [`FreeMotion::absolute_jerk`]),
+    /// the interior by propagation from the piece's start.
+    fn scan_group_gauges(&self, ex: &mut LocalExtrema, g: usize, ws: &[usize], a: f64, b: f64) {
+        let free = &self.free;
+        let m = free.groups()[g].bodies().len();
+        let (t0, x0) = &self.exact[g];
+        let mut xa = x0.clone();
+        free.propagate(g, *t0, a, &mut xa);
+        // The bodies' accelerations in the group's state x at t.
+        let accelerations = |t: f64, x: &[f64], acc: &mut Vec<f64>| {
+            acc.clear();
+            acc.extend((0..m).map(|i| free.acceleration(g, t, x, i)));
+        };
+        // The gauge's value and rate in the group's state x at t, with its
+        // bodies' accelerations acc.
+        let read = |gauge: &Gauge, t: f64, x: &[f64], acc: &[f64]| -> (f64, f64) {
+            match *gauge {
+                Gauge::Separation { left, right, .. } => {
+                    let side = |i: Option<usize>| {
+                        i.map_or((0.0, 0.0), |i| {
+                            let j = free.place(i).1;
+                            (x[2 * j], x[2 * j + 1])
+                        })
+                    };
+                    let (l, r) = (side(left), side(right));
+                    (l.0 - r.0, l.1 - r.1)
+                }
+                Gauge::AbsoluteAcceleration { body } => {
+                    let j = free.place(body).1;
+                    let ground = self.model.base().at(t);
+                    (acc[j] + ground, free.absolute_jerk(g, t, x, acc, j))
+                }
+            }
+        };
+        let (mut acc_a, mut acc_b) = (Vec::with_capacity(m), Vec::with_capacity(m));
+        accelerations(a, &xa, &mut acc_a);
+        let mut xb = xa.clone();
+        let mut ta = a;
+        for tb in grid(a, b, ex.grid[g]) {
+            xb.copy_from_slice(&xa);
+            free.propagate(g, ta, tb, &mut xb);
+            accelerations(tb, &xb, &mut acc_b);
+            for &w in ws {
+                let gauge = ex.gauges[w].gauge;
+                let ends = (read(&gauge, ta, &xa, &acc_a), read(&gauge, tb, &xb, &acc_b));
+                ex.gauges[w].scan_ends((ta, tb), ends, |t| {
+                    let mut x = xa.clone();
+                    free.propagate(g, ta, t, &mut x);
+                    let mut acc = Vec::with_capacity(m);
+                    accelerations(t, &x, &mut acc);
+                    read(&gauge, t, &x, &acc)
+                });
+            }
+            std::mem::swap(&mut xa, &mut xb);
+            std::mem::swap(&mut acc_a, &mut acc_b);
+            ta = tb;
+        }
     }
 
     /// Whether gauge `w` reads a body in the set.
@@ -246,35 +362,63 @@ impl Run<'_> {
     }
 
     /// Gauge `w` on `[a, b]`: over the grid of its exact sides (one piece
-    /// within a step of the set), as [`GaugeScan::scan`] reads a piece.
+    /// within a step of the set), as [`GaugeScan::scan`] reads a piece; an
+    /// exact side's group state carried from piece to piece.
     fn scan_gauge(&mut self, ex: &mut LocalExtrema, w: usize, a: f64, b: f64) {
-        let gauge = ex.gauges[w].gauge.clone();
-        let step = gauge
-            .sides()
+        let gauge = ex.gauges[w].gauge;
+        let sides = gauge.sides();
+        let step = sides
             .into_iter()
             .flatten()
             .filter(|&i| self.slot[i].is_none())
             .map(|i| ex.grid[self.free.place(i).0])
             .fold(f64::INFINITY, f64::min);
+        let mut carried = sides.map(|side| {
+            let i = side.filter(|&i| self.slot[i].is_none())?;
+            let (g, j) = self.free.place(i);
+            let (t0, x0) = &self.exact[g];
+            let mut x = x0.clone();
+            self.free.propagate(g, *t0, a, &mut x);
+            Some(Carried { g, j, t: a, x })
+        });
+        let (free, set, slot) = (&self.free, &mut self.set, &self.slot);
+        let ground = |t| self.model.base().at(t);
         let mut ta = a;
         for tb in grid(a, b, step) {
             let reading = &mut ex.gauges[w];
+            // A side's (u, v) at t: carried exactly, or the set's dense
+            // output.
+            let mut side = |k: usize, t: f64| match (sides[k], &carried[k]) {
+                (None, _) => (0.0, 0.0),
+                (Some(_), Some(c)) => c.at(free, t),
+                (Some(i), None) => match (slot[i], set.as_mut()) {
+                    (Some(j), Some(set)) => (
+                        set.st.dense_component(&mut set.sys, 2 * j, t),
+                        set.st.dense_component(&mut set.sys, 2 * j + 1, t),
+                    ),
+                    _ => (f64::NAN, f64::NAN),
+                },
+            };
             match gauge {
-                Gauge::Separation { left, right, .. } => reading.scan(ta, tb, |t| {
-                    let (l, r) = (self.side_at(left, t), self.side_at(right, t));
+                Gauge::Separation { .. } => reading.scan(ta, tb, |t| {
+                    let (l, r) = (side(0, t), side(1, t));
                     (l.0 - r.0, l.1 - r.1)
                 }),
-                Gauge::AbsoluteAcceleration { body } => {
+                // (A body's own gauge reaches here only while it is in the
+                // set: the slope of its dense velocity.)
+                Gauge::AbsoluteAcceleration { .. } => {
                     let h = 1e-4 * (tb - ta);
+                    let mut acceleration =
+                        |t: f64| (side(0, t + h).1 - side(0, t - h).1) / (2.0 * h) + ground(t);
                     reading.scan(ta, tb, |t| {
                         let (lo, hi) = ((t - h).max(ta), (t + h).min(tb));
-                        let x = self.absolute_acceleration(body, t);
-                        let rate = (self.absolute_acceleration(body, hi)
-                            - self.absolute_acceleration(body, lo))
-                            / (hi - lo);
-                        (x, rate)
+                        let x = acceleration(t);
+                        (x, (acceleration(hi) - acceleration(lo)) / (hi - lo))
                     });
                 }
+            }
+            for c in carried.iter_mut().flatten() {
+                c.advance(free, tb);
             }
             ta = tb;
         }
@@ -293,27 +437,6 @@ impl Run<'_> {
             ),
             (Some(_), None) => (f64::NAN, f64::NAN),
             (None, _) => self.exact_body(i, t),
-        }
-    }
-
-    /// Body i's absolute acceleration at `t`: its exact motion's, or the
-    /// slope of the set's dense velocity, plus the ground's.
-    fn absolute_acceleration(&mut self, i: usize, t: f64) -> f64 {
-        let ground = self.model.base().at(t);
-        match (self.slot[i], self.set.as_mut()) {
-            (Some(j), Some(set)) => {
-                let h = 1e-4 * set.st.h_last();
-                let mut v = |t| set.st.dense_component(&mut set.sys, 2 * j + 1, t);
-                (v(t + h) - v(t - h)) / (2.0 * h) + ground
-            }
-            (Some(_), None) => f64::NAN,
-            (None, _) => {
-                let (g, j) = self.free.place(i);
-                let (t0, x0) = &self.exact[g];
-                let mut x = x0.clone();
-                self.free.propagate(g, *t0, t, &mut x);
-                self.free.acceleration(g, t, &x, j) + ground
-            }
         }
     }
 

@@ -580,6 +580,31 @@ impl FreeMotion {
         f / group.mass[j] - self.base.at(t)
     }
 
+    /// The rate of body `j`'s absolute acceleration (its acceleration
+    /// plus the base's) in group `g` at `t`, given the group's state `x`
+    /// and its bodies' accelerations `acc` ([`FreeMotion::acceleration`]):
+    /// the springs' and dampers' forces differentiated along the motion,
+    /// and the forces' rates (m/s³; the base's rate cancels).
+    pub fn absolute_jerk(&self, g: usize, t: f64, x: &[f64], acc: &[f64], j: usize) -> f64 {
+        let group = &self.groups[g];
+        let v = |i: usize| x[2 * i + 1];
+        let mut f = -group.stiffness[j] * v(j) - group.damping[j] * acc[j];
+        for &(a, b, k, c) in &group.couplings {
+            let other = match (a == j, b == j) {
+                (true, _) => b,
+                (_, true) => a,
+                _ => continue,
+            };
+            f += k * (v(other) - v(j)) + c * (acc[other] - acc[j]);
+        }
+        for &(i, p, w, phi) in &group.forces {
+            if i == j {
+                f += p * w * (w * t + phi).cos();
+            }
+        }
+        f / group.mass[j]
+    }
+
     /// `x ← e^{Aτ} x` for group `g`: a tangent vector of the free motion
     /// (the forcing does not enter the variational equations).
     pub fn propagate_homogeneous(&self, g: usize, tau: f64, x: &mut [f64]) {
