@@ -136,6 +136,8 @@ pub(super) struct ExtremaScan {
     pub(super) found: Extrema,
     /// The gauges being read.
     pub(super) gauges: Vec<GaugeScan>,
+    /// Whether the bodies and contacts are scanned (else the gauges alone).
+    bodies: bool,
     /// With acceleration gauges: every body's absolute jerk at the last
     /// step's end, and scratch for the right-hand side that gives it.
     jerk: Option<Jerk>,
@@ -178,7 +180,7 @@ impl ExtremaScan {
     pub(super) fn new(
         (from, to): (f64, f64),
         bodies: usize,
-        (s_on, gauges): (Vec<f64>, &[Gauge]),
+        (s_on, gauges, of_bodies): (Vec<f64>, &[Gauge], bool),
         st: &Stepper,
         sys: &ChainDynamics,
     ) -> Self {
@@ -196,6 +198,7 @@ impl ExtremaScan {
             },
             s_on,
             gauges: gauges.iter().copied().map(GaugeScan::new).collect(),
+            bodies: of_bodies,
             jerk: gauges
                 .iter()
                 .any(|g| matches!(g, Gauge::AbsoluteAcceleration { .. }))
@@ -251,40 +254,49 @@ impl ExtremaScan {
         self.found
     }
 
+    /// The bodies' |u|, |v| and the contacts' margins on `[a, b]` within
+    /// the step ending at `st.t()`.
+    fn bodies_step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, (a, b): (f64, f64)) {
+        let t1 = st.t();
+        for i in 0..self.found.max_displacement.len() {
+            let (iu, iv) = (2 * i, 2 * i + 1);
+            let (ua, va) = if a == self.t {
+                (self.y[iu], self.y[iv])
+            } else {
+                dense_pair(st, sys, (iu, iv), a)
+            };
+            let (ub, vb) = if b == t1 {
+                (st.y()[iu], st.y()[iv])
+            } else {
+                dense_pair(st, sys, (iu, iv), b)
+            };
+            let mut max_u = ua.abs().max(ub.abs());
+            let mut max_v = va.abs().max(vb.abs());
+            if va * vb < 0.0 {
+                let v = |t| st.dense_component(sys, iv, t);
+                if let Ok(t) = EventLocator::FINE.locate(v, (a, va), (b, vb)) {
+                    max_u = max_u.max(st.dense_component(sys, iu, t).abs());
+                }
+            }
+            if self.dydt[iv] * st.dydt()[iv] < 0.0 {
+                let speed = |t| st.dense_component(sys, iv, t).abs();
+                max_v = max_v.max(golden_max(speed, a, b).0);
+            }
+            let f = &mut self.found;
+            f.max_displacement[i] = f.max_displacement[i].max(max_u);
+            f.max_velocity[i] = f.max_velocity[i].max(max_v);
+        }
+        self.contact_step(st, sys, a, b);
+    }
+
     /// Processes the accepted step from the previous end to `st.t()`.
     pub(super) fn step<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
         let t1 = st.t();
         let (a, b) = (self.t.max(self.from), t1.min(self.to));
+        if a <= b && self.bodies {
+            self.bodies_step(st, sys, (a, b));
+        }
         if a <= b {
-            for i in 0..self.found.max_displacement.len() {
-                let (iu, iv) = (2 * i, 2 * i + 1);
-                let (ua, va) = if a == self.t {
-                    (self.y[iu], self.y[iv])
-                } else {
-                    dense_pair(st, sys, (iu, iv), a)
-                };
-                let (ub, vb) = if b == t1 {
-                    (st.y()[iu], st.y()[iv])
-                } else {
-                    dense_pair(st, sys, (iu, iv), b)
-                };
-                let mut max_u = ua.abs().max(ub.abs());
-                let mut max_v = va.abs().max(vb.abs());
-                if va * vb < 0.0 {
-                    let v = |t| st.dense_component(sys, iv, t);
-                    if let Ok(t) = EventLocator::FINE.locate(v, (a, va), (b, vb)) {
-                        max_u = max_u.max(st.dense_component(sys, iu, t).abs());
-                    }
-                }
-                if self.dydt[iv] * st.dydt()[iv] < 0.0 {
-                    let speed = |t| st.dense_component(sys, iv, t).abs();
-                    max_v = max_v.max(golden_max(speed, a, b).0);
-                }
-                let f = &mut self.found;
-                f.max_displacement[i] = f.max_displacement[i].max(max_u);
-                f.max_velocity[i] = f.max_velocity[i].max(max_v);
-            }
-            self.contact_step(st, sys, a, b);
             // The bodies' accelerations and jerks at the step's ends, where
             // the scan's ends are the step's.
             let whole = a == self.t && b == t1 && self.t == st.t_prev();

@@ -56,7 +56,7 @@ pub fn simulate_streaming(
             Some(ExtremaScan::new(
                 window,
                 n2 / 2,
-                (s_on, &opts.gauges),
+                (s_on, &opts.gauges, opts.extrema_of_bodies),
                 &st,
                 &sys,
             ))

@@ -85,6 +85,10 @@ pub struct SimulationOptions {
     /// Further quantities whose extrema (and means) are located over the
     /// extrema window: drifts, closings, absolute accelerations.
     pub gauges: Vec<Gauge>,
+    /// Whether the extrema cover the bodies' |u|, |v| and the contacts'
+    /// margins (default true); false: the gauges alone (a study that reads
+    /// only what its gauges give skips the rest).
+    pub extrema_of_bodies: bool,
     /// Stop request checked at every step (see [`Interrupt`]): the
     /// simulation then ends early with [`IntegrationError::Interrupted`] as
     /// its error, keeping what was computed.
@@ -119,6 +123,7 @@ impl Default for SimulationOptions {
             method: Method::Dop853,
             extrema_window: None,
             gauges: Vec::new(),
+            extrema_of_bodies: true,
             interrupt: None,
             integrator: Integrator::Auto,
             accelerations: false,

@@ -592,6 +592,7 @@ impl Row {
         let mut peaks = Peaks::new(self, &rm, opts.t_end);
         opts.gauges = peaks.gauges();
         opts.extrema_window = Some((0.0, opts.t_end));
+        opts.extrema_of_bodies = false;
         let model = &rm.model;
         let mut passed = None;
         let sim = simulate_streaming(model, &opts, |t, row| {

@@ -13,9 +13,10 @@ pub(super) struct Peaks {
     /// Per building: where its floors start, its slab, how many floors.
     layout: Vec<(usize, Option<usize>, usize)>,
     /// The gauges, in order: per building, per floor, its storey's drift
-    /// (with its mean over the building's last fundamental period) and its
-    /// absolute acceleration, then its slab's displacement (with its mean)
-    /// if isolated; then per joint, per floor, its closing.
+    /// (with its mean over the building's last fundamental period), its
+    /// absolute acceleration and its displacement, then its slab's
+    /// displacement (with its mean) if isolated; then per joint, per
+    /// floor, its closing.
     gauges: Vec<Gauge>,
     /// Per building, its first gauge.
     building_gauges: Vec<usize>,
@@ -54,6 +55,11 @@ impl Peaks {
                     mean_from,
                 });
                 gauges.push(Gauge::AbsoluteAcceleration { body: first + i });
+                gauges.push(Gauge::Separation {
+                    left: Some(first + i),
+                    right: None,
+                    mean_from: None,
+                });
             }
             slab_gauges.push(base.map(|slab| {
                 gauges.push(Gauge::Separation {
@@ -164,7 +170,6 @@ impl Peaks {
         // A run stopped before a building's window opened (a collapse
         // study's drift limit) has no residual: NaN (null in documents).
         let mean = |w: usize| read(w).mean.unwrap_or(f64::NAN);
-        let displaced = |i: usize| sim.extrema.as_ref().map_or(0.0, |e| e.max_displacement[i]);
         let per_floor = |f: &dyn Fn(usize, usize) -> f64| -> Vec<Vec<f64>> {
             self.layout
                 .iter()
@@ -172,11 +177,11 @@ impl Peaks {
                 .map(|(k, l)| (0..l.2).map(|i| f(k, i)).collect())
                 .collect()
         };
-        let drift_gauge = |k: usize, i: usize| self.building_gauges[k] + 2 * i;
+        let drift_gauge = |k: usize, i: usize| self.building_gauges[k] + 3 * i;
         let drift = per_floor(&|k, i| read(drift_gauge(k, i)).peak());
         let residual = per_floor(&|k, i| mean(drift_gauge(k, i)));
         let acceleration = per_floor(&|k, i| read(drift_gauge(k, i) + 1).peak());
-        let displacement = per_floor(&|k, i| displaced(self.layout[k].0 + i));
+        let displacement = per_floor(&|k, i| read(drift_gauge(k, i) + 2).peak());
         let isolators = rm
             .placements
             .iter()

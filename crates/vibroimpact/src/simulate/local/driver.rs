@@ -691,7 +691,7 @@ impl<'a> Run<'a> {
                 window,
                 model,
                 &run.free,
-                (s_on, &opts.gauges),
+                (s_on, &opts.gauges, opts.extrema_of_bodies),
             ));
         }
         Ok(run)

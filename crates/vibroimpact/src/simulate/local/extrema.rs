@@ -36,6 +36,8 @@ pub(super) struct LocalExtrema {
     group_gauges: Vec<Vec<usize>>,
     /// Per gauge: whether it reads one group alone (with the ground).
     within: Vec<bool>,
+    /// Whether the bodies and contacts are scanned (else the gauges alone).
+    bodies: bool,
 }
 
 impl LocalExtrema {
@@ -44,7 +46,7 @@ impl LocalExtrema {
         window: (f64, f64),
         model: &Model,
         free: &FreeMotion,
-        (s_on, gauges): (Vec<f64>, &[Gauge]),
+        (s_on, gauges, bodies): (Vec<f64>, &[Gauge], bool),
     ) -> Self {
         let mut group_gauges = vec![Vec::new(); free.groups().len()];
         let within = gauges
@@ -98,6 +100,7 @@ impl LocalExtrema {
             gauge_scanned: vec![f64::NEG_INFINITY; gauges.len()],
             group_gauges,
             within,
+            bodies,
         }
     }
 
@@ -129,7 +132,13 @@ impl LocalExtrema {
     ) -> ExtremaScan {
         let s_on = ids.iter().map(|&k| self.s_on[k]).collect();
         // (The gauges are read by the run, on the set's steps.)
-        ExtremaScan::new(self.window, bodies, (s_on, &[]), st, sys.chain())
+        ExtremaScan::new(
+            self.window,
+            bodies,
+            (s_on, &[], self.bodies),
+            st,
+            sys.chain(),
+        )
     }
 
     /// The part of `[from, t]` inside the window, if any (a point counts).
@@ -204,11 +213,16 @@ impl Run<'_> {
             return;
         };
         let from = ex.group_scanned[g].max(self.exact[g].0);
-        if let Some((a, b)) = ex.span(from, t) {
+        if let (Some((a, b)), true) = (ex.span(from, t), ex.bodies) {
             self.scan_bodies(&mut ex, g, a, b);
         }
         ex.group_scanned[g] = ex.group_scanned[g].max(t);
-        for c in 0..self.group_contacts[g].len() {
+        let contacts = if ex.bodies {
+            self.group_contacts[g].len()
+        } else {
+            0
+        };
+        for c in 0..contacts {
             let k = self.group_contacts[g][c];
             if self.touches_set(k) {
                 continue;
@@ -345,7 +359,11 @@ impl Run<'_> {
                 scan.step(&mut set.st, &mut set.sys);
             }
             let t = set.st.t();
-            let boundary = set.boundary.clone();
+            let boundary = if ex.bodies {
+                set.boundary.clone()
+            } else {
+                Vec::new()
+            };
             for k in boundary {
                 if let Some((a, b)) = ex.span(ex.contact_scanned[k], t) {
                     self.scan_contact(&mut ex, k, a, b);
