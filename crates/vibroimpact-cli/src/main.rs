@@ -28,8 +28,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    basins, branch, chart, collapse, hysteresis, identify, impact, periodic, pounding, simulate,
-    spectrum, sweep,
+    basins, branch, chart, collapse, hysteresis, identify, impact, periodic, pounding, pushover,
+    simulate, spectrum, sweep,
 };
 
 /// Vibrating systems with mutual impacts (after T. Fujita 1977).
@@ -73,6 +73,11 @@ enum Command {
     /// drift history: its hysteresis loop and dissipated energy.
     #[command(allow_negative_numbers = true)]
     Hysteresis(hysteresis::HysteresisArgs),
+    /// The static pushover of a building of a row or pair file: base shear
+    /// against roof displacement, FEMA P695's overstrength and
+    /// period-based ductility μ_T.
+    #[command(allow_negative_numbers = true)]
+    Pushover(pushover::PushoverArgs),
     /// Pounding of a row of buildings (a pair of frames, K buildings,
     /// isolated ones in their moats) under recorded ground motions:
     /// response with and without pounding, the gap that avoids contact,
@@ -161,6 +166,7 @@ fn main() -> ExitCode {
         Some(Command::Basins(args)) => basins::run(args),
         Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Hysteresis(args)) => hysteresis::run(args),
+        Some(Command::Pushover(args)) => pushover::run(args),
         Some(Command::Pounding(args)) => pounding::run(args),
         Some(Command::Collapse(args)) => collapse::run(args),
         Some(Command::Report { out }) => report::run(out),

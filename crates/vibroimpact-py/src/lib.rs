@@ -23,6 +23,7 @@ mod impact;
 mod model;
 mod monitor;
 mod periodic;
+mod pushover;
 mod records;
 mod simulate;
 mod sweep;
@@ -66,6 +67,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(records::pounding, m)?)?;
     m.add_function(wrap_pyfunction!(records::pounding_history, m)?)?;
     m.add_function(wrap_pyfunction!(records::value_range, m)?)?;
+    m.add_function(wrap_pyfunction!(pushover::pushover, m)?)?;
     m.add_function(wrap_pyfunction!(collapse::collapse_record, m)?)?;
     m.add_function(wrap_pyfunction!(collapse::collapse_document, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::parameter_values, m)?)?;

@@ -267,7 +267,10 @@ def test_isolated_building_documents_have_one_shape(cli):
         ("isolated", k) for k in (1, 2, 3, 4)]
     bearings = h["loops"][0]
     assert bearings["drift"].shape == bearings["force"].shape == h["t"].shape
-    assert np.max(np.abs(bearings["drift"])) == pytest.approx(iso["peak_displacement"], rel=1e-12)
+    # The loop's samples stay below the exact peak (on the dense output),
+    # within 1e-3 of it at 2.5 ms.
+    sampled, exact = np.max(np.abs(bearings["drift"])), iso["peak_displacement"]
+    assert exact * (1 - 1e-3) <= sampled <= exact * (1 + 1e-12)
     assert "isolated moat" in h["impact_at"] and h["slab"]["isolated"].shape == h["t"].shape
     with pytest.raises(ValueError, match="moat_gaps: give it or gaps and ratios"):
         vi.pounding(building, quake, units="m/s2", gaps="0.1:0.2:2", ratios="1:2:2", moat_gaps="0.1:0.2:2")
@@ -457,3 +460,25 @@ def test_spectrum_document_has_the_cli_shape(cli):
     got = {k: v for k, v in r.to_dict().items() if k in doc}
     assert set(got) == set(doc)
     _same_document(got, doc, "spectrum")
+
+
+def test_pushover(cli):
+    # The archetype's pushover: the same curve and FEMA P695 quantities;
+    # options and a missing building refused by name.
+    path = EXAMPLES / "moment-frame-4.toml"
+    doc = cli("pushover", str(path), "--points", "200")
+    r = vi.pushover(path, points=200)
+    for key in ("roof_displacement", "base_shear", "drifts", "pattern"):
+        close(r[key], doc[key])
+    for key in ("max_base_shear", "yield_displacement", "ultimate_displacement", "ductility", "c0"):
+        close(r[key], doc[key])
+    assert r["critical_storey"] == doc["critical_storey"] == 2
+    assert 1.5 < r["ductility"] < 2.5
+    with pytest.raises(ValueError, match="drift_ratio_limit"):
+        vi.pushover(path, drift_ratio_limit=-1.0)
+    with pytest.raises(ValueError, match="points"):
+        vi.pushover(path, points=1)
+    with pytest.raises(ValueError, match="building"):
+        vi.pushover(path, "nope")
+    with pytest.raises(ValueError, match="heights"):
+        vi.pushover(EXAMPLES / "pounding-frames.toml")

@@ -20,6 +20,7 @@ FUNCTIONS = {
     "basins": vi.basins,
     "spectrum": vi.response_spectrum,
     "pounding": vi.pounding,
+    "pushover": vi.pushover,
     "hysteresis": vi.hysteresis,
     "collapse": vi.collapse_study,
 }

@@ -10,6 +10,7 @@ pub mod identify;
 pub mod impact;
 pub mod periodic;
 pub mod pounding;
+pub mod pushover;
 pub mod simulate;
 pub mod spectrum;
 pub mod sweep;

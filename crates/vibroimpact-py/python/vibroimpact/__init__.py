@@ -26,7 +26,7 @@ from __future__ import annotations
 from . import _checks
 from ._core import LongRunWarning, Model, VibroimpactError
 from .collapse import collapse_study
-from ._earthquakes import pounding, pounding_history, read_record, response_spectrum
+from ._earthquakes import pounding, pounding_history, pushover, read_record, response_spectrum
 from ._impacts import contact_force, identify, impact
 from ._maps import basins, chart, parameter_values, sweep
 from ._motion import simulate
@@ -54,6 +54,7 @@ __all__ = [
     "periodic",
     "pounding",
     "pounding_history",
+    "pushover",
     "read_record",
     "response_spectrum",
     "simulate",

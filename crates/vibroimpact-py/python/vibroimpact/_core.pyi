@@ -113,6 +113,10 @@ def hysteresis(
     law: tuple[str, float, Optional[float], float, float, float, float, float, float, float],
     amplitudes: list[float], cycles: int, points: int, drift: Optional[F64], rtol: float,
 ) -> dict[str, Any]: ...
+def pushover(
+    pair_text: str, source: str, building: Optional[str], drift_ratio_limit: float, points: int,
+    code_period: Optional[float],
+) -> dict[str, Any]: ...
 def pounding_history(
     pair_text: str, source: str, times: F64, acceleration: F64, scale: float, sample: float,
     rtol: float, method: str, integrator: str,

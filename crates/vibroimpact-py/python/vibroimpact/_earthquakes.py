@@ -286,6 +286,40 @@ def pounding(
     )
 
 
+def pushover(
+    pair: Any,
+    building: Any = None,
+    *,
+    drift_ratio_limit: float = 0.10,
+    points: int = 400,
+    code_period: Any = None,
+) -> Result:
+    """The static pushover of one building (``vibroimpact pushover``,
+    docs/earthquakes.md): ``pair`` a row or pair file (name or TOML text),
+    ``building`` its name (default: the first; it needs ``heights``). The
+    loads follow the first mode times the floor masses and grow until the
+    critical storey collapses or reaches ``drift_ratio_limit`` (``points``
+    along its drift); ``code_period`` is FEMA P695's T = C_u T_a for
+    δ_y,eff (default: T1 with P-Δ).
+
+    Returns the CLI's document: ``roof_displacement``, ``roof_drift_ratio``,
+    ``base_shear``, ``drifts`` per point, ``pattern``, ``critical_storey``,
+    ``collapsed``, ``max_base_shear``, ``weight``, ``period``, ``c0``,
+    ``yield_displacement``, ``ultimate_displacement``, ``strength_loss``,
+    ``ductility`` (μ_T) and ``units``."""
+    from . import _core
+    from ._checks import _real
+
+    source, text = _pair_text(pair)
+    if building is not None and not isinstance(building, str):
+        raise TypeError(f"building: expected a building's name, got {building!r}")
+    limit = _real(drift_ratio_limit, "drift_ratio_limit", positive=True)
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
+        raise ValueError(f"points: expected an integer >= 2, got {points!r}")
+    period = _real(code_period, "code_period", positive=True, optional=True)
+    return Result(_core.pushover(text, source, building, limit, int(points), period))
+
+
 def pounding_history(
     pair: Union[str, "os.PathLike[str]"],
     record: Any,

@@ -2,7 +2,8 @@
 //! storey as a function of its drift d and its history, carried by a
 //! hysteretic drift z.
 //!
-//! Files: `mod.rs` (the laws), `tests.rs` (loops against closed forms).
+//! Files: `mod.rs` (the laws), `imk.rs` (the modified IMK storey),
+//! `tests.rs` (loops against closed forms).
 //!
 //! - Elastic: F = k d.
 //! - Bilinear with kinematic hardening (OpenSees `Steel01` without its
@@ -573,6 +574,8 @@ pub fn cyclic_protocol(
         })
         .collect())
 }
+
+pub mod imk;
 
 #[cfg(test)]
 mod tests;

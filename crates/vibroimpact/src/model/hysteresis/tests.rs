@@ -230,3 +230,115 @@ fn a_vanishing_yield_drift_is_refused() {
     };
     assert!(ok.law(1e8).is_ok());
 }
+
+/// An IMK storey: k = 1.2e8 N/m, u_y = 0.01 m, cap at 1.1 F_y after
+/// d_p = 0.03 m, zero force 0.1 m past the cap, residual 0.3 F_y, ultimate
+/// drift 0.2 m.
+fn imk(lambda: f64) -> imk::Imk {
+    imk::Imk {
+        stiffness: K,
+        yield_drift: UY,
+        cap_ratio: 1.1,
+        plastic_drift: 0.03,
+        post_capping_drift: 0.1,
+        residual_ratio: 0.3,
+        ultimate_drift: 0.2,
+        lambda: [lambda; 3],
+        exponent: [1.0; 3],
+    }
+}
+
+/// A monotonic push follows the backbone's closed form to 1e-12 of F_y:
+/// k d, then F_y + K_p (d − u_y) to the cap, F_c − (F_c/d_pc)(d − u_cap) to
+/// the residual, the residual to the ultimate drift, then nothing; and the
+/// same pulled negative.
+#[test]
+fn imk_monotonic_push_is_its_backbone() {
+    let law = imk(1e9);
+    let fy = K * UY;
+    let (fc, ucap, fres) = (1.1 * fy, UY + 0.03, 0.3 * fy);
+    let kp = (fc - fy) / 0.03;
+    let backbone = |d: f64| {
+        if d <= UY {
+            K * d
+        } else if d <= ucap {
+            fy + kp * (d - UY)
+        } else if d < 0.2 {
+            (fc - fc / 0.1 * (d - ucap)).max(fres)
+        } else {
+            0.0
+        }
+    };
+    for sign in [1.0, -1.0] {
+        let mut s = law.rest();
+        for j in 1..=500 {
+            let d = 0.25 * j as f64 / 500.0;
+            law.advance(&mut s, sign * d);
+            let want = sign * backbone(d);
+            assert!(
+                (s.force - want).abs() < 1e-12 * fy,
+                "d {d}: {} against {want}",
+                s.force
+            );
+        }
+    }
+}
+
+/// The energy rule over one excursion, to 1e-9 of F_y: pushed to 0.03 m
+/// (on the hardening line) and reversed, K_u drops by β_K = E/(λ F_y − E)
+/// with E the work less the spring's F²/(2k); at the zero crossing the
+/// negative backbone's yield strength and hardening slope drop by
+/// β_S = E_i/(λ F_y − E_i) (E_i the work so far) and the post-capping
+/// line's intercept by β_C (the same, one λ); reloading negative then
+/// meets the new hardening line where the closed form says.
+#[test]
+fn imk_deteriorates_by_the_energy_rule() {
+    let lambda = 2.0;
+    let law = imk(lambda);
+    let fy = K * UY;
+    let e_ref = lambda * fy;
+    let (fc, ucap) = (1.1 * fy, UY + 0.03);
+    let (kp, kpc) = ((fc - fy) / 0.03, -fc / 0.1);
+    let d1 = 0.03;
+    let f1 = fy + kp * (d1 - UY);
+    let mut s = law.rest();
+    law.advance(&mut s, d1);
+    assert!((s.force - f1).abs() < 1e-9 * fy);
+    let work1 = 0.5 * fy * UY + 0.5 * (fy + f1) * (d1 - UY);
+    assert!((s.work - work1).abs() < 1e-9 * work1);
+    // The reversal: β_K, then unloading at K_u to zero force.
+    let stored = 0.5 * f1 * f1 / K;
+    let beta_k = (work1 - stored) / (e_ref - (work1 - stored));
+    let ku = K * (1.0 - beta_k);
+    let x_c = d1 - f1 / ku;
+    law.advance(&mut s, x_c + 1e-6);
+    assert!(
+        (s.force - ku * 1e-6).abs() < 1e-9 * fy,
+        "{} against {}",
+        s.force,
+        ku * 1e-6
+    );
+    // At the crossing: E_i = the work so far, β_S = β_C = E_i/(λ F_y − E_i).
+    let e_i = work1 - 0.5 * f1 * f1 / ku;
+    let beta = e_i / (e_ref - e_i);
+    let fy_n = -fy * (1.0 - beta);
+    let kp_n = kp * (1.0 - beta);
+    let fcap_proj = (-fc - kpc * -ucap) * (1.0 - beta);
+    let uy_n = fy_n / K;
+    let fy_proj = fy_n - kp_n * uy_n;
+    let kpc_n = kpc * (fy_n + 0.3 * fy) / (-fy + 0.3 * fy);
+    let ucap_n = (fcap_proj - fy_proj) / (kp_n - kpc_n);
+    assert!(ucap_n < uy_n && uy_n < 0.0);
+    // Reloading negative from the crossing along K_u meets the new
+    // hardening line F = fy_proj + kp_n x at x_h.
+    let x_h = (fy_proj + ku * x_c) / (ku - kp_n);
+    assert!(x_h < x_c && x_h > ucap_n, "{x_h}");
+    let x = x_h - 0.005;
+    law.advance(&mut s, x);
+    let want = fy_proj + kp_n * x;
+    assert!(
+        (s.force - want).abs() < 1e-9 * fy,
+        "{} against {want}",
+        s.force
+    );
+}

@@ -332,5 +332,39 @@ fn ultimate(roof: &[f64], shear: &[f64], v_max: f64) -> (f64, bool) {
     (roof.last().copied().unwrap_or(0.0), false)
 }
 
+impl Pushover {
+    /// The pushover as a document (every face prints this): the curve
+    /// (`roof_displacement`, `base_shear`, `drifts` per point), the pattern,
+    /// the critical storey (from 1), whether it collapsed, and FEMA P695's
+    /// quantities with their `units`.
+    pub fn document(&self, building: &str, frame: &ShearFrame) -> serde_json::Value {
+        let height: f64 = frame.heights.iter().sum();
+        serde_json::json!({
+            "building": building,
+            "pattern": self.pattern,
+            "roof_displacement": self.roof_displacement,
+            "roof_drift_ratio": self.roof_displacement.iter().map(|u| u / height).collect::<Vec<_>>(),
+            "base_shear": self.base_shear,
+            "drifts": self.drifts,
+            "critical_storey": self.critical_storey + 1,
+            "collapsed": self.collapsed,
+            "max_base_shear": self.max_base_shear,
+            "weight": self.weight,
+            "max_base_shear_over_weight": self.max_base_shear / self.weight,
+            "period": self.period,
+            "c0": self.c0,
+            "yield_displacement": self.yield_displacement,
+            "ultimate_displacement": self.ultimate_displacement,
+            "strength_loss": self.strength_loss,
+            "ductility": self.ductility,
+            "units": {
+                "roof_displacement": "m", "base_shear": "N", "drifts": "m",
+                "max_base_shear": "N", "weight": "N", "period": "s",
+                "yield_displacement": "m", "ultimate_displacement": "m",
+            },
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests;

@@ -1,0 +1,474 @@
+//! The modified Ibarra–Medina–Krawinkler storey (docs/theory.md §11), in
+//! the bilinear-hysteresis form of Lignos and Krawinkler as OpenSees'
+//! `IMKBilin` (Nov22) has it, symmetric, under a drift history.
+//!
+//! The backbone: elastic k to the yield force F_y = k u_y; hardening to the
+//! cap F_c = (F_c/F_y)·F_y at u_y + d_p; a post-capping slope −F_c/d_pc
+//! (d_pc runs from the cap to zero force); the residual F_r; nothing past
+//! the ultimate drift d_u. The loop: the force moves along the unloading
+//! stiffness K_u and is bounded, in the direction the drift moves, by that
+//! direction's backbone, whose hardening and post-capping lines extend
+//! across the origin (bilinear, kinematic). Cyclic deterioration by the
+//! hysteretic energy, E_ref = λ F_y for each mode (λ a drift): at each
+//! zero-force crossing after yield, β = (E_i/(E_ref − E))^c of the last
+//! excursion's energy E_i scales the loaded direction's yield strength and
+//! hardening slope (β_S) and its post-capping line's intercept (β_C); at
+//! each reversal from the backbone, β_K scales K_u. Here the drift moves
+//! continuously: every crossing, hit and corner is located exactly on the
+//! piecewise-linear path, and the energy is its exact integral (OpenSees
+//! takes them at its steps, so it converges to this as its steps shrink).
+
+use super::{need, LawError};
+
+/// The law's parameters (symmetric: one set for both directions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Imk {
+    /// Elastic stiffness k (N/m).
+    pub stiffness: f64,
+    /// Yield drift u_y (m): F_y = k u_y.
+    pub yield_drift: f64,
+    /// F_c/F_y ≥ 1.
+    pub cap_ratio: f64,
+    /// Plastic drift to the cap d_p (m, > 0): the cap at u_y + d_p.
+    pub plastic_drift: f64,
+    /// Post-capping drift d_pc (m, > 0): from the cap to zero force.
+    pub post_capping_drift: f64,
+    /// F_r/F_y in [0, 1].
+    pub residual_ratio: f64,
+    /// Ultimate drift d_u (m, total, > the cap's): no force past it.
+    pub ultimate_drift: f64,
+    /// λ_S, λ_C, λ_K (m): E_ref = λ F_y for strength, cap and unloading
+    /// stiffness.
+    pub lambda: [f64; 3],
+    /// c_S, c_C, c_K (> 0).
+    pub exponent: [f64; 3],
+}
+
+/// One direction's current backbone (signed: the negative side's values
+/// are negative, its slopes positive as drawn).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Side {
+    fy: f64,
+    kp: f64,
+    kpc: f64,
+    ucap: f64,
+    fcap: f64,
+    fres: f64,
+}
+
+/// What the loop carries: drift, force, both backbones, the unloading
+/// stiffness, the energies and the failure state (0 elastic, 1 yielded,
+/// 2 residual reached, 3/4 positive/negative strength lost, 5 both).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImkState {
+    /// Drift (m).
+    pub u: f64,
+    /// Force (N).
+    pub force: f64,
+    pos: Side,
+    neg: Side,
+    kunload: f64,
+    /// ∫ F dd so far (J).
+    pub work: f64,
+    /// The work at the last excursion's start.
+    work_excursion: f64,
+    failure: u8,
+    on_backbone: bool,
+}
+
+/// Sub-ulp guard on the drift axis.
+fn tiny(x: f64) -> f64 {
+    4.0 * f64::EPSILON * x.abs().max(1e-300)
+}
+
+impl Imk {
+    /// Refuses parameters out of order: stiffness and yield drift > 0, a
+    /// cap ratio ≥ 1, plastic and post-capping drifts > 0, a residual ratio
+    /// in [0, 1] (not above the yield strength), an ultimate drift past
+    /// the cap, λ > 0 and c > 0.
+    pub fn check(&self) -> Result<(), LawError> {
+        need(
+            "stiffness",
+            self.stiffness,
+            self.stiffness > 0.0,
+            "must be finite and > 0",
+        )?;
+        need(
+            "yield_drift",
+            self.yield_drift,
+            self.yield_drift >= super::MIN_YIELD_DRIFT,
+            "must be at least 1e-9 m",
+        )?;
+        need(
+            "cap_ratio",
+            self.cap_ratio,
+            self.cap_ratio >= 1.0,
+            "must be >= 1 (the cap at or above yield)",
+        )?;
+        need(
+            "plastic_drift",
+            self.plastic_drift,
+            self.plastic_drift > 0.0,
+            "must be > 0 (the capping drift beyond the yield drift)",
+        )?;
+        need(
+            "post_capping_drift",
+            self.post_capping_drift,
+            self.post_capping_drift > 0.0,
+            "must be > 0 (a negative post-capping slope)",
+        )?;
+        need(
+            "residual_ratio",
+            self.residual_ratio,
+            (0.0..=1.0).contains(&self.residual_ratio),
+            "must be in [0, 1] (the residual strength at most the yield strength)",
+        )?;
+        need(
+            "ultimate_drift",
+            self.ultimate_drift,
+            self.ultimate_drift > self.yield_drift + self.plastic_drift,
+            "must exceed the capping drift u_y + d_p",
+        )?;
+        for (k, key) in ["lambda_s", "lambda_c", "lambda_k"].into_iter().enumerate() {
+            need(
+                key,
+                self.lambda[k],
+                self.lambda[k] > 0.0,
+                "must be finite and > 0 (a drift, m)",
+            )?;
+        }
+        for (k, key) in ["c_s", "c_c", "c_k"].into_iter().enumerate() {
+            need(
+                key,
+                self.exponent[k],
+                self.exponent[k] > 0.0,
+                "must be finite and > 0",
+            )?;
+        }
+        Ok(())
+    }
+
+    fn fy(&self) -> f64 {
+        self.stiffness * self.yield_drift
+    }
+
+    /// The positive side at rest; the negative is its mirror.
+    fn initial_side(&self) -> Side {
+        let fy = self.fy();
+        let fcap = self.cap_ratio * fy;
+        Side {
+            fy,
+            kp: (fcap - fy) / self.plastic_drift,
+            kpc: -fcap / self.post_capping_drift,
+            ucap: self.yield_drift + self.plastic_drift,
+            fcap,
+            fres: self.residual_ratio * fy,
+        }
+    }
+
+    /// The loop at rest.
+    pub fn rest(&self) -> ImkState {
+        let p = self.initial_side();
+        ImkState {
+            u: 0.0,
+            force: 0.0,
+            pos: p,
+            neg: Side {
+                fy: -p.fy,
+                kp: p.kp,
+                kpc: p.kpc,
+                ucap: -p.ucap,
+                fcap: -p.fcap,
+                fres: -p.fres,
+            },
+            kunload: self.stiffness,
+            work: 0.0,
+            work_excursion: 0.0,
+            failure: 0,
+            on_backbone: false,
+        }
+    }
+
+    /// The energy dissipated in `s`: the work less what the unloading
+    /// spring stores, F²/(2 K_u).
+    pub fn dissipated(&self, s: &ImkState) -> f64 {
+        s.work - 0.5 * s.force * s.force / s.kunload
+    }
+
+    /// The backbone bound of the direction `dir` at drift `x` (a maximum
+    /// force moving positive, a minimum moving negative).
+    fn bound(&self, s: &ImkState, dir: f64, x: f64) -> f64 {
+        let (side, lost, other_lost) = if dir > 0.0 {
+            (&s.pos, 3, 4)
+        } else {
+            (&s.neg, 4, 3)
+        };
+        if s.failure == lost {
+            return 0.0;
+        }
+        let beyond = if dir > 0.0 {
+            x >= side.ucap
+        } else {
+            x <= side.ucap
+        };
+        let line = side.fcap + (x - side.ucap) * if beyond { side.kpc } else { side.kp };
+        if s.failure == other_lost {
+            return side.fres;
+        }
+        if dir > 0.0 {
+            line.max(side.fres)
+        } else {
+            line.min(side.fres)
+        }
+    }
+
+    /// The drifts ahead of `u` in direction `dir` (up to `to`) where the
+    /// bound of `dir` has a corner.
+    fn corners(&self, s: &ImkState, dir: f64, u: f64, to: f64) -> Vec<f64> {
+        let side = if dir > 0.0 { &s.pos } else { &s.neg };
+        let mut xs = vec![side.ucap];
+        if side.kp != 0.0 {
+            xs.push(side.ucap + (side.fres - side.fcap) / side.kp);
+        }
+        if side.kpc != 0.0 {
+            xs.push(side.ucap + (side.fres - side.fcap) / side.kpc);
+        }
+        let mut ahead: Vec<f64> = xs
+            .into_iter()
+            .filter(|&x| x.is_finite() && (x - u) * dir > tiny(u) && (to - x) * dir > 0.0)
+            .collect();
+        ahead.sort_by(|a, b| ((a - u) * dir).total_cmp(&((b - u) * dir)));
+        ahead
+    }
+
+    /// The state after the drift moves monotonically from `s.u` to `to`.
+    pub fn advance(&self, s: &mut ImkState, to: f64) {
+        if to == s.u {
+            return;
+        }
+        let dir = (to - s.u).signum();
+        if s.failure == 5 {
+            s.u = to;
+            s.force = 0.0;
+            return;
+        }
+        if s.on_backbone && (s.force * dir < 0.0 || (s.force == 0.0 && s.u * dir <= 0.0)) {
+            self.reversal(s);
+            if s.failure == 5 {
+                s.u = to;
+                s.force = 0.0;
+                return;
+            }
+        }
+        // Each pass moves to the next event ahead (at most a few dozen).
+        for _ in 0..64 {
+            if (to - s.u) * dir <= 0.0 {
+                break;
+            }
+            let next = if s.on_backbone {
+                self.along_backbone(s, dir, to)
+            } else {
+                self.along_unloading(s, dir, to)
+            };
+            self.move_to(s, dir, next.0);
+            match next.1 {
+                Event::None => {}
+                Event::Crossing => self.excursion(s, dir),
+                Event::Hit => {
+                    s.on_backbone = true;
+                    s.force = self.bound(s, dir, s.u);
+                    if s.failure == 0 {
+                        s.failure = 1;
+                    }
+                }
+            }
+            self.check_failure(s, dir);
+            if s.failure == 5 {
+                s.u = to;
+                s.force = 0.0;
+                return;
+            }
+        }
+    }
+
+    /// Moves the state along its current piece to `x` (the force on the
+    /// piece's line, the work its exact integral).
+    fn move_to(&self, s: &mut ImkState, dir: f64, x: f64) {
+        let f1 = if s.on_backbone {
+            self.bound(s, dir, x)
+        } else {
+            s.force + s.kunload * (x - s.u)
+        };
+        s.work += 0.5 * (s.force + f1) * (x - s.u);
+        s.u = x;
+        s.force = f1;
+    }
+
+    /// On the backbone: to the next corner, the ultimate drift or `to`.
+    fn along_backbone(&self, s: &ImkState, dir: f64, to: f64) -> (f64, Event) {
+        let mut x = to;
+        if let Some(&c) = self.corners(s, dir, s.u, to).first() {
+            x = c;
+        }
+        // A backbone line through zero force (no residual): there the
+        // direction's strength is lost.
+        let side = if dir > 0.0 { &s.pos } else { &s.neg };
+        if side.fres == 0.0 && side.kpc != 0.0 {
+            let zero = side.ucap - side.fcap / side.kpc;
+            if (zero - s.u) * dir > tiny(s.u) && (x - zero) * dir > 0.0 {
+                x = zero;
+            }
+        }
+        (self.before_ultimate(s.u, dir, x), Event::None)
+    }
+
+    /// Off the backbone, on the unloading line: to the zero crossing (after
+    /// yield), the bound's hit, the ultimate drift or `to`, whichever first.
+    fn along_unloading(&self, s: &ImkState, dir: f64, to: f64) -> (f64, Event) {
+        let mut end = (self.before_ultimate(s.u, dir, to), Event::None);
+        if s.failure > 0 && s.force * dir < 0.0 {
+            let x0 = s.u - s.force / s.kunload;
+            if (x0 - s.u) * dir > 0.0 && (end.0 - x0) * dir >= 0.0 {
+                end = (x0, Event::Crossing);
+            }
+        }
+        // The hit: g(x) = dir (F(x) − bound(x)) reaches 0, the bound
+        // piecewise linear between its corners.
+        let g = |x: f64| dir * (s.force + s.kunload * (x - s.u) - self.bound(s, dir, x));
+        let (mut a, mut ga) = (s.u, g(s.u));
+        if ga >= 0.0 {
+            return (s.u, Event::Hit);
+        }
+        let mut stops = self.corners(s, dir, s.u, end.0);
+        stops.push(end.0);
+        for b in stops {
+            let gb = g(b);
+            if gb >= 0.0 {
+                return (a + (b - a) * (-ga) / (gb - ga), Event::Hit);
+            }
+            (a, ga) = (b, gb);
+        }
+        end
+    }
+
+    /// `x`, or the ultimate drift if that comes first on the way.
+    fn before_ultimate(&self, u: f64, dir: f64, x: f64) -> f64 {
+        let edge = dir * self.ultimate_drift;
+        if (edge - u) * dir > 0.0 && (x - edge) * dir > 0.0 {
+            edge
+        } else {
+            x
+        }
+    }
+
+    /// A reversal from the backbone: the unloading stiffness deteriorates
+    /// by β_K of the energy since the last excursion less what the spring
+    /// stores.
+    fn reversal(&self, s: &mut ImkState) {
+        s.on_backbone = false;
+        let stored = 0.5 * s.force * s.force / s.kunload;
+        let e_ref = self.lambda[2] * self.fy();
+        let total = s.work - stored;
+        let excursion = s.work - s.work_excursion - stored;
+        let beta = (excursion / (e_ref - total)).powf(self.exponent[2]);
+        if beta > 1.0 {
+            s.failure = 5;
+            s.force = 0.0;
+            return;
+        }
+        s.kunload *= 1.0 - beta.max(0.0);
+        if s.failure > 1 {
+            s.kunload = 0.5 * self.stiffness;
+        }
+    }
+
+    /// A zero-force crossing after yield: the backbone of the direction
+    /// now loaded deteriorates by the last excursion's energy.
+    fn excursion(&self, s: &mut ImkState, dir: f64) {
+        let fy = self.fy();
+        let e_i = (s.work - s.work_excursion).max(0.0);
+        let beta = |k: usize| (e_i / (self.lambda[k] * fy - s.work)).powf(self.exponent[k]);
+        let (bs, bc) = (beta(0), beta(1));
+        if bs > 1.0 || bc > 1.0 {
+            s.failure = 5;
+            s.force = 0.0;
+            return;
+        }
+        let (bs, bc) = (bs.max(0.0), bc.max(0.0));
+        s.work_excursion = s.work;
+        let initial = self.initial_side();
+        let (k, u_cross, ku) = (self.stiffness, s.u, s.kunload);
+        let side = if dir > 0.0 { &mut s.pos } else { &mut s.neg };
+        let sign = dir;
+        let fcap_proj = side.fcap - side.kpc * side.ucap;
+        side.fy *= 1.0 - bs;
+        side.kp *= 1.0 - bs;
+        let fcap_proj = fcap_proj * (1.0 - bc);
+        let uy = side.fy / k;
+        // The post-capping slope scaled by (F_y' − F_r)/(F_y − F_r), or
+        // flat once the yield strength fell below the residual.
+        side.kpc = if (side.fy - side.fres) * sign < 0.0 {
+            0.0
+        } else {
+            initial.kpc * (side.fy - side.fres) / (sign * initial.fy - side.fres)
+        };
+        let fy_proj = side.fy - side.kp * uy;
+        side.ucap = if side.kp <= side.kpc {
+            0.0
+        } else {
+            (fcap_proj - fy_proj) / (side.kp - side.kpc)
+        };
+        side.fcap = fy_proj + side.kp * side.ucap;
+        // Where the unloading line (through the crossing) reaches the
+        // residual: the hardening slope pivots about the cap if the
+        // backbone would start beneath it.
+        let candidate = (side.fcap - side.fres) / (side.ucap - (u_cross + side.fres / ku));
+        if (side.fcap - side.fres) * sign < 0.0 {
+            side.fy = side.fres;
+            side.fcap = side.fres;
+            side.kp = 0.0;
+            side.kpc = 0.0;
+            side.ucap = 0.0;
+        } else if candidate > 0.0 && side.kp > candidate {
+            side.kp = candidate;
+        }
+    }
+
+    /// Strength lost at the ultimate drift, or where the backbone reaches
+    /// zero force; the residual reached.
+    fn check_failure(&self, s: &mut ImkState, dir: f64) {
+        let at_ultimate = s.u * dir >= self.ultimate_drift * (1.0 - 1e-15);
+        let through_zero = s.on_backbone && s.force * dir <= 0.0 && s.u * dir > 0.0;
+        if at_ultimate || through_zero {
+            let (lost, other) = if dir > 0.0 { (3, 4) } else { (4, 3) };
+            s.force = 0.0;
+            s.failure = if s.failure == other { 5 } else { lost };
+            return;
+        }
+        if s.failure < 2 {
+            // (sign: +1 for the positive side, −1 for the negative.)
+            let residual = |side: &Side, sign: f64| {
+                if side.kpc == 0.0 {
+                    s.force == side.fres && s.on_backbone
+                } else {
+                    let ures = (side.fres - side.fcap + side.kpc * side.ucap) / side.kpc;
+                    (s.u - ures) * sign >= 0.0
+                }
+            };
+            if residual(&s.pos, 1.0) || residual(&s.neg, -1.0) {
+                s.failure = 2;
+            }
+        }
+    }
+}
+
+/// What ends a piece.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Event {
+    /// `to`, a corner or the ultimate drift.
+    None,
+    /// A zero-force crossing off the backbone.
+    Crossing,
+    /// The unloading line meets the backbone.
+    Hit,
+}
