@@ -408,6 +408,31 @@ pub fn storey_law_document(law: &crate::model::hysteresis::StoreyLaw) -> Value {
             "degradation_nu": w.degradation.nu,
             "degradation_eta": w.degradation.eta,
         }),
+        StoreyLaw::Imk(m) => json!({
+            "law": "imk",
+            "stiffness": m.stiffness,
+            "yield_drift": m.yield_drift,
+            "cap_ratio": m.cap_ratio,
+            "plastic_drift": m.plastic_drift,
+            "post_capping_drift": m.post_capping_drift,
+            "residual_ratio": m.residual_ratio,
+            "ultimate_drift": m.ultimate_drift,
+            "lambda_s": finite(m.lambda[0]),
+            "lambda_c": finite(m.lambda[1]),
+            "lambda_k": finite(m.lambda[2]),
+            "c_s": m.exponent[0],
+            "c_c": m.exponent[1],
+            "c_k": m.exponent[2],
+        }),
+    }
+}
+
+/// A value, or null where it is infinite (an IMK λ without deterioration).
+fn finite(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
     }
 }
 

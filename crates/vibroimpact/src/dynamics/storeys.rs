@@ -12,6 +12,7 @@
 //! it and switches the branch there ([`StoreyTerms::switch_value`],
 //! [`StoreyTerms::switch`]).
 
+use crate::model::hysteresis::imk::ImkState;
 use crate::model::hysteresis::{Hysteretic, StoreyLaw};
 use crate::model::Storey;
 
@@ -41,6 +42,9 @@ pub enum Branch {
         /// The hysteretic part's work there (J).
         e0: f64,
     },
+    /// An IMK storey's state at its last event: the force is linear in the
+    /// drift from there ([`crate::model::hysteresis::imk::Imk::piece_force`]).
+    Imk(ImkState),
 }
 
 /// One storey's term.
@@ -78,16 +82,26 @@ impl StoreyTerms {
                     states += 2;
                     first_state + states - 2
                 });
+                // An IMK storey starts from rest at zero drift, pushed
+                // monotonically to the initial drift.
+                let branch = match s.law {
+                    StoreyLaw::Imk(m) => {
+                        let mut st = m.rest();
+                        m.advance(&mut st, d0);
+                        Branch::Imk(st)
+                    }
+                    _ => Branch::Elastic {
+                        d0,
+                        z0: 0.0,
+                        e0: 0.0,
+                    },
+                };
                 Term {
                     below: s.below,
                     above: s.above,
                     law: s.law,
                     p_delta: s.p_delta,
-                    branch: Branch::Elastic {
-                        d0,
-                        z0: 0.0,
-                        e0: 0.0,
-                    },
+                    branch,
                     state,
                 }
             })
@@ -159,6 +173,30 @@ impl StoreyTerms {
                 z,
                 work: e0 + kh * z * (d - d0),
             },
+            // (An IMK storey's memory is its state; z is not used.)
+            (None, Branch::Imk(_)) => Hysteretic::default(),
+        }
+    }
+
+    /// Storey k's law force at drift `d` in `y` (an IMK storey's from its
+    /// state).
+    fn law_force(&self, k: usize, d: f64, y: &[f64]) -> f64 {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_force(&st, d),
+            _ => t.law.force(d, self.hysteretic(k, d, y)),
+        }
+    }
+
+    /// The energy storey k has dissipated by hysteresis in `y`.
+    pub fn dissipated_by(&self, k: usize, y: &[f64]) -> f64 {
+        let t = &self.terms[k];
+        match (t.law, t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => {
+                let (d, _) = self.drift(k, y);
+                m.piece_work(&st, d) - m.piece_stored(&st, d)
+            }
+            _ => t.law.dissipated(self.state(k, y)),
         }
     }
 
@@ -166,7 +204,7 @@ impl StoreyTerms {
     /// the P-Δ shear.
     pub fn force(&self, k: usize, y: &[f64]) -> f64 {
         let (d, _) = self.drift(k, y);
-        self.terms[k].law.force(d, self.hysteretic(k, d, y))
+        self.law_force(k, d, y)
     }
 
     /// The energy the storeys store in `y`: ½ b k d² + ½ (1 − b) k z² each
@@ -176,9 +214,12 @@ impl StoreyTerms {
         (0..self.terms.len())
             .map(|k| {
                 let (d, _) = self.drift(k, y);
-                let s = self.hysteretic(k, d, y);
                 let t = &self.terms[k];
-                t.law.stored(d, s) - 0.5 * t.p_delta * d * d
+                let stored = match (t.law, t.branch) {
+                    (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_stored(&st, d),
+                    _ => t.law.stored(d, self.hysteretic(k, d, y)),
+                };
+                stored - 0.5 * t.p_delta * d * d
             })
             .sum()
     }
@@ -186,7 +227,7 @@ impl StoreyTerms {
     /// The energy the storeys have dissipated by hysteresis in `y`.
     pub fn dissipated(&self, y: &[f64]) -> f64 {
         (0..self.terms.len())
-            .map(|k| self.terms[k].law.dissipated(self.state(k, y)))
+            .map(|k| self.dissipated_by(k, y))
             .sum()
     }
 
@@ -195,13 +236,13 @@ impl StoreyTerms {
     pub fn apply(&self, y: &[f64], force: &mut [f64], dydt: &mut [f64]) {
         for (k, t) in self.terms.iter().enumerate() {
             let (d, dd) = self.drift(k, y);
-            let s = self.hysteretic(k, d, y);
-            let f = t.law.force(d, s) - t.p_delta * d;
+            let f = self.law_force(k, d, y) - t.p_delta * d;
             force[t.above] -= f;
             if let Some(b) = t.below {
                 force[b] += f;
             }
             if let (Some(i), StoreyLaw::BoucWen(w)) = (t.state, &t.law) {
+                let s = self.hysteretic(k, d, y);
                 let (dz, de) = w.slope(s, dd);
                 dydt[i] = dd * dz;
                 dydt[i + 1] = dd * de;
@@ -209,9 +250,14 @@ impl StoreyTerms {
         }
     }
 
-    /// The bilinear storeys (the ones whose branch switches).
-    pub fn bilinear(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..self.terms.len()).filter(|&k| matches!(self.terms[k].law, StoreyLaw::Bilinear(_)))
+    /// The storeys whose branch switches (bilinear and IMK).
+    pub fn switching(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.terms.len()).filter(|&k| {
+            matches!(
+                self.terms[k].law,
+                StoreyLaw::Bilinear(_) | StoreyLaw::Imk(_)
+            )
+        })
     }
 
     /// Bilinear storey k's switch function in `y`: positive while its
@@ -219,22 +265,32 @@ impl StoreyTerms {
     /// branch, unloading from the plastic one).
     pub fn switch_value(&self, k: usize, y: &[f64]) -> f64 {
         let t = &self.terms[k];
+        let (d, dd) = self.drift(k, y);
+        if let (StoreyLaw::Imk(m), Branch::Imk(st)) = (t.law, t.branch) {
+            return m.switch_value(&st, d, dd);
+        }
         let StoreyLaw::Bilinear(b) = t.law else {
             return 1.0;
         };
-        let (d, dd) = self.drift(k, y);
         match t.branch {
             Branch::Elastic { d0, z0, .. } => {
                 b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs()
             }
             Branch::Plastic { z, .. } => dd * z.signum(),
+            Branch::Imk(_) => 1.0,
         }
     }
 
     /// Switches bilinear storey k's branch in the state `y` where its
     /// switch function vanished.
     pub fn switch(&mut self, k: usize, y: &[f64]) {
-        let (d, _) = self.drift(k, y);
+        let (d, dd) = self.drift(k, y);
+        if let (StoreyLaw::Imk(m), Branch::Imk(mut st)) = (self.terms[k].law, self.terms[k].branch)
+        {
+            m.switch(&mut st, d, dd);
+            self.terms[k].branch = Branch::Imk(st);
+            return;
+        }
         let s = self.hysteretic(k, d, y);
         let t = &mut self.terms[k];
         let StoreyLaw::Bilinear(b) = t.law else {
@@ -251,6 +307,7 @@ impl StoreyTerms {
                 z0: z,
                 e0: s.work,
             },
+            other => other,
         };
     }
 

@@ -248,6 +248,15 @@ impl ExtremaScan {
         }
     }
 
+    /// The right-hand side changed where the last step ended (an event: a
+    /// storey's branch, a contact's onset): the jerk there is one-sided,
+    /// so the next step reads its accelerations on the dense output.
+    pub(super) fn restarted(&mut self) {
+        if let Some(jerk) = self.jerk.as_mut() {
+            jerk.at_end.fill(f64::NAN);
+        }
+    }
+
     /// What the scan found.
     pub(super) fn finish(mut self) -> Extrema {
         self.found.gauges = self.gauges.iter().map(GaugeScan::reading).collect();

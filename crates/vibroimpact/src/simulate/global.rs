@@ -78,6 +78,9 @@ pub fn simulate_streaming(
                 // (counted as a step: events alone cannot run forever).
                 Err(event) => {
                     steps += 1;
+                    if let Some(x) = extrema.as_mut() {
+                        x.restarted();
+                    }
                     error = apply_event(&mut st, &mut sys, event)
                         .err()
                         .or_else(|| early_end(&st, method, opts, steps));
@@ -146,6 +149,9 @@ pub fn simulate_streaming(
         // velocity is set, where the step ended; the right-hand side
         // changes there, so the stepper restarts.
         if let Some(event) = switch_here {
+            if let Some(x) = extrema.as_mut() {
+                x.restarted();
+            }
             if let Err(e) = apply_event(&mut st, &mut sys, event) {
                 error = Some(e);
                 break;
@@ -421,7 +427,7 @@ fn global_result(
             .storeys()
             .iter()
             .enumerate()
-            .map(|(k, s)| s.law.dissipated(sys.storeys().state(k, &y)))
+            .map(|(k, _)| sys.storeys().dissipated_by(k, &y))
             .collect(),
         energy,
         error,

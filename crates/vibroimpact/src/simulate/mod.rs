@@ -531,7 +531,7 @@ fn simulate_local(
             .storeys()
             .iter()
             .enumerate()
-            .map(|(k, s)| s.law.dissipated(run.storeys.state(k, &run.y)))
+            .map(|(k, _)| run.storeys.dissipated_by(k, &run.y))
             .collect(),
         energy: run
             .energy

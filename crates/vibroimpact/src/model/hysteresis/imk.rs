@@ -38,7 +38,7 @@ pub struct Imk {
     /// Ultimate drift d_u (m, total, > the cap's): no force past it.
     pub ultimate_drift: f64,
     /// λ_S, λ_C, λ_K (m): E_ref = λ F_y for strength, cap and unloading
-    /// stiffness.
+    /// stiffness (∞: none of that deterioration).
     pub lambda: [f64; 3],
     /// c_S, c_C, c_K (> 0).
     pub exponent: [f64; 3],
@@ -74,6 +74,8 @@ pub struct ImkState {
     work_excursion: f64,
     failure: u8,
     on_backbone: bool,
+    /// The direction the drift last moved (±1).
+    dir: f64,
 }
 
 /// Sub-ulp guard on the drift axis.
@@ -130,12 +132,15 @@ impl Imk {
             "must exceed the capping drift u_y + d_p",
         )?;
         for (k, key) in ["lambda_s", "lambda_c", "lambda_k"].into_iter().enumerate() {
-            need(
-                key,
-                self.lambda[k],
-                self.lambda[k] > 0.0,
-                "must be finite and > 0 (a drift, m)",
-            )?;
+            // (∞: no deterioration of that kind.)
+            let l = self.lambda[k];
+            if l.is_nan() || l <= 0.0 {
+                return Err(LawError {
+                    key,
+                    value: l,
+                    message: "must be > 0 (a drift, m; omit it for no deterioration)",
+                });
+            }
         }
         for (k, key) in ["c_s", "c_c", "c_k"].into_iter().enumerate() {
             need(
@@ -186,6 +191,7 @@ impl Imk {
             work_excursion: 0.0,
             failure: 0,
             on_backbone: false,
+            dir: 1.0,
         }
     }
 
@@ -247,6 +253,7 @@ impl Imk {
             return;
         }
         let dir = (to - s.u).signum();
+        s.dir = dir;
         if s.failure == 5 {
             s.u = to;
             s.force = 0.0;
@@ -459,6 +466,186 @@ impl Imk {
                 s.failure = 2;
             }
         }
+    }
+}
+
+/// The IMK storey between events of a time history (docs/theory.md §11):
+/// from the state at its last event the force is linear in the drift (the
+/// unloading line, or the backbone's segment), so a step sees a smooth
+/// force; what ends the piece is a switch, located on the dense output.
+impl Imk {
+    /// The slope of the piece `s` is on (N/m).
+    fn piece_slope(&self, s: &ImkState) -> f64 {
+        if s.failure == 5 {
+            return 0.0;
+        }
+        if !s.on_backbone {
+            return s.kunload;
+        }
+        // The segment just ahead of the anchor (the bound is linear on it).
+        let dir = s.dir;
+        let x = s.u + dir * 1e-9 * self.yield_drift;
+        let (side, lost, other_lost) = if dir > 0.0 {
+            (&s.pos, 3, 4)
+        } else {
+            (&s.neg, 4, 3)
+        };
+        if s.failure == lost || s.failure == other_lost {
+            return 0.0;
+        }
+        let beyond = if dir > 0.0 {
+            x >= side.ucap
+        } else {
+            x <= side.ucap
+        };
+        let slope = if beyond { side.kpc } else { side.kp };
+        let line = side.fcap + (x - side.ucap) * slope;
+        let clamped = if dir > 0.0 {
+            line < side.fres
+        } else {
+            line > side.fres
+        };
+        if clamped {
+            0.0
+        } else {
+            slope
+        }
+    }
+
+    /// The force at drift `d` on the piece `s` is on.
+    pub fn piece_force(&self, s: &ImkState, d: f64) -> f64 {
+        if s.failure == 5 {
+            0.0
+        } else {
+            s.force + self.piece_slope(s) * (d - s.u)
+        }
+    }
+
+    /// The work ∫ F dd up to drift `d` along the piece.
+    pub fn piece_work(&self, s: &ImkState, d: f64) -> f64 {
+        s.work + 0.5 * (s.force + self.piece_force(s, d)) * (d - s.u)
+    }
+
+    /// The energy stored at drift `d` on the piece: F²/(2 K_u).
+    pub fn piece_stored(&self, s: &ImkState, d: f64) -> f64 {
+        let f = self.piece_force(s, d);
+        0.5 * f * f / s.kunload
+    }
+
+    /// The switch function of the piece at drift `d` moving at `rate`:
+    /// positive while the piece holds, zero where it ends. On the backbone:
+    /// a reversal (the rate turns), its next corner, zero force without a
+    /// residual, the ultimate drift. On the unloading line: the zero-force
+    /// crossing (after yield), the bound of the direction it moves (with a
+    /// slack of 1e-10 F_y, so that a piece just begun on a bound does not
+    /// end at once), the ultimate drift. Drifts in force units (× k).
+    pub fn switch_value(&self, s: &ImkState, d: f64, rate: f64) -> f64 {
+        if s.failure == 5 {
+            return 1.0;
+        }
+        let f = self.piece_force(s, d);
+        let mut g = self.ultimate_ahead(s, d).min(self.residual_ahead(s, d));
+        if s.on_backbone {
+            g = g
+                .min(rate * s.dir * self.stiffness)
+                .min(self.backbone_ahead(s, d));
+        } else {
+            if s.failure > 0 && s.force != 0.0 {
+                g = g.min(f * s.force.signum());
+            }
+            let dir = if rate != 0.0 { rate.signum() } else { s.dir };
+            let slack = 1e-10 * self.fy();
+            g = g.min(dir * (self.bound(s, dir, d) - f) + slack);
+        }
+        g
+    }
+
+    /// On the backbone, what ends the segment ahead other than a reversal:
+    /// its next corner, zero force without a residual (force units).
+    fn backbone_ahead(&self, s: &ImkState, d: f64) -> f64 {
+        let (k, dir) = (self.stiffness, s.dir);
+        let mut g = f64::INFINITY;
+        if let Some(&c) = self.corners(s, dir, s.u, dir * f64::INFINITY).first() {
+            g = g.min(k * dir * (c - d));
+        }
+        let side = if dir > 0.0 { &s.pos } else { &s.neg };
+        if side.fres == 0.0 && s.u * dir > 0.0 {
+            g = g.min(self.piece_force(s, d) * dir);
+        }
+        g.min(self.ultimate_ahead(s, d))
+    }
+
+    /// Before the residual is first reached: the distance to either side's
+    /// residual drift (force units; ∞ after, or where a side has none). The
+    /// unloading stiffness at the next reversal depends on it.
+    fn residual_ahead(&self, s: &ImkState, d: f64) -> f64 {
+        if s.failure >= 2 {
+            return f64::INFINITY;
+        }
+        let k = self.stiffness;
+        let ures = |side: &Side| {
+            (side.kpc != 0.0).then(|| (side.fres - side.fcap + side.kpc * side.ucap) / side.kpc)
+        };
+        let mut g = f64::INFINITY;
+        if let Some(x) = ures(&s.pos) {
+            g = g.min(k * (x - d));
+        }
+        if let Some(x) = ures(&s.neg) {
+            g = g.min(k * (d - x));
+        }
+        g
+    }
+
+    /// The ultimate drift on the side of `d`, while that side stands
+    /// (force units; ∞ once its strength is lost).
+    fn ultimate_ahead(&self, s: &ImkState, d: f64) -> f64 {
+        let lost = if d >= 0.0 {
+            matches!(s.failure, 3 | 5)
+        } else {
+            matches!(s.failure, 4 | 5)
+        };
+        if lost {
+            f64::INFINITY
+        } else {
+            self.stiffness * (self.ultimate_drift - d.abs())
+        }
+    }
+
+    /// The state at the event where the piece ended, at drift `d` moving
+    /// at `rate`: the piece followed to `d` (to its zero crossing exactly
+    /// where that ended it), then the law's own rules a hair on in the
+    /// direction of motion: reversal, crossing, hit, corner, failure.
+    pub fn switch(&self, s: &mut ImkState, d: f64, rate: f64) {
+        // On the backbone a reversal is the event where the rate's term
+        // is the least (the rate itself may have either sign there, by a
+        // rounding): the direction turns.
+        let dir = if s.on_backbone {
+            if rate * s.dir * self.stiffness <= self.backbone_ahead(s, d) {
+                -s.dir
+            } else {
+                s.dir
+            }
+        } else if rate != 0.0 {
+            rate.signum()
+        } else {
+            s.dir
+        };
+        let slope = self.piece_slope(s);
+        let mut at = d;
+        let crossing = !s.on_backbone && s.failure > 0 && s.force != 0.0;
+        if crossing && (self.piece_force(s, d) * s.force <= 1e-9 * self.fy() * s.force.abs()) {
+            at = s.u - s.force / slope;
+        }
+        let f = self.piece_force(s, at);
+        s.work += 0.5 * (s.force + f) * (at - s.u);
+        s.u = at;
+        s.force = if at == d { f } else { 0.0 };
+        if s.force == 0.0 && crossing && s.failure < 5 {
+            s.dir = dir;
+            self.excursion(s, dir);
+        }
+        let hair = 1e-12 * self.yield_drift.max(at.abs());
+        self.advance(s, at + dir * hair);
     }
 }
 

@@ -97,6 +97,9 @@ pub enum StoreyLaw {
     Bilinear(Bilinear),
     /// Bouc–Wen.
     BoucWen(BoucWen),
+    /// The modified Ibarra–Medina–Krawinkler storey (OpenSees `IMKBilin`):
+    /// its memory is an [`imk::ImkState`], not a hysteretic drift.
+    Imk(imk::Imk),
 }
 
 /// What a storey carries besides its drift: the hysteretic drift z (m)
@@ -319,6 +322,7 @@ impl StoreyLaw {
             ),
             StoreyLaw::Bilinear(b) => b.check(),
             StoreyLaw::BoucWen(w) => w.check(),
+            StoreyLaw::Imk(m) => m.check(),
         }
     }
 
@@ -328,15 +332,20 @@ impl StoreyLaw {
             StoreyLaw::Elastic { stiffness } => *stiffness,
             StoreyLaw::Bilinear(b) => b.stiffness,
             StoreyLaw::BoucWen(w) => w.stiffness,
+            StoreyLaw::Imk(m) => m.stiffness,
         }
     }
 
     /// The force at drift `d` in state `s`.
+    ///
+    /// An IMK storey's force, stored and dissipated energy come from its
+    /// own state ([`imk::Imk::piece_force`]): NaN here.
     pub fn force(&self, d: f64, s: Hysteretic) -> f64 {
         match self {
             StoreyLaw::Elastic { stiffness } => stiffness * d,
             StoreyLaw::Bilinear(b) => b.force(d, s.z),
             StoreyLaw::BoucWen(w) => w.force(d, s.z),
+            StoreyLaw::Imk(_) => f64::NAN,
         }
     }
 
@@ -348,6 +357,7 @@ impl StoreyLaw {
             StoreyLaw::Elastic { stiffness } => return 0.5 * stiffness * d * d,
             StoreyLaw::Bilinear(b) => (b.stiffness, b.post_yield_ratio),
             StoreyLaw::BoucWen(w) => (w.stiffness, w.post_yield_ratio),
+            StoreyLaw::Imk(_) => return f64::NAN,
         };
         0.5 * k * (b * d * d + (1.0 - b) * s.z * s.z)
     }
@@ -359,6 +369,7 @@ impl StoreyLaw {
             StoreyLaw::Elastic { .. } => return 0.0,
             StoreyLaw::Bilinear(b) => (b.stiffness, b.post_yield_ratio),
             StoreyLaw::BoucWen(w) => (w.stiffness, w.post_yield_ratio),
+            StoreyLaw::Imk(_) => return f64::NAN,
         };
         s.work - 0.5 * (1.0 - b) * k * s.z * s.z
     }
@@ -372,6 +383,16 @@ pub fn under_drift(
     drifts: &[f64],
     rtol: f64,
 ) -> Result<Vec<(f64, f64)>, IntegrationError> {
+    if let StoreyLaw::Imk(m) = law {
+        let mut s = m.rest();
+        return Ok(drifts
+            .iter()
+            .map(|&d| {
+                m.advance(&mut s, d);
+                (s.force, m.dissipated(&s))
+            })
+            .collect());
+    }
     let mut s = Hysteretic::default();
     let mut out = Vec::with_capacity(drifts.len());
     let mut d0 = 0.0;
@@ -380,6 +401,7 @@ pub fn under_drift(
             StoreyLaw::Elastic { .. } => s,
             StoreyLaw::Bilinear(b) => b.advance(s, d0, d),
             StoreyLaw::BoucWen(w) => w.advance(s, d0, d, rtol)?,
+            StoreyLaw::Imk(_) => s,
         };
         out.push((law.force(d, s), law.dissipated(s)));
         d0 = d;
@@ -421,6 +443,33 @@ pub enum StoreySpec {
         /// δ_η (1/J), default 0.
         degradation_eta: Option<f64>,
     },
+    /// The modified IMK storey (OpenSees `IMKBilin`, symmetric).
+    Imk {
+        /// Yield drift u_y (m).
+        yield_drift: f64,
+        /// F_c/F_y ≥ 1.
+        cap_ratio: f64,
+        /// Plastic drift to the cap d_p (m).
+        plastic_drift: f64,
+        /// Post-capping drift d_pc (m), cap to zero force.
+        post_capping_drift: f64,
+        /// F_r/F_y in [0, 1].
+        residual_ratio: f64,
+        /// Ultimate drift d_u (m).
+        ultimate_drift: f64,
+        /// λ_S (m), default none (no strength deterioration).
+        lambda_s: Option<f64>,
+        /// λ_C (m), default none.
+        lambda_c: Option<f64>,
+        /// λ_K (m), default none.
+        lambda_k: Option<f64>,
+        /// c_S, default 1.
+        c_s: Option<f64>,
+        /// c_C, default 1.
+        c_c: Option<f64>,
+        /// c_K, default 1.
+        c_k: Option<f64>,
+    },
 }
 
 impl StoreySpec {
@@ -457,6 +506,30 @@ impl StoreySpec {
                     nu: degradation_nu.unwrap_or(0.0),
                     eta: degradation_eta.unwrap_or(0.0),
                 },
+            }),
+            StoreySpec::Imk {
+                yield_drift,
+                cap_ratio,
+                plastic_drift,
+                post_capping_drift,
+                residual_ratio,
+                ultimate_drift,
+                lambda_s,
+                lambda_c,
+                lambda_k,
+                c_s,
+                c_c,
+                c_k,
+            } => StoreyLaw::Imk(imk::Imk {
+                stiffness,
+                yield_drift,
+                cap_ratio,
+                plastic_drift,
+                post_capping_drift,
+                residual_ratio,
+                ultimate_drift,
+                lambda: [lambda_s, lambda_c, lambda_k].map(|l| l.unwrap_or(f64::INFINITY)),
+                exponent: [c_s, c_c, c_k].map(|c| c.unwrap_or(1.0)),
             }),
         };
         law.check()?;

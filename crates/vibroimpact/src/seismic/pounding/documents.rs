@@ -68,6 +68,7 @@ fn yield_drift(law: &StoreyLaw) -> Option<f64> {
         StoreyLaw::Elastic { .. } => None,
         StoreyLaw::Bilinear(b) => Some(b.yield_drift),
         StoreyLaw::BoucWen(w) => Some(w.yield_drift),
+        StoreyLaw::Imk(m) => Some(m.yield_drift),
     }
 }
 

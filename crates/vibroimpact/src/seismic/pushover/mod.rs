@@ -15,6 +15,9 @@
 //! where it softens; the other storeys load along their own monotonic
 //! curves to λ, and unload elastically (slope k_i − P_i/h_i) when λ falls
 //! below the largest they carried.
+//!
+//! Files: `mod.rs` (the pushover and its document), `tests.rs` (the
+//! closed forms).
 
 use crate::model::hysteresis::{under_drift, StoreyLaw};
 use crate::model::record::STANDARD_GRAVITY;

@@ -63,7 +63,7 @@ impl Switches {
             .map(Event::Onset);
         let events: Vec<Event> = sys
             .storeys()
-            .bilinear()
+            .switching()
             .map(Event::Storey)
             .chain(onsets)
             .collect();
