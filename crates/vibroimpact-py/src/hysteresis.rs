@@ -16,9 +16,15 @@ use crate::convert::{array1, floats, numerical_error, to_python, value_error};
 /// yield drift, post-yield ratio, exponent, β, γ, δ_A, δ_ν, δ_η.
 type Law = (String, f64, Option<f64>, f64, f64, f64, f64, f64, f64, f64);
 
-/// The spec of the law named `name`.
+/// An IMK storey's keys as Python gives them: the five of
+/// [`vibroimpact::model::hysteresis::IMK_KEYS`],
+/// λ_S, λ_C, λ_K (None: no such deterioration), c_S, c_C, c_K.
+type ImkKeys = ([Option<f64>; 5], [Option<f64>; 3], [f64; 3]);
+
+/// The spec of the law named `name` (`imk`: the IMK storey's keys).
 fn spec(
     (name, _, yield_drift, post_yield_ratio, exponent, beta, gamma, a, nu, eta): &Law,
+    imk: Option<ImkKeys>,
 ) -> PyResult<StoreySpec> {
     let uy = || yield_drift.ok_or_else(|| value_error("yield_drift: give the yield drift (m)"));
     let post_yield_ratio = *post_yield_ratio;
@@ -43,9 +49,14 @@ fn spec(
             degradation_nu: Some(nu),
             degradation_eta: Some(eta),
         },
+        "imk" => {
+            let (keys, lambda, c) = imk.unwrap_or(([None; 5], [None; 3], [1.0; 3]));
+            StoreySpec::imk(*yield_drift, keys, lambda, c)
+                .map_err(|key| value_error(format!("{key}: give it for law='imk'")))?
+        }
         other => {
             return Err(value_error(format!(
-                "law = {other:?}: give \"elastic\", \"bilinear\" or \"bouc-wen\""
+                "law = {other:?}: give \"elastic\", \"bilinear\", \"bouc-wen\" or \"imk\""
             )))
         }
     })
@@ -56,7 +67,8 @@ fn spec(
 /// values, from rest) or, without it, the cyclic protocol of `amplitudes`
 /// (m) × `cycles`, `points` samples a cycle.
 #[pyfunction]
-#[pyo3(signature = (law, amplitudes, cycles, points, drift, rtol))]
+#[pyo3(signature = (law, amplitudes, cycles, points, drift, rtol, imk = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn hysteresis<'py>(
     py: Python<'py>,
     law: Law,
@@ -65,8 +77,9 @@ pub fn hysteresis<'py>(
     points: usize,
     drift: Option<PyReadonlyArray1<'py, f64>>,
     rtol: f64,
+    imk: Option<ImkKeys>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let storey = spec(&law)?.law(law.1).map_err(value_error)?;
+    let storey = spec(&law, imk)?.law(law.1).map_err(value_error)?;
     let drifts = match drift {
         Some(d) => floats(&d, "drift")?,
         None => cyclic_protocol(&amplitudes, cycles, points).map_err(value_error)?,

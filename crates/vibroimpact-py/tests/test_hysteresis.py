@@ -97,3 +97,30 @@ def test_bad_settings_name_the_argument(tmp_path):
     r = vi.hysteresis(stiffness=K, yield_drift=UY, drift=ok)
     # One excursion to +2 u_y and back to −2 u_y: 3 u_y of plastic drift.
     assert math.isclose(r.total_dissipated, 0.95 * K * UY * (0.01 + 0.02), rel_tol=1e-12)
+
+
+IMK = dict(cap_ratio=1.1, plastic_drift=0.03, post_capping_drift=0.1, residual_ratio=0.3,
+           ultimate_drift=0.2, lambda_s=4.0, lambda_c=4.0, lambda_k=4.0)
+
+
+def test_imk_on_both_faces(cli_exe):
+    # The IMK storey: the CLI's document equals Python's; its monotonic
+    # push reaches the cap F_c = 1.1 F_y at u_y + d_p; a key missing or out
+    # of order is named.
+    k, uy = 1.2e8, 0.01
+    flags = [f"--{key.replace('_', '-')}={value}" for key, value in IMK.items()]
+    args = ["--law", "imk", "--stiffness", str(k), "--yield-drift", str(uy), *flags,
+            "--amplitudes", "0.02,0.05", "--cycles", "1", "--points", "40", "--format", "json"]
+    doc = json.loads(subprocess.run([cli_exe, "hysteresis", *args], capture_output=True,
+                                    text=True, check=True).stdout)
+    r = vi.hysteresis(law="imk", stiffness=k, yield_drift=uy, amplitudes=[0.02, 0.05],
+                      cycles=1, points=40, **IMK)
+    assert doc["law"] == r.law and doc["law"]["law"] == "imk"
+    assert [row["force"] for row in doc["rows"]] == list(r.force)
+    push = vi.hysteresis(law="imk", stiffness=k, yield_drift=uy, drift=[0.04], **IMK)
+    assert push.force[-1] == pytest.approx(1.1 * k * uy, rel=1e-12)
+    with pytest.raises(ValueError, match="ultimate_drift: give it for law='imk'"):
+        vi.hysteresis(law="imk", stiffness=k, yield_drift=uy, amplitudes=[uy],
+                      **{key: v for key, v in IMK.items() if key != "ultimate_drift"})
+    with pytest.raises(ValueError, match="cap_ratio = 0.9: must be >= 1"):
+        vi.hysteresis(law="imk", stiffness=k, yield_drift=uy, amplitudes=[uy], **{**IMK, "cap_ratio": 0.9})

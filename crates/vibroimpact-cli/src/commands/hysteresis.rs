@@ -27,6 +27,9 @@ pub enum LawName {
     Bilinear,
     /// Bouc–Wen with optional degradation (OpenSees BoucWen).
     BoucWen,
+    /// The modified Ibarra–Medina–Krawinkler storey (OpenSees IMKBilin,
+    /// symmetric) with cyclic deterioration.
+    Imk,
 }
 
 /// Options of `vibroimpact hysteresis`.
@@ -62,6 +65,39 @@ pub struct HysteresisArgs {
     /// Bouc–Wen δ_η (1/J), stiffness degradation.
     #[arg(long, default_value_t = 0.0)]
     degradation_eta: f64,
+    /// IMK: the capping strength over the yield strength (≥ 1).
+    #[arg(long)]
+    cap_ratio: Option<f64>,
+    /// IMK: the plastic drift from yield to the cap (m).
+    #[arg(long)]
+    plastic_drift: Option<f64>,
+    /// IMK: the drift from the cap to zero force (m).
+    #[arg(long)]
+    post_capping_drift: Option<f64>,
+    /// IMK: the residual strength over the yield strength, in [0, 1].
+    #[arg(long)]
+    residual_ratio: Option<f64>,
+    /// IMK: the ultimate drift (m, total).
+    #[arg(long)]
+    ultimate_drift: Option<f64>,
+    /// IMK: λ_S (m), strength deterioration (none if not given).
+    #[arg(long)]
+    lambda_s: Option<f64>,
+    /// IMK: λ_C (m), cap deterioration (none if not given).
+    #[arg(long)]
+    lambda_c: Option<f64>,
+    /// IMK: λ_K (m), unloading-stiffness deterioration (none if not given).
+    #[arg(long)]
+    lambda_k: Option<f64>,
+    /// IMK: c_S.
+    #[arg(long, default_value_t = 1.0)]
+    c_s: f64,
+    /// IMK: c_C.
+    #[arg(long, default_value_t = 1.0)]
+    c_c: f64,
+    /// IMK: c_K.
+    #[arg(long, default_value_t = 1.0)]
+    c_k: f64,
     /// Drift amplitudes of the cyclic protocol (m), comma separated, each
     /// held for --cycles sine cycles.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
@@ -116,6 +152,21 @@ impl HysteresisArgs {
                 degradation_nu: Some(self.degradation_nu),
                 degradation_eta: Some(self.degradation_eta),
             },
+            LawName::Imk => StoreySpec::imk(
+                self.yield_drift,
+                [
+                    self.cap_ratio,
+                    self.plastic_drift,
+                    self.post_capping_drift,
+                    self.residual_ratio,
+                    self.ultimate_drift,
+                ],
+                [self.lambda_s, self.lambda_c, self.lambda_k],
+                [self.c_s, self.c_c, self.c_k],
+            )
+            .map_err(|key| {
+                CliError::new(format!("--{}: give it for --law imk", key.replace('_', "-")))
+            })?,
         })
     }
 }

@@ -112,6 +112,7 @@ def parse_drifts(text: str, source: str) -> F64: ...
 def hysteresis(
     law: tuple[str, float, Optional[float], float, float, float, float, float, float, float],
     amplitudes: list[float], cycles: int, points: int, drift: Optional[F64], rtol: float,
+    imk: Optional[tuple[list[Optional[float]], list[Optional[float]], list[float]]] = ...,
 ) -> dict[str, Any]: ...
 def pushover(
     pair_text: str, source: str, building: Optional[str], drift_ratio_limit: float, points: int,

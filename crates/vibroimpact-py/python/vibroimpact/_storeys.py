@@ -47,6 +47,17 @@ def hysteresis(
     degradation_a: float = 0.0,
     degradation_nu: float = 0.0,
     degradation_eta: float = 0.0,
+    cap_ratio: Optional[float] = None,
+    plastic_drift: Optional[float] = None,
+    post_capping_drift: Optional[float] = None,
+    residual_ratio: Optional[float] = None,
+    ultimate_drift: Optional[float] = None,
+    lambda_s: Optional[float] = None,
+    lambda_c: Optional[float] = None,
+    lambda_k: Optional[float] = None,
+    c_s: float = 1.0,
+    c_c: float = 1.0,
+    c_k: float = 1.0,
     amplitudes: Optional[Sequence[float]] = None,
     cycles: int = 2,
     points: int = 200,
@@ -56,8 +67,13 @@ def hysteresis(
     """A storey law under cyclic drift (``vibroimpact hysteresis``).
 
     ``law``: ``"elastic"``, ``"bilinear"`` (kinematic hardening, OpenSees
-    Steel01 without isotropic terms) or ``"bouc-wen"`` (OpenSees BoucWen in
-    yield-drift form, docs/theory.md §11). ``stiffness`` (N/m),
+    Steel01 without isotropic terms), ``"bouc-wen"`` (OpenSees BoucWen in
+    yield-drift form, docs/theory.md §11) or ``"imk"`` (the modified
+    Ibarra–Medina–Krawinkler storey, OpenSees IMKBilin, symmetric:
+    ``cap_ratio``, ``plastic_drift``, ``post_capping_drift``,
+    ``residual_ratio``, ``ultimate_drift``; ``lambda_s``, ``lambda_c``,
+    ``lambda_k`` (m, none: no such deterioration) and ``c_s``, ``c_c``,
+    ``c_k``). ``stiffness`` (N/m),
     ``yield_drift`` (m), ``post_yield_ratio`` in [0, 1); Bouc–Wen's
     ``exponent``, ``beta``, ``gamma`` and degradation ``degradation_a``,
     ``degradation_nu``, ``degradation_eta`` (1/J). The drift: the protocol
@@ -76,7 +92,7 @@ def hysteresis(
     if history is not None and amps:
         raise ValueError("drift: give drift= or amplitudes=, not both")
     spec = (
-        _method(law, ("elastic", "bilinear", "bouc-wen"), "law"),
+        _method(law, ("elastic", "bilinear", "bouc-wen", "imk"), "law"),
         _real(stiffness, "stiffness"),
         _real(yield_drift, "yield_drift", optional=True),
         _real(post_yield_ratio, "post_yield_ratio"),
@@ -87,6 +103,15 @@ def hysteresis(
         _real(degradation_nu, "degradation_nu"),
         _real(degradation_eta, "degradation_eta"),
     )
+    imk = (
+        [_real(v, k, optional=True) for k, v in (
+            ("cap_ratio", cap_ratio), ("plastic_drift", plastic_drift),
+            ("post_capping_drift", post_capping_drift), ("residual_ratio", residual_ratio),
+            ("ultimate_drift", ultimate_drift))],
+        [_real(v, k, optional=True) for k, v in (
+            ("lambda_s", lambda_s), ("lambda_c", lambda_c), ("lambda_k", lambda_k))],
+        [_real(v, k) for k, v in (("c_s", c_s), ("c_c", c_c), ("c_k", c_k))],
+    )
     return Result(
         _core.hysteresis(
             spec,
@@ -95,5 +120,6 @@ def hysteresis(
             _count(points, "points", minimum=4, maximum=10**7),
             history,
             _real(rtol, "rtol", positive=True),
+            imk,
         )
     )

@@ -472,7 +472,47 @@ pub enum StoreySpec {
     },
 }
 
+/// The keys an IMK storey needs besides its yield drift, in the order
+/// [`StoreySpec::imk`] takes them.
+pub const IMK_KEYS: [&str; 5] = [
+    "cap_ratio",
+    "plastic_drift",
+    "post_capping_drift",
+    "residual_ratio",
+    "ultimate_drift",
+];
+
 impl StoreySpec {
+    /// An IMK storey's spec from the keys as the faces take them: the yield
+    /// drift, the five of [`IMK_KEYS`], λ_S, λ_C, λ_K (None: no such
+    /// deterioration) and c_S, c_C, c_K. Err: the first key missing.
+    pub fn imk(
+        yield_drift: Option<f64>,
+        keys: [Option<f64>; 5],
+        lambda: [Option<f64>; 3],
+        c: [f64; 3],
+    ) -> Result<Self, &'static str> {
+        let yield_drift = yield_drift.ok_or("yield_drift")?;
+        let mut v = [0.0; 5];
+        for (k, key) in IMK_KEYS.iter().enumerate() {
+            v[k] = keys[k].ok_or(*key)?;
+        }
+        Ok(StoreySpec::Imk {
+            yield_drift,
+            cap_ratio: v[0],
+            plastic_drift: v[1],
+            post_capping_drift: v[2],
+            residual_ratio: v[3],
+            ultimate_drift: v[4],
+            lambda_s: lambda[0],
+            lambda_c: lambda[1],
+            lambda_k: lambda[2],
+            c_s: Some(c[0]),
+            c_c: Some(c[1]),
+            c_k: Some(c[2]),
+        })
+    }
+
     /// The law with the storey's elastic `stiffness`, checked.
     pub fn law(&self, stiffness: f64) -> Result<StoreyLaw, LawError> {
         let law = match *self {
