@@ -247,8 +247,10 @@ fn random_models_simulate_or_fail_cleanly() {
 const PAIR: &str = include_str!("../../../examples/pounding-frames.toml");
 const ISOLATED: &str = include_str!("../../../examples/isolated-building.toml");
 const FIVE: &str = include_str!("../../../examples/pounding-five-storeys.toml");
+const ARCHETYPE: &str = include_str!("../../../examples/moment-frame-4.toml");
 
-/// Pair, row and isolated-building files (issue 37): every mutant parses
+/// Pair, row and isolated-building files, and the IMK + P-Δ archetype
+/// (issue 37): every mutant parses
 /// or is refused naming the file; a row that parses runs a short record
 /// where its estimate says the run is short (a long one would say so up
 /// front), and a run that completes has finite peaks.
@@ -267,7 +269,7 @@ fn row_file_mutants_parse_and_run_without_panics() {
         )
         .unwrap()
     };
-    let corpus = [PAIR, ISOLATED, FIVE];
+    let corpus = [PAIR, ISOLATED, FIVE, ARCHETYPE];
     let inputs: Vec<String> = (0..cases(600)).map(|_| mutant(&mut rng, &corpus)).collect();
     let run = RunSettings::new(0.01, 1e-6);
     no_panics("row file", inputs.into_iter(), |text| {
