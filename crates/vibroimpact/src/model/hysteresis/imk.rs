@@ -230,21 +230,26 @@ impl Imk {
 
     /// The drifts ahead of `u` in direction `dir` (up to `to`) where the
     /// bound of `dir` has a corner.
-    fn corners(&self, s: &ImkState, dir: f64, u: f64, to: f64) -> Vec<f64> {
+    fn corners(&self, s: &ImkState, dir: f64, u: f64, to: f64) -> Corners {
         let side = if dir > 0.0 { &s.pos } else { &s.neg };
-        let mut xs = vec![side.ucap];
-        if side.kp != 0.0 {
-            xs.push(side.ucap + (side.fres - side.fcap) / side.kp);
+        let cand = [
+            side.ucap,
+            side.ucap + (side.fres - side.fcap) / side.kp,
+            side.ucap + (side.fres - side.fcap) / side.kpc,
+        ];
+        // (A zero slope has no corner: its candidate is not finite.)
+        let mut out = Corners {
+            xs: [f64::NAN; 3],
+            n: 0,
+        };
+        for x in cand {
+            if x.is_finite() && (x - u) * dir > tiny(u) && (to - x) * dir > 0.0 {
+                out.xs[out.n] = x;
+                out.n += 1;
+            }
         }
-        if side.kpc != 0.0 {
-            xs.push(side.ucap + (side.fres - side.fcap) / side.kpc);
-        }
-        let mut ahead: Vec<f64> = xs
-            .into_iter()
-            .filter(|&x| x.is_finite() && (x - u) * dir > tiny(u) && (to - x) * dir > 0.0)
-            .collect();
-        ahead.sort_by(|a, b| ((a - u) * dir).total_cmp(&((b - u) * dir)));
-        ahead
+        out.xs[..out.n].sort_by(|a, b| ((a - u) * dir).total_cmp(&((b - u) * dir)));
+        out
     }
 
     /// The state after the drift moves monotonically from `s.u` to `to`.
@@ -314,7 +319,7 @@ impl Imk {
     /// On the backbone: to the next corner, the ultimate drift or `to`.
     fn along_backbone(&self, s: &ImkState, dir: f64, to: f64) -> (f64, Event) {
         let mut x = to;
-        if let Some(&c) = self.corners(s, dir, s.u, to).first() {
+        if let Some(&c) = self.corners(s, dir, s.u, to).ahead().first() {
             x = c;
         }
         // A backbone line through zero force (no residual): there the
@@ -346,9 +351,8 @@ impl Imk {
         if ga >= 0.0 {
             return (s.u, Event::Hit);
         }
-        let mut stops = self.corners(s, dir, s.u, end.0);
-        stops.push(end.0);
-        for b in stops {
+        let corners = self.corners(s, dir, s.u, end.0);
+        for &b in corners.ahead().iter().chain([end.0].iter()) {
             let gb = g(b);
             if gb >= 0.0 {
                 return (a + (b - a) * (-ga) / (gb - ga), Event::Hit);
@@ -565,7 +569,11 @@ impl Imk {
     fn backbone_ahead(&self, s: &ImkState, d: f64) -> f64 {
         let (k, dir) = (self.stiffness, s.dir);
         let mut g = f64::INFINITY;
-        if let Some(&c) = self.corners(s, dir, s.u, dir * f64::INFINITY).first() {
+        if let Some(&c) = self
+            .corners(s, dir, s.u, dir * f64::INFINITY)
+            .ahead()
+            .first()
+        {
             g = g.min(k * dir * (c - d));
         }
         let side = if dir > 0.0 { &s.pos } else { &s.neg };
@@ -646,6 +654,20 @@ impl Imk {
         }
         let hair = 1e-12 * self.yield_drift.max(at.abs());
         self.advance(s, at + dir * hair);
+    }
+}
+
+/// The corners of a bound ahead of a drift, nearest first (at most three:
+/// the cap and where each line meets the residual; no allocation, as
+/// the switch function asks at every step).
+struct Corners {
+    xs: [f64; 3],
+    n: usize,
+}
+
+impl Corners {
+    fn ahead(&self) -> &[f64] {
+        &self.xs[..self.n]
     }
 }
 
