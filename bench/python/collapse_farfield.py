@@ -57,7 +57,7 @@ def study(records, period, contacts, client=None):
 
 def intensities(doc):
     """Per record its collapse intensity S_T x scale (g) and censoring."""
-    s_t = doc["summary"]["s_t"] / 9.80665
+    s_t = doc["summary"]["s_t"]  # g
     values, censored = [], []
     for r in doc["records"]:
         c = r["collapse"]
@@ -112,8 +112,8 @@ def main():
         rows[name] = {
             "records": s["records"], "collapsed": s["collapsed"], "modes": verdicts,
             "median_collapse_scale": s["median_collapse_scale"],
-            "s_t_g": s["s_t"] / 9.80665, "s_ct_g": None if s["s_ct"] is None else s["s_ct"] / 9.80665,
-            "s_mt_g": s["smt"] / 9.80665, "cmr": s["cmr"], "ssf": s["ssf"], "acmr": s["acmr"],
+            "s_t_g": s["s_t"], "s_ct_g": s["s_ct"],
+            "s_mt_g": s["smt"], "cmr": s["cmr"], "ssf": s["ssf"], "acmr": s["acmr"],
             "acmr10": doc["margins"]["acmr10"], "acmr20": doc["margins"]["acmr20"],
             "passes_acmr10": doc["margins"]["passes_acmr10"], "passes_acmr20": doc["margins"]["passes_acmr20"],
             "fragility_median_g": None if fit is None else fit["median"],

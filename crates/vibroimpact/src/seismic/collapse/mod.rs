@@ -5,8 +5,9 @@
 //! records, censored records (no collapse up to the largest scale) never
 //! folded in.
 //!
-//! Files: `mod.rs` (IDA per record, the median, margins), `study.rs` (the
-//! study every face runs and its documents), `tests.rs` (the checks).
+//! Files: `mod.rs` (IDA per record, the median, margins), `fragility.rs`
+//! (the lognormal fragility by maximum likelihood), `study.rs` (the study
+//! every face runs and its documents), `tests.rs` (the checks).
 //!
 //! A run collapses when a storey drift passes the drift limit (the run
 //! stops there), when an isolator passes its stated capacity (if the
@@ -400,9 +401,12 @@ pub fn median_collapse(records: &[RecordIda]) -> Option<f64> {
     m.is_finite().then_some(m)
 }
 
+mod fragility;
+pub use fragility::{fragility, Fragility, FragilityError};
 mod study;
 pub use study::{
-    check_margins, record_document, study_document, summary_document, CollapseStudy, RecordCollapse,
+    check_margins, fit_fragility, record_document, study_document, summary_document, CollapseStudy,
+    RecordCollapse,
 };
 
 #[cfg(test)]

@@ -5,9 +5,12 @@
 
 use serde_json::{json, Value};
 
-use super::{median_collapse, record_ida, Criterion, DriftLimit, IdaSettings, RecordIda, Verdict};
+use super::{
+    fragility, median_collapse, record_ida, Criterion, DriftLimit, Fragility, FragilityError,
+    IdaSettings, RecordIda, Verdict,
+};
 use crate::field_error::FieldError;
-use crate::model::record::Record;
+use crate::model::record::{Record, STANDARD_GRAVITY};
 use crate::seismic::pounding::{PoundingError, Row, RunSettings};
 use crate::simulate::WorkEstimate;
 
@@ -32,7 +35,8 @@ pub struct CollapseStudy {
 pub struct RecordCollapse {
     /// Its IDA.
     pub ida: RecordIda,
-    /// Its pseudo-spectral acceleration at the period, unscaled (m/s²).
+    /// Its pseudo-spectral acceleration at the period, unscaled, in g
+    /// (FEMA P695 states S_T, Ŝ_CT and S_MT in g).
     pub sa: Option<f64>,
 }
 
@@ -87,7 +91,7 @@ impl CollapseStudy {
             .period
             .map(|t| {
                 crate::seismic::spectrum::response_spectrum(record, 1.0, self.damping, &[t])
-                    .map(|p| p[0].pseudo_acceleration)
+                    .map(|p| p[0].pseudo_acceleration / STANDARD_GRAVITY)
             })
             .transpose()?;
         let ida = record_ida(row, record, &self.criterion, &self.ida, &self.run)?;
@@ -158,14 +162,14 @@ pub fn record_document(r: &RecordCollapse) -> Value {
     })
 }
 
-/// Refuses an S_MT or SSF that is not positive and finite (a negative
+/// Refuses an S_MT (g) or SSF that is not positive and finite (a negative
 /// S_MT gave a negative CMR): checked before any run.
 pub fn check_margins(smt: Option<f64>, ssf: Option<f64>) -> Result<(), FieldError> {
     for (field, v, what) in [
         (
             "smt",
             smt,
-            "give the positive MCE spectral acceleration S_MT",
+            "give the positive MCE spectral acceleration S_MT in g",
         ),
         ("ssf", ssf, "give the positive spectral shape factor"),
     ] {
@@ -180,9 +184,10 @@ pub fn check_margins(smt: Option<f64>, ssf: Option<f64>) -> Result<(), FieldErro
 /// where censored records leave it undetermined, with a note naming
 /// them); with spectral accelerations, the set's median S_T at the period
 /// (their geometric mean, as FEMA P695's S_NRT) and the median collapse
-/// intensity Ŝ_CT = median scale × S_T; with
-/// `smt` the collapse margin ratio CMR = Ŝ_CT / S_MT, and with `ssf` also
-/// ACMR = SSF × CMR.
+/// intensity Ŝ_CT = median scale × S_T, both in g; with
+/// `smt` (S_MT, g) the collapse margin ratio CMR = Ŝ_CT / S_MT, and with
+/// `ssf` also ACMR = SSF × CMR; the lognormal fragility fitted to the
+/// records ([`fit_fragility`]) or, where none is determined, the note why.
 pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Option<f64>) -> Value {
     let idas: Vec<RecordIda> = records.iter().map(|r| r.ida.clone()).collect();
     let median = median_collapse(&idas);
@@ -200,6 +205,19 @@ pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Optio
         .filter(|r| r.collapse.is_none())
         .map(|r| format!("{}: no collapse up to scale {}", r.source, r.survived))
         .collect();
+    let (fragility, fragility_note) = match fit_fragility(records) {
+        Ok(f) => (
+            json!({
+                "median": f.median,
+                "dispersion": f.dispersion,
+                "records": f.records,
+                "censored": f.censored,
+                "intensity": if s_t.is_some() { "sa" } else { "scale" },
+            }),
+            Value::Null,
+        ),
+        Err(e) => (Value::Null, json!(format!("no fragility: {e}"))),
+    };
     json!({
         "records": records.len(),
         "collapsed": records.len() - censored.len(),
@@ -211,12 +229,43 @@ pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Optio
         "ssf": ssf,
         "acmr": cmr.zip(ssf).map(|(c, s)| c * s),
         "censored": censored,
+        "fragility": fragility,
+        "fragility_note": fragility_note,
         "note": median.is_none().then(|| format!(
             "the median collapse scale is not determined: {} of {} records did not collapse; raise the largest scale",
             censored.len(),
             records.len()
         )),
     })
+}
+
+/// The lognormal fragility of the records' intensities (module
+/// `fragility`): each record's collapse scale, or the largest it survived
+/// (censored), times its Sa(T1) in g where every record has one, else the
+/// scale itself.
+pub fn fit_fragility(records: &[RecordCollapse]) -> Result<Fragility, FragilityError> {
+    let (values, censored): (Vec<f64>, Vec<bool>) = records
+        .iter()
+        .map(|r| {
+            let scale = r.ida.collapse.unwrap_or(r.ida.survived);
+            let per = if records.iter().all(|r| r.sa.is_some()) {
+                r.sa.unwrap_or(1.0)
+            } else {
+                1.0
+            };
+            (scale * per, r.ida.collapse.is_none())
+        })
+        .unzip();
+    fragility(&values, &censored)
+}
+
+/// The units of a study's document: the pounding runs' units, with the
+/// spectral accelerations (each record's `sa`, S_T, Ŝ_CT, S_MT) in g, as
+/// FEMA P695 states them.
+fn units_document() -> Value {
+    let mut units = crate::seismic::pounding::documents::units_document();
+    units["spectral_acceleration"] = json!("g");
+    units
 }
 
 /// The study's document: the row, the settings, every record's document
@@ -250,7 +299,7 @@ pub fn study_document(
         "period": study.period,
         "damping": study.damping,
         "settings": crate::seismic::pounding::documents::settings_document(&study.run),
-        "units": crate::seismic::pounding::documents::units_document(),
+        "units": units_document(),
         "records": records,
         "summary": summary,
     })
