@@ -92,6 +92,8 @@ fn bad_records_and_options_are_refused() {
     std::fs::write(&nounits, "t a\n0 1\n0.01 2\n").unwrap();
     let gap_s = gap.display().to_string();
     let nounits_s = nounits.display().to_string();
+    let frame = repo_file("examples/moment-frame-4.toml");
+    let quake = repo_file("examples/synthetic-quake.csv");
     for (args, needle) in [
         (
             vec!["spectrum", &at2, "--units", "furlong"],
@@ -105,6 +107,14 @@ fn bad_records_and_options_are_refused() {
         (vec!["spectrum", &gap_s], "gap.txt:5: a gap"),
         (vec!["spectrum", &nounits_s], "states no units"),
         (vec!["spectrum", "/nonexistent/x.AT2"], "x.AT2"),
+        // Found by the option fuzzer: rtol 0.5 controls no error (a run
+        // under a scale of 5e8 did not end); refused before any run.
+        (
+            vec![
+                "pounding", &frame, &quake, "--units", "m/s2", "--scale", "5e8", "--rtol", "0.5",
+            ],
+            "--rtol 0.5: give a relative tolerance in [1e-13, 1e-2]",
+        ),
     ] {
         let out = run(&args);
         assert!(!out.status.success(), "{args:?}");

@@ -152,3 +152,16 @@ def test_h3_a_long_hysteresis_warns_before_it_starts():
             vi.hysteresis(stiffness=1e6, law="bouc-wen", yield_drift=0.01,
                           amplitudes=[0.02], cycles=10, points=2_000_000)
         assert time.perf_counter() - start < 5.0
+
+
+def test_a_tolerance_that_controls_no_error_is_refused_before_any_run():
+    # Found by the option fuzzer: rtol 0.5 gave the archetype's peak drift
+    # 3 times too large, and under a scale of 5e8 a run that did not end.
+    frame = EXAMPLES / "moment-frame-4.toml"
+    for rtol in (0.5, 1.88, 1e-15):
+        start = time.perf_counter()
+        with pytest.raises(ValueError, match=r"^rtol .*: give a relative tolerance in \[1e-13, 1e-2\]"):
+            vi.pounding(frame, _sine(2.0), scale=5e8, rtol=rtol)
+        with pytest.raises(ValueError, match=r"^rtol"):
+            vi.collapse_study(frame, [_sine(2.0)], rtol=rtol)
+        assert time.perf_counter() - start < 1.0

@@ -125,17 +125,26 @@ impl Storey {
 }
 
 /// The peak of `f` over `[0, top]` on a grid of `n` pieces refined by golden
-/// section around the best: (where, value).
+/// section around the best: (where, value). `f` rises from 0 (a storey's
+/// resistance, stable at zero drift), so a best at 0 means the grid is too
+/// coarse for the law (a push far past its collapse, or few points): the
+/// first piece is searched again, down to where the rise shows.
 fn peak(f: impl Fn(f64) -> Result<f64, String>, top: f64, n: usize) -> Result<(f64, f64), String> {
-    let mut best = (0.0, f(0.0)?);
-    let mut at = 0;
-    for j in 1..=n {
-        let d = top * j as f64 / n as f64;
-        let v = f(d)?;
-        if v > best.1 {
-            best = (d, v);
-            at = j;
+    let mut top = top;
+    let (mut best, mut at) = ((0.0, f(0.0)?), 0);
+    for _ in 0..1100 {
+        for j in 1..=n {
+            let d = top * j as f64 / n as f64;
+            let v = f(d)?;
+            if v > best.1 {
+                best = (d, v);
+                at = j;
+            }
         }
+        if at > 0 || top / n as f64 <= f64::MIN_POSITIVE {
+            break;
+        }
+        top /= n as f64;
     }
     if at == n || at == 0 {
         return Ok(best);
@@ -176,6 +185,10 @@ pub fn storey_tangent(frame: &ShearFrame, i: usize, d: f64) -> Result<f64, Strin
     Ok((s.resistance(d + h)? - s.resistance(d)?) / h)
 }
 
+/// The most points a push takes (found by the option fuzzer: 2^40 points
+/// ran for hours).
+pub const MAX_POINTS: usize = 100_000;
+
 /// The pushover of `frame` (it needs the storeys' heights); errors name
 /// the option or storey.
 pub fn pushover(frame: &ShearFrame, opts: &PushoverOptions) -> Result<Pushover, String> {
@@ -185,14 +198,20 @@ pub fn pushover(frame: &ShearFrame, opts: &PushoverOptions) -> Result<Pushover, 
             "heights: the pushover needs the storeys' heights (m) for its drift limit".into(),
         );
     }
-    if !(opts.drift_ratio_limit.is_finite() && opts.drift_ratio_limit > 0.0) {
+    if !(opts.drift_ratio_limit.is_finite()
+        && opts.drift_ratio_limit > 0.0
+        && opts.drift_ratio_limit <= 1.0)
+    {
         return Err(format!(
-            "drift_ratio_limit = {}: give a positive drift ratio",
+            "drift_ratio_limit = {}: give a drift ratio in (0, 1] (past 1 a storey has moved more than its height, where the shear building's P-Δ means nothing)",
             opts.drift_ratio_limit
         ));
     }
-    if opts.points < 2 {
-        return Err(format!("points = {}: give at least 2", opts.points));
+    if !(2..=MAX_POINTS).contains(&opts.points) {
+        return Err(format!(
+            "points = {}: give 2 to {MAX_POINTS} (each point solves every storey; 1e5 take about a second)",
+            opts.points
+        ));
     }
     if let Some(t) = opts.code_period {
         if !(t.is_finite() && t > 0.0) {

@@ -132,10 +132,25 @@ fn bad_pushovers_are_refused() {
         ),
         (
             PushoverOptions {
+                points: 1 << 40,
+                ..Default::default()
+            },
+            "points",
+        ),
+        (
+            PushoverOptions {
                 code_period: Some(-1.0),
                 ..Default::default()
             },
             "code_period",
+        ),
+        // Found by the option fuzzer: 85.6 gave μ_T NaN.
+        (
+            PushoverOptions {
+                drift_ratio_limit: 1.5,
+                ..Default::default()
+            },
+            "drift_ratio_limit",
         ),
     ] {
         let e = pushover(&f, &opts).unwrap_err();
@@ -147,4 +162,39 @@ fn bad_pushovers_are_refused() {
     assert!(pushover(&bare, &PushoverOptions::default())
         .unwrap_err()
         .starts_with("heights"));
+}
+
+/// An IMK storey pushed on a grid far coarser than its backbone (two
+/// points over a drift ratio of 1, where its cap lies at 3 %): the peak
+/// is still the cap's, R_c = F_c − (P/h) d_c, as on the default grid, to
+/// 1e-12 (found by the option fuzzer: the coarse push gave V_max 0 and
+/// μ_T NaN).
+#[test]
+fn a_coarse_push_still_finds_the_cap() {
+    let (k, uy, dp) = (4e7, 0.02, 0.085);
+    let imk = StoreySpec::imk(
+        Some(uy),
+        [Some(1.1), Some(dp), Some(0.3), Some(0.4), Some(0.6)],
+        [None, None, None],
+        [1.0, 1.0, 1.0],
+    )
+    .unwrap();
+    let f = frame(vec![1e5], vec![k], vec![imk], vec![1e5]);
+    let g = f.geometric_stiffnesses()[0];
+    let (dc, fc) = (uy + dp, 1.1 * k * uy);
+    let expected = fc - g * dc;
+    for points in [2, 400] {
+        let opts = PushoverOptions {
+            drift_ratio_limit: 1.0,
+            points,
+            ..Default::default()
+        };
+        let p = pushover(&f, &opts).unwrap();
+        assert!(
+            (p.max_base_shear / expected - 1.0).abs() < 1e-12,
+            "{points}: {} against {expected}",
+            p.max_base_shear
+        );
+        assert!(p.ductility.is_finite() && p.ductility > 1.0);
+    }
 }
