@@ -43,6 +43,8 @@ that yield"; docs/theory.md §11):
   coefficients carry over); such a storey's Rayleigh damper ``beta k`` is
   a ``zeroLength`` dashpot of its own beside it (``Elastic`` with E = 0),
   the damping staying linear on the initial stiffness as in vibroimpact;
+  ``imk`` is ``IMKBilin`` (Nov22) with the same values on both sides
+  (:func:`imk_args`; an absent lambda is :data:`NO_DETERIORATION`);
 * the record is followed by the same free-vibration tail as ours: 5 T1 of
   the longer-period frame (``TAIL_PERIODS``) at zero ground acceleration,
   the record's last sample ramped to zero over one record step (a 0
@@ -136,7 +138,36 @@ def storey_material(spec: Dict[str, Any], k: float):
             b, k, n, spec.get("gamma", 0.5) / uy**n, spec.get("beta", 0.5) / uy**n, 1.0,
             spec.get("degradation_a", 0.0), spec.get("degradation_nu", 0.0), spec.get("degradation_eta", 0.0),
         )
-    raise ValueError(f"storey law {law!r}: OpenSees has no equal material here (bilinear or bouc-wen)")
+    if law == "imk":
+        return "IMKBilin", imk_args(spec, k)
+    raise ValueError(f"storey law {law!r}: OpenSees has no equal material here (bilinear, bouc-wen or imk)")
+
+
+NO_DETERIORATION = 1e30
+"""IMKBilin's lambda (m) for a lambda vibroimpact does not have (infinite:
+no deterioration of that kind): beta = (E_i/(lambda F_y - E))^c rounds to
+0 against 1, for any c (lambda = 0 is off only with c = 1: with c != 1
+OpenSees' pow of a negative base is NaN; the peer notes)."""
+
+
+def imk_args(spec: Dict[str, Any], k: float):
+    """OpenSees' ``IMKBilin`` (Nov22) arguments after the tag for an IMK
+    storey of elastic stiffness ``k`` (vibroimpact's symmetric ``imk`` law,
+    crates/vibroimpact/src/model/hysteresis/imk.rs): Ke = k; both sides
+    dp = plastic_drift (the cap at u_y + dp), dpc = post_capping_drift (cap
+    to zero force), du = ultimate_drift (total), Fy = k yield_drift,
+    FmaxFy = cap_ratio, FresFy = residual_ratio; lambda_s, lambda_c,
+    lambda_k (m, the reference energy lambda F_y; absent:
+    :data:`NO_DETERIORATION`), c_s, c_c, c_k (default 1); D = 1 both sides
+    (bench/opensees/imk_reference.py; /work/shared/design/
+    opensees-imkbilin-notes.md)."""
+    fy = k * spec["yield_drift"]
+    side = (spec["plastic_drift"], spec["post_capping_drift"], spec["ultimate_drift"], fy,
+            spec["cap_ratio"], spec["residual_ratio"])
+    lam = [spec.get(key) for key in ("lambda_s", "lambda_c", "lambda_k")]
+    lam = [NO_DETERIORATION if v is None else v for v in lam]
+    c = [spec.get(key, 1.0) for key in ("c_s", "c_c", "c_k")]
+    return (k, *side, *side, *lam, *c, 1.0, 1.0)
 
 
 def add_storey(ops, new, below: int, node: int, k: float, law: Dict[str, Any], beta: float) -> int:
@@ -160,11 +191,13 @@ def add_storey(ops, new, below: int, node: int, k: float, law: Dict[str, Any], b
     return ele
 
 
-def transient(ops, system: str, algorithm: str, tol: float, integrator: str) -> None:
+def transient(ops, system: str, algorithm: str, tol: float, integrator: str, constraints: str = "Plain") -> None:
     """The transient analysis of a model: the equation ``system``; Newmark's
     average acceleration with a Newton ``algorithm`` and a displacement test
-    at ``tol``, or the explicit ``CentralDifference`` (linear algorithm)."""
-    ops.constraints("Plain")
+    at ``tol``, or the explicit ``CentralDifference`` (linear algorithm);
+    ``constraints`` the constraint handler (``Transformation`` for a model
+    with ``equalDOF``)."""
+    ops.constraints(constraints)
     ops.numberer("Plain")
     ops.system(system)
     if integrator == "CentralDifference":
