@@ -1,7 +1,8 @@
 //! Fuzzing of every parser and of the model constructor: seeded,
 //! deterministic, bounded in `cargo test`; longer with
 //! `VIBROIMPACT_FUZZ_CASES=20000 cargo test --release -p vibroimpact --test fuzz`
-//! (and `VIBROIMPACT_FUZZ_SEED=<n>` for another sequence).
+//! (and `VIBROIMPACT_FUZZ_SEED=<n>` for another sequence; `FUZZ_TRACE=1`
+//! prints each option case's seed before its run, to find one that hangs).
 //!
 //! Inputs are mutants of the repository's own examples (byte and token
 //! edits, extreme numbers, duplicated and swapped lines), so that they pass
@@ -312,6 +313,197 @@ fn record_and_drift_file_mutants_never_panic() {
         match parse_drifts(text, "d.txt") {
             Err(e) => assert!(e.to_string().starts_with("d.txt"), "unnamed error: {e}"),
             Ok(d) => assert!(d.iter().all(|x| x.is_finite()) && !d.is_empty()),
+        }
+    });
+}
+
+/// A number for an option: half the time near its typical value, else one
+/// of the probing numbers (zero, negatives, extremes, NaN, infinities).
+fn option_value(rng: &mut Rng, typical: f64) -> f64 {
+    if rng.below(2) == 0 {
+        typical * rng.log_uniform(0.1, 10.0)
+    } else {
+        rng.pick(NUMBERS).parse().unwrap()
+    }
+}
+
+/// A count for an option: near its typical value, or an extreme.
+fn option_count(rng: &mut Rng, typical: usize) -> usize {
+    *rng.pick(&[typical, typical / 2 + 1, 0, 1, 3, usize::MAX, 1 << 40])
+}
+
+/// The options of `pounding`, `collapse`, `pushover` and `hysteresis`
+/// (issue 37), each drawn near its typical value or from the probing
+/// numbers: every combination is refused before any work (`check`), or is
+/// priced and, where the estimate says short, runs to a result with
+/// finite values or an error; never a panic, never a hang, never a
+/// non-finite result presented as success.
+#[test]
+fn option_mutants_are_refused_or_run_finitely() {
+    use vibroimpact::integrate::Method;
+    use vibroimpact::model::hysteresis::{cyclic_protocol, under_drift, StoreySpec};
+    use vibroimpact::seismic::collapse::{CollapseStudy, Criterion, DriftLimit, IdaSettings};
+    use vibroimpact::seismic::pounding::{parse_row, RunSettings};
+    use vibroimpact::seismic::pushover::{pushover, PushoverOptions};
+    let mut rng = Rng(seed() ^ 39);
+    let record = {
+        let units = Some(vibroimpact::model::record::Units::MetersPerSecond2);
+        let r = vibroimpact::model::record::parse_record(QUAKE, "quake.csv", units).unwrap();
+        let n = r.times.len().min(101);
+        vibroimpact::model::record::Record::from_samples(
+            "quake",
+            r.times[..n].to_vec(),
+            &r.acceleration[..n],
+        )
+        .unwrap()
+    };
+    let rows = [
+        parse_row(PAIR, "pair.toml").unwrap(),
+        parse_row(ARCHETYPE, "archetype.toml").unwrap(),
+    ];
+    // Each case's seed is its input: a failing case is reported with it.
+    let inputs: Vec<String> = (0..cases(600))
+        .map(|_| rng.next_u64().to_string())
+        .collect();
+    no_panics("options", inputs.into_iter(), |case| {
+        let mut rng = Rng(case.parse().unwrap());
+        let row = rng.pick(&rows);
+        let mut run = RunSettings::new(option_value(&mut rng, 0.01), option_value(&mut rng, 1e-6));
+        run.method = *rng.pick(&[Method::Dop853, Method::Dopri5]);
+        run.integrator = *rng.pick(&[Integrator::Global, Integrator::Local, Integrator::Auto]);
+        let scale = option_value(&mut rng, 1.0);
+        let short = |w: Option<vibroimpact::simulate::WorkEstimate>| {
+            w.is_some_and(|w| w.seconds < 0.02 && !w.exceeds_step_limit())
+        };
+        // pounding
+        if let Ok(est) = row.estimate(&record, scale, true, &run) {
+            if short(est) {
+                if std::env::var("FUZZ_TRACE").is_ok() {
+                    eprintln!(
+                        "CASE {case} {} scale {scale} {:?}",
+                        row.buildings.len(),
+                        (run.sample, run.rtol, run.method, run.integrator)
+                    );
+                }
+                if let Ok(r) = row.respond(&record, scale, true, &run) {
+                    let peaks = r.drift.iter().chain(&r.acceleration).flatten();
+                    assert!(peaks.into_iter().all(|p| p.is_finite()), "a finite run");
+                    assert!(r.peak_impact_force.is_finite());
+                }
+            }
+        }
+        // collapse
+        let study = CollapseStudy {
+            criterion: Criterion {
+                drift: if rng.below(2) == 0 {
+                    DriftLimit::Ratio(option_value(&mut rng, 0.1))
+                } else {
+                    DriftLimit::Drift(option_value(&mut rng, 0.3))
+                },
+                capacity: rng.below(2) == 0,
+                contacts: rng.below(2) == 0,
+            },
+            ida: IdaSettings {
+                first: option_value(&mut rng, 0.25),
+                growth: option_value(&mut rng, 1.5),
+                max_scale: option_value(&mut rng, 4.0),
+                tolerance: option_value(&mut rng, 0.05),
+            },
+            run: run.clone(),
+            period: (rng.below(2) == 0).then(|| option_value(&mut rng, 1.0)),
+            damping: option_value(&mut rng, 0.05),
+        };
+        if study.check().is_ok() {
+            if let Ok(Some(w)) = study.estimate(row, &record) {
+                if w.seconds < 0.05 && !w.exceeds_step_limit() {
+                    if let Ok(part) = study.record(row, &record) {
+                        assert!(part.sa.is_none_or(f64::is_finite));
+                        for p in &part.ida.points {
+                            assert!(p.scale.is_finite() && p.scale > 0.0);
+                            assert!(!p.max_drift.is_nan());
+                        }
+                    }
+                }
+            }
+        }
+        // pushover
+        let opts = PushoverOptions {
+            drift_ratio_limit: option_value(&mut rng, 0.1),
+            points: option_count(&mut rng, 400),
+            code_period: (rng.below(2) == 0).then(|| option_value(&mut rng, 1.0)),
+        };
+        if let Ok(p) = pushover(&rows[1].buildings[0].frame, &opts) {
+            assert!(p
+                .base_shear
+                .iter()
+                .chain(&p.roof_displacement)
+                .all(|v| v.is_finite()));
+            assert!(
+                p.ductility.is_finite() && p.ductility >= 0.0,
+                "{opts:?}: μT {} δy {} δu {}",
+                p.ductility,
+                p.yield_displacement,
+                p.ultimate_displacement
+            );
+        }
+        // hysteresis
+        let uy = option_value(&mut rng, 0.01);
+        let spec = match rng.below(4) {
+            0 => StoreySpec::Elastic {},
+            1 => StoreySpec::Bilinear {
+                yield_drift: uy,
+                post_yield_ratio: option_value(&mut rng, 0.05),
+            },
+            2 => StoreySpec::BoucWen {
+                yield_drift: uy,
+                post_yield_ratio: option_value(&mut rng, 0.05),
+                exponent: Some(option_value(&mut rng, 2.0)),
+                beta: Some(option_value(&mut rng, 0.5)),
+                gamma: Some(option_value(&mut rng, 0.5)),
+                degradation_a: Some(option_value(&mut rng, 0.01)),
+                degradation_nu: Some(option_value(&mut rng, 0.01)),
+                degradation_eta: Some(option_value(&mut rng, 0.01)),
+            },
+            _ => {
+                let v = |rng: &mut Rng, t| Some(option_value(rng, t));
+                StoreySpec::imk(
+                    Some(uy),
+                    [
+                        v(&mut rng, 1.1),
+                        v(&mut rng, 0.03),
+                        v(&mut rng, 0.1),
+                        v(&mut rng, 0.3),
+                        v(&mut rng, 0.2),
+                    ],
+                    [v(&mut rng, 4.0), v(&mut rng, 4.0), v(&mut rng, 4.0)],
+                    [
+                        option_value(&mut rng, 1.0),
+                        option_value(&mut rng, 1.0),
+                        option_value(&mut rng, 1.0),
+                    ],
+                )
+                .unwrap()
+            }
+        };
+        let amplitudes: Vec<f64> = (0..1 + rng.below(3))
+            .map(|_| option_value(&mut rng, 0.02))
+            .collect();
+        let protocol = cyclic_protocol(
+            &amplitudes,
+            option_count(&mut rng, 2),
+            4 * option_count(&mut rng, 25).min(1 << 60),
+        );
+        let rtol = option_value(&mut rng, 1e-10);
+        if let (Ok(law), Ok(drifts)) = (spec.law(option_value(&mut rng, 1e6)), protocol) {
+            if drifts.len() <= 20_000 && rtol.is_finite() && rtol > 0.0 {
+                if let Ok(rows) = under_drift(&law, &drifts, rtol) {
+                    assert!(
+                        rows.iter().all(|(f, e)| f.is_finite() && e.is_finite()),
+                        "{law:?} {amplitudes:?} rtol {rtol}: {:?}",
+                        rows.iter().find(|(f, e)| !(f.is_finite() && e.is_finite()))
+                    );
+                }
+            }
         }
     });
 }

@@ -431,6 +431,11 @@ fn print_table(doc: &Value) {
                 largest(&p["peak_floor_acceleration"][name]) / GRAVITY,
             );
         }
+        for (what, key) in [("", "pounding"), (" without the contacts", "free")] {
+            if let Some(n) = r[key]["collapse"]["note"].as_str() {
+                println!("  collapse{what}: {n}");
+            }
+        }
         for j in r["pounding"]["joint_impacts"]
             .as_array()
             .into_iter()

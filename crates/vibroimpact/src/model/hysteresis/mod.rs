@@ -383,6 +383,24 @@ pub fn under_drift(
     drifts: &[f64],
     rtol: f64,
 ) -> Result<Vec<(f64, f64)>, IntegrationError> {
+    let rows = path(law, drifts, rtol)?;
+    // A force or energy past double precision (a drift of 1e300 m on a
+    // stiff storey) is refused, never drawn.
+    if let Some(k) = rows
+        .iter()
+        .position(|(f, e)| !(f.is_finite() && e.is_finite()))
+    {
+        return Err(IntegrationError::InvalidOptions(format!(
+            "drift sample {} = {:e} m: the storey's force or energy is not finite there (beyond double precision for this law); give smaller drifts",
+            k + 1,
+            drifts[k]
+        )));
+    }
+    Ok(rows)
+}
+
+/// [`under_drift`]'s rows, unchecked.
+fn path(law: &StoreyLaw, drifts: &[f64], rtol: f64) -> Result<Vec<(f64, f64)>, IntegrationError> {
     if let StoreyLaw::Imk(m) = law {
         let mut s = m.rest();
         return Ok(drifts

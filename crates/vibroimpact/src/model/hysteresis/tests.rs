@@ -342,3 +342,22 @@ fn imk_deteriorates_by_the_energy_rule() {
         s.force
     );
 }
+
+/// A drift past double precision for the law (1e300 m on a stiff storey,
+/// found by the option fuzzer: a force of inf was returned as a loop) is
+/// refused naming the sample, never drawn.
+#[test]
+fn a_force_past_double_precision_is_refused() {
+    let law = StoreyLaw::Elastic { stiffness: 2.5e12 };
+    let e = under_drift(&law, &[0.01, 1e300], 1e-8)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("drift sample 2 = 1e300 m") && e.contains("not finite"),
+        "{e}"
+    );
+    assert_eq!(
+        under_drift(&law, &[0.01], 1e-8).unwrap(),
+        vec![(2.5e10, 0.0)]
+    );
+}

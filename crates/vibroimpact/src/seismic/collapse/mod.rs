@@ -191,13 +191,19 @@ impl IdaSettings {
 }
 
 impl Criterion {
-    /// Refuses a drift limit that is not positive and finite.
+    /// Refuses a drift limit that is not positive and finite, and a drift
+    /// ratio above 1.
     pub fn check(&self) -> Result<(), PoundingError> {
         let (key, v, m) = match self.drift {
             DriftLimit::Drift(d) => ("drift_limit", d, "give a positive storey drift (m)"),
-            DriftLimit::Ratio(r) => ("drift_ratio_limit", r, "give a positive drift ratio"),
+            DriftLimit::Ratio(r) => (
+                "drift_ratio_limit",
+                r,
+                "give a drift ratio in (0, 1] (a storey past its height has collapsed whatever the limit)",
+            ),
         };
-        if v.is_finite() && v > 0.0 {
+        let ratio_above_one = matches!(self.drift, DriftLimit::Ratio(r) if r > 1.0);
+        if v.is_finite() && v > 0.0 && !ratio_above_one {
             Ok(())
         } else {
             Err(crate::field_error::FieldError::new(key, v, m).into())

@@ -76,8 +76,10 @@ fn yield_drift(law: &StoreyLaw) -> Option<f64> {
 /// drifts, ductility demands (peak over yield drift; null for an elastic
 /// storey), hysteretic energies, floor accelerations and displacements;
 /// the isolators' response (isolated buildings); the peak impact force
-/// and impact count between buildings, each joint's closings, and per
-/// joint its impacts and peak impact force (`joint_impacts`).
+/// and impact count between buildings, each joint's closings, per joint
+/// its impacts and peak impact force (`joint_impacts`), and where a storey
+/// moved more than its height, the `collapse` that stopped the run (null
+/// for a run to its end).
 pub fn response_document(row: &Row, r: &Response) -> Value {
     let ductility = row.buildings.iter().zip(&r.drift).map(|(b, drift)| {
         let laws = b.frame.laws().unwrap_or_default();
@@ -108,6 +110,15 @@ pub fn response_document(row: &Row, r: &Response) -> Value {
         "peak_impact_force": r.peak_impact_force,
         "impacts": r.impacts,
         "closing": r.closing,
+        "collapse": r.collapse.map(|c| json!({
+            "building": row.buildings[c.building].name,
+            "storey": c.storey + 1,
+            "time": c.time,
+            "note": format!(
+                "storey {} of {} moved more than its height by t = {:.4} s: the building has collapsed, the run stopped there, and its peaks are those up to then",
+                c.storey + 1, row.buildings[c.building].name, c.time
+            ),
+        })),
         "joint_impacts": r.joint_impacts.iter().enumerate().map(|(j, &(n, f))| json!({
             "between": [row.buildings[j].name, row.buildings[j + 1].name],
             "impacts": n,

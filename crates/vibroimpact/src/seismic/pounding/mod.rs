@@ -139,6 +139,21 @@ pub struct Response {
     /// The hysteresis loop of every hysteretic storey and bearing layer,
     /// at the samples.
     pub loops: Vec<StoreyLoop>,
+    /// Where a storey moved more than its height (the building has
+    /// collapsed): the run stopped there, and its peaks are those up to
+    /// then. None for a run to its end.
+    pub collapse: Option<Collapse>,
+}
+
+/// A storey past its height: the run that found it stops ([`Response`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collapse {
+    /// The building (index in the row).
+    pub building: usize,
+    /// The storey from 0.
+    pub storey: usize,
+    /// The check at which it was found (s): at least every record sample.
+    pub time: f64,
 }
 
 /// A hysteretic storey's (or bearing layer's) loop: drift and force at
@@ -153,6 +168,15 @@ pub struct StoreyLoop {
     pub drift: Vec<f64>,
     /// Force (N).
     pub force: Vec<f64>,
+}
+
+/// A record's sampling step (s): its mean spacing.
+fn record_step(record: &Record) -> f64 {
+    let t = &record.times;
+    match t.len() {
+        0 | 1 => f64::INFINITY,
+        n => (t[n - 1] - t[0]) / (n - 1) as f64,
+    }
 }
 
 /// Why a run ([`Row::respond_until`]) ended.
@@ -602,18 +626,63 @@ impl Row {
         opts.gauges = peaks.gauges();
         opts.extrema_window = Some((0.0, opts.t_end));
         opts.extrema_of_bodies = false;
+        // Every storey is checked against its limit (and its height: a
+        // storey moved more than its height has collapsed, and a run past
+        // it only grows absurd) at least every record sample, whatever
+        // the sampling of the loops: the output step is the sample split
+        // into `every` parts no longer than the record's step.
+        let heights: Vec<Vec<f64>> = self
+            .buildings
+            .iter()
+            .map(|b| {
+                let n = b.frame.masses.len();
+                (0..n)
+                    .map(|i| b.frame.heights.get(i).copied().unwrap_or(f64::INFINITY))
+                    .collect()
+            })
+            .collect();
+        let bounds: Vec<Vec<f64>> = match limits {
+            Some(l) => l
+                .iter()
+                .zip(&heights)
+                .map(|(l, h)| l.iter().zip(h).map(|(l, h)| l.min(*h)).collect())
+                .collect(),
+            None => heights.clone(),
+        };
+        let record_step = record_step(record);
+        let every = if run.sample >= opts.t_end {
+            // One sample of the loops (at 0), the checks at the record's.
+            opts.output_step = Some(record_step.min(opts.t_end));
+            u64::MAX
+        } else {
+            let every = (run.sample / record_step).ceil().max(1.0);
+            opts.output_step = Some(run.sample / every);
+            every as u64
+        };
         let model = &rm.model;
-        let mut passed = None;
+        let (mut passed, mut collapse, mut k) = (None, None, 0u64);
         let sim = simulate_streaming(model, &opts, |t, row| {
-            let worst = peaks.sample(row, limits);
+            let (worst, building, storey) = peaks.check(row, &bounds);
+            if k % every == 0 {
+                peaks.sample(row);
+            }
+            k += 1;
             if worst > 1.0 {
                 passed = Some(t);
+                if bounds[building][storey] == heights[building][storey] {
+                    collapse = Some(Collapse {
+                        building,
+                        storey,
+                        time: t,
+                    });
+                }
             }
             passed.is_none()
         })
         .map_err(|e| PoundingError::run(record, e.0))?;
         let stop = match (&sim.error, passed) {
-            (_, Some(time)) => Stop::Limit { time },
+            (_, Some(time)) if limits.is_some() => Stop::Limit { time },
+            (_, Some(_)) => Stop::End,
             (None, None) => Stop::End,
             (Some(e), None) => match e.source {
                 IntegrationError::StepSizeUnderflow { .. }
@@ -624,7 +693,9 @@ impl Row {
                 _ => return Err(PoundingError::run(record, e)),
             },
         };
-        Ok((peaks.finish(self, &rm, &sim), stop))
+        let mut response = peaks.finish(self, &rm, &sim);
+        response.collapse = collapse;
+        Ok((response, stop))
     }
 
     /// The time history of the row with its contacts under `record` ×
@@ -651,7 +722,7 @@ impl Row {
         let sim = simulate_streaming(model, &opts, |t, row| {
             times.push(t);
             displacement.extend_from_slice(&row[..n]);
-            peaks.sample(row, None);
+            peaks.sample(row);
             true
         })
         .map_err(|e| PoundingError::run(record, e.0))?;

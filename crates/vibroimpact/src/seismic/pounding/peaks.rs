@@ -115,28 +115,33 @@ impl Peaks {
         self.gauges.clone()
     }
 
-    /// Takes the sample `row` = [u.., v.., a.., storey forces..] at `t`
-    /// into the loops; returns the largest storey drift in it over its
-    /// limit in `limits` (per building and storey; 0 without).
-    pub(super) fn sample(&mut self, row: &[f64], limits: Option<&[Vec<f64>]>) -> f64 {
+    /// A sample of the loops: each hysteretic storey's drift and force.
+    pub(super) fn sample(&mut self, row: &[f64]) {
         let n = (row.len() - self.loops.len()) / 3;
         let (u, forces) = (&row[..n], &row[3 * n..]);
         for ((below, above, l), &f) in self.loops.iter_mut().zip(forces) {
             l.drift.push(u[*above] - below.map_or(0.0, |b| u[b]));
             l.force.push(f);
         }
-        let Some(limits) = limits else {
-            return 0.0;
-        };
-        let mut worst = 0.0f64;
-        for (&(first, base, floors), limit) in self.layout.iter().zip(limits) {
+    }
+
+    /// The storey drifts of a sample against `bounds` (m, per building and
+    /// storey): the largest drift over its bound, with its building and
+    /// storey.
+    pub(super) fn check(&self, row: &[f64], bounds: &[Vec<f64>]) -> (f64, usize, usize) {
+        let u = &row[..(row.len() - self.loops.len()) / 3];
+        let mut worst = (0.0f64, 0, 0);
+        for (k, (&(first, base, floors), bound)) in self.layout.iter().zip(bounds).enumerate() {
             for i in 0..floors {
                 let below = match (i, base) {
                     (0, None) => 0.0,
                     (0, Some(b)) => u[b],
                     _ => u[first + i - 1],
                 };
-                worst = worst.max((u[first + i] - below).abs() / limit[i]);
+                let r = (u[first + i] - below).abs() / bound[i];
+                if r > worst.0 {
+                    worst = (r, k, i);
+                }
             }
         }
         worst
@@ -232,6 +237,7 @@ impl Peaks {
                 .map(|&(first, n)| (first..first + n).map(|w| read(w).max).collect())
                 .collect(),
             loops: self.loops.into_iter().map(|(_, _, l)| l).collect(),
+            collapse: None,
         }
     }
 }

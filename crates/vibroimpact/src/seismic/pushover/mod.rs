@@ -320,6 +320,11 @@ pub fn pushover(frame: &ShearFrame, opts: &PushoverOptions) -> Result<Pushover, 
         / (4.0 * std::f64::consts::PI.powi(2))
         * t
         * t;
+    if !(yield_displacement.is_finite() && yield_displacement > 0.0) {
+        return Err(format!(
+            "code_period = {t}: δ_y,eff = C0 (V_max/W) (g/4π²) T² = {yield_displacement:e} m is not a displacement; give the code period T = C_u T_a (s)"
+        ));
+    }
     let (ultimate_displacement, strength_loss) = ultimate(&roof, &shear, max_base_shear);
     Ok(Pushover {
         pattern,
