@@ -516,17 +516,18 @@ fn collapse_of_an_elastic_perfectly_plastic_storey() {
     assert!(out.status.success());
     assert!(figures.join("fragility.svg").is_file() && figures.join("fragility.png").is_file());
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s_t = doc["summary"]["s_t"].as_f64().unwrap();
     let sa: Vec<f64> = doc["records"]
         .as_array()
         .unwrap()
         .iter()
-        .map(|r| r["collapse"].as_f64().unwrap() * r["sa"].as_f64().unwrap())
+        .map(|r| r["collapse"].as_f64().unwrap() * s_t)
         .collect();
     let fit = &doc["summary"]["fragility"];
     let (l0, l1) = (sa[0].ln(), sa[1].ln());
     assert!((fit["median"].as_f64().unwrap() - (0.5 * (l0 + l1)).exp()).abs() < 1e-12);
     assert!((fit["dispersion"].as_f64().unwrap() - 0.5 * (l0 - l1).abs()).abs() < 1e-12);
-    assert_eq!(fit["intensity"], "sa");
+    assert_eq!(fit["intensity"], "s_t");
     let short = args(&["--max-scale", "1.5"]);
     let doc = json(&short.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(doc["records"][0]["note"], "no collapse up to scale 1.5");

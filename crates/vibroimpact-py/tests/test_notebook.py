@@ -36,7 +36,8 @@ def test_plots_draw_the_results():
     plt.close("all")
 
 
-@pytest.mark.parametrize("name", ["seed-study.ipynb", "pounding-records.ipynb", "isolation-collapse.ipynb"])
+@pytest.mark.parametrize("name", ["seed-study.ipynb", "pounding-records.ipynb", "isolation-collapse.ipynb",
+                                  "moment-frame-collapse.ipynb"])
 def test_example_notebook_runs(name):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")

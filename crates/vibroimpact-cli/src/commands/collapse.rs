@@ -154,19 +154,17 @@ fn ida_figure(doc: &Value) -> Figure {
 /// maximum likelihood with the censored records' survival) as a curve
 /// against the empirical collapse fractions (the i-th smallest collapse
 /// intensity at i / N, N every record, censored ones included), the
-/// intensity Sa(T1) in g where the study has a period, else the scale.
+/// intensity S_T in g (the set's Sa(T) times the collapse scale, as Ŝ_CT)
+/// where the study has a period, else the scale.
 /// None where the summary determines no fit (its note says why).
 fn fragility_figure(doc: &Value) -> Option<Figure> {
     let fit = &doc["summary"]["fragility"];
     let (theta, beta) = (fit["median"].as_f64()?, fit["dispersion"].as_f64()?);
-    let in_g = doc["period"].as_f64().is_some();
+    let per = doc["summary"]["s_t"].as_f64().unwrap_or(1.0);
     let records = doc["records"].as_array()?;
     let mut fell: Vec<f64> = records
         .iter()
-        .filter_map(|r| {
-            let per = if in_g { r["sa"].as_f64()? } else { 1.0 };
-            Some(r["collapse"].as_f64()? * per)
-        })
+        .filter_map(|r| Some(r["collapse"].as_f64()? * per))
         .collect();
     fell.sort_by(f64::total_cmp);
     let n = records.len() as f64;
@@ -187,7 +185,7 @@ fn fragility_figure(doc: &Value) -> Option<Figure> {
         .map(|s| (s, model.probability(s)))
         .collect();
     let x_label = match doc["period"].as_f64() {
-        Some(t) => format!("Sa(T1 = {t} s)  [g]"),
+        Some(t) => format!("S_T = the set's Sa(T = {t} s) at collapse  [g]"),
         None => "scale".to_string(),
     };
     let mut fig = Figure::new("Collapse fragility", x_label, "probability of collapse")

@@ -150,8 +150,9 @@ def fragility(study, ax=None):
     result, as ``vibroimpact collapse --out`` draws it: the summary's
     lognormal fit (maximum likelihood, censored records entering with their
     survival) against the empirical collapse fractions (the i-th smallest
-    collapse intensity at i / N, N every record), in Sa(T1) (g) where the
-    study has a period, else the scale. Raises ValueError, with the
+    collapse intensity at i / N, N every record), in S_T (g: the set's
+    Sa(T) times the collapse scale, as Ŝ_CT) where the study has a period,
+    else the scale. Raises ValueError, with the
     summary's reason, where no fit is determined."""
     from math import erfc, log, sqrt
 
@@ -161,9 +162,9 @@ def fragility(study, ax=None):
         raise ValueError(f"study: {summary.get('fragility_note') or 'no fragility fitted'}")
     theta, beta = fit["median"], fit["dispersion"]
     in_g = study["period"] is not None
+    per = summary["s_t"] if in_g else 1.0
     records = study["records"]
-    fell = np.sort([r["collapse"] * (r["sa"] if in_g else 1.0)
-                    for r in records if r["collapse"] is not None])
+    fell = np.sort([r["collapse"] * per for r in records if r["collapse"] is not None])
     top = 1.2 * max(fell.max() if fell.size else theta, theta * np.exp(2 * beta))
     s = np.linspace(0.0, top, 201)
     p = [0.0 if x <= 0 else 0.5 * erfc(-log(x / theta) / beta / sqrt(2)) for x in s]
@@ -173,7 +174,7 @@ def fragility(study, ax=None):
             label="collapsed records (fraction)")
     ax.plot([theta, theta], [0.0, 0.5], "--", color="C1", label="median θ")
     ax.set_ylim(0.0, 1.0)
-    x = f"Sa(T1 = {study['period']} s) (g)" if in_g else "scale"
+    x = f"S_T = the set's Sa(T = {study['period']:.4g} s) at collapse (g)" if in_g else "scale"
     _labels(ax, x, "probability of collapse")
     ax.legend(fontsize="small", loc="lower right")
     return ax

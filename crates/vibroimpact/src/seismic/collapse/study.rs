@@ -191,13 +191,9 @@ pub fn check_margins(smt: Option<f64>, ssf: Option<f64>) -> Result<(), FieldErro
 pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Option<f64>) -> Value {
     let idas: Vec<RecordIda> = records.iter().map(|r| r.ida.clone()).collect();
     let median = median_collapse(&idas);
-    let sas: Option<Vec<f64>> = records.iter().map(|r| r.sa).collect();
     // The set's median as FEMA P695 tabulates it (S_NRT, Table A-3): the
     // geometric mean, the median of the lognormal fit.
-    let s_t = sas
-        .as_deref()
-        .filter(|v| !v.is_empty())
-        .map(|v| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp());
+    let s_t = set_intensity(records);
     let s_ct = median.zip(s_t).map(|(m, s)| m * s);
     let cmr = s_ct.zip(smt).map(|(c, m)| c / m);
     let censored: Vec<String> = idas
@@ -212,7 +208,7 @@ pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Optio
                 "dispersion": f.dispersion,
                 "records": f.records,
                 "censored": f.censored,
-                "intensity": if s_t.is_some() { "sa" } else { "scale" },
+                "intensity": if s_t.is_some() { "s_t" } else { "scale" },
             }),
             Value::Null,
         ),
@@ -241,22 +237,27 @@ pub fn summary_document(records: &[RecordCollapse], smt: Option<f64>, ssf: Optio
 
 /// The lognormal fragility of the records' intensities (module
 /// `fragility`): each record's collapse scale, or the largest it survived
-/// (censored), times its Sa(T1) in g where every record has one, else the
-/// scale itself.
+/// (censored), times the set's S_T in g where every record has its Sa
+/// (the intensity of FEMA P695, whose median is Ŝ_CT), else the scale
+/// itself.
 pub fn fit_fragility(records: &[RecordCollapse]) -> Result<Fragility, FragilityError> {
+    let per = set_intensity(records).unwrap_or(1.0);
     let (values, censored): (Vec<f64>, Vec<bool>) = records
         .iter()
         .map(|r| {
             let scale = r.ida.collapse.unwrap_or(r.ida.survived);
-            let per = if records.iter().all(|r| r.sa.is_some()) {
-                r.sa.unwrap_or(1.0)
-            } else {
-                1.0
-            };
             (scale * per, r.ida.collapse.is_none())
         })
         .unzip();
     fragility(&values, &censored)
+}
+
+/// The set's S_T (g): the geometric mean of the records' Sa, as FEMA P695
+/// tabulates S_NRT; None unless every record has one.
+fn set_intensity(records: &[RecordCollapse]) -> Option<f64> {
+    let sas: Option<Vec<f64>> = records.iter().map(|r| r.sa).collect();
+    sas.filter(|v| !v.is_empty())
+        .map(|v| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp())
 }
 
 /// The units of a study's document: the pounding runs' units, with the
