@@ -144,3 +144,35 @@ fn forcing_frequency() {
     let m = m.with_base(BaseExcitation::None);
     assert_eq!(m.forcing_frequency(), None);
 }
+
+/// A record with its tail appended (a pounding run's ramp to rest: one
+/// long last segment): the segment guess keeps the record's own rate (the
+/// average one sent every guess to bisection: 21 % of a frame's run), and
+/// the values equal the linear interpolation, scale included, to 1e-15.
+#[test]
+fn a_record_with_a_tail_interpolates_exactly() {
+    let mut times: Vec<f64> = (0..3000).map(|k| k as f64 * 0.01).collect();
+    times.push(36.4);
+    let values: Vec<f64> = (0..times.len())
+        .map(|k| {
+            if k + 1 == times.len() {
+                0.0
+            } else {
+                (0.37 * k as f64).sin()
+            }
+        })
+        .collect();
+    let r = Accelerogram::new(times.clone(), values.clone(), 1.7).unwrap();
+    for j in 0..20_000 {
+        let t = 36.4 * j as f64 / 20_000.0;
+        let k = times.partition_point(|&x| x <= t).clamp(1, times.len() - 1);
+        let w = (t - times[k - 1]) / (times[k] - times[k - 1]);
+        let expected = 1.7 * (values[k - 1] + w * (values[k] - values[k - 1]));
+        assert!(
+            (r.at(t) - expected).abs() <= 1e-15 * 1.7 + 1e-15 * expected.abs(),
+            "t = {t}"
+        );
+        assert_eq!(r.segment(t), k);
+    }
+    assert_eq!(r.at(times[5]), 1.7 * values[5]);
+}

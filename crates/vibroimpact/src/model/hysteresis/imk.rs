@@ -54,6 +54,30 @@ struct Side {
     ucap: f64,
     fcap: f64,
     fres: f64,
+    /// Derived by [`Side::settled`] whenever the others change, so that
+    /// the switch function, asked several times a step, divides nothing:
+    /// the drifts where the backbone has a corner (the cap, the residual
+    /// on the hardening and on the post-capping line; not finite where a
+    /// slope is zero), the last being also the residual drift.
+    corners: [f64; 3],
+}
+
+impl Side {
+    /// The side with its derived drifts computed.
+    fn settled(mut self) -> Self {
+        self.corners = [
+            self.ucap,
+            self.ucap + (self.fres - self.fcap) / self.kp,
+            self.ucap + (self.fres - self.fcap) / self.kpc,
+        ];
+        self
+    }
+
+    /// Where the post-capping line reaches the residual (None for a flat
+    /// one).
+    fn residual_drift(&self) -> Option<f64> {
+        (self.kpc != 0.0).then_some(self.corners[2])
+    }
 }
 
 /// What the loop carries: drift, force, both backbones, the unloading
@@ -168,7 +192,9 @@ impl Imk {
             ucap: self.yield_drift + self.plastic_drift,
             fcap,
             fres: self.residual_ratio * fy,
+            corners: [0.0; 3],
         }
+        .settled()
     }
 
     /// The loop at rest.
@@ -185,7 +211,9 @@ impl Imk {
                 ucap: -p.ucap,
                 fcap: -p.fcap,
                 fres: -p.fres,
-            },
+                corners: [0.0; 3],
+            }
+            .settled(),
             kunload: self.stiffness,
             work: 0.0,
             work_excursion: 0.0,
@@ -232,11 +260,7 @@ impl Imk {
     /// bound of `dir` has a corner.
     fn corners(&self, s: &ImkState, dir: f64, u: f64, to: f64) -> Corners {
         let side = if dir > 0.0 { &s.pos } else { &s.neg };
-        let cand = [
-            side.ucap,
-            side.ucap + (side.fres - side.fcap) / side.kp,
-            side.ucap + (side.fres - side.fcap) / side.kpc,
-        ];
+        let cand = side.corners;
         // (A zero slope has no corner: its candidate is not finite.)
         let mut out = Corners {
             xs: [f64::NAN; 3],
@@ -443,6 +467,7 @@ impl Imk {
         } else if candidate > 0.0 && side.kp > candidate {
             side.kp = candidate;
         }
+        *side = side.settled();
     }
 
     /// Strength lost at the ultimate drift, or where the backbone reaches
@@ -591,14 +616,11 @@ impl Imk {
             return f64::INFINITY;
         }
         let k = self.stiffness;
-        let ures = |side: &Side| {
-            (side.kpc != 0.0).then(|| (side.fres - side.fcap + side.kpc * side.ucap) / side.kpc)
-        };
         let mut g = f64::INFINITY;
-        if let Some(x) = ures(&s.pos) {
+        if let Some(x) = s.pos.residual_drift() {
             g = g.min(k * (x - d));
         }
-        if let Some(x) = ures(&s.neg) {
+        if let Some(x) = s.neg.residual_drift() {
             g = g.min(k * (d - x));
         }
         g
