@@ -66,9 +66,7 @@ import json
 import os
 import platform
 import re
-import subprocess
 import sys
-import time
 import tomllib
 from pathlib import Path
 
@@ -82,7 +80,7 @@ from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_frame import load, run, yield_drifts  # noqa: E402
 from opensees_pair import import_opensees  # noqa: E402
-from timing import Watch, retime, scan_opensees, timed  # noqa: E402
+from timing import IdleGate, Watch, retime, scan_opensees, timed  # noqa: E402
 
 CASE = HERE.parents[1] / "examples" / "moment-frame-4.toml"
 CASES = {
@@ -169,54 +167,10 @@ def shown(e):
     return "  ".join(f"{k} {v:.1e}" for k, v in e.items() if k != "error")
 
 
-def busy():
-    """Process ids of what makes the machine busy: a process that ``pgrep -f``
-    lists for :data:`BUSY` whose program or script (its first three
-    arguments' base names) matches it; not this one (isolated_peer.busy
-    with this study's pattern)."""
-    found = subprocess.run(["pgrep", "-f", BUSY.pattern], capture_output=True, text=True).stdout.split()
-    pids = []
-    for pid in map(int, found):
-        if pid == os.getpid():
-            continue
-        try:
-            argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")[:3]
-        except OSError:
-            continue
-        if any(BUSY.search(os.path.basename(a.decode(errors="replace"))) for a in argv):
-            pids.append(pid)
-    return pids
-
-
-NO_WAIT = False
-"""``--no-wait``: time without waiting for an idle machine (smoke runs)."""
-
-
-def wait_idle(limit=3600.0, settle=10.0, every=5.0):
-    """Waits until :func:`busy` has been empty for ``settle`` seconds (at
-    most ``limit``); returns how long it waited and what it saw."""
-    if NO_WAIT:
-        return {"waited_s": 0.0, "busy_pids_seen": [], "idle": not busy(), "no_wait": True}
-    t0 = time.monotonic()
-    quiet_since, seen = None, set()
-    while True:
-        pids = busy()
-        seen.update(pids)
-        now = time.monotonic()
-        if pids:
-            quiet_since = None
-        elif quiet_since is None:
-            quiet_since = now
-        if quiet_since is not None and now - quiet_since >= settle:
-            break
-        if now - t0 > limit:
-            break
-        time.sleep(every)
-    waited = time.monotonic() - t0
-    entry = {"waited_s": round(waited, 1), "busy_pids_seen": sorted(seen), "idle": not busy()}
-    if seen:
-        print(f"  (waited {waited:.0f} s for an idle machine: {sorted(seen)})", flush=True)
-    return entry
+GATE = IdleGate(BUSY)
+"""The idle machine this study waits for (``timing.IdleGate``)."""
+busy = GATE.busy
+wait_idle = GATE.wait_idle
 
 
 def study(name, record, quick, waits, timing=True):
@@ -427,8 +381,7 @@ def main():
                     help="the convergence and accuracy part only, nothing timed (default --out: "
                          "results/frame-<date>-accuracy.json)")
     args = ap.parse_args()
-    global NO_WAIT
-    NO_WAIT = args.no_wait
+    GATE.no_wait = args.no_wait
     if args.out is None:
         args.out = HERE / "results" / f"frame-{datetime.date.today()}{'-accuracy' if args.no_timing else ''}.json"
     record = fema_p695("farfield")[0]

@@ -114,3 +114,62 @@ class Watch:
             "load_before": self.load_before,
             "load_after": self.load_after,
         }
+
+
+class IdleGate:
+    """What a study waits for before each timed phase: no process that
+    ``pgrep -f`` lists for ``pattern`` (a compiled regular expression)
+    whose program or script (its first three arguments' base names)
+    matches it, this one excepted; a plain ``pgrep -f`` also lists
+    processes that only carry such a word in their environment, and is
+    never empty here. ``no_wait`` (``--no-wait``) times at once (smoke
+    runs)."""
+
+    def __init__(self, pattern):
+        self.pattern = pattern
+        self.no_wait = False
+
+    def busy(self):
+        """Process ids of what makes the machine busy."""
+        import subprocess
+        from pathlib import Path
+
+        found = subprocess.run(["pgrep", "-f", self.pattern.pattern], capture_output=True,
+                               text=True).stdout.split()
+        pids = []
+        for pid in map(int, found):
+            if pid == os.getpid():
+                continue
+            try:
+                argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")[:3]
+            except OSError:
+                continue
+            if any(self.pattern.search(os.path.basename(a.decode(errors="replace"))) for a in argv):
+                pids.append(pid)
+        return pids
+
+    def wait_idle(self, limit=3600.0, settle=10.0, every=5.0):
+        """Waits until :meth:`busy` has been empty for ``settle`` seconds
+        (at most ``limit``); returns how long it waited and what it saw."""
+        if self.no_wait:
+            return {"waited_s": 0.0, "busy_pids_seen": [], "idle": not self.busy(), "no_wait": True}
+        t0 = time.monotonic()
+        quiet_since, seen = None, set()
+        while True:
+            pids = self.busy()
+            seen.update(pids)
+            now = time.monotonic()
+            if pids:
+                quiet_since = None
+            elif quiet_since is None:
+                quiet_since = now
+            if quiet_since is not None and now - quiet_since >= settle:
+                break
+            if now - t0 > limit:
+                break
+            time.sleep(every)
+        waited = time.monotonic() - t0
+        entry = {"waited_s": round(waited, 1), "busy_pids_seen": sorted(seen), "idle": not self.busy()}
+        if seen:
+            print(f"  (waited {waited:.0f} s for an idle machine: {sorted(seen)})", flush=True)
+        return entry
