@@ -159,8 +159,8 @@ def imk_args(spec: Dict[str, Any], k: float):
     FmaxFy = cap_ratio, FresFy = residual_ratio; lambda_s, lambda_c,
     lambda_k (m, the reference energy lambda F_y; absent:
     :data:`NO_DETERIORATION`), c_s, c_c, c_k (default 1); D = 1 both sides
-    (bench/opensees/imk_reference.py; /work/shared/design/
-    opensees-imkbilin-notes.md)."""
+    (bench/opensees/imk_reference.py; the arguments' meanings in
+    docs/theory.md §11, "IMK")."""
     fy = k * spec["yield_drift"]
     side = (spec["plastic_drift"], spec["post_capping_drift"], spec["ultimate_drift"], fy,
             spec["cap_ratio"], spec["residual_ratio"])
