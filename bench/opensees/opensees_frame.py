@@ -59,13 +59,12 @@ from __future__ import annotations
 import os
 import tempfile
 import time
-import tomllib
-from pathlib import Path
 from typing import Any, Dict, List, Union
 
 import numpy as np
 
 from opensees_pair import (
+    one_building,
     TAIL_PERIODS,
     add_storey,
     import_opensees,
@@ -89,16 +88,7 @@ def load(row: Union[str, os.PathLike, Dict[str, Any]]) -> Dict[str, Any]:
     """The one fixed-base building of a row file (a path, TOML text, the
     parsed document or the building's own table), checked to be what this
     module builds."""
-    if isinstance(row, dict):
-        doc = row if "building" in row else {"building": [row]}
-    elif isinstance(row, Path) or (isinstance(row, str) and "\n" not in row and row.endswith(".toml")):
-        doc = tomllib.loads(Path(row).read_text())
-    else:
-        doc = tomllib.loads(row)
-    buildings = doc.get("building", [])
-    if len(buildings) != 1:
-        raise ValueError(f"a row of one building is needed, got {len(buildings)} buildings")
-    b = buildings[0]
+    b = one_building(row, "building")
     if b.get("isolation") is not None:
         raise ValueError(f"building {b.get('name')!r} is isolated: bench/opensees/opensees_isolated.py builds it")
     n = len(b["masses"])

@@ -87,6 +87,25 @@ def import_opensees():
     return ops
 
 
+def one_building(row, what: str) -> Dict[str, Any]:
+    """The one building of a row file (a path, TOML text, the parsed
+    document or the building's own table); ``what`` names the kind asked
+    for in the error ("isolated building", "building")."""
+    import tomllib
+    from pathlib import Path
+
+    if isinstance(row, dict):
+        doc = row if "building" in row else {"building": [row]}
+    elif isinstance(row, Path) or (isinstance(row, str) and "\n" not in row and row.endswith(".toml")):
+        doc = tomllib.loads(Path(row).read_text())
+    else:
+        doc = tomllib.loads(row)
+    buildings = doc.get("building", [])
+    if len(buildings) != 1:
+        raise ValueError(f"a row of one {what} is needed, got {len(buildings)} buildings")
+    return buildings[0]
+
+
 def rayleigh(frame: Dict[str, Any]):
     """(alpha, beta) giving the frame's damping ratio in its first two modes
     (one mode: mass-proportional only), as vibroimpact's ``ShearFrame``."""
