@@ -130,6 +130,8 @@ pub struct ChainDynamics {
     contacts: Vec<ContactTerm>,
     forces: Vec<(usize, f64, f64, f64)>,
     base: BaseExcitation,
+    /// The record segment of the last right-hand side (a lookup hint).
+    segment: usize,
     /// Onset approach velocity of each contact's current impact (read by
     /// laws that need it: Lankarani–Nikravesh).
     onset_velocity: Vec<f64>,
@@ -271,6 +273,7 @@ impl ChainDynamics {
                 .map(|f| (f.body, f.amplitude, f.frequency, f.phase))
                 .collect(),
             base: model.base().clone(),
+            segment: 0,
             energy,
             force: vec![0.0; n],
             contact_evaluations: 0,
@@ -523,7 +526,7 @@ impl OdeSystem for ChainDynamics {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
-        let zdd = self.base.at(t);
+        let zdd = self.base.at_from(t, &mut self.segment);
         let n = self.n;
         for ((((f, uv), k), c), m) in self
             .force

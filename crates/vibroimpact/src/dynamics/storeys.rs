@@ -66,6 +66,16 @@ struct Term {
 pub struct StoreyTerms {
     terms: Vec<Term>,
     states: usize,
+    /// Changes whenever a branch does (unique over the process: a copy
+    /// has its original's, any change a new one), so that what was
+    /// computed from the branches can be kept while the stamp holds.
+    stamp: u64,
+}
+
+/// A stamp no branches had before.
+fn new_stamp() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl StoreyTerms {
@@ -106,7 +116,16 @@ impl StoreyTerms {
                 }
             })
             .collect();
-        Self { terms, states }
+        Self {
+            terms,
+            states,
+            stamp: new_stamp(),
+        }
+    }
+
+    /// The branches' stamp: equal stamps, equal branches.
+    pub fn stamp(&self) -> u64 {
+        self.stamp
     }
 
     /// Whether there are none.
@@ -134,6 +153,7 @@ impl StoreyTerms {
     }
 
     /// Storey k's drift and drift rate in the interleaved state `y`.
+    #[inline]
     fn drift(&self, k: usize, y: &[f64]) -> (f64, f64) {
         let t = &self.terms[k];
         let (u, v) = (y[2 * t.above], y[2 * t.above + 1]);
@@ -157,19 +177,19 @@ impl StoreyTerms {
             StoreyLaw::Bilinear(b) => (1.0 - b.post_yield_ratio) * b.stiffness,
             _ => 0.0,
         };
-        match (t.state, t.branch) {
+        match (t.state, &t.branch) {
             (Some(i), _) => Hysteretic {
                 z: y[i],
                 work: y[i + 1],
             },
-            (None, Branch::Elastic { d0, z0, e0 }) => {
+            (None, &Branch::Elastic { d0, z0, e0 }) => {
                 let z = z0 + d - d0;
                 Hysteretic {
                     z,
                     work: e0 + 0.5 * kh * (z * z - z0 * z0),
                 }
             }
-            (None, Branch::Plastic { z, d0, e0 }) => Hysteretic {
+            (None, &Branch::Plastic { z, d0, e0 }) => Hysteretic {
                 z,
                 work: e0 + kh * z * (d - d0),
             },
@@ -180,10 +200,11 @@ impl StoreyTerms {
 
     /// Storey k's law force at drift `d` in `y` (an IMK storey's from its
     /// state).
+    #[inline]
     fn law_force(&self, k: usize, d: f64, y: &[f64]) -> f64 {
         let t = &self.terms[k];
-        match (t.law, t.branch) {
-            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_force(&st, d),
+        match (&t.law, &t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_force(st, d),
             _ => t.law.force(d, self.hysteretic(k, d, y)),
         }
     }
@@ -191,10 +212,10 @@ impl StoreyTerms {
     /// The energy storey k has dissipated by hysteresis in `y`.
     pub fn dissipated_by(&self, k: usize, y: &[f64]) -> f64 {
         let t = &self.terms[k];
-        match (t.law, t.branch) {
+        match (&t.law, &t.branch) {
             (StoreyLaw::Imk(m), Branch::Imk(st)) => {
                 let (d, _) = self.drift(k, y);
-                m.piece_work(&st, d) - m.piece_stored(&st, d)
+                m.piece_work(st, d) - m.piece_stored(st, d)
             }
             _ => t.law.dissipated(self.state(k, y)),
         }
@@ -215,8 +236,8 @@ impl StoreyTerms {
             .map(|k| {
                 let (d, _) = self.drift(k, y);
                 let t = &self.terms[k];
-                let stored = match (t.law, t.branch) {
-                    (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_stored(&st, d),
+                let stored = match (&t.law, &t.branch) {
+                    (StoreyLaw::Imk(m), Branch::Imk(st)) => m.piece_stored(st, d),
                     _ => t.law.stored(d, self.hysteretic(k, d, y)),
                 };
                 stored - 0.5 * t.p_delta * d * d
@@ -260,30 +281,62 @@ impl StoreyTerms {
         })
     }
 
-    /// Bilinear storey k's switch function in `y`: positive while its
-    /// branch holds, zero where it switches (yield from the elastic
-    /// branch, unloading from the plastic one).
+    /// Storey k's switch function in `y`: positive while its branch
+    /// holds, zero where it switches (a bilinear storey: yield from the
+    /// elastic branch, unloading from the plastic one; an IMK storey:
+    /// [`Imk::switch_value`](crate::model::hysteresis::Imk::switch_value)).
     pub fn switch_value(&self, k: usize, y: &[f64]) -> f64 {
+        let (drift, rate) = self.switch_parts(k, y);
+        drift.min(rate)
+    }
+
+    /// Storey k's switch function ([`StoreyTerms::switch_value`]) in two
+    /// parts, whose least it is: the terms in the drift, and those in its
+    /// rate (a reversal's; ∞ where none).
+    pub fn switch_parts(&self, k: usize, y: &[f64]) -> (f64, f64) {
         let t = &self.terms[k];
         let (d, dd) = self.drift(k, y);
-        if let (StoreyLaw::Imk(m), Branch::Imk(st)) = (t.law, t.branch) {
-            return m.switch_value(&st, d, dd);
+        match (&t.law, &t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.switch_parts(st, d, dd),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => (
+                b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs(),
+                f64::INFINITY,
+            ),
+            (StoreyLaw::Bilinear(_), Branch::Plastic { z, .. }) => (f64::INFINITY, dd * z.signum()),
+            _ => (1.0, f64::INFINITY),
         }
-        let StoreyLaw::Bilinear(b) = t.law else {
-            return 1.0;
-        };
-        match t.branch {
-            Branch::Elastic { d0, z0, .. } => {
-                b.yield_drift * (1.0 + YIELD_SLACK) - (z0 + d - d0).abs()
-            }
-            Branch::Plastic { z, .. } => dd * z.signum(),
-            Branch::Imk(_) => 1.0,
+    }
+
+    /// Bounds on how fast storey k's two [`StoreyTerms::switch_parts`]
+    /// change over a step of length `h` between the states `y0` and `y1`
+    /// with derivatives `f0` and `f1`: its drift's speed is bounded by the
+    /// larger end speed plus half a step at the acceleration bound A, A
+    /// the larger end acceleration plus their difference (a step is short
+    /// against the motion's periods: its acceleration barely turns). A
+    /// step where each part stays, by its bound, further from zero than it
+    /// can move needs no look inside.
+    pub fn switch_rate_bounds(
+        &self,
+        k: usize,
+        (y0, f0): (&[f64], &[f64]),
+        (y1, f1): (&[f64], &[f64]),
+        h: f64,
+    ) -> (f64, f64) {
+        let t = &self.terms[k];
+        let ((_, v0), (_, v1)) = (self.drift(k, y0), self.drift(k, y1));
+        let ((_, a0), (_, a1)) = (self.drift(k, f0), self.drift(k, f1));
+        let acceleration = a0.abs().max(a1.abs()) + (a1 - a0).abs();
+        let speed = v0.abs().max(v1.abs()) + 0.5 * acceleration * h;
+        match (&t.law, &t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.switch_rate_bounds(st, speed, acceleration),
+            _ => (speed, acceleration),
         }
     }
 
     /// Switches bilinear storey k's branch in the state `y` where its
     /// switch function vanished.
     pub fn switch(&mut self, k: usize, y: &[f64]) {
+        self.stamp = new_stamp();
         let (d, dd) = self.drift(k, y);
         if let (StoreyLaw::Imk(m), Branch::Imk(mut st)) = (self.terms[k].law, self.terms[k].branch)
         {
@@ -318,6 +371,7 @@ impl StoreyTerms {
 
     /// Sets bilinear storey k's branch (carried from another run's terms).
     pub fn set_branch(&mut self, k: usize, branch: Branch) {
+        self.stamp = new_stamp();
         self.terms[k].branch = branch;
     }
 
@@ -343,7 +397,7 @@ impl StoreyTerms {
     /// Bouc–Wen, whose force is not linear in the drift.
     pub fn linear_force(&self, k: usize) -> Option<f64> {
         let t = &self.terms[k];
-        match (t.law, t.branch) {
+        match (&t.law, &t.branch) {
             (StoreyLaw::Elastic { .. }, _) => Some(0.0),
             (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
                 Some((1.0 - b.post_yield_ratio) * b.stiffness * (z0 - d0))
@@ -357,7 +411,7 @@ impl StoreyTerms {
     /// elastic law); None where [`linear_force`](Self::linear_force) is.
     pub fn linear_window(&self, k: usize, margin: f64) -> Option<(f64, f64)> {
         let t = &self.terms[k];
-        match (t.law, t.branch) {
+        match (&t.law, &t.branch) {
             (StoreyLaw::Elastic { .. }, _) => Some((f64::NEG_INFINITY, f64::INFINITY)),
             (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
                 let reach = b.yield_drift * (1.0 - margin);

@@ -124,6 +124,30 @@ impl Accelerogram {
         a0 + slope * (t - self.times[k - 1])
     }
 
+    /// [`Accelerogram::at`] (the same value) from the segment `hint` or
+    /// the next when one holds `t` (its end included), else found; the
+    /// segment is kept in `hint`. A run's steps end on the samples, so
+    /// that its evaluations move one segment a step.
+    #[inline]
+    pub fn at_from(&self, t: f64, hint: &mut usize) -> f64 {
+        let n = self.times.len();
+        for k in [*hint, *hint + 1] {
+            if k >= 1 && k < n && self.times[k - 1] <= t && t <= self.times[k] {
+                *hint = k;
+                if t == self.times[k] {
+                    return self.scale * self.values[k];
+                }
+                let [a0, slope] = self.lines[k];
+                return a0 + slope * (t - self.times[k - 1]);
+            }
+        }
+        if t < self.times[0] || t > self.times[n - 1] {
+            return 0.0;
+        }
+        *hint = self.segment(t);
+        self.at(t)
+    }
+
     /// Sample times (the interpolant's breakpoints).
     pub fn times(&self) -> &[f64] {
         &self.times
@@ -171,6 +195,16 @@ impl BaseExcitation {
                 phase,
             } => amplitude * (frequency * t + phase).sin(),
             BaseExcitation::Record(r) => r.at(t),
+        }
+    }
+
+    /// [`BaseExcitation::at`], a record's segment looked up from `hint`
+    /// ([`Accelerogram::at_from`]).
+    #[inline]
+    pub fn at_from(&self, t: f64, hint: &mut usize) -> f64 {
+        match self {
+            BaseExcitation::Record(r) => r.at_from(t, hint),
+            _ => self.at(t),
         }
     }
 

@@ -176,3 +176,47 @@ fn a_record_with_a_tail_interpolates_exactly() {
     }
     assert_eq!(r.at(times[5]), 1.7 * values[5]);
 }
+
+/// A value looked up from a hint ([`Accelerogram::at_from`]) is the
+/// value itself, bit for bit, whatever the hint: at every sample, inside
+/// segments, before and after the record, walking forward as a run does
+/// (a step's stages, its end on the next sample) and jumping about.
+#[test]
+fn a_hinted_record_value_is_the_value() {
+    let mut times: Vec<f64> = (0..500).map(|k| k as f64 * 0.01).collect();
+    times.push(7.3);
+    let values: Vec<f64> = (0..times.len()).map(|k| (0.37 * k as f64).sin()).collect();
+    let r = Accelerogram::new(times.clone(), values, 1.7).unwrap();
+    let mut hint = 0;
+    let stages = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0];
+    for k in 0..times.len() - 1 {
+        for c in stages {
+            let t = times[k] + c * (times[k + 1] - times[k]);
+            assert_eq!(
+                r.at_from(t, &mut hint).to_bits(),
+                r.at(t).to_bits(),
+                "t = {t}"
+            );
+        }
+    }
+    let mut seed = 3u64;
+    for _ in 0..20_000 {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
+        let t = if seed % 7 == 0 {
+            times[(seed >> 20) as usize % times.len()]
+        } else {
+            9.0 * u - 1.0
+        };
+        if seed % 5 == 0 {
+            hint = (seed >> 30) as usize % (times.len() + 3);
+        }
+        assert_eq!(
+            r.at_from(t, &mut hint).to_bits(),
+            r.at(t).to_bits(),
+            "t = {t}"
+        );
+    }
+}

@@ -100,6 +100,10 @@ pub struct ImkState {
     on_backbone: bool,
     /// The direction the drift last moved (±1).
     dir: f64,
+    /// The slope of the piece it is on (N/m; [`Imk::piece_slope`]), kept
+    /// by every change of the state: the equations of motion ask for the
+    /// piece's force a dozen times a step.
+    slope: f64,
 }
 
 /// Sub-ulp guard on the drift axis.
@@ -220,6 +224,7 @@ impl Imk {
             failure: 0,
             on_backbone: false,
             dir: 1.0,
+            slope: self.stiffness,
         }
     }
 
@@ -278,6 +283,12 @@ impl Imk {
 
     /// The state after the drift moves monotonically from `s.u` to `to`.
     pub fn advance(&self, s: &mut ImkState, to: f64) {
+        self.follow(s, to);
+        s.slope = self.slope_of(s);
+    }
+
+    /// [`Imk::advance`] but for the piece's slope.
+    fn follow(&self, s: &mut ImkState, to: f64) {
         if to == s.u {
             return;
         }
@@ -503,8 +514,13 @@ impl Imk {
 /// unloading line, or the backbone's segment), so a step sees a smooth
 /// force; what ends the piece is a switch, located on the dense output.
 impl Imk {
-    /// The slope of the piece `s` is on (N/m).
+    /// The slope of the piece `s` is on (N/m), as last settled.
     fn piece_slope(&self, s: &ImkState) -> f64 {
+        s.slope
+    }
+
+    /// The slope of the piece `s` is on (N/m), from its state.
+    fn slope_of(&self, s: &ImkState) -> f64 {
         if s.failure == 5 {
             return 0.0;
         }
@@ -561,6 +577,21 @@ impl Imk {
         0.5 * f * f / s.kunload
     }
 
+    /// Bounds on how fast the two [`Imk::switch_parts`] change while the
+    /// drift moves no faster than `speed` and its rate changes no faster
+    /// than `acceleration` (force units per second): each drift term is a
+    /// line in the drift of slope at most the steepest backbone or
+    /// unloading slope S (a bound less the piece's force: 2 S); the
+    /// reversal's is k × the rate.
+    pub fn switch_rate_bounds(&self, s: &ImkState, speed: f64, acceleration: f64) -> (f64, f64) {
+        let steepest = [s.pos, s.neg]
+            .iter()
+            .fold(self.stiffness.max(s.kunload.abs()), |m, side| {
+                m.max(side.kp.abs()).max(side.kpc.abs())
+            });
+        (2.0 * steepest * speed, self.stiffness * acceleration)
+    }
+
     /// The switch function of the piece at drift `d` moving at `rate`:
     /// positive while the piece holds, zero where it ends. On the backbone:
     /// a reversal (the rate turns), its next corner, zero force without a
@@ -569,24 +600,34 @@ impl Imk {
     /// slack of 1e-10 F_y, so that a piece just begun on a bound does not
     /// end at once), the ultimate drift. Drifts in force units (× k).
     pub fn switch_value(&self, s: &ImkState, d: f64, rate: f64) -> f64 {
+        let (drift, turn) = self.switch_parts(s, d, rate);
+        drift.min(turn)
+    }
+
+    /// [`Imk::switch_value`] in two parts, whose least it is: the terms in
+    /// the drift (each a line in it), and the reversal's k × the rate on
+    /// the backbone (∞ off it).
+    pub fn switch_parts(&self, s: &ImkState, d: f64, rate: f64) -> (f64, f64) {
         if s.failure == 5 {
-            return 1.0;
+            return (1.0, f64::INFINITY);
         }
         let f = self.piece_force(s, d);
         let mut g = self.ultimate_ahead(s, d).min(self.residual_ahead(s, d));
         if s.on_backbone {
-            g = g
-                .min(rate * s.dir * self.stiffness)
-                .min(self.backbone_ahead(s, d));
-        } else {
-            if s.failure > 0 && s.force != 0.0 {
-                g = g.min(f * s.force.signum());
-            }
-            let dir = if rate != 0.0 { rate.signum() } else { s.dir };
-            let slack = 1e-10 * self.fy();
-            g = g.min(dir * (self.bound(s, dir, d) - f) + slack);
+            return (
+                g.min(self.backbone_ahead(s, d)),
+                rate * s.dir * self.stiffness,
+            );
         }
-        g
+        if s.failure > 0 && s.force != 0.0 {
+            g = g.min(f * s.force.signum());
+        }
+        let dir = if rate != 0.0 { rate.signum() } else { s.dir };
+        let slack = 1e-10 * self.fy();
+        (
+            g.min(dir * (self.bound(s, dir, d) - f) + slack),
+            f64::INFINITY,
+        )
     }
 
     /// On the backbone, what ends the segment ahead other than a reversal:
@@ -675,7 +716,8 @@ impl Imk {
             self.excursion(s, dir);
         }
         let hair = 1e-12 * self.yield_drift.max(at.abs());
-        self.advance(s, at + dir * hair);
+        self.follow(s, at + dir * hair);
+        s.slope = self.slope_of(s);
     }
 }
 

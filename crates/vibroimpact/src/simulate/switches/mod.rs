@@ -48,6 +48,18 @@ pub(super) struct Switches {
     s_on: Vec<f64>,
     t_prev: f64,
     y_prev: Vec<f64>,
+    /// The derivative at the step's start.
+    f_prev: Vec<f64>,
+    /// Per event, its value at the step's start and end, and whether the
+    /// step's inside is looked at (kept between steps: no allocation).
+    ends: Vec<(f64, f64)>,
+    look: Vec<bool>,
+    /// The storeys' two switch parts at the last step's end (NaN where
+    /// not computed), the state there and the branches' stamp: the next
+    /// step's start, while both hold.
+    carried: Vec<(f64, f64)>,
+    carried_y: Vec<f64>,
+    carried_stamp: Option<u64>,
     buf: Vec<f64>,
     /// The states at the three inside points of the last step.
     inside: [Vec<f64>; 3],
@@ -69,10 +81,16 @@ impl Switches {
             .collect();
         (!events.is_empty()).then(|| Self {
             armed: vec![true; events.len()],
+            ends: vec![(0.0, 0.0); events.len()],
+            look: vec![false; events.len()],
+            carried: vec![(f64::NAN, f64::NAN); events.len()],
+            carried_y: vec![0.0; dim],
+            carried_stamp: None,
             events,
             s_on,
             t_prev: 0.0,
             y_prev: vec![0.0; dim],
+            f_prev: vec![0.0; dim],
             buf: vec![0.0; dim],
             inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
             pending: None,
@@ -85,6 +103,7 @@ impl Switches {
     pub(super) fn before_step(&mut self, st: &Stepper, bound: f64) -> Result<f64, Event> {
         self.t_prev = st.t();
         self.y_prev.copy_from_slice(st.y());
+        self.f_prev.copy_from_slice(st.dydt());
         match self.pending {
             Some((t, e)) if t <= st.t() => {
                 self.pending = None;
@@ -137,38 +156,72 @@ impl Switches {
                 return Ok(Verdict::Switch(e));
             }
         }
-        // The three inside points' states, taken once for all the events
-        // (a dense output may cost stages of its own), and only if an
-        // event is live.
-        let live: Vec<usize> = (0..self.events.len())
-            .filter(|&i| {
-                self.armed[i] && self.value(sys.chain(), self.events[i], &self.y_prev) > 0.0
-            })
-            .collect();
-        if live.is_empty() {
+        // Live events: armed, and positive at the step's start. Each is
+        // looked at inside the step (three points on the dense output)
+        // only if it is not positive at the end, or if one of its parts
+        // could reach zero inside by twice the bound on its rate
+        // ([`StoreyTerms::switch_rate_bounds`]); a contact's onset always.
+        let h = t1 - t0;
+        let mut any = false;
+        let stamp = sys.chain().storeys().stamp();
+        let carried = self.carried_stamp == Some(stamp) && self.carried_y == self.y_prev;
+        self.carried_stamp = Some(stamp);
+        self.carried_y.copy_from_slice(st.y());
+        for i in 0..self.events.len() {
+            self.look[i] = false;
+            if !self.armed[i] {
+                continue;
+            }
+            let e = self.events[i];
+            let Event::Storey(k) = e else {
+                let g0 = self.value(sys.chain(), e, &self.y_prev);
+                self.ends[i] = (g0, self.value(sys.chain(), e, st.y()));
+                self.look[i] = g0 > 0.0;
+                any |= self.look[i];
+                continue;
+            };
+            let storeys = sys.chain().storeys();
+            let (d0, r0) = match self.carried[i] {
+                parts if carried && !parts.0.is_nan() => parts,
+                _ => storeys.switch_parts(k, &self.y_prev),
+            };
+            let g0 = d0.min(r0);
+            if g0 <= 0.0 {
+                self.carried[i] = (f64::NAN, f64::NAN);
+                continue;
+            }
+            let (d1, r1) = storeys.switch_parts(k, st.y());
+            self.carried[i] = (d1, r1);
+            let (ld, lr) =
+                storeys.switch_rate_bounds(k, (&self.y_prev, &self.f_prev), (st.y(), st.dydt()), h);
+            self.ends[i] = (g0, d1.min(r1));
+            self.look[i] =
+                d1.min(r1) <= 0.0 || d0.min(d1) <= 2.0 * ld * h || r0.min(r1) <= 2.0 * lr * h;
+            any |= self.look[i];
+        }
+        if !any {
             self.rearm(sys.chain(), st.y());
             return Ok(Verdict::Clear);
         }
-        let times: [f64; 4] = [1.0, 2.0, 3.0, 4.0].map(|j| {
-            if j == 4.0 {
-                t1
-            } else {
-                t0 + (t1 - t0) * j / 4.0
-            }
-        });
+        // The three inside points' states, taken once for all the events
+        // looked at (a dense output may cost stages of its own).
+        let times: [f64; 4] =
+            [1.0, 2.0, 3.0, 4.0].map(|j| if j == 4.0 { t1 } else { t0 + h * j / 4.0 });
         for (k, t) in times[..3].iter().enumerate() {
             st.dense_output(sys, *t, &mut self.inside[k]);
         }
         let mut first: Option<(f64, Event)> = None;
-        for i in live {
+        for i in 0..self.events.len() {
+            if !self.look[i] {
+                continue;
+            }
             let e = self.events[i];
-            let (mut ta, mut ga) = (t0, self.value(sys.chain(), e, &self.y_prev));
+            let (mut ta, mut ga) = (t0, self.ends[i].0);
             for (j, &tb) in times.iter().enumerate() {
-                let gb = self.value(
-                    sys.chain(),
-                    e,
-                    if j == 3 { st.y() } else { &self.inside[j] },
-                );
+                let gb = match j {
+                    3 => self.ends[i].1,
+                    _ => self.value(sys.chain(), e, &self.inside[j]),
+                };
                 if gb <= 0.0 {
                     let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
                     let mut buf = std::mem::take(&mut self.buf);
