@@ -99,8 +99,19 @@ pub fn commit_temp(tmp: &Path, path: &Path) -> Result<(), OutputError> {
     })
 }
 
-/// Creates the directory `dir` (and parents) if missing.
+/// Creates the directory `dir` (and parents) if missing; a path that is
+/// there but not a folder (`--out /dev/null`, a file) is named as such,
+/// not as the system's "File exists".
 pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(OutputError {
+            path: dir.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "not a folder: --out names the folder the command writes its files into",
+            ),
+        });
+    }
     fs::create_dir_all(dir).map_err(|source| OutputError {
         path: dir.to_path_buf(),
         source,

@@ -73,7 +73,7 @@ fn sweep_example_row_json_and_outputs() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "parameter,direction,period,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3"
+        "parameter,direction,section,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3"
     );
     assert_eq!(lines.count(), 6 * 4, "one row per Poincaré sample");
     // The same run again gives the same bytes.
@@ -260,7 +260,7 @@ fn sweep_lyapunov_exponents() {
         (&["--lyapunov", "5"][..], "--lyapunov 5"),
         (
             &["--lyapunov", "--record", "1"][..],
-            "at least 2 recorded periods",
+            "--record 1: record at least two periods",
         ),
     ] {
         assert_clean_error(&[&base[..], extra].concat(), needle);
@@ -273,7 +273,7 @@ fn sweep_lyapunov_exponents() {
 fn sweep_bad_input_and_failures() {
     let model = repo_file("examples/fujita-row.toml");
     let base = |extra: &[&str]| -> Vec<String> {
-        let mut v: Vec<String> = ["sweep", &model, "--transient", "1", "--record", "1"]
+        let mut v: Vec<String> = ["sweep", &model, "--transient", "1", "--record", "2"]
             .iter()
             .map(|s| s.to_string())
             .collect();
@@ -345,9 +345,10 @@ fn sweep_bad_input_and_failures() {
     );
 }
 
-/// An integration failure at one value of a sweep (an impossible
-/// tolerance once the bodies move): the other value is kept, the failed
-/// one is named.
+/// An integration failure at one value of a sweep (a base acceleration
+/// of 1e9 m/s² drives the bodies into the walls' stiff range, where the
+/// explicit method gives up): the other value is kept, the failed one is
+/// named.
 #[test]
 fn sweep_failure_keeps_the_other_values() {
     let model = repo_file("examples/fujita-row.toml");
@@ -360,17 +361,13 @@ fn sweep_failure_keeps_the_other_values() {
         "--from",
         "0",
         "--to",
-        "0.05",
+        "1e9",
         "--points",
         "2",
         "--transient",
         "0",
         "--record",
         "2",
-        "--rtol",
-        "1e-18",
-        "--atol",
-        "1e-30",
         "--format",
         "json",
         "--out",
@@ -380,7 +377,7 @@ fn sweep_failure_keeps_the_other_values() {
     assert!(!out.status.success(), "should fail");
     assert!(!err.contains("panicked"), "{err}");
     assert!(
-        err.contains("amplitude = 0.05") && err.contains("1 of 2"),
+        err.contains("amplitude = 1000000000") && err.contains("1 of 2"),
         "{err}"
     );
     let doc: serde_json::Value =
@@ -391,7 +388,7 @@ fn sweep_failure_keeps_the_other_values() {
     assert!(doc["points"][1]["error"]
         .as_str()
         .unwrap()
-        .contains("step size"));
+        .contains("stiff at t ="));
     assert!(out_dir.join("summary.json").is_file());
 }
 
@@ -653,12 +650,33 @@ fn continue_starts_by_homotopy_where_simulation_does_not() {
 fn continue_krylov_options_checked() {
     let model = repo_file("examples/fujita-row-n2.toml");
     let range = ["--parameter", "frequency", "--from", "7", "--to", "8"];
+    // Too few Arnoldi vectors for a verdict are refused by the option's
+    // name; more than the state's size 2N (the default 20 on a row of
+    // three was refused as "between 6 and 6") is the whole state space, so
+    // it is taken as 2N (issue 38).
     let args = [
-        &["continue", &model, "--krylov", "--arnoldi", "10"][..],
+        &["continue", &model, "--krylov", "--arnoldi", "1"][..],
         &range,
     ]
     .concat();
-    assert_clean_error(&args, "Arnoldi dimension 10: between 4");
+    assert_clean_error(&args, "--arnoldi: Arnoldi dimension 1: between 4");
+    let row3 = repo_file("examples/fujita-row.toml");
+    let out = run(&[
+        "continue",
+        &row3,
+        "--krylov",
+        "--parameter",
+        "frequency",
+        "--from",
+        "11.1",
+        "--to",
+        "10.9",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let dir = temp_dir("long-row");
     let text = std::fs::read_to_string(&model).unwrap();
     let long = write_model(

@@ -4,6 +4,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use vibroimpact::maps::attractor::map_work;
 use vibroimpact::maps::basins::{basins as run_basins, Component};
 use vibroimpact::maps::sweep::SweepOptions;
 
@@ -53,18 +54,23 @@ pub fn basins<'py>(
     let (cx, cy) = (component(x, "x")?, component(y, "y")?);
     let pool = thread_pool(threads)?;
     let total = xs.len() * ys.len();
+    let options = SweepOptions {
+        transient,
+        record,
+        rtol,
+        atol,
+        method,
+        cluster_tolerance,
+        integrator,
+        ..SweepOptions::default()
+    };
+    let work = py.detach(|| map_work(&loaded, &options, total));
+    crate::simulate::warn_if_long(py, work)?;
     let out = monitor::run(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
-            transient,
-            record,
-            rtol,
-            atol,
-            method,
-            cluster_tolerance,
             interrupt: Some(p.interrupt.clone()),
-            integrator,
-            ..SweepOptions::default()
+            ..options
         };
         pool.install(|| {
             run_basins(

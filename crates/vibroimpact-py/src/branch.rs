@@ -145,14 +145,25 @@ pub fn continue_branch<'py>(
     if let Some(text) = &second.5 {
         return curves_from_document(py, progress, text, checked, &study);
     }
-    let out = monitor::run(py, progress, move |p: &Progress| {
+    let out = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.set_total(max_points);
         checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());
         checked.run(|_| {
             p.tick();
             !p.interrupt.requested()
         })
-    })?;
+    });
+    let out = match out {
+        Ok(out) => out,
+        // KeyboardInterrupt keeps the branch so far (its stop
+        // "Interrupted"), as the command line writes it: `result`.
+        Err((e, Some(Ok(outcome)))) => {
+            e.value(py)
+                .setattr("result", to_python(py, &continue_document(&outcome))?)?;
+            return Err(e);
+        }
+        Err((e, _)) => return Err(e),
+    };
     let outcome = out.map_err(|e| spell(e, &study))?;
     let mut doc = continue_document(&outcome);
     if let Some(Err(e)) = &outcome.branch.switched {

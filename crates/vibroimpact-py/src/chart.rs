@@ -4,6 +4,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use vibroimpact::maps::attractor::map_work;
 use vibroimpact::maps::chart::{chart as run_chart, ChartOptions};
 use vibroimpact::maps::sweep::SweepOptions;
 
@@ -45,20 +46,27 @@ pub fn chart<'py>(
     let doc = model.document.clone();
     let (x, y) = (x.to_string(), y.to_string());
     let total = xs.len() * ys.len();
+    let sweep = SweepOptions {
+        transient,
+        record,
+        rtol,
+        atol,
+        method,
+        cluster_tolerance,
+        lyapunov: lyapunov.then_some(1),
+        integrator,
+        ..SweepOptions::default()
+    };
+    if let Ok(base) = doc.build() {
+        let work = py.detach(|| map_work(&base, &sweep, total * starts));
+        crate::simulate::warn_if_long(py, work)?;
+    }
     let out = monitor::run(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = ChartOptions {
             sweep: SweepOptions {
-                transient,
-                record,
-                rtol,
-                atol,
-                method,
-                cluster_tolerance,
-                lyapunov: lyapunov.then_some(1),
                 interrupt: Some(p.interrupt.clone()),
-                integrator,
-                ..SweepOptions::default()
+                ..sweep
             },
             starts,
         };

@@ -109,6 +109,22 @@ where
     T: Send + 'static,
     F: FnOnce(&Progress) -> T + Send + 'static,
 {
+    run_keeping(py, callback, work).map_err(|(e, _)| e)
+}
+
+/// [`run`], and on KeyboardInterrupt (or the callback's exception) what
+/// the work returned once stopped, if it did within [`ABANDON`]: the
+/// caller attaches it to the exception as `result`, as the command line
+/// keeps it (a branch with `stop: "Interrupted"`).
+pub fn run_keeping<T, F>(
+    py: Python<'_>,
+    callback: Option<&Bound<'_, PyAny>>,
+    work: F,
+) -> Result<T, (PyErr, Option<T>)>
+where
+    T: Send + 'static,
+    F: FnOnce(&Progress) -> T + Send + 'static,
+{
     let progress = Arc::new(Progress::default());
     let (tx, rx) = mpsc::channel();
     let shared = progress.clone();
@@ -151,19 +167,22 @@ where
         });
         let result = match (received, stop) {
             (Ok(r), Ok(())) => r,
-            (Ok(_), Err(e)) => return Err(e),
+            (Ok(r), Err(e)) => return Err((e, r.ok())),
             (Err(mpsc::RecvTimeoutError::Timeout), Ok(())) => continue,
             (Err(_), Err(e)) => {
                 progress.interrupt.request();
                 // Integrations stop at their next step; work that cannot be
                 // interrupted (a least-squares fit) finishes on its own: the
                 // job owns its data, so it is left to end in the background.
-                let _ = py.detach(|| recv(Some(ABANDON)));
-                return Err(e);
+                let stopped = py.detach(|| recv(Some(ABANDON)));
+                return Err((e, stopped.ok().and_then(Result::ok)));
             }
             (Err(mpsc::RecvTimeoutError::Disconnected), Ok(())) => {
-                return Err(VibroimpactError::new_err(
-                    "internal error: the worker thread ended without a result",
+                return Err((
+                    VibroimpactError::new_err(
+                        "internal error: the worker thread ended without a result",
+                    ),
+                    None,
                 ))
             }
         };
@@ -173,9 +192,12 @@ where
                 .map(|s| s.to_string())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown".into());
-            VibroimpactError::new_err(format!(
-                "internal error (please report): the computation panicked: {msg}"
-            ))
+            (
+                VibroimpactError::new_err(format!(
+                    "internal error (please report): the computation panicked: {msg}"
+                )),
+                None,
+            )
         });
     }
 }

@@ -28,7 +28,7 @@ fn spell(e: StudyError, study: &OrbitStudy, interrupted: bool) -> PyErr {
         StudyError::Invalid { field: f, message } => {
             value_error(format!("{}: {message}", field(f)))
         }
-        StudyError::Model(_) | StudyError::File(_) => value_error(e),
+        StudyError::Model(_) | StudyError::File(_) | StudyError::Field(_) => value_error(e),
         StudyError::Continuation(ContinuationError::Invalid(_)) if !interrupted => value_error(e),
         other => numerical_error(other),
     }

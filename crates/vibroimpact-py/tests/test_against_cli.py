@@ -443,7 +443,7 @@ def test_parameter_values_match_the_cli(cli):
     # at some i: the values must be the CLI's to the bit.
     m = ROOT / "examples" / "fujita-row.toml"
     doc = cli("sweep", m, "--parameter", "row.clearance", "--from", "1e-3", "--to", "2.3e-3",
-              "--points", "13", "--transient", "0", "--record", "1")
+              "--points", "13", "--transient", "0", "--record", "2")
     v = vi.parameter_values(1e-3, 2.3e-3, 13)
     assert v.tolist() == [p["parameter"] for p in doc["points"]]
 

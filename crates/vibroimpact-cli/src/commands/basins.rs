@@ -106,6 +106,10 @@ pub fn run(args: &BasinsArgs) -> Result<(), CliError> {
     let (cx, cy) = (parse("x", &args.grid.x)?, parse("y", &args.grid.y)?);
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = args.runs.options(interrupt.clone());
+    crate::progress::announce_long_as(
+        vibroimpact::maps::attractor::map_work(&loaded, &options, xs.len() * ys.len()),
+        "Ctrl-C stops it (basins are written whole: nothing then)",
+    );
     let progress = crate::progress::bar(xs.len() * ys.len(), "states").with_prefix("basins");
     let result = basins(
         &loaded,

@@ -213,7 +213,7 @@ fn print_outcome(args: &ContinueArgs, outcome: &ContinueOutcome) -> Result<(), C
             }
             for (i, b) in branches.into_iter().enumerate() {
                 println!(
-                    "{}: {} points from {} to {} ({:?})",
+                    "{}: {} points from {} to {}: {}",
                     if i == 0 { "branch" } else { "switched branch" },
                     b.points.len(),
                     b.points.first().map_or(f64::NAN, |p| p.parameter),
@@ -301,7 +301,7 @@ fn print_curves(c: &Curves) {
             })
             .collect();
         println!(
-            "{} curve from {label}: {} points ({:?}){}{}",
+            "{} curve from {label}: {} points, {}{}{}",
             curve.kind.name(),
             curve.points.len(),
             curve.stop,

@@ -185,9 +185,6 @@ fn overlay_series(path: &Path, x: &str, y: &str) -> Result<Vec<Series>, CliError
 /// Runs `vibroimpact chart`.
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let (xs, ys) = args.grid.values()?;
-    if args.runs.record < 1 {
-        return Err(CliError::new("--record 0: record at least one period"));
-    }
     let document = read_document(&args.model)?;
     let overlay = match &args.overlay {
         Some(path) => overlay_series(path, &args.grid.x, &args.grid.y)?,
@@ -201,6 +198,16 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         },
         starts: args.starts,
     };
+    if let Ok(base) = document.build() {
+        crate::progress::announce_long_as(
+            vibroimpact::maps::attractor::map_work(
+                &base,
+                &options.sweep,
+                xs.len() * ys.len() * options.starts,
+            ),
+            "Ctrl-C stops it (a chart is written whole: nothing then)",
+        );
+    }
     let progress = crate::progress::bar(xs.len() * ys.len(), "cells").with_prefix("chart");
     let chart = chart(
         &document,

@@ -69,7 +69,14 @@ fn read_guess(spec: &str) -> Result<Guess, CliError> {
         "homotopy" => return Ok(Guess::Homotopy),
         _ => {}
     }
-    let text = crate::input::read_text(Path::new(spec))
+    let path = Path::new(spec);
+    if !path.exists() {
+        // A keyword's typo (`homotpy`) is not a missing file.
+        return Err(CliError::new(format!(
+            "--guess {spec}: neither `simulate`, `homotopy` nor an existing JSON file with `initial_state`"
+        )));
+    }
+    let text = crate::input::read_text(path)
         .map_err(|e| CliError::new(format!("{spec}: cannot read the guess: {e}")))?;
     let doc: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| CliError::new(format!("{spec}: not JSON: {e}")))?;
@@ -101,6 +108,7 @@ fn study_error(e: StudyError, args: &PeriodicArgs, interrupt: &Interrupt) -> Cli
             };
             CliError::new(format!("{option}: {message}"))
         }
+        StudyError::Field(f) => crate::error::option_error(&f),
         other => CliError::new(other.to_string()),
     }
 }

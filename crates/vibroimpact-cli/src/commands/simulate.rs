@@ -66,9 +66,24 @@ pub struct SimulateArgs {
 /// Simulation options from the command line and the model file.
 fn options(args: &SimulateArgs, loaded: &LoadedModel) -> Result<SimulationOptions, CliError> {
     let model = &loaded.model;
+    let positive = |flag: &str, v: f64| {
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(CliError::new(format!(
+                "{flag} {v}: give a positive, finite {}",
+                if flag == "--periods" {
+                    "number of forcing periods"
+                } else {
+                    "time (s)"
+                }
+            )))
+        }
+    };
     let t_end = match (args.duration, args.periods) {
-        (Some(d), _) => d,
+        (Some(d), _) => positive("--duration", d)?,
         (None, Some(p)) => {
+            positive("--periods", p)?;
             let w = model.forcing_frequency().ok_or_else(|| {
                 CliError::new(
                     "--periods needs a periodic excitation with one frequency; use --duration",
@@ -302,9 +317,19 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let mut sim = simulate_streaming(model, &opts, |t, state| {
+    let run = simulate_streaming(model, &opts, |t, state| {
         history.as_mut().is_none_or(|h| h.sample(t, state))
-    })?;
+    });
+    let mut sim = match run {
+        Ok(sim) => sim,
+        // Refused before any step (`--output-step 0`): no file is left.
+        Err(e) => {
+            if let Some(h) = history {
+                h.discard();
+            }
+            return Err(e.into());
+        }
+    };
     let mut s = simulation_summary(model, &sim);
     s.record = loaded.record.clone();
     if let (Some(dir), Some(history)) = (&args.out, history) {
@@ -406,6 +431,12 @@ impl HistoryFile {
         }
         self.count += 1;
         true
+    }
+
+    /// Removes the temporary file (a run refused before its first step).
+    fn discard(self) {
+        drop(self.writer);
+        let _ = std::fs::remove_file(&self.tmp);
     }
 
     /// Flushes and renames the file into place; returns the samples kept

@@ -73,7 +73,9 @@ pub struct SweepArgs {
 /// Axis label of the parameter.
 fn sweep_csv(summary: &SweepSummary) -> Result<String, CliError> {
     let mut w = CsvText::new();
-    let mut header: Vec<String> = vec!["parameter".into(), "direction".into(), "period".into()];
+    // `section`: which recorded forcing period's Poincaré sample (1, 2,
+    // …), not an orbit's period (the summary's distinct section points).
+    let mut header: Vec<String> = vec!["parameter".into(), "direction".into(), "section".into()];
     header.extend(summary.bodies.iter().map(|b| format!("u_{b}")));
     header.extend(summary.bodies.iter().map(|b| format!("v_{b}")));
     w.row(&header)?;
@@ -241,10 +243,6 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             args.points
         )));
     }
-    if args.record < 1 {
-        return Err(CliError::new("--record 0: record at least one period"));
-    }
-
     let family = read_family(&args.range.model, &args.range.parameter)?;
     let values = parameter_values(args.range.from, args.range.to, args.points);
     let lyapunov = match args.lyapunov {

@@ -59,7 +59,13 @@ pub fn write_model(dir: &Path, name: &str, text: &str) -> String {
 }
 
 /// Sends SIGINT to a child after `ms` milliseconds and returns its output.
-pub fn interrupt_after(mut cmd: Command, ms: u64) -> Output {
+pub fn interrupt_after(cmd: Command, ms: u64) -> Output {
+    signal_after(cmd, ms, libc::SIGINT)
+}
+
+/// Sends `signal` to a child after `ms` milliseconds and returns its
+/// output.
+pub fn signal_after(mut cmd: Command, ms: u64, signal: libc::c_int) -> Output {
     let child = cmd
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -68,7 +74,7 @@ pub fn interrupt_after(mut cmd: Command, ms: u64) -> Output {
     std::thread::sleep(std::time::Duration::from_millis(ms));
     // SAFETY: signalling our own child process.
     unsafe {
-        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+        libc::kill(child.id() as libc::pid_t, signal);
     }
     child.wait_with_output().unwrap()
 }

@@ -216,7 +216,15 @@ def _pairs(data: Any, name: str, second: str) -> tuple:
             raise OSError(f"{name}: {path}: cannot read: {e.strerror}") from None
         u, y = _core.parse_measured(text, path, ["impact_velocity", second])
         return u, y
-    if isinstance(data, tuple) and len(data) == 2:
+    if isinstance(data, dict):
+        missing = [k for k in ("impact_velocity", second) if k not in data]
+        if missing or len(data) != 2:
+            raise ValueError(
+                f"{name}: a dict needs exactly the keys 'impact_velocity' and '{second}', got {sorted(data)}"
+            )
+        u = _floats(data["impact_velocity"], f"{name}['impact_velocity']")
+        y = _floats(data[second], f"{name}['{second}']")
+    elif isinstance(data, tuple) and len(data) == 2:
         u, y = data
         u, y = _floats(u, f"{name}[0] (impact_velocity)"), _floats(y, f"{name}[1] ({second})")
     else:
@@ -224,6 +232,14 @@ def _pairs(data: Any, name: str, second: str) -> tuple:
         if arr.ndim != 2 or arr.shape[1] != 2:
             raise ValueError(
                 f"{name}: give (impact_velocity, {second}) arrays or an (n, 2) array, got shape {arr.shape}"
+            )
+        if arr.shape[0] == 2:
+            # Rows of pairs or the two columns? The same numbers fit a/b
+            # 1.020 one way and 0.552 the other (issue 38).
+            raise ValueError(
+                f"{name}: a 2 x 2 array is ambiguous (two (impact_velocity, {second}) rows, or the two "
+                f"columns?): give a tuple (impact_velocities, {second}s) or a dict with the keys "
+                f"'impact_velocity' and '{second}'"
             )
         u, y = _floats(arr[:, 0], f"{name}[:, 0]"), _floats(arr[:, 1], f"{name}[:, 1]")
     if u.shape != y.shape:
@@ -245,8 +261,10 @@ def identify(
 
     ``restitution``: (impact velocity, restitution) measurements and
     ``acceleration``: (impact velocity, peak acceleration of body 1 =
-    F_max/m1) measurements, each as a pair of arrays, an (n, 2) array or a
-    CSV file with the columns ``impact_velocity`` and ``restitution`` (or
+    F_max/m1) measurements, each as a tuple of two arrays (the columns), a
+    dict with the keys ``impact_velocity`` and ``restitution`` (or
+    ``peak_acceleration``), an (n, 2) array of rows (n > 2: a 2 x 2 array
+    is refused as ambiguous) or a CSV file with the columns ``impact_velocity`` and ``restitution`` (or
     ``peak_acceleration``), as the CLI reads it; either may be omitted. ``a_over_b`` fixes a/b; ``joint`` fits both at
     once. Returns ``method``, ``a_over_b`` and ``alpha`` (each with
     ``value`` and ``std_error``), ``restitution_fit`` and

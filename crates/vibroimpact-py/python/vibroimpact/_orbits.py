@@ -203,31 +203,39 @@ def continue_(
     ``spectral_radius``, ``floquet_multipliers``, ``initial_state``,
     ``label``) and ``special_points``; ``result.column("parameter")`` gives
     one field over the points. Raises VibroimpactError if the branch cannot
-    continue (the points so far are on the exception as ``.result``).
+    continue, and KeyboardInterrupt on Ctrl-C: the points so far are on
+    the exception as ``.result`` (on Ctrl-C with ``stop`` "Interrupted").
     """
     m = _model(model)
     if not isinstance(parameter, str):
         raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
     if switch_at is not None and not isinstance(switch_at, str):
         raise TypeError("switch_at: expected a label such as 'BP1'")
-    d = _core.continue_branch(
-        m,
-        parameter,
-        _real(from_, "from_"),
-        _real(to, "to"),
-        _count(subharmonic, "subharmonic", minimum=1, maximum=10**6),
-        switch_at,
-        _count(max_points, "max_points", minimum=2, maximum=10**8),
-        _real(ds_max, "ds_max", positive=True),
-        _real(guess_periods, "guess_periods", positive=True),
-        _progress(progress),
-        _method(integrator, ("auto", "global", "local"), "integrator"),
-        _method(start, ("auto", "simulate", "homotopy"), "start"),
-        _flag(krylov, "krylov"),
-        _flag(dense, "dense"),
-        _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
-        _second_parameter(parameter2, from2, to2, curves, curve_step, special_points),
-    )
+    try:
+        d = _core.continue_branch(
+            m,
+            parameter,
+            _real(from_, "from_"),
+            _real(to, "to"),
+            _count(subharmonic, "subharmonic", minimum=1, maximum=10**6),
+            switch_at,
+            _count(max_points, "max_points", minimum=2, maximum=10**8),
+            _real(ds_max, "ds_max", positive=True),
+            _real(guess_periods, "guess_periods", positive=True),
+            _progress(progress),
+            _method(integrator, ("auto", "global", "local"), "integrator"),
+            _method(start, ("auto", "simulate", "homotopy"), "start"),
+            _flag(krylov, "krylov"),
+            _flag(dense, "dense"),
+            _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
+            _second_parameter(parameter2, from2, to2, curves, curve_step, special_points),
+        )
+    except KeyboardInterrupt as e:
+        # Ctrl-C keeps the branch so far (stop "Interrupted"), as the CLI
+        # writes it.
+        if isinstance(getattr(e, "result", None), dict):
+            e.result = Result(e.result)
+        raise
     r = Result(d)
     if special_points is not None:
         return r

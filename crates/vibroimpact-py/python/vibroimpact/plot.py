@@ -28,6 +28,20 @@ _MARKERS = {
 _DIRECTIONS = {"none": "0.2", "up": "tab:red", "down": "tab:green"}
 
 
+def _need(result, argument, keys, source):
+    """Refuses, naming the argument, what is not the result ``source``
+    returns: a plot of the wrong result raised ``KeyError: 'points'``, of
+    None an ``AttributeError`` (issue 38)."""
+    try:
+        missing = [k for k in keys if k not in result]
+    except TypeError:
+        missing = list(keys)
+    if missing:
+        got = (f"a result with {', '.join(sorted(result.keys())[:6])}, without {', '.join(missing)}"
+               if hasattr(result, "keys") else type(result).__name__)
+        raise TypeError(f"{argument}: give the result of {source}, got {got}")
+
+
 def _axes(ax):
     if ax is None:
         import matplotlib.pyplot as plt
@@ -75,6 +89,7 @@ def frequency_response(branch, ax=None, body=0, x_scale=1.0, label="branch", swi
     for Omega/omega0); stable stretches solid, unstable dashed, special
     points marked by kind and labelled (BP1, PD1, ...). With ``switched``,
     the ``switched_branch`` (if any) is drawn too, in another colour."""
+    _need(branch, 'branch', ('points', 'special_points', 'parameter_name'), 'vibroimpact.continue_')
     ax = _axes(ax)
     seen: set = set()
     _branch(ax, branch, body, x_scale, label, "tab:blue", seen)
@@ -92,6 +107,7 @@ def time_history(history, ax=None, bodies=None):
     :func:`vibroimpact.simulate` result, for the body indices ``bodies``
     (default: all, at most 8), with each impact's start time ticked along
     the bottom of the axes in its contact's colour."""
+    _need(history, 'history', ('t', 'displacement', 'impacts', 'impacts_per_contact'), 'vibroimpact.simulate')
     if len(history.t) == 0:
         raise ValueError("history: no samples to draw (simulated with output_step=0)")
     ax = _axes(ax)
@@ -116,6 +132,7 @@ def poincare(sweep, ax=None, body=0, x_scale=1.0):
     result: every point's Poincaré samples of body ``body``'s displacement
     (mm) against the parameter times ``x_scale``; an up-down sweep's two
     directions in two colours, with a legend."""
+    _need(sweep, 'sweep', ('points', 'bodies', 'parameter_name', 'up_down'), 'vibroimpact.sweep')
     ax = _axes(ax)
     n = 2 * len(sweep.bodies)
     xs: dict = {}
@@ -138,6 +155,7 @@ def restitution(impact, ax=None, label=None):
     """Coefficient of restitution against impact velocity (m/s, log axis)
     of a :func:`vibroimpact.impact` result; ``label`` defaults to its
     method ("closed-form" or "integrate")."""
+    _need(impact, 'impact', ('impact_velocity', 'restitution', 'method'), 'vibroimpact.impact')
     ax = _axes(ax)
     ax.semilogx(impact.impact_velocity, impact.restitution, label=label or impact.method)
     _labels(ax, "impact velocity V (m/s)", "coefficient of restitution e")
@@ -154,6 +172,7 @@ def fragility(study, ax=None):
     Sa(T) times the collapse scale, as Ŝ_CT) where the study has a period,
     else the scale. Raises ValueError, with the
     summary's reason, where no fit is determined."""
+    _need(study, 'study', ('summary', 'records', 'period'), 'vibroimpact.collapse_study')
     from math import erfc, log, sqrt
 
     summary = study["summary"]

@@ -480,6 +480,9 @@ fn validate(p0: f64, p_end: f64, opts: &ContinuationOptions) -> Result<(), Conti
             )));
         }
     }
+    opts.shooting
+        .check()
+        .map_err(|e| ContinuationError::Invalid(e.to_string()))?;
     if let Some(scale) = opts.parameter_scale {
         if !(scale > 0.0 && scale.is_finite()) {
             return Err(ContinuationError::Invalid(format!(

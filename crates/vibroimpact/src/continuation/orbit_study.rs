@@ -88,6 +88,9 @@ impl OrbitStudy {
                 document.source()
             )));
         }
+        for (field, v) in [("rtol", self.options.rtol), ("tol", self.options.tol)] {
+            crate::field_error::FieldError::tolerance(field, v).map_err(StudyError::Field)?;
+        }
         let n = self.options.subharmonic;
         if n == 0 {
             return Err(invalid(StudyField::Subharmonic, "must be >= 1".into()));

@@ -90,7 +90,10 @@ impl Linear {
             Linear::Dense => false,
             Linear::MatrixFree => true,
         };
-        free.then_some(arnoldi)
+        // At most the state's size 2N: its Krylov space is the whole state
+        // space, so a larger dimension (the default 20 on a row of three,
+        // refused as "between 6 and 6") can give no more.
+        free.then_some(arnoldi.min(2 * bodies))
     }
 }
 
@@ -234,6 +237,10 @@ impl BranchStudy {
             field,
             message: message.into(),
         };
+        let shooting = &self.options.shooting;
+        for (field, v) in [("rtol", shooting.rtol), ("tol", shooting.tol)] {
+            crate::field_error::FieldError::tolerance(field, v).map_err(StudyError::Field)?;
+        }
         if !(self.from.is_finite() && self.to.is_finite()) || self.from == self.to {
             return Err(invalid(
                 StudyField::Range,
@@ -260,7 +267,15 @@ impl BranchStudy {
             krylov: self.linear.krylov(start_model.bodies().len(), self.arnoldi),
             ..self.options.clone()
         };
-        validate_size(&start_model, &options)?;
+        validate_size(&start_model, &options).map_err(|e| match (e, options.krylov) {
+            (ContinuationError::Invalid(m), Some(_)) if m.starts_with("Arnoldi") => {
+                StudyError::Invalid {
+                    field: StudyField::Arnoldi,
+                    message: m,
+                }
+            }
+            (e, _) => e.into(),
+        })?;
         Ok(CheckedBranch {
             study: self,
             family,

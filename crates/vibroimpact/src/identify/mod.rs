@@ -174,6 +174,11 @@ fn validate_restitution(samples: &[RestitutionSample]) -> Result<(), IdentifyErr
             need: 2,
         });
     }
+    repeated(
+        W,
+        samples.iter().map(|s| (s.impact_velocity, s.restitution)),
+        2,
+    )?;
     Ok(())
 }
 
@@ -206,6 +211,34 @@ fn validate_acceleration(samples: &[AccelerationSample], need: usize) -> Result<
             got: samples.len(),
             need,
         });
+    }
+    repeated(
+        W,
+        samples
+            .iter()
+            .map(|s| (s.impact_velocity, s.peak_acceleration)),
+        need,
+    )
+}
+
+/// Refuses points that hold fewer than `need` distinct pairs: repeats of
+/// one measurement fix a value but not its standard error (three
+/// identical restitution points gave a/b ± 1e-15, "0.00 %").
+fn repeated(
+    what: &'static str,
+    points: impl Iterator<Item = (f64, f64)>,
+    need: usize,
+) -> Result<(), IdentifyError> {
+    let mut pairs: Vec<(u64, u64)> = points.map(|(a, b)| (a.to_bits(), b.to_bits())).collect();
+    let n = pairs.len();
+    pairs.sort_unstable();
+    pairs.dedup();
+    if pairs.len() < need {
+        return Err(IdentifyError::NotIdentifiable(format!(
+            "a standard error: the {n} {what} points hold {} distinct (impact velocity, value) pair{}; give {need} distinct points at least",
+            pairs.len(),
+            if pairs.len() == 1 { "" } else { "s" }
+        )));
     }
     Ok(())
 }

@@ -189,3 +189,30 @@ fn unidentifiable_and_invalid_data_are_reported() {
         Err(IdentifyError::InvalidSample { index: 1, .. })
     ));
 }
+
+/// Issue 38: three identical restitution points gave a/b with a standard
+/// error of 1e-15 ("0.00 %"). Repeats of one point fix a/b but not its
+/// uncertainty: refused, saying how many distinct points there are; two
+/// distinct points fit. The same for the acceleration points of α.
+#[test]
+fn repeated_points_do_not_give_a_standard_error() {
+    let point = |u: f64, e: f64| RestitutionSample {
+        impact_velocity: u,
+        restitution: e,
+    };
+    let same = vec![point(0.1, 0.5); 3];
+    let e = fit_a_over_b(&same).unwrap_err().to_string();
+    assert!(
+        e.contains("the 3 restitution points hold 1 distinct (impact velocity, value) pair; give 2 distinct points at least"),
+        "{e}"
+    );
+    let two = vec![point(0.1, 0.5), point(0.1, 0.5), point(0.3, 0.45)];
+    let fit = fit_a_over_b(&two).unwrap();
+    assert!(fit.a_over_b.std_error > 0.0, "{:?}", fit.a_over_b);
+    let a = AccelerationSample {
+        impact_velocity: 0.1,
+        peak_acceleration: 300.0,
+    };
+    let e = fit_alpha(&[a; 3], bodies(), 1.2).unwrap_err().to_string();
+    assert!(e.contains("acceleration points hold 1 distinct"), "{e}");
+}

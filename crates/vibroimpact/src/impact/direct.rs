@@ -266,7 +266,13 @@ pub fn integrate_impact(
     opts: &DirectOptions,
 ) -> Result<DirectImpact, ImpactError> {
     let u = positive("impact velocity", impact_velocity)?;
-    positive("rtol", opts.rtol)?;
+    if crate::field_error::FieldError::tolerance("rtol", opts.rtol).is_err() {
+        return Err(ImpactError::InvalidParameter {
+            name: "rtol",
+            value: opts.rtol,
+            requirement: "must lie in (1e-15, 0.1): a looser tolerance controls no error (at 1 the restitution came out 1.0967), a tighter one is below double precision",
+        });
+    }
     let mu = bodies.reduced_mass();
     let length = law.length_scale(mu, u);
     let s0 = match *law.kind() {

@@ -24,7 +24,7 @@ use crate::numeric::RootError;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ImpactError {
     /// A parameter is out of its domain.
-    #[error("{name} = {value} is invalid: {requirement}")]
+    #[error("{name} = {} is invalid: {requirement}", crate::field_error::shown(*value))]
     InvalidParameter {
         /// Parameter name.
         name: &'static str,

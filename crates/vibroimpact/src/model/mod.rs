@@ -13,6 +13,7 @@
 //! - `family.rs` — a family of models, the problem every parameter study
 //!   takes;
 //! - `reference.rs` — the reference problems R1–R3 (docs/theory.md §6);
+//! - `scales.rs` — the model's force scales against double precision;
 //! - `tests.rs` — the checks.
 //!
 //! Equations of motion in displacements `u` relative to a frame that moves
@@ -260,6 +261,7 @@ impl Model {
             storeys: Vec::new(),
         };
         check_overlaps(&model)?;
+        scales::check_rounding(&model)?;
         Ok(model)
     }
 
@@ -564,6 +566,7 @@ pub mod hysteresis;
 pub mod parameter;
 pub mod record;
 pub mod reference;
+mod scales;
 mod storey;
 
 pub use excitation::{Accelerogram, BaseExcitation, HarmonicForce};

@@ -102,6 +102,23 @@ pub struct ShootingOptions {
 }
 
 impl ShootingOptions {
+    /// Refuses tolerances outside [`FieldError::tolerance`]'s range and a
+    /// displacement scale that is not positive, by name.
+    pub fn check(&self) -> Result<(), PeriodicError> {
+        use crate::field_error::FieldError;
+        let named = |e: FieldError| PeriodicError::Options(e.to_string());
+        FieldError::tolerance("rtol", self.rtol).map_err(named)?;
+        FieldError::tolerance("tol", self.tol).map_err(named)?;
+        if !(self.displacement_scale > 0.0 && self.displacement_scale.is_finite()) {
+            return Err(named(FieldError::new(
+                "displacement_scale",
+                self.displacement_scale,
+                "must be finite and > 0",
+            )));
+        }
+        Ok(())
+    }
+
     /// The integrator's options for a period map: these tolerances, at most
     /// `max_steps` steps, the stop request; with `state` = Some(d) carried
     /// columns (variational, tangent) ride along on the steps of the first

@@ -170,6 +170,7 @@ fn shooting_checks(
     guess: &[f64],
     opts: &ShootingOptions,
 ) -> Result<(f64, usize), PeriodicError> {
+    opts.check()?;
     let period = forcing_period(model)? * f64::from(opts.subharmonic.max(1));
     map_time(model, opts)?;
     let d = 2 * model.bodies().len();
@@ -190,11 +191,6 @@ pub fn shoot(
     opts: &ShootingOptions,
 ) -> Result<PeriodicSolution, PeriodicError> {
     let (period, _) = shooting_checks(model, guess, opts)?;
-    if !(opts.rtol > 0.0 && opts.tol > 0.0 && opts.displacement_scale > 0.0) {
-        return Err(PeriodicError::Options(
-            "shooting: rtol, tol and displacement scale must be > 0".into(),
-        ));
-    }
     let mut sys = DenseShooting {
         model,
         opts,

@@ -76,11 +76,13 @@ impl WorkEstimate {
         }
     }
 
-    /// `runs` such runs one after the other.
+    /// `runs` such runs one after the other, each with its own step
+    /// budget.
     pub fn times(self, runs: f64) -> Self {
         Self {
             steps: self.steps * runs,
             seconds: self.seconds * runs,
+            max_steps: (self.max_steps as f64 * runs.max(1.0)).min(u64::MAX as f64) as u64,
             ..self
         }
     }

@@ -276,8 +276,8 @@ fn check_options(opts: &SimulationOptions) -> Result<(), OptionsError> {
     if !(opts.t_end > 0.0 && opts.t_end.is_finite()) {
         return bad("duration", opts.t_end);
     }
-    if !(opts.rtol > 0.0 && opts.rtol.is_finite()) {
-        return bad("rtol", opts.rtol);
+    if let Err(e) = crate::field_error::FieldError::tolerance("rtol", opts.rtol) {
+        return Err(OptionsError(e.to_string()));
     }
     if !(opts.atol > 0.0 && opts.atol.is_finite()) {
         return bad("atol", opts.atol);
@@ -340,6 +340,20 @@ fn effective_method(model: &Model, opts: &SimulationOptions) -> Result<Method, O
         .map_or(opts.t_end, |w| 2.0 * std::f64::consts::PI / w)
         .min(opts.t_end);
     match opts.method {
+        // Not stiff: the run is long (--periods 1e12 was called stiff,
+        // with rodas as the advice).
+        Method::Dop853 | Method::Dopri5
+            if steps_per(opts.t_end) > opts.max_steps as f64
+                && steps_per(reference) <= STIFF_FREE_FLIGHT_STEPS =>
+        {
+            Err(OptionsError(format!(
+                "duration = {:e} s: about {:.1e} steps, more than the limit of {}; simulate a shorter time (the model is not stiff: {:.0} steps a forcing period)",
+                opts.t_end,
+                steps_per(opts.t_end),
+                opts.max_steps,
+                steps_per(reference)
+            )))
+        }
         Method::Dop853 | Method::Dopri5 if steps_per(opts.t_end) > opts.max_steps as f64 => {
             let b = &model.bodies()[fast.body];
             let cause = if fast.damping {

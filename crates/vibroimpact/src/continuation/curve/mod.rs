@@ -181,6 +181,20 @@ pub enum CurveStop {
     MaxPoints,
 }
 
+impl std::fmt::Display for CurveStop {
+    /// What a reader is told: "left the parameter bounds", "came back to
+    /// its first point", "the corrector failed at the smallest step", "used
+    /// the point budget".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::LeftBounds => "left the parameter bounds",
+            Self::Closed => "came back to its first point",
+            Self::StepTooSmall => "the corrector failed at the smallest step",
+            Self::MaxPoints => "used the point budget",
+        })
+    }
+}
+
 /// A codimension-two point located on a curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurveSpecial {

@@ -194,6 +194,14 @@ pub fn basins(
                 })
             })
             .collect();
+    // Nothing to run is an input error, as for a sweep (it exited 0 with
+    // no attractors).
+    if !states.iter().any(|s| admissible(model, &s[..n])) {
+        return Err(BasinError::Input(format!(
+            "every one of the {} initial states overlaps a contact, so none can be run: choose values within the clearances",
+            states.len()
+        )));
+    }
     let results: Vec<Option<(Run, Recorded)>> = states
         .into_par_iter()
         .map(|state| {

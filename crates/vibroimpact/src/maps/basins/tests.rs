@@ -111,6 +111,13 @@ fn bad_input_is_refused() {
     assert_eq!(Component::parse("v2", 2).unwrap(), Component::Velocity(1));
     let big: Vec<f64> = (0..10_000).map(|k| k as f64 * 1e-7).collect();
     assert!(run((u1, &big), (Component::Velocity(0), &big), None).contains("coarser grid"));
+    // Issue 38: a grid every start of which overlaps (u1 past the wall's
+    // 1 mm gap) exited 0 with no attractors; it is refused, as a sweep's.
+    let e = run((u1, &[-2e-3, -1.5e-3]), (Component::Velocity(0), &v), None);
+    assert!(
+        e.contains("every one of the 2 initial states overlaps a contact"),
+        "{e}"
+    );
 }
 
 /// R2 N = 2 at 1.1 ω0 (8.151 rad/s): beside the symmetric period-1 orbit

@@ -156,8 +156,8 @@ pub fn lyapunov_spectrum(
     if opts.periods < 2 {
         return invalid(format!("periods = {}: at least 2", opts.periods));
     }
-    if !(opts.rtol > 0.0 && opts.rtol < 1.0) {
-        return invalid(format!("rtol = {}: in (0, 1)", opts.rtol));
+    if let Err(e) = crate::field_error::FieldError::tolerance("rtol", opts.rtol) {
+        return invalid(e.to_string());
     }
     let period = forcing_period(model).map_err(|e| LyapunovError::Invalid(e.to_string()))?;
     let weights = energy_weights(model);

@@ -221,6 +221,39 @@ pub(crate) struct Settings {
 }
 
 impl Settings {
+    /// The options of one run of `model` from its initial state: the
+    /// transient and the recorded periods as one simulation (None where
+    /// the model has no forcing period).
+    fn run_options(&self, model: &Model) -> Option<SimulationOptions> {
+        let w = model.forcing_frequency()?;
+        Some(SimulationOptions {
+            t_end: (self.transient + self.record) as f64 * 2.0 * std::f64::consts::PI / w,
+            integrator: self.integrator,
+            ..self.opts.clone()
+        })
+    }
+
+    /// The estimated work of one run ([`Settings::run_options`];
+    /// [`estimate_work`](crate::simulate::estimate_work)); None where
+    /// there is no run or its checks refuse it.
+    pub(crate) fn run_work(&self, model: &Model) -> Option<crate::simulate::WorkEstimate> {
+        crate::simulate::estimate_work(model, &self.run_options(model)?)
+    }
+
+    /// One run ([`Settings::run_options`]) simulated and timed: its steps
+    /// and seconds (None if it failed or was stopped).
+    pub(crate) fn timed_run(&self, model: &Model) -> Option<crate::simulate::WorkEstimate> {
+        let opts = self.run_options(model)?;
+        let clock = std::time::Instant::now();
+        let sim = simulate(model, &opts).ok().filter(|s| s.error.is_none())?;
+        Some(crate::simulate::WorkEstimate {
+            steps: sim.stats.steps as f64,
+            seconds: clock.elapsed().as_secs_f64(),
+            probed: sim.final_time,
+            max_steps: opts.max_steps,
+        })
+    }
+
     /// The relative tolerance of the integration.
     pub(crate) fn rtol(&self) -> f64 {
         self.opts.rtol
@@ -230,8 +263,13 @@ impl Settings {
     /// `[simulation]` tolerances where the options leave them open),
     /// checked.
     pub(crate) fn new(base: &LoadedModel, options: &SweepOptions) -> Result<Self, SweepError> {
-        if options.record < 1 {
-            return Err(FieldError::new("record", 0, "record at least one period").into());
+        if options.record < 2 {
+            return Err(FieldError::new(
+                "record",
+                options.record,
+                "record at least two periods: one Poincaré sample is always one distinct point, whatever the orbit's period",
+            )
+            .into());
         }
         if options.transient > 1_000_000_000 {
             return Err(
@@ -240,7 +278,7 @@ impl Settings {
         }
         let rtol = options.rtol.or(base.simulation.rtol).unwrap_or(1e-8);
         let atol = options.atol.or(base.simulation.atol).unwrap_or(rtol * 1e-4);
-        finite_positive("rtol", rtol)?;
+        FieldError::tolerance("rtol", rtol)?;
         let cluster_tolerance = options
             .cluster_tolerance
             .unwrap_or(1e-5_f64.max(1e3 * rtol));

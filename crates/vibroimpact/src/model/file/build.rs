@@ -338,7 +338,13 @@ fn contact_table(
         (None, None) => return Err(cx.err_at(span, "[[contact]]: between two walls")),
         (None, Some(r)) => ContactPair::LeftWall { body: r },
         (Some(l), None) => ContactPair::RightWall { body: l },
-        (Some(l), Some(r)) if l >= r => {
+        (Some(l), Some(r)) if l == r => {
+            return Err(cx.err_at(
+                span,
+                format!("[[contact]] between = [\"{left}\", \"{right}\"]: a body cannot strike itself; name two different bodies, or a body and `wall`"),
+            ));
+        }
+        (Some(l), Some(r)) if l > r => {
             return Err(cx.err_at(
                 span,
                 format!("[[contact]] between = [\"{left}\", \"{right}\"]: give the left body first (bodies are in order along the line)"),
@@ -428,6 +434,10 @@ fn simulation_table(cx: &Ctx<'_>, file: &ModelFile) -> Result<SimulationSpec, Mo
         if let Some(v) = value.filter(|v| !(*v > 0.0 && v.is_finite())) {
             return Err(cx.plain(format!("[simulation] {key} = {v}: must be finite and > 0")));
         }
+    }
+    if let Some(rtol) = simulation.rtol {
+        crate::field_error::FieldError::tolerance("rtol", rtol)
+            .map_err(|e| cx.plain(format!("[simulation] {e}")))?;
     }
     Ok(simulation)
 }

@@ -165,7 +165,14 @@ impl Support {
                 if !(w >= 0.0 && w.is_finite()) {
                     return Err(format!("natural_frequency = {w}: must be finite and >= 0"));
                 }
-                mass * w * w
+                let k = mass * w * w;
+                if !k.is_finite() {
+                    return Err(format!(
+                        "mass = {mass:e} with natural_frequency = {w}: the stiffness m ω² overflows double precision; give a mass below {:.2e} kg",
+                        f64::MAX / (w * w)
+                    ));
+                }
+                k
             }
             (None, None) => 0.0,
         };
@@ -179,7 +186,17 @@ impl Support {
                 if k == 0.0 && z > 0.0 {
                     return Err("damping_ratio needs a stiffness (or natural_frequency) > 0".into());
                 }
-                2.0 * z * (k * mass).sqrt()
+                // √k √m where k m overflows (the damping itself may not).
+                let c = match (k * mass).sqrt() {
+                    c if c.is_finite() => 2.0 * z * c,
+                    _ => 2.0 * z * k.sqrt() * mass.sqrt(),
+                };
+                if !c.is_finite() {
+                    return Err(format!(
+                        "mass = {mass:e}, damping_ratio = {z}: the damping 2ζ√(km) overflows double precision; give a smaller mass or damping ratio"
+                    ));
+                }
+                c
             }
             (None, None) => 0.0,
         };
@@ -481,7 +498,7 @@ impl ModelDocument {
                         .rev()
                         .map(str::trim)
                         .find(|l| l.starts_with('['))
-                        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim());
+                        .map(header_name);
                     match line.split_once('=') {
                         Some((key, _)) if !key.trim().is_empty() && !key.contains('[') => {
                             let key = match table {
@@ -699,6 +716,14 @@ pub fn parse_accelerogram_csv(text: &str, source: &str) -> Result<Record, ModelF
 }
 
 mod build;
+
+/// The table a header line names: `[row]  # comment` is `row`,
+/// `[[body]]` is `body` (what follows the closing bracket is not the
+/// name: every shipped example comments its headers).
+fn header_name(line: &str) -> &str {
+    let inner = line.trim_start_matches('[');
+    inner.split(']').next().unwrap_or(inner).trim()
+}
 
 #[cfg(test)]
 mod tests;

@@ -194,3 +194,77 @@ fn initial_state_by_body_name() {
     assert!(e.contains("no body named \"q7\""), "{e}");
     assert!(doc.parameter("initial.velocity.1").is_err());
 }
+
+/// Issue 38: a row's mass of 1e-100 kg (down to 1e-300) "completed" with
+/// every body exactly at rest: its moving forces (5e-102 N) were lost in
+/// rounding against the exponential law's tails at rest (7e-57 N). It is
+/// refused at the row's line, naming the mass and the least that works
+/// (KEPT_ABOVE × tails / acceleration); 1e-60 kg, above it, is accepted.
+/// A mass whose stiffness m ω² overflows names the mass and the frequency
+/// (it blamed `damping = inf`, a key never set), and a heavy one whose
+/// damping 2ζ√(km) alone would overflow on the way is computed.
+#[test]
+fn masses_outside_double_precision_are_refused_by_name() {
+    let with = |mass: &str| ROW.replace("mass = 0.227", &format!("mass = {mass}"));
+    for tiny in ["1e-100", "1e-300"] {
+        let e = err(&with(tiny));
+        assert!(
+            e.starts_with("m.toml:2: [row] body p1: mass = ")
+                && e.contains("would be lost in rounding")
+                && e.contains("give a mass of at least 1.27e-65 kg"),
+            "{e}"
+        );
+    }
+    assert!(parse(&with("1e-60")).is_ok());
+    let e = err(&with("1e307"));
+    assert!(
+        e.contains("mass = 1e307 with natural_frequency = 7.41") && !e.contains("damping ="),
+        "{e}"
+    );
+    let heavy = parse(&with("1e300")).unwrap().model;
+    let c = heavy.bodies()[0].damping;
+    assert!(
+        (c / (2.0 * 0.013 * 1e300 * 7.41) - 1.0).abs() < 1e-12,
+        "{c}"
+    );
+}
+
+/// Issue 38: a key's path took in the header's trailing comment (every
+/// shipped example comments its headers): ``key `row]   # N identical
+/// bodies between two walls.mas` ``. Unknown keys, wrong types and
+/// duplicates under commented headers, `[row]` and `[[body]]` alike, now
+/// name `row.mas`, `body.mass`.
+#[test]
+fn a_key_path_ends_at_its_header() {
+    let commented = ROW.replace("[row]", "[row]                       # N identical bodies");
+    let e = err(&commented.replace("mass = 0.227", "mas = 0.227"));
+    assert!(
+        e.starts_with("m.toml:4: key `row.mas`: unknown field `mas`"),
+        "{e}"
+    );
+    let e = err(&commented.replace("mass = 0.227", "mass = \"heavy\""));
+    assert!(
+        e.starts_with("m.toml:4: key `row.mass`: invalid type"),
+        "{e}"
+    );
+    let e = err(&commented.replace("mass = 0.227", "mass = 0.227\nmass = 0.3"));
+    assert!(e.contains("key `row.mass`") && !e.contains('#'), "{e}");
+    let e = err("[[body]]  # the first\nname = \"a\"\nmass = \"x\"\n");
+    assert!(
+        e.starts_with("m.toml:3: key `body.mass`: invalid type"),
+        "{e}"
+    );
+}
+
+/// Issue 38: a contact between a body and itself said "give the left body
+/// first"; it says what is wrong.
+#[test]
+fn a_contact_of_a_body_with_itself_is_named() {
+    let e = err("[[body]]\nname = \"p1\"\nmass = 1.0\n[[contact]]\nbetween = [\"p1\", \"p1\"]\nclearance = 0.001\nlaw = { law = \"hertz\", stiffness = 1e9 }\n");
+    assert!(
+        e.starts_with(
+            "m.toml:4: [[contact]] between = [\"p1\", \"p1\"]: a body cannot strike itself"
+        ),
+        "{e}"
+    );
+}
