@@ -282,3 +282,97 @@ fn long_charts_and_basins_say_so_first() {
         assert!(err.contains("interrupted (Ctrl-C)"), "{err}");
     }
 }
+
+/// The docs' `--special-points` example, chained as written, fed the row
+/// of three's branch to the row of two: "start state: needs 4 values, got
+/// 6", naming neither the file nor the mismatch. Both are named now (and
+/// the docs' example chains a branch of the same model).
+#[test]
+fn special_points_of_another_model_are_named() {
+    let dir = temp_dir("core-special-points");
+    let branch = dir.join("branch");
+    let out = run(&[
+        "continue",
+        &repo_file("examples/fujita-row.toml"),
+        "--parameter",
+        "frequency",
+        "--from",
+        "11.1",
+        "--to",
+        "3.7",
+        "--out",
+        branch.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = branch.join("branch.json");
+    assert_clean_error(
+        &[
+            "continue",
+            &repo_file("examples/fujita-row-n2.toml"),
+            "--parameter",
+            "frequency",
+            "--from",
+            "3.705",
+            "--to",
+            "11.115",
+            "--parameter2",
+            "amplitude",
+            "--from2",
+            "0.001",
+            "--to2",
+            "0.1",
+            "--special-points",
+            json.to_str().unwrap(),
+        ],
+        "branch.json: special_points[0]: a state of 6 values, a branch of a model with 3 bodies; ",
+    );
+}
+
+/// `continue --start homotopy` reported "from 11.1 to 11.1 (ReachedEnd)"
+/// after folding back at 10.387: it says the branch turned back, with
+/// the span it covered.
+#[test]
+fn a_branch_that_turns_back_says_so() {
+    let out = run(&[
+        "continue",
+        &repo_file("examples/fujita-row.toml"),
+        "--parameter",
+        "frequency",
+        "--from",
+        "11.1",
+        "--to",
+        "3.7",
+        "--start",
+        "homotopy",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("from 11.1 to 11.1 (spanning 10.38")
+            && text.contains("turned back and left the range on the side it started from"),
+        "{text}"
+    );
+    let doc = json(&[
+        "continue",
+        &repo_file("examples/fujita-row.toml"),
+        "--parameter",
+        "frequency",
+        "--from",
+        "11.1",
+        "--to",
+        "3.7",
+        "--start",
+        "homotopy",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["stop"], "TurnedBack");
+}

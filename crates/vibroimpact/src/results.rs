@@ -359,6 +359,20 @@ pub fn branch_special_points(
             .map(|v| v.as_f64().filter(|v| v.is_finite()))
             .collect::<Option<_>>()
             .ok_or_else(|| field("initial_state"))?;
+        // A branch of another model (the docs' example once chained the
+        // row of three into the row of two): said here, by size.
+        if let Ok(model) = document.build() {
+            let d = 2 * model.model.bodies().len();
+            if state.len() != d {
+                return Err(at(format!(
+                    "special_points[{k}]: a state of {} values, a branch of a model with {} bodies; {} has {} ({d} values): give a branch.json of this model",
+                    state.len(),
+                    state.len() / 2,
+                    document.source(),
+                    d / 2
+                )));
+            }
+        }
         special.push(SpecialPoint {
             kind,
             label: s["label"]

@@ -212,12 +212,23 @@ fn print_outcome(args: &ContinueArgs, outcome: &ContinueOutcome) -> Result<(), C
                 print_curves(c);
             }
             for (i, b) in branches.into_iter().enumerate() {
-                println!(
-                    "{}: {} points from {} to {}: {}",
-                    if i == 0 { "branch" } else { "switched branch" },
-                    b.points.len(),
+                let (first, last) = (
                     b.points.first().map_or(f64::NAN, |p| p.parameter),
                     b.points.last().map_or(f64::NAN, |p| p.parameter),
+                );
+                // Where a fold turned it, the span is not its ends'.
+                let (lo, hi) = b.points.iter().fold((first, first), |(lo, hi), p| {
+                    (lo.min(p.parameter), hi.max(p.parameter))
+                });
+                let span = if (lo, hi) == (first.min(last), first.max(last)) {
+                    String::new()
+                } else {
+                    format!(" (spanning {lo} to {hi})")
+                };
+                println!(
+                    "{}: {} points from {first} to {last}{span}: {}",
+                    if i == 0 { "branch" } else { "switched branch" },
+                    b.points.len(),
                     b.stop
                 );
                 for s in &b.special {

@@ -304,6 +304,10 @@ fn estimate_text(e: &Estimate) -> String {
 
 /// Runs the default study and writes its report into `out`.
 pub fn run(out: &Path) -> Result<(), CliError> {
+    // Said before any work, as every long run does (measured 90 to 140 s).
+    eprintln!(
+        "note: the default study takes about 2 min on 2 cores; Ctrl-C stops it and keeps any earlier report as it was"
+    );
     let start = Instant::now();
     let mut report = Report::new(
         out,

@@ -197,7 +197,8 @@ def continue_(
     ``skipped``).
 
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
-    MaxPoints, Interrupted, CannotContinue or ClosedLoop) with ``stop_detail``,
+    MaxPoints, Interrupted, CannotContinue, ClosedLoop or TurnedBack: a
+    fold brought it out of the range on its start's side) with ``stop_detail``,
     ``contacts``, ``points`` (each with ``parameter``, ``max_displacement``,
     ``max_velocity``, ``impacts_per_period``, ``stable``,
     ``spectral_radius``, ``floquet_multipliers``, ``initial_state``,

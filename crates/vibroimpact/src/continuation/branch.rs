@@ -45,6 +45,9 @@ pub struct Continuation<F> {
     counts: Vec<usize>,
     /// Parameter interval the branch stays in.
     bounds: (f64, f64),
+    /// The bound toward the end value `p_end`: leaving by the other one is
+    /// [`StopReason::TurnedBack`].
+    far: f64,
     current: Evaluated,
     /// The start, not yet yielded.
     start: Option<BranchPoint>,
@@ -154,6 +157,7 @@ impl<F: Family> Continuation<F> {
             counts: vec![0; events.len()],
             events,
             bounds,
+            far: if p_end >= p0 { bounds.1 } else { bounds.0 },
             origin: (first.solved.z.clone(), first.tangent.clone()),
             start: Some(first.point.clone()),
             current: first,
@@ -339,7 +343,7 @@ impl<F: Family> Continuation<F> {
             };
             match self.problem.end_point(&self.current, &next, bound) {
                 Some(end) => end,
-                None => return BranchStep::Stop(StopReason::ReachedEnd),
+                None => return BranchStep::Stop(self.left_by(bound)),
             }
         } else {
             next
@@ -357,13 +361,28 @@ impl<F: Family> Continuation<F> {
         });
         let previous_z = std::mem::replace(&mut self.current, next).solved.z;
         if beyond {
-            self.pending = Some(StopReason::ReachedEnd);
+            let bound = if p > self.bounds.1 {
+                self.bounds.1
+            } else {
+                self.bounds.0
+            };
+            self.pending = Some(self.left_by(bound));
         } else if self.points > 4 && self.closes_loop(&previous_z) {
             self.pending = Some(StopReason::ClosedLoop);
         } else {
             self.remember_mirror();
         }
         BranchStep::Point { point, special }
+    }
+
+    /// Why a branch that left the range by `bound` stopped: the end, or a
+    /// turn back out on the start's side.
+    fn left_by(&self, bound: f64) -> StopReason {
+        if bound == self.far {
+            StopReason::ReachedEnd
+        } else {
+            StopReason::TurnedBack
+        }
     }
 
     /// Whether the step just taken (from `previous_z`) passed through the

@@ -368,11 +368,16 @@ pub enum StopReason {
     /// asymmetric branch between two symmetry-breaking points and its
     /// mirror image); it is not traversed again.
     ClosedLoop,
+    /// It turned back (a fold) and left the range on the side it started
+    /// from: the far end was not reached (a homotopy start at 11.1 that
+    /// folded back at 10.387 read "from 11.1 to 11.1 (ReachedEnd)").
+    TurnedBack,
 }
 
 impl StopReason {
     /// A stable name: `ReachedEnd`, `MaxPoints`, `Interrupted`,
-    /// `CannotContinue` or `ClosedLoop` (the documents' `stop`).
+    /// `CannotContinue`, `ClosedLoop` or `TurnedBack` (the documents'
+    /// `stop`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::ReachedEnd => "ReachedEnd",
@@ -380,6 +385,7 @@ impl StopReason {
             Self::Interrupted => "Interrupted",
             Self::CannotContinue(_) => "CannotContinue",
             Self::ClosedLoop => "ClosedLoop",
+            Self::TurnedBack => "TurnedBack",
         }
     }
 
@@ -403,6 +409,10 @@ impl std::fmt::Display for StopReason {
             Self::ClosedLoop => write!(
                 f,
                 "closed loop (back at its first point or its mirror image)"
+            ),
+            Self::TurnedBack => write!(
+                f,
+                "turned back and left the range on the side it started from: the far end was not reached"
             ),
         }
     }
