@@ -45,9 +45,11 @@ pub struct Continuation<F> {
     counts: Vec<usize>,
     /// Parameter interval the branch stays in.
     bounds: (f64, f64),
-    /// The bound toward the end value `p_end`: leaving by the other one is
-    /// [`StopReason::TurnedBack`].
-    far: f64,
+    /// The bound the branch starts on, if it starts on one other than
+    /// the bound toward `p_end`: leaving by it is
+    /// [`StopReason::TurnedBack`] (a branch started inside, a switched
+    /// one, ends by either bound).
+    start_bound: Option<f64>,
     current: Evaluated,
     /// The start, not yet yielded.
     start: Option<BranchPoint>,
@@ -157,7 +159,9 @@ impl<F: Family> Continuation<F> {
             counts: vec![0; events.len()],
             events,
             bounds,
-            far: if p_end >= p0 { bounds.1 } else { bounds.0 },
+            start_bound: [bounds.0, bounds.1]
+                .into_iter()
+                .find(|&b| b == p0 && b != if p_end >= p0 { bounds.1 } else { bounds.0 }),
             origin: (first.solved.z.clone(), first.tangent.clone()),
             start: Some(first.point.clone()),
             current: first,
@@ -378,10 +382,10 @@ impl<F: Family> Continuation<F> {
     /// Why a branch that left the range by `bound` stopped: the end, or a
     /// turn back out on the start's side.
     fn left_by(&self, bound: f64) -> StopReason {
-        if bound == self.far {
-            StopReason::ReachedEnd
-        } else {
+        if self.start_bound == Some(bound) {
             StopReason::TurnedBack
+        } else {
+            StopReason::ReachedEnd
         }
     }
 
