@@ -376,3 +376,28 @@ fn a_branch_that_turns_back_says_so() {
     ]);
     assert_eq!(doc["stop"], "TurnedBack");
 }
+
+/// A row of 10⁶ printed 10⁶ + 1 per-contact lines in its summary: the
+/// table lists the 20 busiest and counts the rest; JSON keeps every one.
+#[test]
+fn a_long_row_keeps_its_summary_readable() {
+    let dir = temp_dir("core-long-row");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row.toml"))
+        .unwrap()
+        .replacen("count = 3", "count = 100", 1);
+    let model = write_model(&dir, "row.toml", &text);
+    let out = run(&["simulate", &model, "--periods", "3"]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(table.lines().count() < 30, "{table}");
+    assert!(
+        table.contains("... 81 more contacts not shown ("),
+        "{table}"
+    );
+    let doc = json(&["simulate", &model, "--periods", "3", "--format", "json"]);
+    assert_eq!(doc["impacts_per_contact"].as_array().unwrap().len(), 101);
+}

@@ -259,8 +259,30 @@ pub fn summary_text(s: &SimulationSummary) -> String {
         s.rhs_evaluations,
         s.contact_evaluations
     );
-    for c in &s.impacts_per_contact {
-        t.push_str(&format!("  {:<16} {} impacts\n", c.contact, c.impacts));
+    // A row of 10⁶ printed 10⁶ + 1 lines here: the busiest contacts,
+    // the rest counted (every one is in the JSON summary).
+    let n = s.impacts_per_contact.len();
+    if n <= SHOWN_CONTACTS {
+        for c in &s.impacts_per_contact {
+            t.push_str(&format!("  {:<16} {} impacts\n", c.contact, c.impacts));
+        }
+    } else {
+        let mut busiest: Vec<_> = s.impacts_per_contact.iter().enumerate().collect();
+        busiest.sort_by(|a, b| b.1.impacts.cmp(&a.1.impacts).then(a.0.cmp(&b.0)));
+        busiest.truncate(SHOWN_CONTACTS);
+        busiest.sort_by_key(|(i, _)| *i);
+        for (_, c) in busiest {
+            t.push_str(&format!("  {:<16} {} impacts\n", c.contact, c.impacts));
+        }
+        let silent = s
+            .impacts_per_contact
+            .iter()
+            .filter(|c| c.impacts == 0)
+            .count();
+        t.push_str(&format!(
+            "  ... {} more contacts not shown ({silent} of all {n} without impacts; every one in --format json)\n",
+            n - SHOWN_CONTACTS
+        ));
     }
     if let Some(l) = &s.local {
         t.push_str(&format!(
@@ -364,6 +386,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         ))),
     }
 }
+
+/// Contacts listed in the table summary: the busiest, in model order.
+const SHOWN_CONTACTS: usize = 20;
 
 /// Points of the history kept for the figures (every k-th sample).
 const PLOTTED_SAMPLES: f64 = 20_000.0;

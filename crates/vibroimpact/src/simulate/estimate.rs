@@ -95,9 +95,16 @@ impl WorkEstimate {
         } else {
             "by the fastest time scale".to_string()
         };
+        // A row moving freely may take no step at all (the local
+        // integrator's exact motion): its time is then its samples'
+        // ("about 0.00e0 integration steps, about 5 min" for N = 10⁶).
+        let steps = if self.steps >= 1.0 {
+            format!("about {:.2e} integration steps, ", self.steps)
+        } else {
+            "no integration steps but its samples, ".to_string()
+        };
         let mut text = format!(
-            "a long run: about {:.2e} integration steps, about {} on one core ({how})",
-            self.steps,
+            "a long run: {steps}about {} on one core ({how})",
             duration(self.seconds)
         );
         if self.steps > CRAWL_FACTOR * self.max_steps as f64 {
@@ -203,6 +210,30 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> Option<WorkEsti
 mod tests {
     use super::*;
     use crate::model::reference;
+
+    /// A run that takes no step (a free row moved exactly) but writes its
+    /// samples is told as such, not as "about 0.00e0 integration steps";
+    /// many runs each keep their own step budget (a 40 × 40 basins grid
+    /// was said to end at one run's limit).
+    #[test]
+    fn the_announcement_says_what_the_work_is() {
+        let samples = WorkEstimate {
+            steps: 0.0,
+            seconds: 300.0,
+            probed: 1.0,
+            max_steps: 1000,
+        };
+        assert!(samples.describe().starts_with(
+            "a long run: no integration steps but its samples, about 5 min on one core"
+        ));
+        let grid = WorkEstimate {
+            steps: 600.0,
+            seconds: 1.0,
+            ..samples
+        }
+        .times(1600.0);
+        assert!(!grid.exceeds_step_limit() && grid.is_long(), "{grid:?}");
+    }
 
     /// R2 N = 2 at 0.95 ω0: the bound stays below the steps a run takes
     /// (impacts add steps), a probe of a long run scales to within a
