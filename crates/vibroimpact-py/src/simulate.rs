@@ -59,15 +59,35 @@ pub fn simulate<'py>(
     let work = py.detach(|| estimate_work(m, &opts));
     warn_if_long(py, work)?;
     let job = model.loaded.clone();
-    let result = monitor::run(py, progress, move |p: &Progress| {
+    let result = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.track_time(duration);
         let opts = SimulationOptions {
             interrupt: Some(p.interrupt.clone()),
             ..opts
         };
         vibroimpact::simulate::simulate(&job.model, &opts)
-    })?;
-    let sim = result.map_err(value_error)?;
+    });
+    let sim = match result {
+        Ok(r) => r.map_err(value_error)?,
+        // KeyboardInterrupt keeps the history up to the stop, as the
+        // command line does: `result`.
+        Err((e, Some(Ok(sim)))) => {
+            e.value(py).setattr("result", history(py, model, sim)?)?;
+            return Err(e);
+        }
+        Err((e, _)) => return Err(e),
+    };
+    history(py, model, sim)
+}
+
+/// The `simulate` document of `sim`: the summary, the history's arrays
+/// and the impact log.
+fn history<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    sim: vibroimpact::simulate::Simulation,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.loaded.model;
     let n = m.bodies().len();
     let mut summary = simulation_summary(m, &sim);
     summary.record = model.loaded.record.clone();

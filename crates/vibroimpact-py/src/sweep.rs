@@ -65,7 +65,7 @@ pub fn sweep<'py>(
         }
     };
     let total = values.len() * if up_down && only.is_none() { 2 } else { 1 };
-    let summary = monitor::run(py, progress, move |p: &Progress| {
+    let summary = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
             transient,
@@ -81,9 +81,27 @@ pub fn sweep<'py>(
             integrator,
         };
         pool.install(|| run_sweep(&family, &values, &options, &|| p.tick()))
-    })?
-    .map_err(value_error)?;
-    let d = document(py, &summary)?;
+    });
+    let summary = match summary {
+        Ok(r) => r.map_err(value_error)?,
+        // KeyboardInterrupt keeps the values computed so far, as the
+        // command line writes them: `result`.
+        Err((e, Some(Ok(summary)))) => {
+            e.value(py)
+                .setattr("result", sweep_document(py, &summary)?)?;
+            return Err(e);
+        }
+        Err((e, _)) => return Err(e),
+    };
+    sweep_document(py, &summary)
+}
+
+/// The `sweep` document of `summary`, each point's `sections` an array.
+fn sweep_document<'py>(
+    py: Python<'py>,
+    summary: &vibroimpact::maps::sweep::SweepSummary,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = document(py, summary)?;
     let points = d
         .get_item("points")?
         .ok_or_else(|| numerical_error("no points"))?;

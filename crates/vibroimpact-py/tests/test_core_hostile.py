@@ -81,22 +81,27 @@ def test_plots_check_what_they_are_given():
             f(hit)
 
 
-def test_ctrl_c_keeps_the_branch_so_far():
-    # KeyboardInterrupt came promptly but lost the branch, which the CLI
-    # writes with stop "Interrupted": it is on the exception as .result.
+def _interrupted(call, after=1.0):
+    """The KeyboardInterrupt of ``call()`` under a SIGINT ``after`` s."""
     import os
     import signal
     import threading
 
-    m = vi.Model.load(EXAMPLES / "fujita-row.toml")
-    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer = threading.Timer(after, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt) as info:
-            vi.continue_(m, "frequency", 11.1, 3.7, ds_max=0.001)
+            call()
     finally:
         timer.cancel()
-    branch = info.value.result
+    return info.value
+
+
+def test_ctrl_c_keeps_the_branch_so_far():
+    # KeyboardInterrupt came promptly but lost the branch, which the CLI
+    # writes with stop "Interrupted": it is on the exception as .result.
+    m = vi.Model.load(EXAMPLES / "fujita-row.toml")
+    branch = _interrupted(lambda: vi.continue_(m, "frequency", 11.1, 3.7, ds_max=0.001)).result
     assert branch.stop == "Interrupted"
     assert len(branch.points) >= 2
     assert branch.column("parameter")[0] == pytest.approx(11.1)
@@ -115,3 +120,15 @@ def test_long_charts_and_basins_warn_before_any_work():
             vi.basins(m, "u1", grid[0], "v1", grid[1], transient=400, record=30)
         with pytest.raises(vi.LongRunWarning, match="a long run"):
             vi.chart(m, "frequency", np.linspace(3.7, 11.1, 200), "amplitude", np.linspace(0.01, 0.1, 200))
+
+
+def test_ctrl_c_keeps_the_history_and_the_sweep_so_far():
+    # The CLI keeps a simulation's history and a sweep's values up to
+    # Ctrl-C; Python attaches them to the KeyboardInterrupt as .result.
+    m = vi.Model.load(EXAMPLES / "fujita-row.toml")
+    run = _interrupted(lambda: vi.simulate(m, periods=2e4, output_step=0.01)).result
+    assert run.completed is False and 0.0 < run.final_time
+    assert len(run.t) > 10 and run.t[-1] <= run.final_time
+    sweep = _interrupted(lambda: vi.sweep(m, "frequency", values=np.linspace(5, 9, 400), threads=1)).result
+    done = [p for p in sweep.points if p.completed]
+    assert 0 < len(done) < 400

@@ -13,7 +13,7 @@ import numpy as np
 from . import _core
 from ._checks import Progress, _progress
 from ._core import Model
-from ._results import Result
+from ._results import Result, _keeping_on_ctrl_c
 
 
 def _sweep_local(
@@ -31,23 +31,24 @@ def _sweep_local(
     plain document, for gathering."""
     # Arrays unpickled on a Dask worker are often misaligned: copy those.
     values = np.require(values, np.float64, ["C", "A"])
-    d = _core.sweep(
-        model,
-        parameter,
-        values,
-        options["transient"],
-        options["record"],
-        options["up_down"],
-        options["rtol"],
-        options["atol"],
-        options["method"],
-        options["cluster_tolerance"],
-        threads,
-        only,
-        _progress(progress),
-        options["lyapunov"],
-        options.get("integrator", "auto"),
-    )
+    with _keeping_on_ctrl_c(raw):
+        d = _core.sweep(
+            model,
+            parameter,
+            values,
+            options["transient"],
+            options["record"],
+            options["up_down"],
+            options["rtol"],
+            options["atol"],
+            options["method"],
+            options["cluster_tolerance"],
+            threads,
+            only,
+            _progress(progress),
+            options["lyapunov"],
+            options.get("integrator", "auto"),
+        )
     return d if raw else Result(d)
 
 

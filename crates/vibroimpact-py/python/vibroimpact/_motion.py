@@ -9,7 +9,7 @@ from typing import Optional
 
 from . import _core
 from ._checks import ModelLike, Progress, _flag, _method, _model, _progress, _real
-from ._results import Result
+from ._results import Result, _keeping_on_ctrl_c
 
 
 def simulate(
@@ -67,8 +67,8 @@ def simulate(
         output_step = _real(output_step, "output_step")
         if output_step < 0:
             raise ValueError(f"output_step = {output_step}: must be >= 0")
-    return Result(
-        _core.simulate(
+    with _keeping_on_ctrl_c():
+        d = _core.simulate(
             m,
             t_end,
             _real(rtol, "rtol", positive=True, optional=True),
@@ -80,4 +80,4 @@ def simulate(
             _method(integrator, ("auto", "global", "local"), "integrator"),
             _progress(progress),
         )
-    )
+    return Result(d)

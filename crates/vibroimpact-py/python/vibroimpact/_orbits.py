@@ -16,7 +16,7 @@ from typing import Any, Optional, Sequence
 from . import _core
 from ._checks import ModelLike, Progress, _count, _flag, _floats, _method, _model, _progress, _real
 from ._core import VibroimpactError
-from ._results import Result
+from ._results import Result, _keeping_on_ctrl_c
 
 
 def periodic(
@@ -212,7 +212,7 @@ def continue_(
         raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
     if switch_at is not None and not isinstance(switch_at, str):
         raise TypeError("switch_at: expected a label such as 'BP1'")
-    try:
+    with _keeping_on_ctrl_c():
         d = _core.continue_branch(
             m,
             parameter,
@@ -231,12 +231,6 @@ def continue_(
             _count(arnoldi, "arnoldi", minimum=2, maximum=10**6),
             _second_parameter(parameter2, from2, to2, curves, curve_step, special_points),
         )
-    except KeyboardInterrupt as e:
-        # Ctrl-C keeps the branch so far (stop "Interrupted"), as the CLI
-        # writes it.
-        if isinstance(getattr(e, "result", None), dict):
-            e.result = Result(e.result)
-        raise
     r = Result(d)
     if special_points is not None:
         return r

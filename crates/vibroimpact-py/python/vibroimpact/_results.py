@@ -3,6 +3,8 @@ arrays wherever the JSON has numeric lists."""
 
 from __future__ import annotations
 
+import contextlib
+
 from collections.abc import Mapping
 from typing import Any, Iterator
 
@@ -107,3 +109,15 @@ class Result(Mapping):
             return v
 
         return {k: plain(v) for k, v in self._fields.items()}
+
+
+@contextlib.contextmanager
+def _keeping_on_ctrl_c(raw: bool = False):
+    """KeyboardInterrupt keeps the partial result the core attached
+    (``.result``) as a :class:`Result`, as the CLI keeps what is done."""
+    try:
+        yield
+    except KeyboardInterrupt as e:
+        if not raw and isinstance(getattr(e, "result", None), dict):
+            e.result = Result(e.result)
+        raise
