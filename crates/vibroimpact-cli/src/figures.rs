@@ -283,10 +283,30 @@ pub fn lyapunov_figure(summary: &SweepSummary, directions: &[Direction]) -> Figu
 /// Axis label of a swept parameter.
 pub fn parameter_label(name: &str) -> String {
     match name {
-        "frequency" | "excitation.frequency" => "forcing frequency Ω  [rad/s]".into(),
-        "amplitude" | "excitation.amplitude" => "excitation amplitude".into(),
-        other => other.to_string(),
+        "frequency" | "excitation.frequency" => return "forcing frequency Ω  [rad/s]".into(),
+        "amplitude" | "excitation.amplitude" => {
+            return "base acceleration amplitude  [m/s²]".into()
+        }
+        _ => {}
     }
+    // A model key's units from its last name (issue 38: axes read
+    // "frequency" and "amplitude" with no units).
+    let last = name.rsplit('.').next().unwrap_or(name);
+    let units = match last {
+        "mass" => "kg",
+        "stiffness" => "N/m",
+        "damping" => "N s/m",
+        "clearance" | "displacement" => "m",
+        "velocity" => "m/s",
+        "frequency" | "natural_frequency" => "rad/s",
+        "phase" => "rad",
+        "alpha" => "1/m",
+        "amplitude" if name.starts_with("force") => "N",
+        "amplitude" => "m/s²",
+        "a" => "N",
+        _ => return name.to_string(),
+    };
+    format!("{name}  [{units}]")
 }
 
 /// The directions of a sweep's points: up and down, or the one.
@@ -323,4 +343,27 @@ pub fn diagram_figure(summary: &SweepSummary) -> Figure {
         fig.push(Series::markers(label, pts, Marker::Dot).with_color(c));
     }
     fig
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parameter_label;
+
+    /// Axes carry their units (issue 38: "frequency" and "amplitude" had
+    /// none): the excitation's, and a model key's by its last name.
+    #[test]
+    fn parameter_axes_carry_units() {
+        assert_eq!(parameter_label("frequency"), "forcing frequency Ω  [rad/s]");
+        assert_eq!(
+            parameter_label("amplitude"),
+            "base acceleration amplitude  [m/s²]"
+        );
+        assert_eq!(parameter_label("row.mass"), "row.mass  [kg]");
+        assert_eq!(parameter_label("row.clearance"), "row.clearance  [m]");
+        assert_eq!(
+            parameter_label("force.1.amplitude"),
+            "force.1.amplitude  [N]"
+        );
+        assert_eq!(parameter_label("row.count"), "row.count");
+    }
 }

@@ -132,3 +132,19 @@ def test_ctrl_c_keeps_the_history_and_the_sweep_so_far():
     sweep = _interrupted(lambda: vi.sweep(m, "frequency", values=np.linspace(5, 9, 400), threads=1)).result
     done = [p for p in sweep.points if p.completed]
     assert 0 < len(done) < 400
+
+
+def test_plot_axes_carry_units():
+    # Axes read "frequency" with no units, and x_scale labelled
+    # "frequency × 0.135" instead of Ω/ω0.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import vibroimpact.plot as vp
+
+    m = vi.Model.load(EXAMPLES / "fujita-row-n2.toml")
+    sweep = vi.sweep(m, "frequency", values=[7.0, 7.2], transient=5, record=4)
+    assert vp.poincare(sweep).get_xlabel() == "forcing frequency Ω (rad/s)"
+    assert vp.poincare(sweep, x_scale=1 / 7.41).get_xlabel() == "Ω/ω0 (ω0 = 7.41 rad/s)"
+    clearance = vi.sweep(m, "row.clearance", values=[1e-3, 1.1e-3], transient=5, record=4)
+    assert vp.poincare(clearance).get_xlabel() == "row.clearance (m)"

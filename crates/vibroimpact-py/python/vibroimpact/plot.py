@@ -58,6 +58,21 @@ def _labels(ax, x, y):
         ax.set_ylabel(y)
 
 
+def _parameter_axis(name, x_scale):
+    """The parameter's axis label, with its units; a scaled frequency as
+    Omega/omega0 (issue 38: it read "frequency × 0.135")."""
+    if name in ("frequency", "excitation.frequency"):
+        if x_scale == 1.0:
+            return "forcing frequency Ω (rad/s)"
+        return f"Ω/ω0 (ω0 = {1.0 / x_scale:.4g} rad/s)"
+    last = name.rsplit(".", 1)[-1]
+    units = {"mass": "kg", "stiffness": "N/m", "damping": "N s/m", "clearance": "m",
+             "natural_frequency": "rad/s", "phase": "rad", "alpha": "1/m",
+             "amplitude": "N" if name.startswith("force") else "m/s²"}.get(last)
+    label = name if units is None else f"{name} ({units})"
+    return label if x_scale == 1.0 else f"{label} × {x_scale:.4g}"
+
+
 def _branch(ax, branch, body, x_scale, label, color, seen):
     p = branch.column("parameter")
     u = 1e3 * np.abs(np.array([pt.max_displacement[body] for pt in branch.points]))
@@ -96,8 +111,7 @@ def frequency_response(branch, ax=None, body=0, x_scale=1.0, label="branch", swi
     if switched and "switched_branch" in branch:
         _branch(ax, branch.switched_branch, body, x_scale, f"{label} (switched)",
                 "tab:orange", seen)
-    x = branch.parameter_name + (f" × {x_scale:.4g}" if x_scale != 1.0 else "")
-    _labels(ax, x, f"max |u{body + 1}| (mm)")
+    _labels(ax, _parameter_axis(branch.parameter_name, x_scale), f"max |u{body + 1}| (mm)")
     ax.legend(fontsize="small")
     return ax
 
@@ -144,8 +158,7 @@ def poincare(sweep, ax=None, body=0, x_scale=1.0):
     for direction, (x, y) in xs.items():
         name = "sweep" if direction == "none" else f"sweep {direction}"
         ax.scatter(x, y, s=6, color=_DIRECTIONS.get(direction, "k"), label=name, zorder=2)
-    x = sweep.parameter_name + (f" × {x_scale:.4g}" if x_scale != 1.0 else "")
-    _labels(ax, x, f"u{body + 1} at the Poincaré section (mm)")
+    _labels(ax, _parameter_axis(sweep.parameter_name, x_scale), f"u{body + 1} at the Poincaré section (mm)")
     if sweep.up_down or ax.get_legend() is not None:
         ax.legend(fontsize="small")
     return ax
