@@ -54,7 +54,8 @@ pub struct ContinueArgs {
     linear: LinearAlgebra,
     /// Integrator of the period maps: `local` moves bodies out of contact
     /// exactly and integrates only those in touch (for a parameter of the
-    /// forcing: frequency, amplitude).
+    /// forcing: frequency, amplitude). The start guess is simulated by
+    /// `auto`'s integrator either way, so both follow the same branch.
     #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Output folder: branch.csv, branch_special_points.json, branch.json and

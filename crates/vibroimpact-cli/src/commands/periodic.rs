@@ -50,7 +50,8 @@ pub struct PeriodicArgs {
     symmetric: bool,
     /// Integrator of the period map: `local` carries the state (and the
     /// monodromy matrix, or the record its products replay) by the exact
-    /// motion between contacts.
+    /// motion between contacts. The `simulate` guess is simulated by
+    /// `auto`'s integrator either way, so both shoot from the same start.
     #[arg(long, value_enum, default_value_t = IntegratorName::Auto)]
     integrator: IntegratorName,
     /// Output format.

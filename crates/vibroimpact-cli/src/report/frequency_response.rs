@@ -15,7 +15,6 @@ use vibroimpact::model::family::of;
 use vibroimpact::model::reference;
 use vibroimpact::model::{Model, ModelError};
 use vibroimpact::periodic::{guess_by_simulation_with, ShootingOptions};
-use vibroimpact::simulate::Integrator;
 
 use super::{html_escape, html_table, DataFile, Report};
 use crate::error::CliError;
@@ -60,8 +59,7 @@ pub(super) fn compute(stop: &Interrupt) -> Result<Vec<RowResponse>, CliError> {
     let mut rows = Vec::new();
     for n in [2usize, 3] {
         let start = row(n, 1.5 * w0)?;
-        let guess =
-            guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()), Integrator::Global)?;
+        let guess = guess_by_simulation_with(&start, 200.0, 1e-9, Some(stop.clone()))?;
         let defaults = ContinuationOptions::default();
         let opts = ContinuationOptions {
             max_points: 900,

@@ -48,7 +48,8 @@ def periodic(
     ``symmetric``: shoot on the half map of a mirror-symmetric row.
     ``integrator="local"``: the period map by the exact motion between
     contacts (its monodromy matrix, or with ``krylov`` the record that its
-    products replay).
+    products replay); the simulated guess is the same for every
+    integrator (simulated by the one "auto" picks).
 
     Returns ``converged``, ``method``, ``period``, ``subharmonic``,
     ``initial_state``, ``residual_history``, ``floquet_multipliers`` ([re,
@@ -178,7 +179,8 @@ def continue_(
     continued too (``switched_branch``). ``progress(points, max_points)``.
     ``integrator="local"``: the period maps by the exact motion between
     contacts, integrating only the bodies in touch (a parameter of the
-    forcing: "frequency", "amplitude"). ``start``: "auto" (a guess by
+    forcing: "frequency", "amplitude"); the start guess is simulated by the
+    integrator "auto" picks either way. ``start``: "auto" (a guess by
     simulation over ``guess_periods``, then the homotopy in the forcing
     amplitude if Newton does not converge from it), "simulate" or
     "homotopy" (the primary branch from rest). ``krylov=True``:

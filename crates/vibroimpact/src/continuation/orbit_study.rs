@@ -153,7 +153,6 @@ impl CheckedOrbit {
                 study.guess_periods,
                 opts.rtol.max(1e-9),
                 opts.interrupt.clone(),
-                opts.integrator,
             )
             .map_err(StudyError::Guess)?,
             Guess::Homotopy => {

@@ -316,7 +316,6 @@ impl<F: Family> CheckedBranch<F> {
                 study.guess_periods,
                 1e-9,
                 opts.shooting.interrupt.clone(),
-                opts.shooting.integrator,
             )
             .map_err(StudyError::Guess)?,
         };

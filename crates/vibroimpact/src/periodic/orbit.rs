@@ -11,17 +11,22 @@ pub fn guess_by_simulation(
     periods: f64,
     rtol: f64,
 ) -> Result<Vec<f64>, PeriodicError> {
-    guess_by_simulation_with(model, periods, rtol, None, Integrator::Global)
+    guess_by_simulation_with(model, periods, rtol, None)
 }
 
-/// [`guess_by_simulation`] by `integrator` that stops when `interrupt` is
-/// requested.
+/// [`guess_by_simulation`] that stops when `interrupt` is requested.
+///
+/// The guess is simulated by the integrator [`Integrator::Auto`] picks for
+/// the model, whichever integrator then shoots: near chaotic motion or
+/// coexisting orbits two integrators' transients part at the tolerance
+/// and land on different orbits (R2 N = 2 at 0.5 ω0: a stable two-impact
+/// orbit by one, an unstable four-impact one by the other), so one start
+/// lets the shooting integrators find the same orbit and branch.
 pub fn guess_by_simulation_with(
     model: &Model,
     periods: f64,
     rtol: f64,
     interrupt: Option<Interrupt>,
-    integrator: Integrator,
 ) -> Result<Vec<f64>, PeriodicError> {
     let t = forcing_period(model)?;
     let opts = SimulationOptions {
@@ -29,7 +34,7 @@ pub fn guess_by_simulation_with(
         rtol,
         atol: rtol * 1e-4,
         interrupt,
-        integrator,
+        integrator: Integrator::Auto,
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;
