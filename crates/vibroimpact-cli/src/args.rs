@@ -250,6 +250,11 @@ pub struct AttractorRuns {
     /// Forcing periods simulated and discarded before recording.
     #[arg(long, default_value_t = 100)]
     pub transient: usize,
+    /// At most this many forcing periods added to a run's transient while
+    /// its Poincaré samples still converge onto an orbit (default 9 ×
+    /// --transient; 0: only class it as settling).
+    #[arg(long)]
+    pub settle: Option<usize>,
     /// Forcing periods recorded (one Poincaré sample at the end of each).
     #[arg(long, default_value_t = 20)]
     pub record: usize,
@@ -263,8 +268,8 @@ pub struct AttractorRuns {
     #[arg(long, value_enum, default_value_t = MethodName::Dop853)]
     pub method: MethodName,
     /// Relative tolerance under which two Poincaré samples are the same
-    /// point (default 1e-3: 100 transient periods leave up to ~4e-3 of a
-    /// lightly damped free oscillation).
+    /// point (default max(1e-5, 1000 rtol), as for a sweep: runs still
+    /// settling go on, see --settle).
     #[arg(long)]
     pub cluster_tolerance: Option<f64>,
     /// Integrator of the transients and recorded periods: `local` moves
@@ -281,6 +286,7 @@ impl AttractorRuns {
     ) -> vibroimpact::maps::sweep::SweepOptions {
         vibroimpact::maps::sweep::SweepOptions {
             transient: self.transient,
+            settle: self.settle,
             record: self.record,
             rtol: self.rtol,
             atol: self.atol,

@@ -401,3 +401,46 @@ fn a_long_row_keeps_its_summary_readable() {
     let doc = json(&["simulate", &model, "--periods", "3", "--format", "json"]);
     assert_eq!(doc["impacts_per_contact"].as_array().unwrap().len(), 101);
 }
+
+/// The sweep's default 100 periods left the lightly damped N = 2 row at
+/// 7.3 rad/s as "20 distinct", read as a cloud, while 1000 periods give
+/// period 1. The table now says what the samples do: `period 1` after the
+/// periods the convergence needed (its own transient column over 100), or
+/// with `--settle 0` `settling (+n)`, the periods it still needs.
+#[test]
+fn a_sweep_calls_a_value_periodic_only_once_settled() {
+    let table = |extra: &[&str]| {
+        let mut args = vec![
+            "sweep".to_string(),
+            repo_file("examples/fujita-row-n2.toml"),
+        ];
+        for a in [
+            "--parameter",
+            "frequency",
+            "--from",
+            "7.3",
+            "--to",
+            "7.4",
+            "--points",
+            "2",
+        ]
+        .iter()
+        .chain(extra)
+        {
+            args.push(a.to_string());
+        }
+        let out = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let settled = table(&[]);
+    let row = settled.lines().nth(1).unwrap();
+    assert!(row.contains(" period 1 "), "{settled}");
+    let transient: usize = row.split_whitespace().nth(7).unwrap().parse().unwrap();
+    assert!(transient > 100, "{settled}");
+    let unsettled = table(&["--settle", "0"]);
+    assert!(
+        unsettled.lines().nth(1).unwrap().contains("settling (+"),
+        "{unsettled}"
+    );
+}

@@ -18,7 +18,7 @@ use crate::monitor::{self, Progress};
 /// (`u1`, `v2`, …); `base`: the other components (None: the model's initial
 /// state); `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto"))]
+#[pyo3(signature = (model, x, x_values, y, y_values, base, transient, record, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto", settle = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn basins<'py>(
     py: Python<'py>,
@@ -37,6 +37,7 @@ pub fn basins<'py>(
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
     integrator: &str,
+    settle: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     let xs = floats(&x_values, "x_values")?;
@@ -56,6 +57,7 @@ pub fn basins<'py>(
     let total = xs.len() * ys.len();
     let options = SweepOptions {
         transient,
+        settle,
         record,
         rtol,
         atol,

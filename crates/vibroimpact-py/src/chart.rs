@@ -17,7 +17,7 @@ use crate::monitor::{self, Progress};
 /// each with its `runs`). `lyapunov`: each run's largest exponent;
 /// `threads`: the size of the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto"))]
+#[pyo3(signature = (model, x, x_values, y, y_values, transient, record, starts, lyapunov, rtol, atol, method_name, cluster_tolerance, threads, progress = None, integrator = "auto", settle = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn chart<'py>(
     py: Python<'py>,
@@ -37,6 +37,7 @@ pub fn chart<'py>(
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
     integrator: &str,
+    settle: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
     let xs = floats(&x_values, "x_values")?;
@@ -48,6 +49,7 @@ pub fn chart<'py>(
     let total = xs.len() * ys.len();
     let sweep = SweepOptions {
         transient,
+        settle,
         record,
         rtol,
         atol,

@@ -29,7 +29,7 @@ pub fn parameter_values<'py>(
 /// `lyapunov = k` its k largest Lyapunov exponents. `threads`: the size of
 /// the thread pool (None: all cores).
 #[pyfunction]
-#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None, integrator = "auto"))]
+#[pyo3(signature = (model, parameter, values, transient, record, up_down, rtol, atol, method_name, cluster_tolerance, threads, only = None, progress = None, lyapunov = None, integrator = "auto", settle = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -48,6 +48,7 @@ pub fn sweep<'py>(
     progress: Option<&Bound<'py, PyAny>>,
     lyapunov: Option<usize>,
     integrator: &str,
+    settle: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = ParameterizedModel::new(model.document.clone(), parameter).map_err(value_error)?;
     let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
@@ -69,6 +70,7 @@ pub fn sweep<'py>(
         p.set_total(total);
         let options = SweepOptions {
             transient,
+            settle,
             record,
             up_down,
             only,

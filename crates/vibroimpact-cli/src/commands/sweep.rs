@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use vibroimpact::maps::settling::Motion;
 use vibroimpact::maps::sweep::{
-    parameter_values, sweep, Direction, SweepError, SweepOptions, SweepSummary,
+    parameter_values, sweep, Direction, SweepError, SweepOptions, SweepPoint, SweepSummary,
 };
 
 use crate::args::ParameterRange;
@@ -31,6 +32,11 @@ pub struct SweepArgs {
     /// Forcing periods recorded (one Poincaré sample at the end of each).
     #[arg(long, default_value_t = 20)]
     record: usize,
+    /// At most this many forcing periods added to a value's transient while
+    /// its Poincaré samples still converge onto an orbit (default 9 ×
+    /// --transient; 0: only report it as settling).
+    #[arg(long)]
+    settle: Option<usize>,
     /// Sweep up from --from to --to and down from --to to --from, each value
     /// continuing from the previous value's final state.
     #[arg(long)]
@@ -147,6 +153,18 @@ fn write_outputs(dir: &Path, summary: &SweepSummary) -> Result<(), CliError> {
     Ok(())
 }
 
+/// What a value's samples say: its period once they repeat, the periods
+/// a settling one still needs, or that they do not repeat.
+fn motion_text(p: &SweepPoint) -> String {
+    match (p.motion, p.period, p.settle_periods) {
+        _ if !p.completed => "-".into(),
+        (Motion::Periodic, Some(k), _) => format!("period {k}"),
+        (Motion::Settling, _, Some(more)) => format!("settling (+{more:.0})"),
+        (Motion::Settling, _, None) => "settling".into(),
+        _ => "irregular".into(),
+    }
+}
+
 /// Human-readable table (with the largest Lyapunov exponent when
 /// computed).
 fn table_text(summary: &SweepSummary) -> String {
@@ -158,6 +176,8 @@ fn table_text(summary: &SweepSummary) -> String {
         format!("max|u_{first}| [m]"),
         "distinct".to_string(),
         "spread".to_string(),
+        "motion".to_string(),
+        "transient".to_string(),
         "impacts/T".to_string(),
     ];
     if lyapunov {
@@ -181,6 +201,8 @@ fn table_text(summary: &SweepSummary) -> String {
                 } else {
                     "-".into()
                 },
+                motion_text(p),
+                p.transient_periods.to_string(),
                 if p.impacts_per_period.is_finite() {
                     format!("{:.2}", p.impacts_per_period)
                 } else {
@@ -261,6 +283,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let interrupt = crate::interrupt::on_ctrl_c();
     let options = SweepOptions {
         transient: args.transient,
+        settle: args.settle,
         record: args.record,
         up_down: args.up_down,
         only: None,

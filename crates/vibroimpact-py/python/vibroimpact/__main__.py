@@ -26,6 +26,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--to", type=float, required=True)
     s.add_argument("--points", type=int, required=True)
     s.add_argument("--transient", type=int, default=100)
+    s.add_argument("--settle", type=int, help="periods added at most while a value still settles (default 9 × --transient)")
     s.add_argument("--record", type=int, default=20)
     s.add_argument("--up-down", action="store_true")
     s.add_argument("--rtol", type=float)
@@ -75,6 +76,7 @@ def main(argv=None) -> int:
             to=a.to,
             points=a.points,
             transient=a.transient,
+            settle=a.settle,
             record=a.record,
             up_down=a.up_down,
             rtol=a.rtol,

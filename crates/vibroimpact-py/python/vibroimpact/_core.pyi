@@ -81,20 +81,21 @@ def sweep(
     rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], only: Optional[str] = None,
     progress: Progress = None, lyapunov: Optional[int] = None, integrator: str = "auto",
+    settle: Optional[int] = None,
 ) -> dict[str, Any]: ...
 
 def chart(
     model: Model, x: str, x_values: F64, y: str, y_values: F64, transient: int, record: int,
     starts: int, lyapunov: bool, rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
-    integrator: str = "auto",
+    integrator: str = "auto", settle: Optional[int] = None,
 ) -> dict[str, Any]: ...
 
 def basins(
     model: Model, x: str, x_values: F64, y: str, y_values: F64, base: Optional[F64],
     transient: int, record: int, rtol: Optional[float], atol: Optional[float], method_name: str,
     cluster_tolerance: Optional[float], threads: Optional[int], progress: Progress = None,
-    integrator: str = "auto",
+    integrator: str = "auto", settle: Optional[int] = None,
 ) -> dict[str, Any]: ...
 
 def parse_record(text: str, source: str, units: Optional[str] = None) -> dict[str, Any]: ...

@@ -48,6 +48,7 @@ def _sweep_local(
             _progress(progress),
             options["lyapunov"],
             options.get("integrator", "auto"),
+            options.get("settle"),
         )
     return d if raw else Result(d)
 
@@ -74,5 +75,6 @@ def _chart_local(model: Model, x, y, options: dict, *, threads=None, progress: P
         threads,
         _progress(progress),
         options.get("integrator", "auto"),
+        options.get("settle"),
     )
     return d if raw else Result(d)

@@ -68,6 +68,7 @@ def sweep(
     to: Optional[float] = None,
     points: Optional[int] = None,
     transient: int = 100,
+    settle: Optional[int] = None,
     record: int = 20,
     up_down: bool = False,
     rtol: Optional[float] = None,
@@ -93,11 +94,19 @@ def sweep(
     chunks (see :mod:`vibroimpact.distributed`); the result is bit for bit
     the local one.
 
+    A value whose Poincaré samples still converge onto an orbit runs on
+    for the periods the convergence needs, at most ``settle`` more (default
+    9 × ``transient``): it is called periodic only once its samples repeat
+    to ``cluster_tolerance`` (docs/theory.md §8).
+
     Returns ``parameter_name``, ``bodies``, ``from``, ``to``,
     ``transient_periods``, ``record_periods``, ``up_down``, ``rtol``,
     ``atol``, ``cluster_tolerance`` and ``points`` (each with
     ``parameter``, ``direction``, ``max_displacement``,
-    ``distinct_section_points``, ``section_spread``,
+    ``distinct_section_points``, ``section_spread``, ``motion``
+    ("periodic", "settling" or "irregular"), ``period``,
+    ``settle_periods`` (a settling value: the periods it still needs),
+    ``transient_periods`` (its own, settling included),
     ``impacts_per_period``, ``recorded_periods``, ``completed``, ``error``
     and ``sections``, the Poincaré samples as a record x 2N array). A value
     that fails numerically is kept with its ``error``.
@@ -116,6 +125,7 @@ def sweep(
     v = _sweep_values(values, from_, to, points)
     options = dict(
         transient=_count(transient, "transient"),
+        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
         record=_count(record, "record", minimum=1, maximum=10**7),
         up_down=_flag(up_down, "up_down"),
         rtol=_real(rtol, "rtol", positive=True, optional=True),
@@ -148,6 +158,7 @@ def chart(
     y_values: ArrayLike,
     *,
     transient: int = 100,
+    settle: Optional[int] = None,
     record: int = 20,
     starts: int = 1,
     lyapunov: bool = False,
@@ -168,7 +179,9 @@ def chart(
     its attractor on the Poincaré section (None: not periodic), its impacts
     per period, its largest |u| and, with ``lyapunov``, its largest Lyapunov
     exponent. Defaults as the CLI: ``rtol`` 1e-7 unless the model's
-    ``[simulation]`` gives one, ``cluster_tolerance`` 1e-3.
+    ``[simulation]`` gives one, ``cluster_tolerance`` max(1e-5, 1000
+    rtol), ``settle`` as :func:`sweep` (a run is periodic only once its
+    samples repeat).
     ``integrator="local"``: the transients and recorded periods move
     bodies out of contact exactly.
 
@@ -195,6 +208,7 @@ def chart(
             raise ValueError(f"{name}: at least one value")
     options = dict(
         transient=_count(transient, "transient"),
+        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
         record=_count(record, "record", minimum=1, maximum=10**7),
         starts=_count(starts, "starts", minimum=1, maximum=10**6),
         lyapunov=_flag(lyapunov, "lyapunov"),
@@ -228,6 +242,7 @@ def basins(
     *,
     base: Optional[ArrayLike] = None,
     transient: int = 100,
+    settle: Optional[int] = None,
     record: int = 20,
     rtol: Optional[float] = None,
     atol: Optional[float] = None,
@@ -277,5 +292,6 @@ def basins(
         threads,
         _progress(progress),
         _method(integrator, ("auto", "global", "local"), "integrator"),
+        None if settle is None else _count(settle, "settle", maximum=10**9),
     )
     return Result(d)

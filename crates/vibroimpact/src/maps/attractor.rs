@@ -16,17 +16,11 @@ use crate::model::Model;
 /// Relative tolerance of the integrations of charts and basins unless the
 /// options or the model's `[simulation]` give one. The Poincaré samples of
 /// an impacting orbit under the seed's stiff law carry an integration
-/// noise of ~1e3 × rtol: at 1e-6 it reaches [`DEFAULT_CLUSTER_TOLERANCE`]
+/// noise of ~1e3 × rtol: at 1e-6 it reaches a cluster tolerance of 1e-3
 /// (R2 N = 2 at 1.1 ω0: the period-3 orbit classed not periodic; of a 20 ×
 /// 20 (frequency, amplitude) chart, 46 period-1 cells against 90 at 1e-8),
 /// at 1e-7 the classes are those of 1e-8.
 pub const DEFAULT_RTOL: f64 = 1e-7;
-
-/// Relative tolerance of two equal Poincaré samples unless the options
-/// give one: coarser than a sweep's 1e-5, since 100 transient periods leave
-/// a free oscillation of the lightly damped bodies (ζ = 0.013 in R2) of
-/// up to ~4e-3 of its initial size at 1.5 ω0.
-pub const DEFAULT_CLUSTER_TOLERANCE: f64 = 1e-3;
 
 /// Input errors of charts and basins (numerical failures are kept in the
 /// runs).
@@ -50,14 +44,14 @@ impl From<SweepError> for MapError {
 }
 
 /// The run settings of charts and basins: `options` for models like
-/// `base`, with [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`] where
-/// neither the options nor the model give a value.
+/// `base`, with [`DEFAULT_RTOL`] where neither the options nor the model
+/// give one, and a sweep's cluster tolerance, max(1e-5, 1000 rtol): runs
+/// still settling are extended or classed so (`maps::settling`), so a
+/// coarser tolerance for the free oscillation 100 periods leave is not
+/// needed, and a chart and a sweep agree on which values are periodic.
 pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Settings, SweepError> {
     let options = SweepOptions {
         rtol: options.rtol.or(base.simulation.rtol).or(Some(DEFAULT_RTOL)),
-        cluster_tolerance: options
-            .cluster_tolerance
-            .or(Some(DEFAULT_CLUSTER_TOLERANCE)),
         ..options.clone()
     };
     Settings::new(base, &options)
@@ -111,8 +105,10 @@ pub struct Run {
     pub start: Vec<f64>,
     /// Period of the attractor in forcing periods: the smallest p, at most
     /// half the recorded periods, with s_{k+p} = s_k (to the cluster
-    /// tolerance) for every pair of recorded Poincaré samples; null when
-    /// they do not repeat (quasi-periodic, chaotic, or not settled).
+    /// tolerance) for every pair of recorded Poincaré samples, once they
+    /// have settled ([`crate::maps::settling`]); null when they do not
+    /// repeat (quasi-periodic, chaotic, or still settling when the periods
+    /// allowed ran out).
     pub period: Option<usize>,
     /// Impacts (all contacts) per forcing period.
     pub impacts_per_period: f64,
@@ -162,23 +158,19 @@ pub(crate) fn run_from(
     };
     let (point, _) = run_value(model, x, Direction::None, Some(start), settings);
     let omega = model.forcing_frequency().unwrap_or(1.0);
-    classify(state, point, omega, settings.cluster_tolerance)
+    classify(state, point, omega)
 }
 
 /// A run's summary from its sweep point, with its samples.
-fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, Recorded) {
+fn classify(start: Vec<f64>, point: SweepPoint, omega: f64) -> (Run, Recorded) {
     if let Some(e) = point.error {
         return (Run::failed(start, e), Recorded::default());
     }
     let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
     let scale = (max_u, max_u * omega);
-    let s = &point.sections;
-    // Periodic: every sample equals the one p periods later (a slowly
-    // settling orbit, whose samples drift, is not: its greedy clusters
-    // could number a few).
-    let period = (1..=s.len() / 2)
-        .find(|&p| (0..s.len() - p).all(|k| same_sample(&s[k], &s[k + p], tol, scale)))
-        .filter(|&p| p == 1 || !settling(s, scale));
+    // Periodic only once the samples repeat (a run still settling, or
+    // one whose periods to settle ran out, is not: `maps::settling`).
+    let period = point.period;
     let run = Run {
         start,
         period,
@@ -192,26 +184,6 @@ fn classify(start: Vec<f64>, point: SweepPoint, omega: f64, tol: f64) -> (Run, R
         scale,
     };
     (run, recorded)
-}
-
-/// Whether the samples still spiral into a fixed point: the steps between
-/// consecutive samples shrink by more than half from the first quarter of
-/// the window to the last. A lightly damped free oscillation sampled once
-/// per forcing period turns by 2π ω0/Ω a sample, so a residual near the
-/// cluster tolerance repeats every few samples (R2 N = 2 at Ω = 10 rad/s
-/// after 100 periods: "period 4"); a period-p orbit's steps repeat with
-/// period p and do not shrink.
-fn settling(s: &[Vec<f64>], scale: (f64, f64)) -> bool {
-    let n = s[0].len() / 2;
-    let step = |k: usize| {
-        (0..2 * n).fold(0.0f64, |m, i| {
-            let sc = if i < n { scale.0 } else { scale.1 };
-            m.max((s[k + 1][i] - s[k][i]).abs() / sc.max(f64::MIN_POSITIVE))
-        })
-    };
-    let q = ((s.len() - 1) / 4).max(1);
-    let mean = |ks: std::ops::Range<usize>| ks.clone().map(step).sum::<f64>() / ks.len() as f64;
-    mean(s.len() - 1 - q..s.len() - 1) < 0.5 * mean(0..q)
 }
 
 /// Whether two Poincaré samples are equal: every displacement within

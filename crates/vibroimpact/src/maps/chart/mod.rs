@@ -24,14 +24,14 @@ use crate::model::Model;
 /// ~200 bytes a run.
 pub const MAX_RUNS: usize = 50_000_000;
 
-pub use crate::maps::attractor::{DEFAULT_CLUSTER_TOLERANCE, DEFAULT_RTOL};
+pub use crate::maps::attractor::DEFAULT_RTOL;
 
 /// Options of a chart.
 #[derive(Clone, Debug)]
 pub struct ChartOptions {
     /// Transient, recorded periods, tolerances, method, cluster tolerance
-    /// and interruption as for a sweep (with the defaults
-    /// [`DEFAULT_RTOL`] and [`DEFAULT_CLUSTER_TOLERANCE`]);
+    /// and interruption as for a sweep (with the default rtol
+    /// [`DEFAULT_RTOL`], so a cluster tolerance of 1e-4);
     /// `lyapunov: Some(1)` adds each run's largest Lyapunov exponent
     /// (`up_down`, `only` unused).
     pub sweep: SweepOptions,

@@ -78,7 +78,6 @@ fn cells_match_the_sweep_and_the_linear_limit() {
             transient: 30,
             record: 8,
             rtol: Some(DEFAULT_RTOL),
-            cluster_tolerance: Some(DEFAULT_CLUSTER_TOLERANCE),
             ..SweepOptions::default()
         },
         starts: 3,

@@ -1,6 +1,7 @@
 //! Tests of the sweep (`mod.rs`).
 
 use super::*;
+use crate::maps::settling::Motion;
 use crate::model::parameter::ParameterizedModel;
 
 #[test]
@@ -216,4 +217,75 @@ fn clusters() {
     assert_eq!(distinct_points(&pts, 1, 1e-6, 1e-6), 3);
     assert_eq!(distinct_points(&pts, 1, 1e-6, 1e-2), 2);
     assert_eq!(distinct_points(&[], 1, 1e-6, 1e-6), 0);
+}
+
+/// The lightly damped R2 N = 2 (ζ = 0.013) after the default 100
+/// transient periods was "20 distinct" at 7.3 and 7.5 rad/s, where 1000
+/// periods give period 1: a slowly settling orbit read as a cloud. Its
+/// samples still converge, so the run goes on for the periods the decay
+/// needs and the value is periodic (7.3: period 1 after 160 periods;
+/// 7.35: period 3), the orbit that 1000 periods find (the same samples
+/// to the cluster tolerance). With `settle = 0` the value is "settling"
+/// with the periods it still needs, which then suffice. A chart over the
+/// same values calls the same cells periodic with the same periods.
+#[test]
+fn a_value_is_periodic_only_once_it_has_settled() {
+    let text = ROW.replace("amplitude = 0.5", "amplitude = 0.05");
+    let doc = crate::model::file::ModelDocument::from_toml(&text, "m.toml").unwrap();
+    let family = ParameterizedModel::new(doc.clone(), "frequency").unwrap();
+    let values = [7.3, 7.35];
+    let run = |transient, settle| {
+        let options = SweepOptions {
+            transient,
+            settle: Some(settle),
+            ..SweepOptions::default()
+        };
+        sweep(&family, &values, &options, &|| {}).unwrap().points
+    };
+    let (unsettled, extended, long) = (run(100, 0), run(100, 900), run(1000, 0));
+    for ((u, e), l) in unsettled.iter().zip(&extended).zip(&long) {
+        assert_eq!(u.motion, Motion::Settling, "{}", u.parameter);
+        assert_eq!(u.distinct_section_points, 20);
+        assert_eq!(u.transient_periods, 100);
+        assert_eq!((e.motion, l.motion), (Motion::Periodic, Motion::Periodic));
+        assert_eq!(e.period, l.period);
+        assert!(e.transient_periods > 100 && e.transient_periods < 400);
+        let scale = l.max_displacement.iter().fold(0.0f64, |a, b| a.max(*b));
+        let (a, b) = (&e.sections[19], &l.sections[19]);
+        // The same orbit, its samples perhaps a phase of it apart.
+        let close = (0..e.period.unwrap()).any(|shift| {
+            let b = &l.sections[19 - shift];
+            (0..2).all(|i| (a[i] - b[i]).abs() < 2e-5 * scale)
+        });
+        assert!(close, "{}: {a:?} vs {b:?}", e.parameter);
+        let needed = u.settle_periods.unwrap().ceil() as usize;
+        let again = SweepOptions {
+            transient: 100 + 20 + needed,
+            settle: Some(0),
+            ..SweepOptions::default()
+        };
+        let p = sweep(&family, &[u.parameter], &again, &|| {})
+            .unwrap()
+            .points;
+        assert_eq!(p[0].motion, Motion::Periodic, "{}", u.parameter);
+    }
+    assert_eq!(extended[0].period, Some(1));
+    assert_eq!(extended[1].period, Some(3));
+    let chart = crate::maps::chart::chart(
+        &doc,
+        ("frequency", &values),
+        ("amplitude", &[0.05]),
+        &crate::maps::chart::ChartOptions {
+            sweep: SweepOptions {
+                rtol: Some(1e-8),
+                ..SweepOptions::default()
+            },
+            starts: 1,
+        },
+        &|| {},
+    )
+    .unwrap();
+    for (cell, e) in chart.cells.iter().zip(&extended) {
+        assert_eq!(cell.runs[0].period, e.period, "{}", e.parameter);
+    }
 }
