@@ -83,15 +83,21 @@ pub fn write_curves(dir: &Path, curves: &Curves, p: &str, q: &str) -> Result<(),
         &dir.join("curves.json"),
         serde_json::to_string_pretty(&doc)?.as_bytes(),
     )?;
-    let mut fig = Figure::new("Curves of special points", p, q).legend_at(LegendPosition::Best);
+    let mut fig = Figure::new(
+        "Curves of special points",
+        crate::figures::parameter_label(p),
+        crate::figures::parameter_label(q),
+    )
+    .legend_at(LegendPosition::Best);
     let mut labelled = Vec::new();
     for (_, c) in &curves.followed {
-        let color = match c.kind {
-            CurveKind::Fold => 0,
-            CurveKind::BranchPoint => 1,
-            CurveKind::PeriodDoubling => 2,
-            CurveKind::NeimarkSacker => 3,
-            CurveKind::Grazing => 4,
+        // A colour and a dash per kind, none two alike.
+        let (color, dashed) = match c.kind {
+            CurveKind::Fold => (6, false),
+            CurveKind::BranchPoint => (0, true),
+            CurveKind::PeriodDoubling => (1, true),
+            CurveKind::NeimarkSacker => (2, false),
+            CurveKind::Grazing => (4, false),
         };
         let label = if labelled.contains(&color) {
             ""
@@ -99,7 +105,13 @@ pub fn write_curves(dir: &Path, curves: &Curves, p: &str, q: &str) -> Result<(),
             c.kind.name()
         };
         labelled.push(color);
-        fig.push(Series::line(label, c.points.iter().map(|pt| (pt.p, pt.q))).with_color(color));
+        let points = c.points.iter().map(|pt| (pt.p, pt.q));
+        let series = if dashed {
+            Series::dashed(label, points)
+        } else {
+            Series::line(label, points)
+        };
+        fig.push(series.with_color(color));
     }
     let codim2: Vec<(f64, f64)> = curves
         .followed
@@ -111,7 +123,7 @@ pub fn write_curves(dir: &Path, curves: &Curves, p: &str, q: &str) -> Result<(),
         })
         .collect();
     if !codim2.is_empty() {
-        fig.push(Series::markers("codimension two", codim2, Marker::Square).with_color(5));
+        fig.push(Series::markers("codimension two", codim2, Marker::Square).with_color(3));
     }
     render(&fig, &dir.join("curves"))?;
     Ok(())

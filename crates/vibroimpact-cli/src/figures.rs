@@ -7,8 +7,54 @@ use vibroimpact::maps::sweep::{Direction, SweepSummary};
 
 use crate::plot::{Figure, LegendPosition, Marker, Series};
 
+/// The marker and palette colour of each kind of special point: a shape
+/// and a colour of its own (the shapes those of Python's figure).
+const SPECIAL_MARKERS: [(SpecialKind, Marker, usize); 5] = [
+    (SpecialKind::Fold, Marker::Circle, 3),
+    (SpecialKind::BranchPoint, Marker::Square, 5),
+    (SpecialKind::PeriodDoubling, Marker::Diamond, 1),
+    (SpecialKind::NeimarkSacker, Marker::Triangle, 4),
+    (SpecialKind::Grazing, Marker::Cross, 6),
+];
+
+/// One vertex of a drawn branch: a point (with its stability) or a special
+/// point between two (None).
+type Vertex = ((f64, f64), Option<bool>);
+
+/// The vertices of `branch` in order: its points, and after each point the
+/// special points located after it that carry their own amplitude (so the
+/// curve passes through them).
+fn vertices(branch: &Branch, x_scale: f64, body: usize) -> Vec<Vertex> {
+    let mut out = Vec::with_capacity(branch.points.len() + branch.special.len());
+    for (i, p) in branch.points.iter().enumerate() {
+        let Some(&u) = p.max_displacement.get(body) else {
+            continue;
+        };
+        out.push(((p.parameter * x_scale, 1e3 * u), Some(p.stable)));
+        let mut after: Vec<_> = branch
+            .special
+            .iter()
+            .filter(|s| s.after_point == i)
+            .filter_map(|s| Some((s.parameter, *s.max_displacement.get(body)?)))
+            .collect();
+        // Along the step from point i: nearest first.
+        after.sort_by(|a, b| {
+            (a.0 - p.parameter)
+                .abs()
+                .total_cmp(&(b.0 - p.parameter).abs())
+        });
+        out.extend(
+            after
+                .into_iter()
+                .map(|(q, u)| ((q * x_scale, 1e3 * u), None)),
+        );
+    }
+    out
+}
+
 /// Frequency-response figure: max |u| of the first body against the
-/// parameter, stable solid, unstable dashed, special points marked.
+/// parameter, stable solid, unstable dashed, through the special points,
+/// which are marked and labelled (`BP1`, `GR2`, …).
 pub fn branch_figure(
     branches: &[(&Branch, &str)],
     title: &str,
@@ -21,19 +67,23 @@ pub fn branch_figure(
     let mut labelled: Vec<SpecialKind> = Vec::new();
     for (bi, (branch, name)) in branches.iter().enumerate() {
         let color = 2 * bi;
-        let mut start = 0;
-        let pts = &branch.points;
+        let v = vertices(branch, x_scale, body);
+        // A segment is drawn as the point it starts from is stable, or
+        // from a special point as the next point.
+        let style = |k: usize| {
+            v[k].1
+                .or_else(|| v[k + 1..].iter().find_map(|w| w.1))
+                .unwrap_or(true)
+        };
         let (mut stable_labelled, mut unstable_labelled) = (false, false);
-        while start < pts.len() {
-            let stable = pts[start].stable;
+        let mut start = 0;
+        while start + 1 < v.len() {
+            let stable = style(start);
             let mut end = start + 1;
-            while end < pts.len() && pts[end].stable == stable {
+            while end + 1 < v.len() && style(end) == stable {
                 end += 1;
             }
-            let seg: Vec<(f64, f64)> = pts[start..(end + 1).min(pts.len())]
-                .iter()
-                .map(|p| (p.parameter * x_scale, 1e3 * p.max_displacement[body]))
-                .collect();
+            let seg: Vec<(f64, f64)> = v[start..=end].iter().map(|w| w.0).collect();
             let label = match (stable, stable_labelled, unstable_labelled) {
                 (true, false, _) => {
                     stable_labelled = true;
@@ -55,21 +105,23 @@ pub fn branch_figure(
             );
             start = end;
         }
-        for (kind, marker, c) in [
-            (SpecialKind::Fold, Marker::Triangle, 1),
-            (SpecialKind::PeriodDoubling, Marker::Square, 3),
-            (SpecialKind::BranchPoint, Marker::Circle, 4),
-            (SpecialKind::NeimarkSacker, Marker::Triangle, 5),
-        ] {
-            let sp: Vec<(f64, f64)> = branch
+        for (kind, marker, c) in SPECIAL_MARKERS {
+            let (sp, tags): (Vec<(f64, f64)>, Vec<String>) = branch
                 .special
                 .iter()
                 .filter(|s| s.kind == kind)
                 .filter_map(|s| {
-                    let p = &branch.points[s.after_point.min(pts.len() - 1)];
-                    Some((s.parameter * x_scale, 1e3 * p.max_displacement.get(body)?))
+                    // Its own amplitude; from a file without it, the nearest
+                    // point's.
+                    let own = s.max_displacement.get(body).copied();
+                    let near = || {
+                        let p = &branch.points[s.after_point.min(branch.points.len() - 1)];
+                        p.max_displacement.get(body).copied()
+                    };
+                    let u = own.or_else(near)?;
+                    Some(((s.parameter * x_scale, 1e3 * u), s.label.clone()))
                 })
-                .collect();
+                .unzip();
             if !sp.is_empty() {
                 // Each kind in the legend once, wherever it first appears.
                 let name = if labelled.contains(&kind) {
@@ -78,7 +130,11 @@ pub fn branch_figure(
                     labelled.push(kind);
                     kind.name()
                 };
-                fig.push(Series::markers(name, sp, marker).with_color(c));
+                fig.push(
+                    Series::markers(name, sp, marker)
+                        .with_color(c)
+                        .with_tags(tags),
+                );
             }
         }
     }
@@ -170,7 +226,7 @@ pub fn chart_figure(chart: &Chart) -> Figure {
         parameter_label(&chart.x_name),
         parameter_label(&chart.y_name),
     )
-    .legend_at(LegendPosition::Best);
+    .legend_at(LegendPosition::Outside);
     let classes: Vec<usize> = chart.cells.iter().map(class).collect();
     let labels: Vec<String> = CLASSES.iter().map(|c| c.to_string()).collect();
     let colors: Vec<usize> = (0..CLASSES.len()).collect();
@@ -196,17 +252,18 @@ pub fn chart_figure(chart: &Chart) -> Figure {
     fig
 }
 
-/// A continued curve of special points over a chart, by kind: black folds
-/// (solid) and branch points (dashed), vermillion period doublings
-/// (dashed) and Neimark–Sacker points (solid), purple grazings; over a
+/// A continued curve of special points over a chart, by kind, each kind
+/// a colour and a dash of its own: black folds (solid), sky-blue branch
+/// points (dashed), vermillion period doublings (dashed), purple
+/// Neimark–Sacker points (solid) and black grazings (dashed); over a
 /// white halo, so that it stays visible over cells of every colour (black
 /// chaotic ones included).
 pub fn curve_series(kind: &str, label: String, points: Vec<(f64, f64)>) -> Series {
     match kind {
         "fold" => Series::line(label, points).with_color(6),
-        "branch-point" => Series::dashed(label, points).with_color(6),
-        "neimark-sacker" => Series::line(label, points).with_color(1),
-        "grazing" => Series::line(label, points).with_color(4),
+        "branch-point" => Series::dashed(label, points).with_color(5),
+        "neimark-sacker" => Series::line(label, points).with_color(4),
+        "grazing" => Series::dashed(label, points).with_color(6),
         _ => Series::dashed(label, points).with_color(1),
     }
     .with_halo()
@@ -235,7 +292,7 @@ pub fn basins_figure(b: &Basins) -> Figure {
         format!("{} at t = 0  {}", b.x_component, unit(&b.x_component)),
         format!("{} at t = 0  {}", b.y_component, unit(&b.y_component)),
     )
-    .legend_at(LegendPosition::Best);
+    .legend_at(LegendPosition::Outside);
     let none = b.attractors.len();
     let classes: Vec<usize> = b.cells.iter().map(|c| c.unwrap_or(none)).collect();
     let mut labels: Vec<String> = (0..none).map(|k| attractor_label(b, k)).collect();

@@ -444,3 +444,45 @@ fn a_sweep_calls_a_value_periodic_only_once_settled() {
         "{unsettled}"
     );
 }
+
+/// `summary.json` said nothing of how it was made. It now carries the
+/// version, the method, rtol, atol, the integrator and the SHA-256 of the
+/// model's canonical text: a comment changes nothing, a value changes it.
+#[test]
+fn a_simulation_summary_says_how_it_was_made() {
+    let dir = temp_dir("core-provenance");
+    let text = std::fs::read_to_string(repo_file("examples/fujita-row-n2.toml")).unwrap();
+    let provenance = |name: &str, text: &str| {
+        let model = write_model(&dir, name, text);
+        let doc = json(&[
+            "simulate",
+            &model,
+            "--periods",
+            "1",
+            "--rtol",
+            "1e-7",
+            "--format",
+            "json",
+        ]);
+        doc["provenance"].clone()
+    };
+    let p = provenance("a.toml", &text);
+    assert_eq!(p["version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(
+        (p["method"].as_str(), p["integrator"].as_str()),
+        (Some("dop853"), Some("auto"))
+    );
+    assert_eq!(
+        (p["rtol"].as_f64(), p["atol"].as_f64()),
+        (Some(1e-7), Some(1e-11))
+    );
+    let digest = p["model_sha256"].as_str().unwrap();
+    assert_eq!(digest.len(), 64);
+    let commented = provenance("b.toml", &format!("# another comment\n{text}"));
+    assert_eq!(commented["model_sha256"], digest);
+    let changed = provenance(
+        "c.toml",
+        &text.replace("amplitude = 0.05", "amplitude = 0.06"),
+    );
+    assert_ne!(changed["model_sha256"], digest);
+}

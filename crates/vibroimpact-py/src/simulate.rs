@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::results::simulation_summary;
+use vibroimpact::results::{simulation_summary, Provenance};
 use vibroimpact::simulate::{estimate_work, SimulationOptions, WorkEstimate};
 
 use crate::convert::{array1, document, method, split_states, value_error};
@@ -58,6 +58,7 @@ pub fn simulate<'py>(
     };
     let work = py.detach(|| estimate_work(m, &opts));
     warn_if_long(py, work)?;
+    let provenance = Provenance::new(&model.document, &opts);
     let job = model.loaded.clone();
     let result = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.track_time(duration);
@@ -72,25 +73,28 @@ pub fn simulate<'py>(
         // KeyboardInterrupt keeps the history up to the stop, as the
         // command line does: `result`.
         Err((e, Some(Ok(sim)))) => {
-            e.value(py).setattr("result", history(py, model, sim)?)?;
+            e.value(py)
+                .setattr("result", history(py, model, sim, &provenance)?)?;
             return Err(e);
         }
         Err((e, _)) => return Err(e),
     };
-    history(py, model, sim)
+    history(py, model, sim, &provenance)
 }
 
-/// The `simulate` document of `sim`: the summary, the history's arrays
-/// and the impact log.
+/// The `simulate` document of `sim`: the summary (with its provenance),
+/// the history's arrays and the impact log.
 fn history<'py>(
     py: Python<'py>,
     model: &PyModel,
     sim: vibroimpact::simulate::Simulation,
+    provenance: &Provenance,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.loaded.model;
     let n = m.bodies().len();
     let mut summary = simulation_summary(m, &sim);
     summary.record = model.loaded.record.clone();
+    summary.provenance = Some(provenance.clone());
     let d = document(py, &summary)?;
     let (u, v) = split_states(py, &sim.states, sim.times.len(), n)?;
     d.set_item("t", array1(py, sim.times))?;

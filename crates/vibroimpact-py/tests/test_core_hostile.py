@@ -148,3 +148,37 @@ def test_plot_axes_carry_units():
     assert vp.poincare(sweep, x_scale=1 / 7.41).get_xlabel() == "Ω/ω0 (ω0 = 7.41 rad/s)"
     clearance = vi.sweep(m, "row.clearance", values=[1e-3, 1.1e-3], transient=5, record=4)
     assert vp.poincare(clearance).get_xlabel() == "row.clearance (m)"
+
+
+def test_a_simulation_says_how_it_was_made(cli):
+    # The summary said nothing of its settings or model: it carries the
+    # version, method, tolerances, integrator and the model's digest, the
+    # command line's for the same file.
+    path = EXAMPLES / "fujita-row-n2.toml"
+    r = vi.simulate(vi.Model.load(path), periods=1, rtol=1e-7)
+    p = r.provenance
+    assert (p.method, p.integrator, p.rtol, p.atol) == ("dop853", "auto", 1e-7, 1e-11)
+    assert len(p.model_sha256) == 64
+    assert dict(p) == cli("simulate", path, "--periods", 1, "--rtol", 1e-7)["provenance"]
+    other = vi.Model.from_toml(path.read_text().replace("amplitude = 0.05", "amplitude = 0.06"), "m.toml")
+    assert vi.simulate(other, periods=1, rtol=1e-7).provenance.model_sha256 != p.model_sha256
+
+
+def test_special_points_sit_on_their_drawn_curve():
+    # BP1 was drawn at the nearest branch point's amplitude, off its curve:
+    # each special point now has its own orbit's amplitude, the curve passes
+    # through it, and its label sits there.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import vibroimpact.plot as vp
+
+    b = vi.continue_(EXAMPLES / "fujita-row-n2.toml", "frequency", 3.705, 11.115)
+    ax = vp.frequency_response(b)
+    labels = {t.get_text(): t.xy for t in ax.texts}
+    curve = np.vstack([line.get_xydata() for line in ax.lines if line.get_linestyle() in ("-", "--")])
+    for sp in b.special_points:
+        x, y = labels[sp.label]
+        assert (x, y) == (sp.parameter, 1e3 * sp.max_displacement[0])
+        # A vertex of the drawn curve, exactly.
+        assert np.any((curve[:, 0] == x) & (curve[:, 1] == y)), sp.label

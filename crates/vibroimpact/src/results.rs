@@ -307,6 +307,8 @@ pub fn branch_document(branch: &Branch, model: &Model, name: &str) -> Value {
             "symmetry_breaking": s.symmetry_breaking,
             "floquet_multipliers": s.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
             "initial_state": s.state,
+            "max_displacement": s.max_displacement,
+            "after_point": s.after_point,
         })).collect::<Vec<_>>(),
     })
 }
@@ -384,6 +386,7 @@ pub fn branch_special_points(
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| field("parameter"))?,
             state,
+            max_displacement: Vec::new(),
             multipliers: Vec::new(),
             tangent: Vec::new(),
             after_point: 0,
@@ -592,6 +595,48 @@ pub struct SimulationSummary {
     /// caller from [`crate::model::file::LoadedModel::record`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub record: Option<crate::model::record::RecordMetadata>,
+    /// What produced it (set by the caller: [`Provenance::new`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+}
+
+/// What produced a result: the program's version, the integration's
+/// settings and a digest of the model, so that a result file says how to
+/// reproduce it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Provenance {
+    /// vibroimpact's version.
+    pub version: &'static str,
+    /// The integration method asked for (`auto` switches between DOP853
+    /// and RODAS as the run needs).
+    pub method: &'static str,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance (m and m/s).
+    pub atol: f64,
+    /// The integrator asked for (`auto`, `global`, `local`).
+    pub integrator: &'static str,
+    /// SHA-256 (hex) of the model's canonical text
+    /// ([`ModelDocument::to_toml`]: comments and layout aside, an
+    /// accelerogram inlined): the same model, the same digest, from a
+    /// file or from Python.
+    pub model_sha256: String,
+}
+
+impl Provenance {
+    /// The provenance of a run of `document` with `opts`.
+    pub fn new(document: &ModelDocument, opts: &crate::simulate::SimulationOptions) -> Self {
+        use sha2::{Digest, Sha256};
+        let hash = Sha256::digest(document.to_toml().as_bytes());
+        Self {
+            version: env!("CARGO_PKG_VERSION"),
+            method: opts.method.name(),
+            rtol: opts.rtol,
+            atol: opts.atol,
+            integrator: opts.integrator.name(),
+            model_sha256: hash.iter().map(|b| format!("{b:02x}")).collect(),
+        }
+    }
 }
 
 /// Impacts of one contact.
@@ -691,5 +736,6 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
             residual: e.residual(),
         }),
         record: None,
+        provenance: None,
     }
 }

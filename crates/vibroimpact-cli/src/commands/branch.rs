@@ -18,7 +18,7 @@ use vibroimpact::results::{branch_document, continue_document, curves_document};
 use crate::args::{IntegratorName, LinearAlgebra, ParameterRange, StartMethod};
 use crate::curves::{self, SecondParameter};
 use crate::error::{option_error, CliError};
-use crate::figures::branch_figure;
+use crate::figures::{branch_figure, parameter_label};
 use crate::format::{CsvText, Format};
 use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
@@ -104,8 +104,6 @@ fn write_branch(
     branch: &Branch,
     name: &str,
     stem: &str,
-    x_scale: f64,
-    x_label: &str,
 ) -> Result<(), CliError> {
     ensure_dir(dir)?;
     write_atomic(
@@ -124,8 +122,8 @@ fn write_branch(
     let fig = branch_figure(
         &[(branch, "branch")],
         &format!("Response curve in {name}"),
-        x_label,
-        x_scale,
+        &parameter_label(name),
+        1.0,
         0,
     );
     render(&fig, &dir.join(format!("{stem}_response")))?;
@@ -262,7 +260,7 @@ fn write_outcome(
         branches.push((b, "switched_branch"));
     }
     for (b, stem) in branches {
-        write_branch(dir, &outcome.branch.start_model, b, name, stem, 1.0, name)?;
+        write_branch(dir, &outcome.branch.start_model, b, name, stem)?;
     }
     Ok(())
 }

@@ -9,12 +9,12 @@ use vibroimpact::simulate::{estimate_work, simulate_streaming, Simulation, Simul
 use crate::args::{IntegratorName, MethodName};
 use crate::error::CliError;
 use crate::format::{history_header, number, CsvText, SummaryFormat};
-use crate::model_io::read_model;
+use crate::model_io::read_document;
 use crate::output::{commit_temp, temp_path, Pending};
 use crate::output::{ensure_dir, write_atomic, OutputError};
 use crate::plot::{render, Figure, LegendPosition, Marker, Series};
 use vibroimpact::model::file::LoadedModel;
-use vibroimpact::results::{simulation_summary, SimulationSummary};
+use vibroimpact::results::{simulation_summary, Provenance, SimulationSummary};
 
 /// Options of `vibroimpact simulate`.
 #[derive(Args, Debug)]
@@ -315,7 +315,8 @@ pub fn summary_text(s: &SimulationSummary) -> String {
 
 /// Runs `vibroimpact simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let loaded = read_model(&args.model)?;
+    let document = read_document(&args.model)?;
+    let loaded = document.build()?;
     let opts = options(args, &loaded)?;
     let model = &loaded.model;
     let phase_body = match &args.body {
@@ -354,6 +355,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     let mut s = simulation_summary(model, &sim);
     s.record = loaded.record.clone();
+    s.provenance = Some(Provenance::new(&document, &opts));
     if let (Some(dir), Some(history)) = (&args.out, history) {
         (sim.times, sim.states) = history.finish()?;
         write_outputs(dir, model, &sim, &s, phase_body)?;

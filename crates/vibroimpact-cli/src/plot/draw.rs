@@ -134,6 +134,17 @@ impl Canvas {
                 ];
                 area.draw(&Polygon::new(pts, color.filled())).map_err(de)
             }
+            Marker::Cross => {
+                let r = 1.1 * MARKER_SIZE + grow;
+                let stroke = self.stroke(color, LINE_WIDTH + 2.0 * grow);
+                for (a, b) in [
+                    ((x - r, y - r), (x + r, y + r)),
+                    ((x - r, y + r), (x + r, y - r)),
+                ] {
+                    self.line(area, &[a, b], stroke)?;
+                }
+                Ok(())
+            }
             Marker::Diamond => {
                 let r = 1.3 * MARKER_SIZE + 2.0 * grow;
                 let pts = vec![
@@ -247,6 +258,13 @@ fn draw_series<DB: DrawingBackend>(
             }
             for &p in &visible {
                 cv.marker(area, m, p, color, 0.0)?;
+            }
+        }
+        // Tags up and to the right of their points.
+        for (&p, tag) in s.points.iter().zip(&s.tags) {
+            if let Some((x, y)) = plan.data_px(p).filter(|&q| plan.inside(q)) {
+                let (dx, dy) = (MARKER_SIZE + 2.0, MARKER_SIZE + 1.0);
+                cv.text(area, tag, TAG_EM, x + dx, y - dy, HPos::Left, false)?;
             }
         }
     }
@@ -455,6 +473,9 @@ pub(super) fn draw_legend<DB: DrawingBackend>(
 /// Top left corner of a `w`×`h` legend box placed in `corner`.
 pub(super) fn legend_origin(plan: &Plan, corner: LegendPosition, w: f64, h: f64) -> (f64, f64) {
     let inset = 10.0;
+    if corner == LegendPosition::Outside {
+        return (plan.right + LEGEND_GAP, plan.top);
+    }
     let x0 = match corner {
         LegendPosition::UpperLeft | LegendPosition::LowerLeft => plan.left + inset,
         _ => plan.right - inset - w,

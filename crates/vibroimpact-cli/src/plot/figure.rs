@@ -21,6 +21,8 @@ pub enum Marker {
     Triangle,
     /// Filled diamond.
     Diamond,
+    /// A diagonal cross (two strokes).
+    Cross,
     /// A small filled circle, for dense scatter (an orbit diagram's
     /// thousands of samples).
     Dot,
@@ -54,6 +56,9 @@ pub enum LegendPosition {
     LowerRight,
     /// The corner where the legend box covers the least data.
     Best,
+    /// Right of the plot area, which narrows to make room: for figures
+    /// whose data fill the area (a chart's cells).
+    Outside,
     /// No legend.
     None,
 }
@@ -73,6 +78,9 @@ pub struct Series {
     /// Drawn over a light halo, so that it stays visible over filled cells
     /// of any colour.
     pub halo: bool,
+    /// Text beside each point's marker, in the order of `points` (empty:
+    /// none): the labels of a branch's special points.
+    pub tags: Vec<String>,
 }
 
 impl Series {
@@ -89,6 +97,7 @@ impl Series {
             style,
             color: None,
             halo: false,
+            tags: Vec::new(),
         }
     }
 
@@ -126,6 +135,12 @@ impl Series {
     /// Sets the palette index of the series colour.
     pub fn with_color(mut self, palette_index: usize) -> Self {
         self.color = Some(palette_index);
+        self
+    }
+
+    /// Writes `tags` beside the points' markers, one per point in order.
+    pub fn with_tags(mut self, tags: Vec<String>) -> Self {
+        self.tags = tags;
         self
     }
 

@@ -79,8 +79,13 @@ impl Plan {
         if has(&fig.y_label) {
             left += (ASCENT + DESCENT) * y_label_em + 8.0;
         }
-        // The last x tick label may stick out to the right: shrink until it fits.
-        let mut right = W - PAD - 6.0;
+        // The last x tick label may stick out to the right: shrink until it
+        // fits (and leave room for a legend outside).
+        let outside = match fig.legend {
+            LegendPosition::Outside => legend_size(fig).map_or(0.0, |(w, _)| w + LEGEND_GAP),
+            _ => 0.0,
+        };
+        let mut right = W - PAD - 6.0 - outside;
         let mut x = plan_axis(fig.x_scale, xlo, xhi, right - left, false);
         for _ in 0..3 {
             let overhang = x
@@ -88,7 +93,7 @@ impl Plan {
                 .iter()
                 .map(|(t, s)| left + x.frac(*t) * (right - left) + 0.5 * text_width(s, TICK_EM))
                 .fold(0.0, f64::max)
-                - (W - 6.0);
+                - (W - 6.0 - outside);
             if overhang <= 0.0 {
                 break;
             }
@@ -282,3 +287,35 @@ pub(super) fn dashes(line: &[(f64, f64)], (on, off): (f64, f64)) -> Vec<Vec<(f64
 
 // ---------------------------------------------------------------------------
 // Drawing
+
+/// Gap between the plot area and a legend outside it.
+pub(super) const LEGEND_GAP: f64 = 12.0;
+
+/// The legend's labelled series with a finite point, in order.
+pub(super) fn legend_entries(fig: &Figure) -> Vec<(usize, &str)> {
+    fig.series
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            let label = s.label.as_deref().filter(|l| !l.trim().is_empty())?;
+            let finite = s.points.iter().any(|p| p.0.is_finite() && p.1.is_finite());
+            finite.then_some((i, label))
+        })
+        .collect()
+}
+
+/// Width and height of the legend box of `fig` (None: no entries).
+pub(super) fn legend_size(fig: &Figure) -> Option<(f64, f64)> {
+    let entries = legend_entries(fig);
+    if entries.is_empty() {
+        return None;
+    }
+    let em = LEGEND_EM;
+    let text_w = entries
+        .iter()
+        .map(|(_, label)| text_width(label, em))
+        .fold(0.0, f64::max);
+    let w = 2.0 * 0.6 * em + 2.4 * em + 0.5 * em + text_w;
+    let h = 2.0 * 0.6 * em + 1.45 * em * entries.len() as f64 - 0.45 * em;
+    Some((w, h))
+}

@@ -358,3 +358,46 @@ fn dots_are_small_markers() {
     let (circle, dot) = (inked(Marker::Circle), inked(Marker::Dot));
     assert!(dot > 0 && 5 * dot < circle, "dot {dot}, circle {circle}");
 }
+
+/// A chart's cells fill the plot area, so a legend inside covered some
+/// (issue 38). Outside, the plot area narrows by the legend's width and
+/// the legend sits right of it, inside the figure; tags are written as
+/// text beside their points.
+#[test]
+fn an_outside_legend_covers_no_cell() {
+    let cells: Vec<(f64, f64, f64, f64)> = (0..10)
+        .flat_map(|i| {
+            (0..10).map(move |j| {
+                (
+                    f64::from(i),
+                    f64::from(j),
+                    f64::from(i) + 1.0,
+                    f64::from(j) + 1.0,
+                )
+            })
+        })
+        .collect();
+    let inside =
+        Figure::new("cells", "x", "y").with_series(Series::rectangles("period 1", cells.clone()));
+    let fig = Figure::new("cells", "x", "y")
+        .with_series(Series::rectangles("period 1", cells))
+        .with_series(
+            Series::markers("marked", [(2.5, 2.5)], Marker::Cross).with_tags(vec!["BP1".into()]),
+        )
+        .legend_at(LegendPosition::Outside);
+    let (wide, plan) = (Plan::new(&inside).unwrap(), Plan::new(&fig).unwrap());
+    let (w, h) = legend_size(&fig).unwrap();
+    let (x0, y0) = super::draw::legend_origin(&plan, LegendPosition::Outside, w, h);
+    assert!(
+        x0 >= plan.right + LEGEND_GAP - 1e-9,
+        "{x0} vs {}",
+        plan.right
+    );
+    assert!(x0 + w <= W, "{} > {W}", x0 + w);
+    assert!((y0 - plan.top).abs() < 1e-9);
+    assert!(plan.right < wide.right - w);
+    let dir = temp_dir("outside");
+    render(&fig, &dir.join("f")).unwrap();
+    let svg = std::fs::read_to_string(dir.join("f.svg")).unwrap();
+    assert!(svg.contains("BP1"), "the tag is missing");
+}

@@ -21,6 +21,8 @@ pub(super) const TITLE_EM: f64 = 24.0;
 pub(super) const LABEL_EM: f64 = 20.0;
 pub(super) const TICK_EM: f64 = 16.0;
 pub(super) const LEGEND_EM: f64 = 16.0;
+/// Text beside a marker (a special point's label).
+pub(super) const TAG_EM: f64 = 12.0;
 /// Height of digits and capitals, and of ascenders/descenders, in em (DejaVu Sans).
 pub(super) const CAP: f64 = 0.73;
 pub(super) const ASCENT: f64 = 0.76;

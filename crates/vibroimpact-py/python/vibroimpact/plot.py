@@ -73,23 +73,49 @@ def _parameter_axis(name, x_scale):
     return label if x_scale == 1.0 else f"{label} × {x_scale:.4g}"
 
 
+def _special_amplitude(sp, body, branch, p, u):
+    """max |u| (mm) of a special point: its own orbit's; from a document
+    without it, the nearest branch point's in parameter and state."""
+    own = sp["max_displacement"] if "max_displacement" in sp else None
+    if own is not None and len(own) > body:
+        return 1e3 * abs(own[body])
+    states = np.array([pt.initial_state for pt in branch.points])
+    scale = np.ptp(p) or 1.0, np.abs(states).max() or 1.0
+    d = np.hypot((p - sp.parameter) / scale[0],
+                 np.linalg.norm(states - sp.initial_state, axis=1) / scale[1])
+    return u[np.argmin(d)]
+
+
 def _branch(ax, branch, body, x_scale, label, color, seen):
     p = branch.column("parameter")
     u = 1e3 * np.abs(np.array([pt.max_displacement[body] for pt in branch.points]))
-    stable = np.array([bool(pt.stable) for pt in branch.points])
-    starts = np.flatnonzero(np.r_[True, stable[1:] != stable[:-1]])
-    for i, (a, b) in enumerate(zip(starts, np.r_[starts[1:], len(p)])):
-        # Each run ends on the next run's first point: the curve is continuous.
-        end = min(b + 1, len(p))
-        ax.plot(p[a:end] * x_scale, u[a:end], color=color,
-                ls="-" if stable[a] else "--", label=label if i == 0 else None)
-    # A special point sits on the branch point nearest in parameter and state.
-    states = np.array([pt.initial_state for pt in branch.points])
-    scale = np.ptp(p) or 1.0, np.abs(states).max() or 1.0
+    stable = [bool(pt.stable) for pt in branch.points]
+    # The vertices: the points, and after each the special points located
+    # after it that carry their own orbit (the curve passes through them,
+    # as the CLI's figure draws it).
+    after = {}
     for sp in branch.special_points:
-        d = np.hypot((p - sp.parameter) / scale[0],
-                     np.linalg.norm(states - sp.initial_state, axis=1) / scale[1])
-        y = u[np.argmin(d)]
+        if "after_point" in sp and "max_displacement" in sp and len(sp.max_displacement) > body:
+            after.setdefault(int(sp.after_point), []).append(sp)
+    xs, ys, st = [], [], []
+    for i in range(len(p)):
+        xs.append(p[i]), ys.append(u[i]), st.append(stable[i])
+        for sp in sorted(after.get(i, []), key=lambda s: abs(s.parameter - p[i])):
+            xs.append(sp.parameter), ys.append(1e3 * abs(sp.max_displacement[body])), st.append(None)
+    xs, ys = np.array(xs) * x_scale, np.array(ys)
+    # A segment is drawn as its first vertex's stability, or from a special
+    # point as the next point's.
+    style = [next((s for s in st[k:] if s is not None), True) for k in range(len(st))]
+    start, labelled = 0, False
+    while start + 1 < len(xs):
+        end = start + 1
+        while end + 1 < len(xs) and style[end] == style[start]:
+            end += 1
+        ax.plot(xs[start:end + 1], ys[start:end + 1], color=color,
+                ls="-" if style[start] else "--", label=None if labelled else label)
+        labelled, start = True, end
+    for sp in branch.special_points:
+        y = _special_amplitude(sp, body, branch, p, u)
         ax.plot(sp.parameter * x_scale, y, ls="none", marker=_MARKERS.get(sp.kind, "*"),
                 mfc=color, mec="k", ms=7, zorder=3,
                 label=None if sp.kind in seen else sp.kind)

@@ -341,6 +341,10 @@ pub struct SpecialPoint {
     pub parameter: f64,
     /// State at t = 0 (body order).
     pub state: Vec<f64>,
+    /// max |u_i| over the orbit there, body order (m): its own orbit, so a
+    /// figure marks it on the curve (empty where the branch's points carry
+    /// no amplitudes, and in special points read back from a file).
+    pub max_displacement: Vec<f64>,
     /// Multipliers there.
     pub multipliers: Vec<Complex<f64>>,
     /// Unit tangent of the branch there (scaled variables, x then p).
