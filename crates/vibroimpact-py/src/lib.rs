@@ -59,6 +59,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(chart::chart, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(basins::basin_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(basins::basins_merge, m)?)?;
     m.add_function(wrap_pyfunction!(records::parse_record, m)?)?;
     m.add_function(wrap_pyfunction!(records::parse_measured, m)?)?;
     m.add_function(wrap_pyfunction!(records::response_spectrum, m)?)?;

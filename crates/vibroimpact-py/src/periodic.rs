@@ -80,6 +80,8 @@ pub fn periodic<'py>(
         .clone()
         .check(model.document.clone())
         .map_err(|e| spell(e, &study, false))?;
+    let work = py.detach(|| checked.work());
+    crate::simulate::warn_if_long(py, work)?;
     let (m, krylov) = (checked.model.clone(), checked.krylov.is_some());
     let out = monitor::run(py, progress, move |p: &Progress| {
         let mut checked = checked;

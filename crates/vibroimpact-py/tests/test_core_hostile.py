@@ -120,6 +120,10 @@ def test_long_charts_and_basins_warn_before_any_work():
             vi.basins(m, "u1", grid[0], "v1", grid[1], transient=400, record=30)
         with pytest.raises(vi.LongRunWarning, match="a long run"):
             vi.chart(m, "frequency", np.linspace(3.7, 11.1, 200), "amplitude", np.linspace(0.01, 0.1, 200))
+        # periodic on a long row said nothing first.
+        row = vi.Model.from_toml(ROW.replace("count = 3\n", "count = 100000\n"), "row.toml")
+        with pytest.raises(vi.LongRunWarning, match="a long run: about .* on one core"):
+            vi.periodic(row)
 
 
 def test_ctrl_c_keeps_the_history_and_the_sweep_so_far():

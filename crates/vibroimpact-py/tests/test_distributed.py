@@ -56,6 +56,22 @@ def test_chart_is_bit_identical_to_the_local_run(client):
     assert same(local, vi.chart(ROW, "frequency", xs, "amplitude", ys, threads=1, **kw))
 
 
+def test_basins_are_bit_identical_to_the_local_run(client):
+    # vi.basins had no client=: the rows run on the workers, the attractors
+    # are identified here over all of them (the row of two at 7.45 rad/s:
+    # period 3, period 1 and irregular motion side by side).
+    row = vi.Model.load(EXAMPLES / "fujita-row-n2.toml").with_(frequency=7.45)
+    xs, ys = np.linspace(-0.9e-3, 0.9e-3, 5), np.linspace(-0.06, 0.06, 4)
+    kw = dict(transient=100, record=10)
+    local = vi.basins(row, "u1", xs, "v1", ys, **kw)
+    assert sorted(a.period or 0 for a in local.attractors) == [0, 1, 3]
+    for tasks in (None, 3):
+        remote = vi.basins(row, "u1", xs, "v1", ys, client=client, tasks=tasks, **kw)
+        assert same(local, remote), tasks
+    with pytest.raises(ValueError, match="tasks: applies with a Dask client only"):
+        vi.basins(row, "u1", xs, "v1", ys, tasks=2, **kw)
+
+
 def test_up_down_sweep_on_the_cluster(client):
     kw = dict(values=[6.0, 7.0, 8.0], transient=10, record=3, up_down=True)
     assert same(vi.sweep(ROW, "frequency", **kw), vi.sweep(ROW, "frequency", client=client, **kw))

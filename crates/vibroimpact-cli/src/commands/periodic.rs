@@ -134,6 +134,7 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     };
     let spell = |e| study_error(e, args, &interrupt);
     let checked = study.check(read_document(&args.model)?).map_err(spell)?;
+    crate::progress::announce_long(checked.work());
     let (model, krylov) = (checked.model.clone(), checked.krylov.is_some());
     let out = checked.run().map_err(spell)?;
     let (sol, orbit) = (&out.solution, &out.orbit);

@@ -98,6 +98,16 @@ def basins(
     integrator: str = "auto", settle: Optional[int] = None,
 ) -> dict[str, Any]: ...
 
+def basin_runs(
+    model: Model, x: str, x_values: F64, y: str, y_values: F64, base: Optional[F64],
+    options: dict[str, Any],
+) -> str: ...
+
+def basins_merge(
+    model: Model, x: str, x_values: F64, y: str, y_values: F64, base: Optional[F64],
+    options: dict[str, Any], parts: list[str],
+) -> dict[str, Any]: ...
+
 def parse_record(text: str, source: str, units: Optional[str] = None) -> dict[str, Any]: ...
 def response_spectrum(
     times: F64, acceleration: F64, periods: F64, damping: float, scale: float,

@@ -249,6 +249,8 @@ def basins(
     method: str = "dop853",
     cluster_tolerance: Optional[float] = None,
     integrator: str = "auto",
+    client: Any = None,
+    tasks: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Progress = None,
 ) -> Result:
@@ -257,7 +259,11 @@ def basins(
     ``y`` (``"u1"``, ``"v2"``, …; the other components from ``base``, u then
     v, default the model's initial state) run to its attractor in parallel
     (``transient`` periods, then ``record`` recorded ones). Defaults and
-    ``integrator`` as :func:`chart`.
+    ``integrator`` as :func:`chart`. Without ``client`` the states run on
+    this machine's cores (``threads``: pool size). With a
+    ``dask.distributed.Client`` the rows of the grid run on its workers in
+    ``tasks`` chunks and the attractors are identified here over all of
+    them; the result is bit for bit the local one.
 
     Returns ``x_component``, ``y_component``, ``x_values``, ``y_values``,
     ``base_state``, ``transient_periods``, ``record_periods``,
@@ -274,8 +280,28 @@ def basins(
     xs = np.require(_floats(x_values, "x_values", allow_scalar=False), np.float64, ["C", "A"])
     ys = np.require(_floats(y_values, "y_values", allow_scalar=False), np.float64, ["C", "A"])
     b = None if base is None else np.require(_floats(base, "base", allow_scalar=False), np.float64, ["C", "A"])
+    options = dict(
+        transient=_count(transient, "transient"),
+        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
+        record=_count(record, "record", minimum=1, maximum=10**7),
+        rtol=_real(rtol, "rtol", positive=True, optional=True),
+        atol=_real(atol, "atol", positive=True, optional=True),
+        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
+        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
+    )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
+        if client is not None:
+            raise ValueError("threads: applies to local basins; with a client every task runs on one thread")
+    if tasks is not None:
+        if client is None:
+            raise ValueError("tasks: applies with a Dask client only")
+        tasks = _count(tasks, "tasks", minimum=1, maximum=10**6)
+    if client is not None:
+        from .distributed import basins_on
+
+        return basins_on(client, m, (x, xs), (y, ys), b, options, tasks=tasks, progress=progress)
     d = _core.basins(
         m,
         x,
@@ -283,15 +309,15 @@ def basins(
         y,
         ys,
         b,
-        _count(transient, "transient"),
-        _count(record, "record", minimum=1, maximum=10**7),
-        _real(rtol, "rtol", positive=True, optional=True),
-        _real(atol, "atol", positive=True, optional=True),
-        _method(method, ("dop853", "dopri5", "rodas", "auto")),
-        _real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        options["transient"],
+        options["record"],
+        options["rtol"],
+        options["atol"],
+        options["method"],
+        options["cluster_tolerance"],
         threads,
         _progress(progress),
-        _method(integrator, ("auto", "global", "local"), "integrator"),
-        None if settle is None else _count(settle, "settle", maximum=10**9),
+        options["integrator"],
+        options["settle"],
     )
     return Result(d)

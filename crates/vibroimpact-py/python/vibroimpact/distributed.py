@@ -1,4 +1,4 @@
-"""Sweeps and ensembles on a Dask cluster.
+"""Sweeps, charts, basins and ensembles on a Dask cluster.
 
 ``vibroimpact.sweep(..., client=client)`` splits the parameter values into
 contiguous chunks, one Dask task each (a few per worker thread, so a task
@@ -124,6 +124,40 @@ def chart_on(client, model, x, y, options: dict, *, tasks: Optional[int] = None,
     head["y_values"] = [v for d in docs for v in d["y_values"]]
     head["cells"] = [c for d in docs for c in d["cells"]]
     return Result(head)
+
+
+def _basin_task(model, x, y, base, options):
+    from . import _core
+
+    # Arrays unpickled on a Dask worker are often misaligned: copy those.
+    def aligned(a):
+        return None if a is None else np.require(a, np.float64, ["C", "A"])
+
+    return _core.basin_runs(model, x[0], aligned(x[1]), y[0], aligned(y[1]), aligned(base), options)
+
+
+def basins_on(client, model, x, y, base, options: dict, *, tasks: Optional[int] = None, progress=None, retries: int = 2) -> Result:
+    """The basins of :func:`vibroimpact.basins` on the workers of
+    ``client``: the rows of the grid (values of ``y``) in ``tasks`` chunks
+    (default four per worker thread), each task's runs sent back whole and
+    the attractors identified here over all of them, so the result is bit
+    for bit the local one."""
+    from . import _core
+
+    if not hasattr(client, "submit") or not hasattr(client, "scheduler_info"):
+        raise TypeError(
+            f"client: expected a dask.distributed.Client, got {type(client).__name__}"
+        )
+    name, ys = y
+    chunks = _chunks(ys, tasks or 4 * _worker_threads(client))
+    [model_future] = client.scatter([model], broadcast=False, hash=False)
+    futures = [
+        client.submit(_basin_task, model_future, x, (name, c), base, options, retries=retries, pure=False)
+        for c in chunks
+    ]
+    parts = _gather(futures, progress, len(futures))
+    d = _core.basins_merge(model, x[0], x[1], name, ys, base, options, parts)
+    return Result(d)
 
 
 def _ensemble_task(name: str, model, kwargs: dict):

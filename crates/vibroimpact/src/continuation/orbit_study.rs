@@ -10,12 +10,18 @@ use crate::model::file::ModelDocument;
 use crate::model::parameter::ParameterizedModel;
 use crate::model::Model;
 use crate::periodic::{
-    guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, OrbitSummary,
+    forcing_period, guess_by_simulation_with, orbit_summary_by, shoot, shoot_krylov, OrbitSummary,
     PeriodicSolution, ShootingOptions, MIN_ARNOLDI,
 };
+use crate::simulate::{estimate_work, SimulationOptions, WorkEstimate};
 
 /// Samples of the orbit summary over one period.
 const ORBIT_SAMPLES: usize = 512;
+
+/// Newton steps a shooting is priced at in its announcement (the examples
+/// converge in 1 to 19; a homotopy's continuation takes about three times
+/// as many maps).
+const NEWTON_STEPS: f64 = 10.0;
 
 /// Where shooting starts.
 #[derive(Clone, Debug, PartialEq)]
@@ -143,6 +149,44 @@ impl OrbitStudy {
 }
 
 impl CheckedOrbit {
+    /// The estimated work of [`CheckedOrbit::run`] on one core, for the
+    /// faces to announce when it is long (`periodic` on a row of 10⁶
+    /// bodies said nothing first): the guess's simulation, then about
+    /// [`NEWTON_STEPS`] period maps, each with its columns (dense: 2N,
+    /// integrated with the state; matrix-free: the Arnoldi dimension's
+    /// products, each priced at a period), and the orbit's summary. None
+    /// where a run is refused (the run says why).
+    pub fn work(&self) -> Option<WorkEstimate> {
+        let (study, model) = (&self.study, &self.model);
+        let opts = &study.options;
+        let period = forcing_period(model).ok()? * f64::from(opts.subharmonic.max(1));
+        let run = |periods: f64, rtol: f64| {
+            estimate_work(
+                model,
+                &SimulationOptions {
+                    t_end: periods * period,
+                    rtol,
+                    atol: rtol * 1e-4,
+                    integrator: opts.integrator,
+                    interrupt: opts.interrupt.clone(),
+                    ..SimulationOptions::default()
+                },
+            )
+        };
+        let one = run(1.0, opts.rtol)?;
+        let columns = self.krylov.unwrap_or(2 * model.bodies().len()) as f64;
+        let (guess, maps) = match study.guess {
+            Guess::Simulate => (
+                Some(run(study.guess_periods, opts.rtol.max(1e-9))?),
+                NEWTON_STEPS,
+            ),
+            Guess::Homotopy => (None, 4.0 * NEWTON_STEPS),
+            Guess::State(_) => (None, NEWTON_STEPS),
+        };
+        let shooting = one.times(maps * (columns + 1.0)).then(one);
+        Some(guess.map_or(shooting, |g| g.then(shooting)))
+    }
+
     /// Shoots from the study's guess and summarises the orbit.
     pub fn run(self) -> Result<OrbitOutcome, StudyError> {
         let (study, model, opts) = (&self.study, &self.model, &self.study.options);

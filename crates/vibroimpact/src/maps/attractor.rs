@@ -4,7 +4,7 @@
 //! two runs reached the same attractor (docs/theory.md §8). Shared by the
 //! stability chart and the basins of attraction.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::field_error::FieldError;
 use crate::maps::sweep::{
@@ -98,8 +98,9 @@ pub(crate) fn check_axis(name: &str, values: &[f64]) -> Result<(), String> {
     }
 }
 
-/// The attractor one run reached.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// The attractor one run reached (read back by a distributed computation's
+/// merge: [`crate::maps::basins::BasinRuns`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Run {
     /// The initial state `[u.., v..]` (m, m/s).
     pub start: Vec<f64>,
@@ -110,9 +111,13 @@ pub struct Run {
     /// repeat (quasi-periodic, chaotic, or still settling when the periods
     /// allowed ran out).
     pub period: Option<usize>,
-    /// Impacts (all contacts) per forcing period.
+    /// Impacts (all contacts) per forcing period (NaN for a failed run,
+    /// null in JSON).
+    #[serde(deserialize_with = "nan_if_null")]
     pub impacts_per_period: f64,
-    /// Largest |u_i| over the bodies and the recorded periods (m).
+    /// Largest |u_i| over the bodies and the recorded periods (m; NaN for
+    /// a failed run).
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_displacement: f64,
     /// The largest Lyapunov exponent (1/s), if requested.
     pub lyapunov: Option<f64>,
@@ -134,9 +139,15 @@ impl Run {
     }
 }
 
+/// A number written as JSON's null where it was NaN (serde_json writes
+/// NaN so), read back as NaN.
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 /// A run's Poincaré samples and the scales of their displacements (largest
 /// |u| over the window) and velocities (that times the forcing frequency).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub(crate) struct Recorded {
     pub(crate) samples: Vec<Vec<f64>>,
     pub(crate) scale: (f64, f64),

@@ -15,7 +15,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use super::global::check_run;
-use super::{effective_method, simulate, SimulationOptions, CRAWL_FACTOR};
+use super::{effective_method, simulate_streaming, Integrator, SimulationOptions, CRAWL_FACTOR};
 use crate::model::{BaseExcitation, Model};
 
 /// DOP853's steps per cycle of the fastest scale at rtol 1e-8 (a damped
@@ -37,6 +37,12 @@ pub const PROBE_FROM: f64 = 1.0;
 
 /// The probe's work (s, by the bound).
 pub const PROBE_SECONDS: f64 = 0.05;
+
+/// The least share of the run the local integrator's probe covers.
+const LOCAL_PROBE_SHARE: f64 = 0.01;
+
+/// The least step budget of a probe by the local integrator.
+const LOCAL_PROBE_STEPS: u64 = 1000;
 
 /// Runs estimated to take longer than this (s) are announced.
 pub const LONG_RUN: f64 = 30.0;
@@ -179,25 +185,51 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> Option<WorkEsti
     }
     // The probe runs to the bound's share of PROBE_SECONDS, or as many
     // steps as the bound prices at PROBE_SECONDS if impacts make it
-    // slower, and scales from the time it reached.
+    // slower (the local integrator's steps cost its set, not the row: at
+    // least `LOCAL_PROBE_STEPS` of them), and scales from the time it
+    // reached.
+    // The bound prices the global integrator: the local one moves free
+    // bodies exactly, so its probe covers at least a hundredth of the run.
+    let local = opts.integrator.resolve(model) == Integrator::Local;
+    let priced = (PROBE_SECONDS / (parts * SECONDS_PER_STEP_AND_PART)).ceil() as u64;
+    let mut t_probe = opts.t_end * PROBE_SECONDS / (bound.seconds - sampling);
+    if local {
+        t_probe = t_probe.max(LOCAL_PROBE_SHARE * opts.t_end);
+    }
     let probe = SimulationOptions {
-        t_end: opts.t_end * PROBE_SECONDS / (bound.seconds - sampling),
-        output_step: None,
+        t_end: t_probe,
+        // Two samples, at the start and the end: the clock at the first.
+        output_step: Some(t_probe),
+        output_from: 0.0,
         extrema_window: None,
         energy: false,
-        max_steps: (PROBE_SECONDS / (parts * SECONDS_PER_STEP_AND_PART)).ceil() as u64,
+        max_steps: if local {
+            priced.max(LOCAL_PROBE_STEPS)
+        } else {
+            priced
+        },
         interrupt: opts.interrupt.clone(),
         ..opts.clone()
     };
+    // The wall clock at the probe's samples tells the run's setup (a row
+    // of 10⁶ bodies checks every contact once first) from its pace: the
+    // setup scaled with the time said "2 days" for what takes minutes.
     let clock = Instant::now();
+    let mut first: Option<f64> = None;
+    let sim = simulate_streaming(model, &probe, |_, _| {
+        first.get_or_insert_with(|| clock.elapsed().as_secs_f64());
+        true
+    });
+    let elapsed = clock.elapsed().as_secs_f64();
     // (The local integrator may take no step at all in free flight: the
     // probe's time still scales.)
-    Some(match simulate(model, &probe) {
+    Some(match sim {
         Ok(sim) if sim.final_time > 0.0 => {
-            let scale = opts.t_end / sim.final_time;
+            let setup = first.unwrap_or(0.0).min(elapsed);
+            let pace = (elapsed - setup) / sim.final_time;
             WorkEstimate {
-                steps: sim.stats.steps as f64 * scale,
-                seconds: clock.elapsed().as_secs_f64() * scale + sampling,
+                steps: sim.stats.steps as f64 * opts.t_end / sim.final_time,
+                seconds: setup + pace * opts.t_end + sampling,
                 probed: sim.final_time,
                 max_steps: opts.max_steps,
             }
@@ -210,6 +242,7 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> Option<WorkEsti
 mod tests {
     use super::*;
     use crate::model::reference;
+    use crate::simulate::simulate;
 
     /// A run that takes no step (a free row moved exactly) but writes its
     /// samples is told as such, not as "about 0.00e0 integration steps";

@@ -9,7 +9,7 @@
 //! coexisting attractors).
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::field_error::FieldError;
 use crate::maps::attractor::{check_axis, identify, run_from, settings, MapError, Recorded, Run};
@@ -125,20 +125,35 @@ pub struct Basins {
 /// the result).
 pub type BasinError = MapError;
 
-/// The basins of `loaded`'s model over the plane `x` × `y` (component and
-/// values) through `base` (`[u.., v..]`; None: the model's initial state),
-/// with the transient, recording, tolerances and method of `options` (rtol
-/// and cluster tolerance default to the chart's). In parallel on rayon's
-/// pool; the result does not depend on the number of threads. `progress`
-/// is called after every initial state.
-pub fn basins(
+/// The runs of the initial states of a plane, row by row (None where the
+/// state overlaps a contact and is not run): all of them, or one task's
+/// rows of a distributed computation, which [`BasinRuns::concat`] joins in
+/// order and [`basins_of`] identifies. Its JSON reads back bit for bit.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct BasinRuns(Vec<Option<(Run, Recorded)>>);
+
+impl BasinRuns {
+    /// The runs of consecutive rows, joined in order.
+    pub fn concat(parts: Vec<BasinRuns>) -> Self {
+        Self(parts.into_iter().flat_map(|p| p.0).collect())
+    }
+}
+
+/// The checked inputs of a basin computation: the base state, the
+/// forcing frequency and the run settings.
+struct Plane {
+    base_state: Vec<f64>,
+    omega: f64,
+    settings: crate::maps::sweep::Settings,
+}
+
+/// Checks the plane `x` × `y` through `base` of `loaded`'s model.
+fn plane(
     loaded: &LoadedModel,
-    x: Axis<'_>,
-    y: Axis<'_>,
+    (x, y): (Axis<'_>, Axis<'_>),
     base: Option<&[f64]>,
     options: &SweepOptions,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Basins, BasinError> {
+) -> Result<Plane, BasinError> {
     let model = &loaded.model;
     let n = model.bodies().len();
     if x.0 == y.0 {
@@ -181,7 +196,49 @@ pub fn basins(
             "the model has no periodic excitation with one frequency (attractors are recognised once per forcing period)".into(),
         ));
     };
-    let settings = settings(loaded, options)?;
+    Ok(Plane {
+        base_state,
+        omega,
+        settings: settings(loaded, options)?,
+    })
+}
+
+/// The basins of `loaded`'s model over the plane `x` × `y` (component and
+/// values) through `base` (`[u.., v..]`; None: the model's initial state),
+/// with the transient, recording, tolerances and method of `options` (rtol
+/// and cluster tolerance default to the chart's). In parallel on rayon's
+/// pool; the result does not depend on the number of threads. `progress`
+/// is called after every initial state.
+pub fn basins(
+    loaded: &LoadedModel,
+    x: Axis<'_>,
+    y: Axis<'_>,
+    base: Option<&[f64]>,
+    options: &SweepOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Basins, BasinError> {
+    let runs = basin_runs(loaded, x, y, base, options, progress)?;
+    basins_of(loaded, (x, y), base, options, runs)
+}
+
+/// The runs of [`basins`] without their identification: of every initial
+/// state of `x` × `y`, row by row (a task of a distributed computation
+/// gives its rows of `y`).
+pub fn basin_runs(
+    loaded: &LoadedModel,
+    x: Axis<'_>,
+    y: Axis<'_>,
+    base: Option<&[f64]>,
+    options: &SweepOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<BasinRuns, BasinError> {
+    let Plane {
+        base_state,
+        omega,
+        settings,
+    } = plane(loaded, (x, y), base, options)?;
+    let model = &loaded.model;
+    let n = model.bodies().len();
     let states: Vec<Vec<f64>> =
         y.1.iter()
             .flat_map(|&vy| {
@@ -194,23 +251,51 @@ pub fn basins(
                 })
             })
             .collect();
-    // Nothing to run is an input error, as for a sweep (it exited 0 with
-    // no attractors).
-    if !states.iter().any(|s| admissible(model, &s[..n])) {
+    Ok(BasinRuns(
+        states
+            .into_par_iter()
+            .map(|state| {
+                let out = admissible(model, &state[..n])
+                    .then(|| run_from(model, omega, state, &settings));
+                progress();
+                out
+            })
+            .collect(),
+    ))
+}
+
+/// The basins from the `runs` of every initial state of the plane
+/// ([`basin_runs`], or its rows joined by [`BasinRuns::concat`]): the
+/// attractors identified over all of them, in order of first appearance.
+pub fn basins_of(
+    loaded: &LoadedModel,
+    (x, y): (Axis<'_>, Axis<'_>),
+    base: Option<&[f64]>,
+    options: &SweepOptions,
+    runs: BasinRuns,
+) -> Result<Basins, BasinError> {
+    let Plane {
+        base_state,
+        settings,
+        ..
+    } = plane(loaded, (x, y), base, options)?;
+    let results = runs.0;
+    if results.len() != x.1.len() * y.1.len() {
         return Err(BasinError::Input(format!(
-            "every one of the {} initial states overlaps a contact, so none can be run: choose values within the clearances",
-            states.len()
+            "{} runs for a plane of {} × {} initial states",
+            results.len(),
+            x.1.len(),
+            y.1.len()
         )));
     }
-    let results: Vec<Option<(Run, Recorded)>> = states
-        .into_par_iter()
-        .map(|state| {
-            let out =
-                admissible(model, &state[..n]).then(|| run_from(model, omega, state, &settings));
-            progress();
-            out
-        })
-        .collect();
+    // Nothing to run is an input error, as for a sweep (it exited 0 with
+    // no attractors).
+    if results.iter().all(Option::is_none) {
+        return Err(BasinError::Input(format!(
+            "every one of the {} initial states overlaps a contact, so none can be run: choose values within the clearances",
+            results.len()
+        )));
+    }
     let ran: Vec<bool> = results.iter().map(Option::is_some).collect();
     let (runs, recorded): (Vec<Run>, Vec<Recorded>) = results.into_iter().flatten().unzip();
     let (ids, reps) = identify(&runs, &recorded, settings.cluster_tolerance);

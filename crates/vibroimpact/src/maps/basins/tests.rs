@@ -178,3 +178,49 @@ fn period_three_orbit_beside_the_symmetric_one() {
         assert!((a - b).abs() < 1e-3 * s, "{k}: {a} vs {b}");
     }
 }
+
+/// Distributed basins: the runs of rows computed apart (one task each),
+/// sent as JSON (a failed run's NaN as null included) and joined, give
+/// the basins of one computation bit for bit.
+#[test]
+fn rows_run_apart_and_joined_are_the_whole() {
+    let m = loaded(&ROW.replace("frequency = 8.151", "frequency = 7.45"));
+    let opts = SweepOptions {
+        transient: 100,
+        record: 10,
+        ..SweepOptions::default()
+    };
+    let (xs, ys) = ([-0.9e-3, 0.0, 0.9e-3], [-0.06, -0.02, 0.02, 0.06]);
+    let (x, y) = (Component::Displacement(0), Component::Velocity(0));
+    let whole = basins(&m, (x, &xs), (y, &ys), None, &opts, &|| {}).unwrap();
+    assert!(whole.attractors.len() >= 2, "{:?}", whole.attractors);
+    let parts: Vec<BasinRuns> = [&ys[..1], &ys[1..3], &ys[3..]]
+        .iter()
+        .map(|rows| {
+            let runs = basin_runs(&m, (x, &xs), (y, rows), None, &opts, &|| {}).unwrap();
+            serde_json::from_str(&serde_json::to_string(&runs).unwrap()).unwrap()
+        })
+        .collect();
+    let joined = basins_of(
+        &m,
+        ((x, &xs), (y, &ys)),
+        None,
+        &opts,
+        BasinRuns::concat(parts),
+    )
+    .unwrap();
+    let text = |b: &Basins| serde_json::to_string(b).unwrap();
+    assert_eq!(text(&joined), text(&whole));
+    let failed: Run = serde_json::from_str(
+        &serde_json::to_string(&Run::failed(vec![0.0], "stopped".into())).unwrap(),
+    )
+    .unwrap();
+    assert!(failed.impacts_per_period.is_nan() && failed.max_displacement.is_nan());
+    // Runs of another plane are refused.
+    let short = basin_runs(&m, (x, &xs), (y, &ys[..1]), None, &opts, &|| {}).unwrap();
+    let err = basins_of(&m, ((x, &xs), (y, &ys)), None, &opts, short).unwrap_err();
+    assert!(
+        err.to_string().contains("3 runs for a plane of 3 × 4"),
+        "{err}"
+    );
+}
