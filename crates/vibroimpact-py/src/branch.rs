@@ -145,6 +145,8 @@ pub fn continue_branch<'py>(
     if let Some(text) = &second.5 {
         return curves_from_document(py, progress, text, checked, &study);
     }
+    let work = py.detach(|| checked.branch.guess_work());
+    crate::simulate::warn_if_long(py, work)?;
     let out = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.set_total(max_points);
         checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());

@@ -3,7 +3,7 @@
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibroimpact::maps::sweep::{sweep as run_sweep, Direction, SweepOptions};
+use vibroimpact::maps::sweep::{sweep as run_sweep, sweep_work, Direction, SweepOptions};
 use vibroimpact::model::parameter::ParameterizedModel;
 
 use crate::convert::{
@@ -66,6 +66,25 @@ pub fn sweep<'py>(
         }
     };
     let total = values.len() * if up_down && only.is_none() { 2 } else { 1 };
+    // A long sweep warns before any work, as the command line's note.
+    if let Some(base) = values.first().and_then(|&v| family.loaded_at(v).ok()) {
+        let priced = SweepOptions {
+            transient,
+            settle,
+            record,
+            up_down,
+            only,
+            rtol,
+            atol,
+            method,
+            cluster_tolerance,
+            lyapunov,
+            interrupt: None,
+            integrator,
+        };
+        let work = py.detach(|| sweep_work(&base, &priced, values.len()));
+        crate::simulate::warn_if_long(py, work)?;
+    }
     let summary = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {

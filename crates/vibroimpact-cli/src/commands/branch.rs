@@ -333,6 +333,7 @@ pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     if let Some(path) = &args.second.special_points {
         return curves_from_file(args, checked, path, &interrupt);
     }
+    crate::progress::announce_long(checked.branch.guess_work());
     let bar = crate::progress::status();
     let progress = |p: &vibroimpact::continuation::BranchPoint| {
         bar.inc(1);

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use vibroimpact::maps::settling::Motion;
 use vibroimpact::maps::sweep::{
-    parameter_values, sweep, Direction, SweepError, SweepOptions, SweepPoint, SweepSummary,
+    parameter_values, sweep, sweep_work, Direction, SweepError, SweepOptions, SweepPoint,
+    SweepSummary,
 };
 
 use crate::args::ParameterRange;
@@ -295,6 +296,12 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         interrupt: Some(interrupt.clone()),
         integrator: args.integrator.integrator(),
     };
+    if let Ok(base) = family.loaded_at(values[0]) {
+        crate::progress::announce_long_as(
+            sweep_work(&base, &options, values.len()),
+            "Ctrl-C stops it and keeps the values computed",
+        );
+    }
     let progress = crate::progress::bar(if args.up_down { 2 } else { 1 } * values.len(), "values")
         .with_prefix("sweep");
     let summary = sweep(&family, &values, &options, &|| progress.inc(1)).map_err(|e| match e {

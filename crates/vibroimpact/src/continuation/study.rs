@@ -301,6 +301,27 @@ pub struct CheckedBranch<F> {
 }
 
 impl<F: Family> CheckedBranch<F> {
+    /// The estimated work of the start guess's simulation (`start` auto or
+    /// simulate) on one core, for the faces to announce when long: a
+    /// continuation with `--guess-periods 100000` ran silently (the
+    /// branch's own points are priced by none: each ends its own way).
+    pub fn guess_work(&self) -> Option<crate::simulate::WorkEstimate> {
+        if self.study.start == Start::Homotopy {
+            return None;
+        }
+        let period = crate::periodic::forcing_period(&self.start_model).ok()?;
+        crate::simulate::estimate_work(
+            &self.start_model,
+            &crate::simulate::SimulationOptions {
+                t_end: self.study.guess_periods * period,
+                rtol: 1e-9,
+                atol: 1e-13,
+                interrupt: self.options.shooting.interrupt.clone(),
+                ..crate::simulate::SimulationOptions::default()
+            },
+        )
+    }
+
     /// Runs the study. `on_point` sees every point of both branches and
     /// returns false to stop.
     pub fn run(

@@ -37,7 +37,9 @@
 
 use super::{positive, ImpactError, TwoBodies};
 use crate::contact::{ContactLaw, LawKind};
-use crate::numeric::{exp_neg_minus_one_plus, newton_bracketed_from, x_minus_log1p};
+use crate::numeric::{
+    exp_neg_minus_one_plus, ln_x_minus_log1p, newton_bracketed_from, x_minus_log1p,
+};
 
 const XTOL: f64 = 4.0 * f64::EPSILON;
 const MAX_ITER: usize = 200;
@@ -265,7 +267,16 @@ impl ExponentialImpact {
         let w = peak_velocity(v)?;
         let f = w * (1.0 + w);
         let peak_force = f * self.force_scale();
-        let max_penetration = (self.penetration_scale().ln() + x_minus_log1p(v).ln()) / self.alpha;
+        let max_penetration = (self.penetration_scale().ln() + ln_x_minus_log1p(v)) / self.alpha;
+        if !max_penetration.is_finite() || !peak_force.is_finite() {
+            // 1/α or the force scale beyond double precision (α = 5e-324
+            // 1/m gave a penetration of -inf, silently).
+            return Err(ImpactError::InvalidParameter {
+                name: "alpha",
+                value: self.alpha,
+                requirement: "the impact's peak force or penetration (ln(...)/alpha) leaves double precision: give alpha within about 1e-290 to 1e290 1/m, with masses and a/b of ordinary size",
+            });
+        }
         Ok(ClosedFormImpact {
             impact_velocity,
             v,

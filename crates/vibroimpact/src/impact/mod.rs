@@ -111,18 +111,41 @@ impl TwoBodies {
     }
 
     /// Reduced mass `μ = m1 m2 / (m1 + m2)` (`m1` against a wall). The seed's
-    /// equal masses give `μ = m/2` (its eq. 4).
+    /// equal masses give `μ = m/2` (its eq. 4). Written as the smaller mass
+    /// over `1 + small/large`, so that no product overflows: `m1 m2` of
+    /// 1e308 kg against 2 kg was infinite, and with it every force.
     pub fn reduced_mass(&self) -> f64 {
-        if self.m2.is_infinite() {
-            self.m1
+        let (small, large) = if self.m1 <= self.m2 {
+            (self.m1, self.m2)
         } else {
-            self.m1 * self.m2 / (self.m1 + self.m2)
-        }
+            (self.m2, self.m1)
+        };
+        small / (1.0 + small / large)
     }
 
     /// Peak accelerations `F/m1`, `F/m2` of the two bodies for a force `F`
     /// (the seed's "impact acceleration"); 0 for a wall.
     pub fn accelerations(&self, force: f64) -> [f64; 2] {
         [force / self.m1, force / self.m2]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reduced mass never overflows: 1e308 kg against 2 kg is 2 kg to
+    /// rounding (the product m1 m2 was infinite, and every force with it);
+    /// equal masses give exactly half, a wall the body's own mass, and
+    /// unequal ones m1 m2 / (m1 + m2) to rounding.
+    #[test]
+    fn the_reduced_mass_is_exact_where_the_product_overflows() {
+        let mu = |a, b| TwoBodies::new(a, b).unwrap().reduced_mass();
+        assert!((mu(1e308, 2.0) / 2.0 - 1.0).abs() < 1e-15);
+        assert!((mu(2.0, 1e308) / 2.0 - 1.0).abs() < 1e-15);
+        assert_eq!(mu(0.227, 0.227), 0.1135);
+        assert_eq!(mu(0.227, f64::INFINITY), 0.227);
+        let exact: f64 = 3.0 * 7.0 / 10.0;
+        assert!((mu(3.0, 7.0) - exact).abs() < 1e-15 * exact);
     }
 }

@@ -67,25 +67,8 @@ pub fn map_work(
     options: &SweepOptions,
     runs: usize,
 ) -> Option<crate::simulate::WorkEstimate> {
-    let settings = settings(base, options).ok()?;
-    let bound = settings.run_work(&base.model)?;
-    if runs < PROBED_FROM_RUNS {
-        return Some(bound.times(runs as f64));
-    }
-    // The bound knows the free flight, not the impacts (a 40 × 40 basins
-    // grid of the row of two: 7.5 s bound, 180 s measured): one run of the
-    // grid, timed, prices the others.
-    Some(
-        settings
-            .timed_run(&base.model)
-            .unwrap_or(bound)
-            .times(runs as f64),
-    )
+    crate::maps::sweep::runs_work(&settings(base, options).ok()?, &base.model, runs)
 }
-
-/// From this many runs on, [`map_work`] times one (at most 2 % of the
-/// map's work).
-const PROBED_FROM_RUNS: usize = 50;
 
 /// Checks the values of a grid axis named `name`: at least one, all finite.
 pub(crate) fn check_axis(name: &str, values: &[f64]) -> Result<(), String> {

@@ -44,8 +44,9 @@ const LOCAL_PROBE_SHARE: f64 = 0.01;
 /// The least step budget of a probe by the local integrator.
 const LOCAL_PROBE_STEPS: u64 = 1000;
 
-/// Runs estimated to take longer than this (s) are announced.
-pub const LONG_RUN: f64 = 30.0;
+/// Runs estimated to take longer than this (s) are announced (issue 38:
+/// no run over 10 s without a word first).
+pub const LONG_RUN: f64 = 10.0;
 
 /// A run's estimated work.
 #[derive(Clone, Copy, Debug, PartialEq)]
