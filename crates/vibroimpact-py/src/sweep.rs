@@ -66,40 +66,30 @@ pub fn sweep<'py>(
         }
     };
     let total = values.len() * if up_down && only.is_none() { 2 } else { 1 };
+    let options = SweepOptions {
+        transient,
+        settle,
+        record,
+        up_down,
+        only,
+        rtol,
+        atol,
+        method,
+        cluster_tolerance,
+        lyapunov,
+        interrupt: None,
+        integrator,
+    };
     // A long sweep warns before any work, as the command line's note.
     if let Some(base) = values.first().and_then(|&v| family.loaded_at(v).ok()) {
-        let priced = SweepOptions {
-            transient,
-            settle,
-            record,
-            up_down,
-            only,
-            rtol,
-            atol,
-            method,
-            cluster_tolerance,
-            lyapunov,
-            interrupt: None,
-            integrator,
-        };
-        let work = py.detach(|| sweep_work(&base, &priced, values.len()));
+        let work = py.detach(|| sweep_work(&base, &options, values.len()));
         crate::simulate::warn_if_long(py, work)?;
     }
     let summary = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
-            transient,
-            settle,
-            record,
-            up_down,
-            only,
-            rtol,
-            atol,
-            method,
-            cluster_tolerance,
-            lyapunov,
             interrupt: Some(p.interrupt.clone()),
-            integrator,
+            ..options
         };
         pool.install(|| run_sweep(&family, &values, &options, &|| p.tick()))
     });
