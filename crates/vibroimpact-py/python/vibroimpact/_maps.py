@@ -59,6 +59,20 @@ def _sweep_values(values, from_, to, points) -> np.ndarray:
     return parameter_values(from_, to, points)
 
 
+def _run_options(transient, settle, record, rtol, atol, method, cluster_tolerance, integrator) -> dict:
+    """The checked settings every map's runs share (sweep, chart, basins)."""
+    return dict(
+        transient=_count(transient, "transient"),
+        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
+        record=_count(record, "record", minimum=1, maximum=10**7),
+        rtol=_real(rtol, "rtol", positive=True, optional=True),
+        atol=_real(atol, "atol", positive=True, optional=True),
+        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
+        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
+        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
+    )
+
+
 def sweep(
     model: ModelLike,
     parameter: str,
@@ -124,16 +138,9 @@ def sweep(
         raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
     v = _sweep_values(values, from_, to, points)
     options = dict(
-        transient=_count(transient, "transient"),
-        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
-        record=_count(record, "record", minimum=1, maximum=10**7),
+        _run_options(transient, settle, record, rtol, atol, method, cluster_tolerance, integrator),
         up_down=_flag(up_down, "up_down"),
-        rtol=_real(rtol, "rtol", positive=True, optional=True),
-        atol=_real(atol, "atol", positive=True, optional=True),
-        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
-        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
         lyapunov=None if lyapunov is None else _count(lyapunov, "lyapunov", minimum=1, maximum=10**6),
-        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -207,16 +214,9 @@ def chart(
         if v.size < 1:
             raise ValueError(f"{name}: at least one value")
     options = dict(
-        transient=_count(transient, "transient"),
-        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
-        record=_count(record, "record", minimum=1, maximum=10**7),
+        _run_options(transient, settle, record, rtol, atol, method, cluster_tolerance, integrator),
         starts=_count(starts, "starts", minimum=1, maximum=10**6),
         lyapunov=_flag(lyapunov, "lyapunov"),
-        rtol=_real(rtol, "rtol", positive=True, optional=True),
-        atol=_real(atol, "atol", positive=True, optional=True),
-        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
-        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
-        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
     )
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
@@ -280,16 +280,7 @@ def basins(
     xs = np.require(_floats(x_values, "x_values", allow_scalar=False), np.float64, ["C", "A"])
     ys = np.require(_floats(y_values, "y_values", allow_scalar=False), np.float64, ["C", "A"])
     b = None if base is None else np.require(_floats(base, "base", allow_scalar=False), np.float64, ["C", "A"])
-    options = dict(
-        transient=_count(transient, "transient"),
-        settle=None if settle is None else _count(settle, "settle", maximum=10**9),
-        record=_count(record, "record", minimum=1, maximum=10**7),
-        rtol=_real(rtol, "rtol", positive=True, optional=True),
-        atol=_real(atol, "atol", positive=True, optional=True),
-        method=_method(method, ("dop853", "dopri5", "rodas", "auto")),
-        cluster_tolerance=_real(cluster_tolerance, "cluster_tolerance", positive=True, optional=True),
-        integrator=_method(integrator, ("auto", "global", "local"), "integrator"),
-    )
+    options = _run_options(transient, settle, record, rtol, atol, method, cluster_tolerance, integrator)
     if threads is not None:
         threads = _count(threads, "threads", minimum=1, maximum=4096)
         if client is not None:
