@@ -4,11 +4,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use vibroimpact::maps::settling::Motion;
 use vibroimpact::maps::sweep::{
     parameter_values, sweep, sweep_work, Direction, SweepError, SweepOptions, SweepPoint,
     SweepSummary,
 };
+use vibroimpact::periodic::settling::Motion;
 
 use crate::args::ParameterRange;
 use crate::args::{IntegratorName, MethodName};

@@ -239,4 +239,35 @@ mod tests {
         let e = branch.check(family).unwrap().run(|_| true).unwrap_err();
         assert_eq!(field(e), StudyField::Start);
     }
+    /// R2 N = 2 at 0.5 ω0: the 200-period guess has not settled onto a
+    /// period-1 orbit (Newton from it stalled after 23 variational period
+    /// maps), so `auto` starts from the homotopy at once, on the same
+    /// branch as `homotopy`, point for point.
+    #[test]
+    fn an_unsettled_guess_starts_from_the_homotopy_at_once() {
+        let doc = || ModelDocument::from_toml(ROW, "row.toml").unwrap();
+        let model = crate::model::parameter::ParameterizedModel::new(doc(), "frequency")
+            .unwrap()
+            .model_at(3.705)
+            .unwrap();
+        let (_, verdict) = crate::periodic::settled_guess(&model, 200.0, 1e-9, None).unwrap();
+        let verdict = verdict.expect("a 200-period guess is judged");
+        assert!(
+            verdict.motion != crate::periodic::settling::Motion::Periodic
+                || verdict.period != Some(1),
+            "{verdict:?}"
+        );
+        let branch = |start| {
+            let mut s = study(None);
+            s.branch.from = 3.705;
+            s.branch.to = 3.8;
+            s.branch.start = start;
+            s.check(doc()).unwrap().run(|_| true).unwrap().branch.branch
+        };
+        let (auto, homotopy) = (branch(Start::Auto), branch(Start::Homotopy));
+        assert_eq!(auto.points.len(), homotopy.points.len());
+        for (a, h) in auto.points.iter().zip(&homotopy.points) {
+            assert_eq!((a.parameter, &a.state), (h.parameter, &h.state));
+        }
+    }
 }

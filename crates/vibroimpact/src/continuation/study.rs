@@ -11,13 +11,15 @@ use crate::field_error::FieldError;
 use crate::model::family::{Family, FamilyError};
 use crate::model::file::ModelFileError;
 use crate::model::Model;
-use crate::periodic::{guess_by_simulation_with, PeriodicError};
+use crate::periodic::settling::Motion;
+use crate::periodic::{guess_by_simulation_with, settled_guess, PeriodicError};
 
 /// How a branch study finds its first periodic orbit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Start {
-    /// A guess by simulation; where Newton does not converge from it, the
-    /// homotopy. (The simulated guess, where it converges, is the attractor
+    /// A guess by simulation; where its last samples have not settled onto
+    /// an orbit of the sought period (docs/theory.md §8), or Newton does
+    /// not converge from it, the homotopy. (The simulated guess, where it converges, is the attractor
     /// a simulation shows; the homotopy's orbit lies on the branch that
     /// grows from rest, which at a given value may be another one.)
     #[default]
@@ -330,15 +332,29 @@ impl<F: Family> CheckedBranch<F> {
     ) -> Result<BranchOutcome, StudyError> {
         let study = &self.study;
         let opts = &self.options;
+        let interrupt = || opts.shooting.interrupt.clone();
         let guess = match study.start {
             Start::Homotopy => homotopy_guess(&self.family, study.from, opts)?,
-            Start::Auto | Start::Simulate => guess_by_simulation_with(
-                &self.start_model,
-                study.guess_periods,
-                1e-9,
-                opts.shooting.interrupt.clone(),
-            )
-            .map_err(StudyError::Guess)?,
+            Start::Simulate => {
+                guess_by_simulation_with(&self.start_model, study.guess_periods, 1e-9, interrupt())
+                    .map_err(StudyError::Guess)?
+            }
+            Start::Auto => {
+                let (guess, verdict) =
+                    settled_guess(&self.start_model, study.guess_periods, 1e-9, interrupt())
+                        .map_err(StudyError::Guess)?;
+                // Samples that do not repeat, or repeat with a period the
+                // orbit sought does not have, leave Newton no basin.
+                let n = opts.shooting.subharmonic as usize;
+                let hopeless = verdict.is_some_and(|v| {
+                    v.motion == Motion::Irregular || v.period.is_some_and(|p| n % p != 0)
+                });
+                if hopeless {
+                    homotopy_guess(&self.family, study.from, opts)?
+                } else {
+                    guess
+                }
+            }
         };
         let family = &mut self.family;
         let run =

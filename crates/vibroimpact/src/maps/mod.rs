@@ -3,8 +3,6 @@
 //!
 //! - `sweep/` — the bifurcation diagram in one parameter (Poincaré samples,
 //!   up and down, optional Lyapunov exponents); the runs every map shares.
-//! - `settling.rs` — whether a run's Poincaré samples have settled:
-//!   periodic, still settling (and for how long), or irregular.
 //! - `attractor.rs` — the attractor one run reaches, and whether two runs
 //!   reached the same one.
 //! - `chart/` — the stability chart over two parameters.
@@ -16,5 +14,4 @@ pub mod attractor;
 pub mod basins;
 pub mod chart;
 pub mod lyapunov;
-pub mod settling;
 pub mod sweep;

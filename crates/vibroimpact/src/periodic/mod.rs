@@ -6,6 +6,10 @@
 //! - `shooting.rs` — dense and Newton–Krylov shooting;
 //! - `floquet.rs` — Floquet multipliers;
 //! - `orbit.rs` — orbits from simulation (guesses, summaries);
+//! - `settling.rs` — whether a run's Poincaré samples have settled:
+//!   periodic, still settling (and for how long), or irregular (the
+//!   sweeps' verdict, and whether a simulated guess is worth a Newton
+//!   solve);
 //! - `tests.rs` — the checks.
 //!
 //! Under forcing of period `T = 2π/Ω`, a periodic solution of period `nT`
@@ -309,12 +313,14 @@ pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
 mod floquet;
 mod map;
 mod orbit;
+pub mod settling;
 mod shooting;
 
 pub(crate) use floquet::multipliers_of_map;
 pub use floquet::{floquet_multipliers, map_multipliers};
 pub use map::period_map;
 pub(crate) use map::{map_and_product, map_image, period_map_with, MapTangent};
+pub(crate) use orbit::settled_guess;
 pub use orbit::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary, orbit_summary_by, ContactImpacts,
     OrbitSummary,

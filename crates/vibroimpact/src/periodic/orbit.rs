@@ -2,6 +2,7 @@
 //! the summary of an orbit over its first period (samples, exact extrema,
 //! impacts).
 
+use super::settling::{self, Verdict};
 use super::*;
 
 /// A start guess by simulation: the state after `periods` forcing periods
@@ -28,13 +29,52 @@ pub fn guess_by_simulation_with(
     rtol: f64,
     interrupt: Option<Interrupt>,
 ) -> Result<Vec<f64>, PeriodicError> {
+    simulated(model, periods, rtol, interrupt, 0).map(|(state, _)| state)
+}
+
+/// Forcing periods of samples [`settled_guess`] judges.
+pub(crate) const GUESS_WINDOW: usize = 24;
+
+/// [`guess_by_simulation_with`] with the verdict of its last
+/// [`GUESS_WINDOW`] Poincaré samples (docs/theory.md §8, the sweeps' test at
+/// their cluster tolerance max(1e-5, 1000 rtol)): whether a Newton solve
+/// from it can converge. At 0.5 ω0 on R2 N = 2 the 200-period guess is
+/// irregular and Newton stalled after 23 variational period maps, a third
+/// of the whole branch's time, before the homotopy started. None where the
+/// run is shorter than the window.
+pub(crate) fn settled_guess(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+    interrupt: Option<Interrupt>,
+) -> Result<(Vec<f64>, Option<Verdict>), PeriodicError> {
+    simulated(model, periods, rtol, interrupt, GUESS_WINDOW)
+}
+
+/// The state after `periods` forcing periods, and the verdict of the last
+/// `window` samples one forcing period apart (none for 0 or a shorter run).
+fn simulated(
+    model: &Model,
+    periods: f64,
+    rtol: f64,
+    interrupt: Option<Interrupt>,
+    window: usize,
+) -> Result<(Vec<f64>, Option<Verdict>), PeriodicError> {
     let t = forcing_period(model)?;
+    let t_end = periods * t;
+    let sampled = window > 0 && periods >= window as f64;
     let opts = SimulationOptions {
-        t_end: periods * t,
+        t_end,
         rtol,
         atol: rtol * 1e-4,
         interrupt,
         integrator: Integrator::Auto,
+        output_step: sampled.then_some(t),
+        output_from: if sampled {
+            t_end - (window - 1) as f64 * t
+        } else {
+            0.0
+        },
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).map_err(|e: OptionsError| PeriodicError::Options(e.0))?;
@@ -44,7 +84,20 @@ pub fn guess_by_simulation_with(
             source: e.source,
         });
     }
-    Ok(sim.final_state())
+    let d = 2 * model.bodies().len();
+    let samples: Vec<Vec<f64>> = sim.states.chunks_exact(d).map(<[f64]>::to_vec).collect();
+    let verdict = (sampled && samples.len() >= window).then(|| {
+        let n = d / 2;
+        let largest = |r: std::ops::Range<usize>| {
+            samples
+                .iter()
+                .flat_map(|s| s[r.clone()].iter().map(|x| x.abs()))
+                .fold(f64::MIN_POSITIVE, f64::max)
+        };
+        let scale = (largest(0..n), largest(n..d));
+        settling::verdict(&samples, scale, 1e-5_f64.max(1e3 * rtol))
+    });
+    Ok((sim.final_state(), verdict))
 }
 
 /// Impacts of one contact over one period of an orbit.

@@ -30,10 +30,10 @@ use serde::Serialize;
 use crate::field_error::FieldError;
 use crate::integrate::{Interrupt, Method};
 use crate::maps::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use crate::maps::settling::Motion;
 use crate::model::family::{Family, FamilyError};
 use crate::model::file::LoadedModel;
 use crate::model::{BaseExcitation, HarmonicForce, Model, ModelError};
+use crate::periodic::settling::Motion;
 use crate::simulate::{simulate, Integrator, Simulation, SimulationOptions};
 
 mod value;

@@ -1,8 +1,8 @@
 //! Tests of the sweep (`mod.rs`).
 
 use super::*;
-use crate::maps::settling::Motion;
 use crate::model::parameter::ParameterizedModel;
+use crate::periodic::settling::Motion;
 
 #[test]
 fn values_are_even_with_exact_ends() {

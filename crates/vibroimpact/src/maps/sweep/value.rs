@@ -4,7 +4,7 @@
 //! converge (docs/theory.md §8).
 
 use super::*;
-use crate::maps::settling::{verdict, Motion};
+use crate::periodic::settling::{verdict, Motion};
 
 /// `model` started from `(u, v)` at the instant whose forcing phase is
 /// `phase`/[`FINE`] of a period: every harmonic excitation's phase is advanced
