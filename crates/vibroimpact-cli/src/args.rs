@@ -134,9 +134,9 @@ pub struct ParameterRange {
 /// How `continue` finds its first periodic orbit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum StartMethod {
-    /// A guess by simulation, then the homotopy if its last 24 periods
-    /// have not settled onto an orbit of the sought period or Newton does
-    /// not converge from it.
+    /// A guess by simulation, then the homotopy if its last 24 periods are
+    /// neither near repeating with the orbit's period nor settling onto it,
+    /// or if Newton does not converge from it.
     Auto,
     /// The state after --guess-periods forcing periods from the model's
     /// initial state.

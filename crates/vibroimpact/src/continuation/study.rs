@@ -11,15 +11,15 @@ use crate::field_error::FieldError;
 use crate::model::family::{Family, FamilyError};
 use crate::model::file::ModelFileError;
 use crate::model::Model;
-use crate::periodic::settling::Motion;
 use crate::periodic::{guess_by_simulation_with, settled_guess, PeriodicError};
 
 /// How a branch study finds its first periodic orbit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Start {
-    /// A guess by simulation; where its last samples have not settled onto
-    /// an orbit of the sought period (docs/theory.md §8), or Newton does
-    /// not converge from it, the homotopy. (The simulated guess, where it converges, is the attractor
+    /// A guess by simulation; where its last samples are neither near
+    /// repeating with the orbit's period nor settling onto it
+    /// (docs/theory.md §8), or Newton does not converge from it, the
+    /// homotopy. (The simulated guess, where it converges, is the attractor
     /// a simulation shows; the homotopy's orbit lies on the branch that
     /// grows from rest, which at a given value may be another one.)
     #[default]
@@ -340,19 +340,14 @@ impl<F: Family> CheckedBranch<F> {
                     .map_err(StudyError::Guess)?
             }
             Start::Auto => {
-                let (guess, verdict) =
-                    settled_guess(&self.start_model, study.guess_periods, 1e-9, interrupt())
-                        .map_err(StudyError::Guess)?;
-                // Samples that do not repeat, or repeat with a period the
-                // orbit sought does not have, leave Newton no basin.
                 let n = opts.shooting.subharmonic as usize;
-                let hopeless = verdict.is_some_and(|v| {
-                    v.motion == Motion::Irregular || v.period.is_some_and(|p| n % p != 0)
-                });
-                if hopeless {
-                    homotopy_guess(&self.family, study.from, opts)?
-                } else {
+                let (guess, worth) =
+                    settled_guess(&self.start_model, study.guess_periods, 1e-9, interrupt(), n)
+                        .map_err(StudyError::Guess)?;
+                if worth {
                     guess
+                } else {
+                    homotopy_guess(&self.family, study.from, opts)?
                 }
             }
         };

@@ -2,7 +2,7 @@
 //! the summary of an orbit over its first period (samples, exact extrema,
 //! impacts).
 
-use super::settling::{self, Verdict};
+use super::settling::{self, Motion};
 use super::*;
 
 /// A start guess by simulation: the state after `periods` forcing periods
@@ -33,33 +33,58 @@ pub fn guess_by_simulation_with(
 }
 
 /// Forcing periods of samples [`settled_guess`] judges.
-pub(crate) const GUESS_WINDOW: usize = 24;
+const GUESS_WINDOW: usize = 24;
 
-/// [`guess_by_simulation_with`] with the verdict of its last
-/// [`GUESS_WINDOW`] Poincaré samples (docs/theory.md §8, the sweeps' test at
-/// their cluster tolerance max(1e-5, 1000 rtol)): whether a Newton solve
-/// from it can converge. At 0.5 ω0 on R2 N = 2 the 200-period guess is
-/// irregular and Newton stalled after 23 variational period maps, a third
-/// of the whole branch's time, before the homotopy started. None where the
-/// run is shorter than the window.
+/// The largest scaled difference of samples n periods apart at the end of
+/// a simulated guess from which Newton is tried whatever the samples'
+/// verdict. R2 N = 2 (`examples/fujita-row-n2.toml`, 200 periods):
+/// guesses from which Newton converged ended at 6e-6 to 2e-5 (at 1.2 to
+/// 1.5 ω0, still settling too slowly for the verdict's window); those on
+/// period-4 or chaotic motion at 0.3 to 1.1, and Newton stalled there.
+const NEWTON_REACH: f64 = 1e-2;
+
+/// [`guess_by_simulation_with`], and whether a Newton solve for an orbit
+/// of `n` forcing periods is worth starting from it, by its last
+/// [`GUESS_WINDOW`] Poincaré samples: yes where samples n periods apart
+/// end within [`NEWTON_REACH`] of each other, or where the sweeps' test
+/// (docs/theory.md §8, at their cluster tolerance max(1e-5, 1000 rtol))
+/// finds them periodic or settling with a period that divides n. At 0.5 ω0
+/// on R2 N = 2 the 200-period guess settles onto period 4, and Newton from
+/// it stalled after 23 variational period maps, a fifth of the whole
+/// branch's time, before the homotopy started. Yes where the run is
+/// shorter than the window.
 pub(crate) fn settled_guess(
     model: &Model,
     periods: f64,
     rtol: f64,
     interrupt: Option<Interrupt>,
-) -> Result<(Vec<f64>, Option<Verdict>), PeriodicError> {
-    simulated(model, periods, rtol, interrupt, GUESS_WINDOW)
+    n: usize,
+) -> Result<(Vec<f64>, bool), PeriodicError> {
+    let (state, window) = simulated(model, periods, rtol, interrupt, GUESS_WINDOW)?;
+    let worth = window.is_none_or(|(samples, scale)| {
+        let n = n.max(1);
+        let len = samples.len();
+        let near = n < len
+            && (len.saturating_sub(2 * n)..len - n)
+                .all(|k| settling::difference(&samples[k], &samples[k + n], scale) <= NEWTON_REACH);
+        let v = settling::verdict(&samples, scale, 1e-5_f64.max(1e3 * rtol));
+        near || (v.motion != Motion::Irregular && v.period.is_some_and(|p| n % p == 0))
+    });
+    Ok((state, worth))
 }
 
-/// The state after `periods` forcing periods, and the verdict of the last
-/// `window` samples one forcing period apart (none for 0 or a shorter run).
+/// Poincaré samples of a run and their scales (largest |u|, largest |v|).
+type Window = (Vec<Vec<f64>>, (f64, f64));
+
+/// The state after `periods` forcing periods, and its last `window`
+/// samples one forcing period apart (none for 0 or a shorter run).
 fn simulated(
     model: &Model,
     periods: f64,
     rtol: f64,
     interrupt: Option<Interrupt>,
     window: usize,
-) -> Result<(Vec<f64>, Option<Verdict>), PeriodicError> {
+) -> Result<(Vec<f64>, Option<Window>), PeriodicError> {
     let t = forcing_period(model)?;
     let t_end = periods * t;
     let sampled = window > 0 && periods >= window as f64;
@@ -86,18 +111,15 @@ fn simulated(
     }
     let d = 2 * model.bodies().len();
     let samples: Vec<Vec<f64>> = sim.states.chunks_exact(d).map(<[f64]>::to_vec).collect();
-    let verdict = (sampled && samples.len() >= window).then(|| {
-        let n = d / 2;
-        let largest = |r: std::ops::Range<usize>| {
-            samples
-                .iter()
-                .flat_map(|s| s[r.clone()].iter().map(|x| x.abs()))
-                .fold(f64::MIN_POSITIVE, f64::max)
-        };
-        let scale = (largest(0..n), largest(n..d));
-        settling::verdict(&samples, scale, 1e-5_f64.max(1e3 * rtol))
-    });
-    Ok((sim.final_state(), verdict))
+    let largest = |r: std::ops::Range<usize>| {
+        samples
+            .iter()
+            .flat_map(|s| s[r.clone()].iter().map(|x| x.abs()))
+            .fold(f64::MIN_POSITIVE, f64::max)
+    };
+    let scale = (largest(0..d / 2), largest(d / 2..d));
+    let window = (sampled && samples.len() >= window).then_some((samples, scale));
+    Ok((sim.final_state(), window))
 }
 
 /// Impacts of one contact over one period of an orbit.

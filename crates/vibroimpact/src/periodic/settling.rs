@@ -37,7 +37,7 @@ pub(crate) struct Verdict {
 
 /// The largest difference of two samples `[u.., v..]`, each component
 /// relative to its scale (displacements, velocities).
-fn difference(a: &[f64], b: &[f64], scale: (f64, f64)) -> f64 {
+pub(crate) fn difference(a: &[f64], b: &[f64], scale: (f64, f64)) -> f64 {
     let n = a.len() / 2;
     (0..2 * n).fold(0.0f64, |m, i| {
         let s = if i < n { scale.0 } else { scale.1 };

@@ -431,6 +431,14 @@ impl Run<'_> {
         // The rounding of s: a gap that close to activation and closing is
         // active (else checks would hover there at rounding-sized steps).
         let mut size = c.clearance;
+        // Every body feels the base as −m z̈, so between two bodies it
+        // cancels in s̈ (it still feeds their energies); against a wall,
+        // which moves with the base, it does not.
+        let zdd_in_gap = if c.pair.left().is_some() && c.pair.right().is_some() {
+            0.0
+        } else {
+            zdd
+        };
         for (side, sign) in [c.pair.left(), c.pair.right()].into_iter().zip([1.0, -1.0]) {
             let Some(i) = side else { continue };
             let (g, j) = self.free.place(i);
@@ -439,7 +447,8 @@ impl Run<'_> {
             s0 += sign * x[2 * j];
             sd0 += sign * x[2 * j + 1];
             let group = &self.free.groups()[g];
-            acc += group.acceleration_bound(j, group.energy_ahead(x, horizon, zdd), zdd);
+            let energy = group.energy_ahead(x, horizon, zdd);
+            acc += group.acceleration_bound(j, energy, zdd_in_gap);
         }
         if !(s0.is_finite() && sd0.is_finite() && acc.is_finite()) {
             return None;
@@ -456,6 +465,7 @@ impl Run<'_> {
         match self.safe_until(k, t) {
             None => true,
             Some(until) => {
+                let until = self.free.sample_before(t, until);
                 if until < self.opts.t_end {
                     self.queue
                         .push(Reverse((Time(until), k, self.generation[k])));

@@ -92,6 +92,26 @@ impl FreeMotion {
     pub fn base_peak(&self, a: f64, b: f64) -> f64 {
         self.peaks.between(a, b)
     }
+
+    /// A check's time `until` (after `t`) moved back to the last record
+    /// sample after `t`, if there is one: checking earlier is always safe,
+    /// and a group checked at samples moves between them by the whole
+    /// sample step, computed once, instead of the partial steps' complex
+    /// exponentials per mode (a row of 16 buildings under a record: 3.7 µs
+    /// a check, a third of it in those exponentials; the run 105 → 68 ms).
+    /// Only where that keeps four fifths of the safe interval: checks of a
+    /// sample or two, near yield or contact, would come back more often
+    /// (at half, the row at full scale took 29 % more storey checks and
+    /// 6 % more time; at four fifths 2 % less time). Not a record, or no
+    /// such sample: `until`.
+    pub fn sample_before(&self, t: f64, until: f64) -> f64 {
+        let times = &self.peaks.times;
+        let k = times.partition_point(|&s| s <= until);
+        match k.checked_sub(1).map(|i| times[i]) {
+            Some(s) if s - t >= 0.8 * (until - t) => s,
+            _ => until,
+        }
+    }
 }
 
 impl Group {
