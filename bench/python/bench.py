@@ -181,6 +181,8 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--quick", action="store_true", help="fewer repeats, 16 sweep frequencies")
     p.add_argument("--out", help="also write the report (text) and FILE.json")
+    p.add_argument("--only", choices=("overhead", "impact", "scipy", "dask"), action="append",
+                   help="run only these parts (repeatable; default: all)")
     a = p.parse_args()
     repeats = 5 if a.quick else 31
     lines = [
@@ -188,12 +190,13 @@ def main():
         f"# python {platform.python_version()}, numpy {np.__version__}, vibroimpact {vi.__version__}, "
         f"{os.cpu_count()} cores; command: .venv/bin/python bench/python/bench.py{' --quick' if a.quick else ''}",
     ]
-    results = {
-        "overhead": overhead(repeats, lines),
-        "impact": impact_speed(10**6, max(3, repeats // 5), lines),
-        "scipy": scipy_comparison(repeats, lines),
-        "dask": dask_comparison(16 if a.quick else 64, lines),
+    parts = {
+        "overhead": lambda: overhead(repeats, lines),
+        "impact": lambda: impact_speed(10**6, max(3, repeats // 5), lines),
+        "scipy": lambda: scipy_comparison(repeats, lines),
+        "dask": lambda: dask_comparison(16 if a.quick else 64, lines),
     }
+    results = {name: run() for name, run in parts.items() if not a.only or name in a.only}
     text = "\n".join(lines) + "\n"
     print(text, end="")
     if a.out:

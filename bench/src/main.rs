@@ -31,6 +31,12 @@
 //! is in `common.rs`.
 //!
 //! Run: `cargo run --release -p vibroimpact-bench [-- --quick] [--no-peers]`.
+//!
+//! `-- --check` reruns the headline comparisons instead (`check.rs`: the
+//! ratios beside the recorded ones in `bench/results/`, a non-zero exit
+//! where one fell by more than 20 %); `--record` with it makes the new
+//! ratios the recorded ones. Run it before a change to a hot path is
+//! committed.
 //! It builds the peers itself (`bench/peers/build.sh`, which installs
 //! libsundials-dev and a Python venv with NumPy and SciPy if missing).
 
@@ -39,6 +45,7 @@ use std::path::{Path, PathBuf};
 use clap::Parser;
 use serde_json::Value;
 
+mod check;
 mod common;
 mod sections;
 
@@ -57,15 +64,33 @@ struct Args {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Run only one section: n3, n1000, scaling, shooting, local or
-    /// storeys.
+    /// storeys (with --check: one comparison, e.g. auto-n2).
     #[arg(long)]
     only: Option<String>,
+    /// Rerun the headline comparisons and compare each ratio with the
+    /// recorded one (bench/results/NAME.json); exit 1 where one fell by
+    /// more than 20 %.
+    #[arg(long)]
+    check: bool,
+    /// With --check: record the new ratios (the old files go to
+    /// bench/results/archive/DATE/).
+    #[arg(long, requires = "check")]
+    record: bool,
 }
 
 fn main() {
     let args = Args::parse();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let peers = (!args.no_peers).then(|| peer_or_exit(Peers::build(&root)));
+    if args.check {
+        let root = root.canonicalize().unwrap_or(root);
+        std::process::exit(check::run(
+            &root,
+            peers.as_ref(),
+            args.record,
+            args.only.as_deref(),
+        ));
+    }
     let mut results = serde_json::Map::new();
     for (name, section) in sections::ALL {
         if args.only.as_deref().is_none_or(|o| o == name) {

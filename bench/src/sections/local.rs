@@ -48,7 +48,7 @@ pub fn run(peers: Option<&Peers>, quick: bool) -> Entries {
 }
 
 /// Section 1: R2 N = 1000, 3 periods, every solver's robust setting.
-fn r2_n1000(peers: Option<&Peers>, repeats: usize) -> Value {
+pub fn r2_n1000(peers: Option<&Peers>, repeats: usize) -> Value {
     println!("\n== local integrator: R2, N = 1000, 3 periods, error <= 1e-5 against ARKODE Verner 8 at rtol 1e-11 ==");
     let model = r2(1000);
     let t = t_end(3.0);
@@ -132,7 +132,7 @@ fn r2_n1000(peers: Option<&Peers>, repeats: usize) -> Value {
 }
 
 /// Section 2: the struck chain, local from 10³ beads up, global to 10⁴.
-fn struck_chain(quick: bool, repeats: usize) -> Value {
+pub fn struck_chain(quick: bool, repeats: usize) -> Value {
     println!("\n== local integrator: struck Hertzian chain, 0.02 s, default settings (rtol 1e-8, atol 1e-12) ==");
     let duration = 0.02;
     let converged = peak(&ours_with(

@@ -213,9 +213,29 @@ pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
             };
             let (tg, global) = timed(&model, &opts(Integrator::Global), repeats);
             let (tl, local) = timed(&model, &opts(Integrator::Local), repeats);
+            let tight = |rtol: f64| SimulationOptions {
+                rtol,
+                atol: 1e-4 * rtol,
+                method: Method::Dop853,
+                ..opts(Integrator::Global)
+            };
+            let (_, reference) = timed(&model, &tight(1e-12), 1);
+            // The global run at the local one's error, where the local run
+            // is exact (no storey leaves its elastic branch).
+            let (t8, global8) = timed(&model, &tight(1e-8), repeats);
+            let bodies = model.bodies().len();
+            let (err_g, err_l, err_g8) = (
+                difference(&global, &reference, bodies),
+                difference(&local, &reference, bodies),
+                difference(&global8, &reference, bodies),
+            );
+            println!(
+                "K = {k:>3}, scale {scale}: global DOP853 rtol 1e-8 {:>8.2} ms (error {err_g8:.1e})",
+                t8 * 1e3
+            );
             let stats = local.local.clone().expect("a local run");
             println!(
-                "K = {k:>3}, scale {scale}: global {:>8.2} ms, local {:>8.2} ms (local / global {:.2}); {} impacts, {} of {} bodies integrated, {} checks",
+                "K = {k:>3}, scale {scale}: global {:>8.2} ms (error {err_g:.1e}), local {:>8.2} ms (error {err_l:.1e}; local / global {:.2}); {} impacts, {} of {} bodies integrated, {} checks",
                 tg * 1e3,
                 tl * 1e3,
                 tl / tg,
@@ -226,6 +246,8 @@ pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
             );
             rows.push(
                 json!({"buildings": k, "scale": scale, "global_seconds": tg, "local_seconds": tl,
+                "global_error": err_g, "local_error": err_l,
+                "global_dop853_1e-8_seconds": t8, "global_dop853_1e-8_error": err_g8,
                 "impacts": global.impacts.len(), "bodies_integrated": stats.bodies_integrated(),
                 "bodies": model.bodies().len(), "checks": stats.contact_checks}),
             );
