@@ -169,10 +169,10 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
             return;
         }
         self.jacobian_at(t, &z[..d]);
-        for c in 0..self.carried() {
-            let range = d * (1 + c)..d * (2 + c);
-            self.jac.mul_vec(&z[range.clone()], &mut dzdt[range]);
-        }
+        let k = self.carried();
+        let columns = d..d * (1 + k);
+        self.jac
+            .mul_columns(&z[columns.clone()], &mut dzdt[columns], k);
         if let Some((shifted, dp)) = &mut self.parameter {
             shifted.rhs(t, &z[..d], &mut self.f1);
             let (f0, rest) = dzdt.split_at_mut(d);
