@@ -46,7 +46,7 @@ impl From<SweepError> for MapError {
 /// The run settings of charts and basins: `options` for models like
 /// `base`, with [`DEFAULT_RTOL`] where neither the options nor the model
 /// give one, and a sweep's cluster tolerance, max(1e-5, 1000 rtol): runs
-/// still settling are extended or classed so (`maps::settling`), so a
+/// still settling are extended or classed so (`periodic::settling`), so a
 /// coarser tolerance for the free oscillation 100 periods leave is not
 /// needed, and a chart and a sweep agree on which values are periodic.
 pub(crate) fn settings(base: &LoadedModel, options: &SweepOptions) -> Result<Settings, SweepError> {
@@ -90,7 +90,7 @@ pub struct Run {
     /// Period of the attractor in forcing periods: the smallest p, at most
     /// half the recorded periods, with s_{k+p} = s_k (to the cluster
     /// tolerance) for every pair of recorded Poincaré samples, once they
-    /// have settled ([`crate::maps::settling`]); null when they do not
+    /// have settled ([`crate::periodic::settling`]); null when they do not
     /// repeat (quasi-periodic, chaotic, or still settling when the periods
     /// allowed ran out).
     pub period: Option<usize>,
@@ -163,7 +163,7 @@ fn classify(start: Vec<f64>, point: SweepPoint, omega: f64) -> (Run, Recorded) {
     let max_u = point.max_displacement.iter().copied().fold(0.0, f64::max);
     let scale = (max_u, max_u * omega);
     // Periodic only once the samples repeat (a run still settling, or
-    // one whose periods to settle ran out, is not: `maps::settling`).
+    // one whose periods to settle ran out, is not: `periodic::settling`).
     let period = point.period;
     let run = Run {
         start,
