@@ -152,7 +152,7 @@ impl CheckedOrbit {
     /// The estimated work of [`CheckedOrbit::run`] on one core, for the
     /// faces to announce when it is long (`periodic` on a row of 10⁶
     /// bodies said nothing first): the guess's simulation, then about
-    /// [`NEWTON_STEPS`] period maps, each with its columns (dense: 2N,
+    /// `NEWTON_STEPS` period maps, each with its columns (dense: 2N,
     /// integrated with the state; matrix-free: the Arnoldi dimension's
     /// products, each priced at a period), and the orbit's summary. None
     /// where a run is refused (the run says why).

@@ -284,7 +284,7 @@ impl StoreyTerms {
     /// Storey k's switch function in `y`: positive while its branch
     /// holds, zero where it switches (a bilinear storey: yield from the
     /// elastic branch, unloading from the plastic one; an IMK storey:
-    /// [`Imk::switch_value`](crate::model::hysteresis::Imk::switch_value)).
+    /// [`Imk::switch_value`](crate::model::hysteresis::imk::Imk::switch_value)).
     pub fn switch_value(&self, k: usize, y: &[f64]) -> f64 {
         let (drift, rate) = self.switch_parts(k, y);
         drift.min(rate)

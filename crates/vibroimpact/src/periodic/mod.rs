@@ -106,7 +106,7 @@ pub struct ShootingOptions {
 }
 
 impl ShootingOptions {
-    /// Refuses tolerances outside [`FieldError::tolerance`]'s range and a
+    /// Refuses tolerances outside [`FieldError::tolerance`](crate::field_error::FieldError::tolerance)'s range and a
     /// displacement scale that is not positive, by name.
     pub fn check(&self) -> Result<(), PeriodicError> {
         use crate::field_error::FieldError;

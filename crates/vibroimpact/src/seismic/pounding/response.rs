@@ -70,7 +70,7 @@ pub struct StoreyLoop {
     pub force: Vec<f64>,
 }
 
-/// Why a run ([`Row::respond_until`]) ended.
+/// Why a run ([`Row::respond_until`](super::Row::respond_until)) ended.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Stop {
     /// At the end of the record (and its tail).
@@ -88,7 +88,7 @@ pub enum Stop {
     },
 }
 
-/// A row's time history ([`Row::history`]).
+/// A row's time history ([`Row::history`](super::Row::history)).
 #[derive(Clone, Debug)]
 pub struct History {
     /// The model it ran, with its layout.

@@ -40,7 +40,7 @@
 //! rest state; a bilinear storey's approach to yield is checked like a
 //! contact's (its drift against the branch's window), and its group is
 //! integrated, its branches switched at located events, from within
-//! [`storeys::YIELD_APPROACH`] of yield until it is elastic and safely
+//! `storeys::YIELD_APPROACH` of yield until it is elastic and safely
 //! below yield again. A Bouc–Wen storey's group is integrated throughout.
 
 use std::cmp::Reverse;
