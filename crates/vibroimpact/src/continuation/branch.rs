@@ -3,10 +3,10 @@
 //! points), ending with the reason it stopped.
 
 use crate::model::family::Family;
-use nalgebra::Complex;
+use nalgebra::{Complex, DMatrix};
 
 use super::events::{BranchEvent, BUILT_IN};
-use super::problem::{period_image, Evaluated, Problem};
+use super::problem::{period_image, Evaluated, Linear, Problem};
 use super::{
     is_symmetric_orbit, BranchPoint, ContinuationError, ContinuationOptions, SpecialPoint,
     StopReason,
@@ -67,6 +67,10 @@ pub struct Continuation<F> {
     /// The change of the unit tangent per arclength over the last step
     /// (second-order predictor).
     curvature: Option<Vec<f64>>,
+    /// The change of the dense Jacobian [Ĵ_x Ĝ_p] per arclength over the
+    /// last step: the corrector's chord starts from the Jacobian
+    /// extrapolated to the predicted point.
+    jacobian_rate: Option<DMatrix<f64>>,
     done: bool,
 }
 
@@ -171,6 +175,7 @@ impl<F: Family> Continuation<F> {
             symmetric,
             pending: None,
             curvature: None,
+            jacobian_rate: None,
             done: false,
             problem,
         };
@@ -231,7 +236,14 @@ impl<F: Family> Continuation<F> {
                 .for_each(|(z, k)| *z += 0.5 * ds * ds * k);
         }
         let tangent = self.current.tangent.clone();
-        let nearby = Some(&self.current.solved.linear);
+        let extrapolated = match (&self.current.solved.linear, &self.jacobian_rate) {
+            (Linear::Dense { jac, monodromy }, Some(rate)) => Some(Linear::Dense {
+                jac: jac + rate * ds,
+                monodromy: monodromy.clone(),
+            }),
+            _ => None,
+        };
+        let nearby = Some(extrapolated.as_ref().unwrap_or(&self.current.solved.linear));
         let (solved, iterations) = self.problem.correct(&pred, &tangent, nearby).ok_or(fail)?;
         // The cheap checks first: the orbit summary (an integration) only
         // for a step that is kept.
@@ -376,6 +388,12 @@ impl<F: Family> Continuation<F> {
                 .map(|(a, b)| (a - b) / h)
                 .collect()
         });
+        self.jacobian_rate = match (&next.solved.linear, &self.current.solved.linear) {
+            (Linear::Dense { jac: a, .. }, Linear::Dense { jac: b, .. }) if h > 0.0 => {
+                Some((a - b) / h)
+            }
+            _ => None,
+        };
         let previous_z = std::mem::replace(&mut self.current, next).solved.z;
         if beyond {
             let bound = if p > self.bounds.1 {

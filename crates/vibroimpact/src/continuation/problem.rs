@@ -637,8 +637,19 @@ impl<F: Family> Problem<F> {
             }
             let width = hi - lo;
             let secant = lo - g_lo * width / (g_hi - g_lo);
+            // A secant within 2 % of the end that moved last: the root is
+            // next to that point, and a step of half the tolerance past it
+            // closes the bracket (R2 N = 2: one evaluation less a location,
+            // where the 2 % step had taken two). Else at least 2 % in.
+            let near = 0.02 * width;
+            let half_tol = 0.5 * width * self.opts.locate_tol / (p_hi - p_lo).abs();
+            let (m_lo, m_hi) = match moved_hi {
+                Some(true) if secant > hi - near => (near, near.min(half_tol)),
+                Some(false) if secant < lo + near => (near.min(half_tol), near),
+                _ => (near, near),
+            };
             let mid = if secant.is_finite() && g_lo * g_hi < 0.0 {
-                secant.clamp(lo + 0.02 * width, hi - 0.02 * width)
+                secant.clamp(lo + m_lo, hi - m_hi)
             } else {
                 0.5 * (lo + hi)
             };
