@@ -9,7 +9,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector};
 
 use super::events::{BranchEvent, Observed, TestValues};
-use super::{BranchPoint, ContinuationError, ContinuationOptions};
+use super::{BranchPoint, ContinuationError, ContinuationOptions, SpecialKind};
 use crate::model::Model;
 use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
 use crate::periodic::{
@@ -207,29 +207,12 @@ impl<F: Family> Problem<F> {
         t: &[f64],
         nearby: Option<&Linear>,
     ) -> Option<(Solved, usize)> {
-        let opts = NewtonOptions {
-            tol: self.opts.shooting.tol,
-            max_iterations: self.opts.max_corrector.saturating_sub(1),
-            max_step: self.opts.step.corrector_max_step,
-            line_search: false,
-            // The correction is negligible although the residual is a
-            // little above tol.
-            stall: Some((1e-2, 100.0)),
-        };
+        let opts = self.corrector_options();
         let chord = match nearby {
             Some(Linear::Dense { jac, .. }) => Some(bordered(jac, t)),
             _ => None,
         };
-        let mut corrector = Corrector {
-            problem: self,
-            pred,
-            t,
-            chord,
-            chord_norms: Vec::new(),
-            last: None,
-            full_seen: false,
-            krylov_norm: None,
-        };
+        let mut corrector = Corrector::new(self, pred, t, chord, false);
         let out = damped_newton(&mut corrector, pred, &opts).ok()?;
         let rate = corrector
             .chord_norms
@@ -272,6 +255,65 @@ impl<F: Family> Problem<F> {
                 2 * full.saturating_sub(1) + chord.div_ceil(2)
             },
         ))
+    }
+}
+
+impl<F: Family> Problem<F> {
+    /// The corrector's Newton options: no line search, steps damped to
+    /// `step.corrector_max_step`, stagnation at the period map's noise
+    /// floor accepted.
+    fn corrector_options(&self) -> NewtonOptions {
+        NewtonOptions {
+            tol: self.opts.shooting.tol,
+            max_iterations: self.opts.max_corrector.saturating_sub(1),
+            max_step: self.opts.step.corrector_max_step,
+            line_search: false,
+            // The correction is negligible although the residual is a
+            // little above tol.
+            stall: Some((1e-2, 100.0)),
+        }
+    }
+
+    /// The corrector's solution from `pred` by chord iterations alone
+    /// with the dense Jacobian of `nearby` (Broyden-updated): state-only
+    /// maps, no variational one, so the solution comes without its own
+    /// Jacobian. None where `nearby` is matrix-free or the chord does not
+    /// converge.
+    fn correct_chord(&mut self, pred: &[f64], t: &[f64], nearby: &Linear) -> Option<Vec<f64>> {
+        let Linear::Dense { jac, .. } = nearby else {
+            return None;
+        };
+        let opts = self.corrector_options();
+        let chord = Some(bordered(jac, t));
+        let mut corrector = Corrector::new(self, pred, t, chord, true);
+        let out = damped_newton(&mut corrector, pred, &opts).ok()?;
+        (out.stop == NewtonStop::Converged).then_some(out.x)
+    }
+
+    /// A trial point of a location whose event reads only the orbit (a
+    /// grazing: the impacts per period and the impact margin), corrected
+    /// by the chord alone from `a` and summarised. Its linearisation,
+    /// tangent, multipliers and other test values are `a`'s stand-ins, so
+    /// it is provisional: the point a location ends on is evaluated in
+    /// full. R2 N = 2: a grazing whose impact splits in two is bisected in
+    /// 20 trials, each of which had cost a variational map.
+    fn trial_on_orbit(&mut self, pred: &[f64], a: &Evaluated) -> Option<Evaluated> {
+        let z = self.correct_chord(pred, &a.tangent, &a.solved.linear)?;
+        let (state, parameter) = self.unscale(&z);
+        let e = Evaluated {
+            solved: Solved {
+                z,
+                linear: a.solved.linear.clone(),
+            },
+            tangent: a.tangent.clone(),
+            point: BranchPoint {
+                parameter,
+                state,
+                ..a.point.clone()
+            },
+            tests: a.tests,
+        };
+        self.add_orbit(e)
     }
 }
 
@@ -526,8 +568,32 @@ struct Corrector<'p, 'a, F> {
     last: Option<(Vec<f64>, Vec<f64>)>,
     /// Whether an iterate was evaluated in full (Newton from then on).
     full_seen: bool,
+    /// Chord iterations only, never a full evaluation.
+    chord_only: bool,
     /// Residual norm of the last matrix-free iterate (divergence test).
     krylov_norm: Option<f64>,
+}
+
+impl<'p, 'a, F> Corrector<'p, 'a, F> {
+    fn new(
+        problem: &'p mut Problem<F>,
+        pred: &'a [f64],
+        t: &'a [f64],
+        chord: Option<DMatrix<f64>>,
+        chord_only: bool,
+    ) -> Self {
+        Self {
+            problem,
+            pred,
+            t,
+            chord,
+            chord_norms: Vec::new(),
+            last: None,
+            full_seen: false,
+            chord_only,
+            krylov_norm: None,
+        }
+    }
 }
 
 impl<F: Family> NewtonSystem for Corrector<'_, '_, F> {
@@ -539,17 +605,18 @@ impl<F: Family> NewtonSystem for Corrector<'_, '_, F> {
 
     fn evaluate(&mut self, z: &[f64]) -> Result<Self::Point, ()> {
         let tol = self.problem.opts.shooting.tol;
-        let full = self.chord.is_none()
-            || self.full_seen
-            || match self.chord_norms[..] {
-                [.., a, b] => b > 0.25 * a || 10.0 * b * b / a <= tol,
-                // After the first chord iterate: the last correction's
-                // contraction, with a factor 4 to spare, predicts
-                // convergence (R2 N = 2: right 88 times in 89, each time
-                // one state-only map saved).
-                [a] => 4.0 * self.problem.chord_rate * a <= tol,
-                _ => false,
-            };
+        let full = !self.chord_only
+            && (self.chord.is_none()
+                || self.full_seen
+                || match self.chord_norms[..] {
+                    [.., a, b] => b > 0.25 * a || 10.0 * b * b / a <= tol,
+                    // After the first chord iterate: the last correction's
+                    // contraction, with a factor 4 to spare, predicts
+                    // convergence (R2 N = 2: right 88 times in 89, each time
+                    // one state-only map saved).
+                    [a] => 4.0 * self.problem.chord_rate * a <= tol,
+                    _ => false,
+                });
         self.full_seen |= full;
         let r = self.problem.residual(z, full).ok_or(())?;
         let c = (0..z.len())
@@ -650,6 +717,8 @@ impl<F: Family> Problem<F> {
         let mut moved_hi: Option<bool> = None;
         let mut best: Option<Evaluated> = None;
         let mut lo_point: Option<Evaluated> = None;
+        let light = event.kind() == SpecialKind::Grazing;
+        let mut provisional = false;
         for _ in 0..80 {
             if (p_hi - p_lo).abs() <= self.opts.locate_tol && best.is_some() {
                 break;
@@ -672,8 +741,16 @@ impl<F: Family> Problem<F> {
             } else {
                 0.5 * (lo + hi)
             };
-            let (solved, _) = self.correct(&a.predict(mid), &a.tangent, Some(&a.solved.linear))?;
-            let e = self.evaluate_with(solved, &a.tangent, event.needs_orbit())?;
+            let pred = a.predict(mid);
+            let trial = light.then(|| self.trial_on_orbit(&pred, a)).flatten();
+            provisional = trial.is_some();
+            let e = match trial {
+                Some(e) => e,
+                None => {
+                    let (solved, _) = self.correct(&pred, &a.tangent, Some(&a.solved.linear))?;
+                    self.evaluate_with(solved, &a.tangent, event.needs_orbit())?
+                }
+            };
             let g = scalar.map_or(f64::NAN, |f| f(&e.tests));
             if event.between(lo_point.as_ref().unwrap_or(a).observed(), e.observed()) {
                 hi = mid;
@@ -698,6 +775,14 @@ impl<F: Family> Problem<F> {
                 break;
             }
         }
-        best
+        match best {
+            // Evaluated in full where it lies (its own Jacobian, tangent
+            // and multipliers): one chord iterate converges at once.
+            Some(e) if provisional => {
+                let (solved, _) = self.correct(&e.solved.z, &a.tangent, Some(&a.solved.linear))?;
+                self.evaluate_with(solved, &a.tangent, true)
+            }
+            best => best,
+        }
     }
 }
