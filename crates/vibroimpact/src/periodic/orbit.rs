@@ -52,8 +52,8 @@ const NEWTON_REACH: f64 = 1e-2;
 /// end within [`NEWTON_REACH`] of each other, or where the sweeps' test
 /// (docs/theory.md §8, at their cluster tolerance max(1e-5, 1000 rtol))
 /// finds them periodic or settling with a period that divides n. At 0.5 ω0
-/// on R2 N = 2 the 200-period guess settles onto period 4, and Newton from
-/// it stalled after 23 variational period maps, a fifth of the whole
+/// on R2 N = 2 the 200-period guess at rtol 1e-9 settled onto period 4,
+/// and Newton from it stalled after 23 variational period maps, a fifth of the whole
 /// branch's time, before the homotopy started. Yes where the run is
 /// shorter than the window.
 ///
