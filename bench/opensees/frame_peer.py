@@ -80,7 +80,7 @@ from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_frame import load, run, yield_drifts  # noqa: E402
 from opensees_pair import import_opensees  # noqa: E402
-from timing import IdleGate, Watch, retime, scan_opensees, timed  # noqa: E402
+from timing import IdleGate, Watch, finite, retime, scan_opensees, timed  # noqa: E402
 
 CASE = HERE.parents[1] / "examples" / "moment-frame-4.toml"
 CASES = {
@@ -358,17 +358,6 @@ def table(results):
                     f"({e['residual_self']:.1e}){'' if r['residuals_judged'] else ', not judged'} | {os_set} | "
                     f"{our_set} | {r['ratio']:.0f} ({re_:.0f}) |")
     return "\n".join(rows)
-
-
-def finite(x):
-    """``x`` with every non-finite float replaced by None, for strict JSON."""
-    if isinstance(x, float):
-        return x if np.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [finite(v) for v in x]
-    return x
 
 
 def main():

@@ -66,7 +66,7 @@ from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_isolated import load, run, yield_drifts  # noqa: E402
 from opensees_pair import import_opensees  # noqa: E402
-from timing import IdleGate, Watch, retime, scan_opensees, timed  # noqa: E402
+from timing import IdleGate, Watch, finite, retime, scan_opensees, timed  # noqa: E402
 
 CASE = HERE / "isolated-moat.toml"
 SCALE = 2.2
@@ -268,18 +268,6 @@ def table(results):
                     f"{e['drift']:.1e} | {e['residual']:.1e} ({e['residual_self']:.1e}) | {e['displacement']:.1e} | "
                     f"{e['force']:.1e} | {os_set} | {our_set} | {r['ratio']:.0f} |")
     return "\n".join(rows)
-
-
-def finite(x):
-    """``x`` with every non-finite float (a failed run's time or error)
-    replaced by None, for strict JSON."""
-    if isinstance(x, float):
-        return x if np.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [finite(v) for v in x]
-    return x
 
 
 def main():

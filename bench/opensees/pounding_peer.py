@@ -61,7 +61,7 @@ import vibroimpact as vi  # noqa: E402
 from vibroimpact.records import fema_p695  # noqa: E402
 
 from opensees_pair import import_opensees, inelastic, run  # noqa: E402
-from timing import Watch, retime, scan_opensees, timed  # noqa: E402
+from timing import Watch, finite, retime, scan_opensees, timed  # noqa: E402
 
 PAIR = ROOT / "examples" / "pounding-frames.toml"
 INELASTIC_PAIR = HERE / "inelastic-pair.toml"
@@ -310,7 +310,7 @@ def main():
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
     tmp = args.out.with_suffix(".tmp")
-    tmp.write_text(json.dumps(out, indent=1) + "\n")
+    tmp.write_text(json.dumps(finite(out), indent=1, allow_nan=False) + "\n")
     tmp.replace(args.out)
     print(f"\nwrote {args.out}")
     failed = [n for n, r in results.items() if not r.get("meets_target", True)]

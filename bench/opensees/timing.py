@@ -6,10 +6,12 @@ is each study's own test (a function returning the busy process ids)."""
 
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import threading
 import time
+from pathlib import Path
 
 
 def timed(f, repeats):
@@ -116,11 +118,26 @@ class Watch:
         }
 
 
+def _ancestors():
+    """This process and those that started it: `cargo run -p
+    vibroimpact-bench -- --check` runs a study under `cargo`, which the
+    gate would otherwise wait for until its limit (an hour)."""
+    pids, pid = set(), os.getpid()
+    while pid > 1 and pid not in pids:
+        pids.add(pid)
+        try:
+            stat = Path(f"/proc/{pid}/stat").read_text()
+            pid = int(stat.rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
+            break
+    return pids
+
+
 class IdleGate:
     """What a study waits for before each timed phase: no process that
     ``pgrep -f`` lists for ``pattern`` (a compiled regular expression)
     whose program or script (its first three arguments' base names)
-    matches it, this one excepted; a plain ``pgrep -f`` also lists
+    matches it, this one and its ancestors excepted; a plain ``pgrep -f`` also lists
     processes that only carry such a word in their environment, and is
     never empty here. ``no_wait`` (``--no-wait``) times at once (smoke
     runs)."""
@@ -137,8 +154,9 @@ class IdleGate:
         found = subprocess.run(["pgrep", "-f", self.pattern.pattern], capture_output=True,
                                text=True).stdout.split()
         pids = []
+        mine = _ancestors()
         for pid in map(int, found):
-            if pid == os.getpid():
+            if pid in mine:
                 continue
             try:
                 argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")[:3]
@@ -173,3 +191,15 @@ class IdleGate:
         if seen:
             print(f"  (waited {waited:.0f} s for an idle machine: {sorted(seen)})", flush=True)
         return entry
+
+
+def finite(x):
+    """``x`` with every non-finite float (a failed run's time or error in
+    a settings scan) replaced by None, for strict JSON that serde reads."""
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if isinstance(x, dict):
+        return {k: finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [finite(v) for v in x]
+    return x

@@ -196,11 +196,11 @@ impl<F: Family> Problem<F> {
     /// the last two chord iterates, or after the first one that of the
     /// last correction) is evaluated in full (so the solution comes with
     /// its own Jacobian), as is every iterate once the chord contracts
-    /// poorly (ratio above 1/4): Newton from there. Returns the solution and the work of the
-    /// correction in Newton iterations for the step control: a full
-    /// evaluation after the first counts two, two chord iterations one (a
-    /// chord iteration costs a third of a full one, and a few of them are
-    /// no sign of a hard correction).
+    /// poorly (ratio above 1/4): Newton from there. Returns the solution
+    /// and the work of the correction in Newton iterations for the step
+    /// control: a full evaluation after the first counts two, two chord
+    /// iterations one (a chord iteration costs a third of a full one, and
+    /// a few of them are no sign of a hard correction).
     pub(super) fn correct(
         &mut self,
         pred: &[f64],
