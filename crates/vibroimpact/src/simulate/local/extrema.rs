@@ -65,13 +65,7 @@ impl LocalExtrema {
                 }
             }
         }
-        let record_step = match model.base() {
-            BaseExcitation::Record(r) => {
-                let t = r.times();
-                (t[t.len() - 1] - t[0]) / (t.len().max(2) - 1) as f64
-            }
-            _ => f64::INFINITY,
-        };
+        let record_step = free.record_step().unwrap_or(f64::INFINITY);
         let grid = free
             .groups()
             .iter()

@@ -232,7 +232,7 @@ impl Run<'_> {
                     // contacts among set groups and walls are judged here.
                     if sides.iter().all(|g| groups.binary_search(g).is_ok())
                         && self
-                            .bound(k, t, state)
+                            .bound(k, t, lookahead, state)
                             .is_none_or(|until| until - t < lookahead)
                     {
                         engaged[p] = true;

@@ -8,6 +8,7 @@
 //!   matters, the set's edge, rebuilding the set;
 //! - `free_motion/` — exact motion between contacts;
 //! - `storeys.rs` — hysteretic storeys under the local integrator;
+//! - `envelope.rs` — the modal bound of a check;
 //! - `extrema.rs`, `energy.rs`, `tape.rs` — exact extrema, the energy
 //!   audit, the tangent tape;
 //! - `tests/` — against the global integrator (`mod.rs`) and with storeys
@@ -58,6 +59,7 @@ use crate::simulate::local::free_motion::FreeMotion;
 mod activation;
 mod driver;
 mod energy;
+mod envelope;
 mod extrema;
 pub mod free_motion;
 mod membership;
@@ -316,7 +318,7 @@ impl Run<'_> {
         let until = {
             let at = &at;
             let exact = &self.exact;
-            self.bound(k, t, move |g| {
+            self.bound(k, t, f64::INFINITY, move |g| {
                 at.iter()
                     .find(|(h, _)| *h == g)
                     .map_or(exact[g].1.as_slice(), |(_, x)| x.as_slice())
@@ -349,8 +351,16 @@ impl Run<'_> {
     }
 
     /// [`safe_until`](Self::safe_until) from the groups' interleaved states
-    /// at `t` (`state(g)`), as if they moved exactly from there.
-    fn bound<'s>(&self, k: usize, t: f64, state: impl Fn(usize) -> &'s [f64]) -> Option<f64> {
+    /// at `t` (`state(g)`), as if they moved exactly from there. The modal
+    /// bound is tried only where the energy bound falls short of `enough`
+    /// after `t` (a release needs its lookahead, a check all it can get).
+    fn bound<'s>(
+        &self,
+        k: usize,
+        t: f64,
+        enough: f64,
+        state: impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
         if let Some(c) = self.model.contacts().get(k) {
             if let Some(until) = self.alike_bound(c, k, &state) {
                 return Some(until);
@@ -373,19 +383,39 @@ impl Run<'_> {
             remaining
         };
         let floor = 1e-10 * horizon;
-        loop {
+        let start = horizon;
+        let quadratic = loop {
             let zdd = self.free.base_peak(t, t + horizon);
             let tau = match self.model.contacts().get(k) {
-                Some(c) => self.bound_over(c, k, (horizon, zdd), &state)?,
+                Some(c) => self.bound_over(c, k, (horizon, zdd), &state),
                 None => {
                     let s = k - self.model.contacts().len();
-                    self.storey_bound_over(s, (horizon, zdd), &state)?
+                    self.storey_bound_over(s, (horizon, zdd), &state)
                 }
             };
-            if tau < horizon || horizon >= remaining {
-                return (tau > floor && t + tau > t).then_some(t + tau);
+            match tau {
+                Some(tau) if tau < horizon || horizon >= remaining => {
+                    break (tau > floor && t + tau > t).then_some(t + tau);
+                }
+                Some(_) => horizon = remaining.min(2.0 * horizon),
+                None => break None,
             }
-            horizon = remaining.min(2.0 * horizon);
+        };
+        // Both bounds hold: the later wins.
+        let reached = quadratic.map_or(0.0, |until| until - t);
+        if reached >= enough.min(remaining) {
+            return quadratic;
+        }
+        // Both bounds hold: the later wins.
+        let modal = self.modal_until(
+            k,
+            t,
+            (start.max(reached), remaining, reached == 0.0),
+            &state,
+        );
+        match (quadratic, modal) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
         }
     }
 

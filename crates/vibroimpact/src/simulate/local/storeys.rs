@@ -177,7 +177,7 @@ impl Run<'_> {
         self.settle_rest(g)?;
         let storeys = &self.group_storeys[g];
         Ok(storeys.iter().any(|&s| {
-            self.bound(nc + s, t, |_| state)
+            self.bound(nc + s, t, lookahead, |_| state)
                 .is_none_or(|until| until - t < lookahead)
         }))
     }

@@ -9,6 +9,20 @@
 //! body's harmonic forces, with `|z̈|max` the base's largest over the
 //! horizon alone ([`Peaks`]): over a record's quiet stretches the bound is
 //! as tight as they are quiet, not as loose as the record's strongest part.
+//!
+//! A group with modes has a second bound, per quantity ([`Envelope`]): a
+//! linear combination `q = Re Σ_k w_k z_k` of its state about rest, each
+//! mode driven by the base alone (`ż_k = λ_k z_k + β_k f`, |f| ≤ F), so
+//! over a horizon `H`
+//!
+//! ```text
+//! |z_k(t + τ)| ≤ min(max(|z_k|, |β_k| F / σ_k), |z_k| + |β_k| F H),  σ_k = −Re λ_k,
+//! ```
+//!
+//! and `|q − q_rest| ≤ Σ_k |w_k|` times that. It holds for all τ in `[0,
+//! H]`, whatever the phases: a storey or gap whose envelope stays clear of
+//! its limit is safe over the whole horizon, where the energy bound, which
+//! lets every spring take the group's whole energy, crawls.
 
 use super::{FreeMotion, Group};
 use crate::model::BaseExcitation;
@@ -114,7 +128,59 @@ impl FreeMotion {
     }
 }
 
+/// The modal bound of one quantity of a group (module notes): per mode
+/// `[|w_k|, |z_k|, |β_k|, σ_k]`.
+#[derive(Clone, Debug)]
+pub struct Envelope {
+    terms: Vec<[f64; 4]>,
+}
+
+impl Envelope {
+    /// The bound on `|q − q_rest|` over a horizon `horizon` while the
+    /// base's |z̈| stays below `zdd`.
+    pub fn reach(&self, horizon: f64, zdd: f64) -> f64 {
+        self.terms
+            .iter()
+            .map(|&[w, z, b, sigma]| {
+                let drive = b * zdd;
+                let growing = z + drive * horizon;
+                let settled = if sigma > 0.0 {
+                    z.max(drive / sigma)
+                } else {
+                    f64::INFINITY
+                };
+                w * growing.min(settled)
+            })
+            .sum()
+    }
+}
+
+impl FreeMotion {
+    /// The envelope of `q = Σ c x_r` over `rows` (row r of group `g`'s
+    /// interleaved state, coefficient c) from the state `x`; None where
+    /// the group has no modes or harmonic terms (whose steady state the
+    /// envelope leaves out).
+    pub fn envelope(&self, g: usize, x: &[f64], rows: &[(usize, f64)]) -> Option<Envelope> {
+        let group = &self.groups[g];
+        let modal = group.modal.as_ref()?;
+        if !group.harmonic.is_empty() {
+            return None;
+        }
+        let about: Vec<f64> = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
+        let mut z = Vec::with_capacity(x.len());
+        modal.to_modes(&about, &mut z);
+        Some(Envelope {
+            terms: modal.envelope_terms(&z, rows),
+        })
+    }
+}
+
 impl Group {
+    /// Row r of the rest state (interleaved).
+    pub fn rest(&self, r: usize) -> f64 {
+        self.rest[r]
+    }
+
     /// Mechanical energy (kinetic and springs, about the rest state) of the
     /// interleaved state `x`.
     pub fn energy(&self, x: &[f64]) -> f64 {

@@ -124,6 +124,12 @@ impl Modal {
             .collect()
     }
 
+    /// The whole sample step whose coefficients are kept (s).
+    #[cfg(test)]
+    pub(super) fn whole_step(&self) -> Option<f64> {
+        self.step.as_ref().map(|(h, _)| *h)
+    }
+
     /// `z = V⁻¹ x`.
     pub(super) fn to_modes(&self, x: &[f64], z: &mut Vec<C64>) {
         z.clear();
@@ -139,6 +145,23 @@ impl Modal {
         for (xi, r) in x.iter_mut().zip(self.v.row_iter()) {
             *xi = r.iter().zip(z).map(|(a, b)| (a * b).re).sum();
         }
+    }
+
+    /// Per mode `[|w_k|, |z_k|, |β_k|, −Re λ_k]` of the quantity `q = Σ c
+    /// x_r` over `rows` (row r of the interleaved state, coefficient c),
+    /// `w_k = Σ c V_{rk}`, at the modal state `z` (an envelope's terms).
+    pub(super) fn envelope_terms(&self, z: &[C64], rows: &[(usize, f64)]) -> Vec<[f64; 4]> {
+        (0..z.len())
+            .map(|k| {
+                let w: C64 = rows.iter().map(|&(r, c)| self.v[(r, k)] * c).sum();
+                [
+                    w.norm(),
+                    z[k].norm(),
+                    self.beta[k].norm(),
+                    -self.lambda[k].re,
+                ]
+            })
+            .collect()
     }
 
     /// `z ← e^{Λτ} z`, no forcing.

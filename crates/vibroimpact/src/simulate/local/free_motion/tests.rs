@@ -212,6 +212,84 @@ fn a_record_is_exact_under_first_order_hold() {
     }
 }
 
+/// A record with a free-vibration tail appended (one sample step down to
+/// rest, then one long interval, as a pounding row's): its typical step is
+/// the record's own, whole steps take the precomputed coefficients (modes,
+/// and the matrix form for short runs), and the motion across the record
+/// and the tail in pieces of one to five samples, each ending between
+/// samples or on them, equals the integration to 1e-9.
+#[test]
+fn a_record_with_a_tail_keeps_its_whole_steps() {
+    let mut times: Vec<f64> = (0..150).map(|k| 0.01 * k as f64).collect();
+    let mut values: Vec<f64> = times.iter().map(|t| (8.0 * t).sin()).collect();
+    times.extend([1.5, 3.0]);
+    values.extend([0.0, 0.0]);
+    let near = |h: Option<f64>| h.is_some_and(|h| (h - 0.01).abs() < 1e-15);
+    assert!(near(typical_step(&times)));
+    let rec = BaseExcitation::Record(Accelerogram::new(times, values, 0.4).unwrap());
+    let m = coupled_pair(rec);
+    let free = FreeMotion::new(&m).unwrap();
+    let group = &free.groups()[0];
+    let modal = group.modal.as_ref().expect("modes");
+    assert!(near(modal.whole_step()));
+    assert!(near(group.hold_step.as_ref().map(|h| h.tau)));
+    let reference = integrated(&m, 2.2);
+    for pieces in [2200 / 5, 2200 / 3, 2200 / 2, 2200] {
+        assert_close(&exact(&m, 2.2, pieces), &reference, 1e-9);
+    }
+    assert_close(&exact(&m, 2.2, 93), &reference, 1e-9);
+}
+
+/// The modal envelope of a drift and of a velocity bounds them over its
+/// horizon: along the exact motion of a coupled pair under a record, from
+/// several states and horizons (shorter and longer than the slow period),
+/// every state on a fine grid is within `reach(H, F)` of rest, with F the
+/// record's peak over the horizon; at H = 0 the envelope is Σ|w||z|, no
+/// less than the quantity itself, and it grows with H.
+#[test]
+fn the_modal_envelope_bounds_the_motion_over_its_horizon() {
+    let times: Vec<f64> = (0..400).map(|k| 0.01 * k as f64).collect();
+    let values: Vec<f64> = times
+        .iter()
+        .map(|t| (9.0 * t).sin() + 0.6 * (13.0 * t).cos())
+        .collect();
+    let rec = BaseExcitation::Record(Accelerogram::new(times, values, 1.0).unwrap());
+    let m = coupled_pair(rec);
+    let free = FreeMotion::new(&m).unwrap();
+    let drift = [(0usize, 1.0), (2usize, -1.0)];
+    let speed = [(1usize, 1.0)];
+    let mut tightest = f64::INFINITY;
+    for (t0, x0) in [
+        (0.0, [0.0, 0.0, 0.0, 0.0]),
+        (0.37, [0.01, -0.2, -0.004, 0.1]),
+        (1.5, [-0.002, 0.03, 0.006, 0.0]),
+    ] {
+        for horizon in [0.05, 0.3, 2.0] {
+            let peak = free.base_peak(t0, t0 + horizon);
+            for rows in [&drift[..], &speed[..]] {
+                let q = |x: &[f64]| rows.iter().map(|&(r, c)| c * x[r]).sum::<f64>();
+                let envelope = free.envelope(0, &x0, rows).unwrap();
+                let reach = envelope.reach(horizon, peak);
+                assert!(q(&x0).abs() <= envelope.reach(0.0, peak) * (1.0 + 1e-12));
+                assert!(envelope.reach(0.0, peak) <= reach);
+                let mut largest = 0.0f64;
+                for i in 1..=400 {
+                    let mut x = x0.to_vec();
+                    free.propagate(0, t0, t0 + horizon * i as f64 / 400.0, &mut x);
+                    largest = largest.max(q(&x).abs());
+                }
+                assert!(
+                    largest <= reach,
+                    "t0 {t0}, H {horizon}: {largest} > {reach}"
+                );
+                tightest = tightest.min(reach / largest.max(1e-300));
+            }
+        }
+    }
+    // Not vacuous: somewhere the envelope is within a factor 3 of the motion.
+    assert!(tightest < 3.0, "{tightest}");
+}
+
 /// The modal form against the matrix exponential of the augmented matrix:
 /// a coupled pair's whole-sample, partial, tiny and long steps (both
 /// branches of the φ functions) agree to 1e-12; a critically damped body
