@@ -10,9 +10,11 @@
 //!    1e-11) for N = 10, 100, 1000 (global to 100).
 //! 2. Rows of K buildings (3–8 storeys, bilinear, Hertz at floors 1–3)
 //!    under `examples/synthetic-quake.csv` at 0.1 and 1 of its amplitude,
-//!    sampled at the record's step, DOPRI5 rtol 1e-4: every group moves
-//!    with the base, so the local integrator's checks and samples cost
-//!    more than the global steps they spare; why `auto` runs such rows
+//!    sampled at the record's step, DOPRI5 rtol 1e-4, with the global run
+//!    at DOP853 rtol 1e-8 beside it (the local run's error where nothing
+//!    yields). At 0.1 the local run is exact and the faster (modal
+//!    envelopes, docs/decisions.md D37); at full scale, where buildings
+//!    yield and pound, the global one: why `auto` runs such rows
 //!    globally.
 
 use std::time::Instant;

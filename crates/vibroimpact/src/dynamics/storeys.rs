@@ -391,24 +391,40 @@ impl StoreyTerms {
         self.terms[k].p_delta
     }
 
-    /// Storey k on a linear branch: F = k d + F₀ with its initial stiffness
-    /// k (the P-Δ shear −(P/h) d beside it); returns F₀ (an elastic law's is 0; a bilinear storey's elastic
-    /// branch gives (1 − b) k (z₀ − d₀)). None on a plastic branch or for
-    /// Bouc–Wen, whose force is not linear in the drift.
-    pub fn linear_force(&self, k: usize) -> Option<f64> {
+    /// Storey k on a linear branch, F = k_b d + F₀ (the P-Δ shear −(P/h) d
+    /// beside it): returns (k_b, F₀). An elastic law's is (k, 0); a
+    /// bilinear storey's elastic branch (k, (1 − b) k (z₀ − d₀)), its
+    /// plastic branch (b k, (1 − b) k z) with z = ±u_y. None for Bouc–Wen
+    /// and IMK, whose force is not linear in the drift between events
+    /// that the local integrator knows.
+    pub fn linear_branch(&self, k: usize) -> Option<(f64, f64)> {
         let t = &self.terms[k];
         match (&t.law, &t.branch) {
-            (StoreyLaw::Elastic { .. }, _) => Some(0.0),
-            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => {
-                Some((1.0 - b.post_yield_ratio) * b.stiffness * (z0 - d0))
-            }
+            (StoreyLaw::Elastic { .. }, _) => Some((t.law.initial_stiffness(), 0.0)),
+            (StoreyLaw::Bilinear(b), Branch::Elastic { d0, z0, .. }) => Some((
+                b.stiffness,
+                (1.0 - b.post_yield_ratio) * b.stiffness * (z0 - d0),
+            )),
+            (StoreyLaw::Bilinear(b), Branch::Plastic { z, .. }) => Some((
+                b.post_yield_ratio * b.stiffness,
+                (1.0 - b.post_yield_ratio) * b.stiffness * z,
+            )),
+            _ => None,
+        }
+    }
+
+    /// The sign of a bilinear storey k's plastic branch (+1 yielding
+    /// towards +u_y, −1 towards −u_y); None on another branch.
+    pub fn plastic_sign(&self, k: usize) -> Option<f64> {
+        match (&self.terms[k].law, &self.terms[k].branch) {
+            (StoreyLaw::Bilinear(_), Branch::Plastic { z, .. }) => Some(z.signum()),
             _ => None,
         }
     }
 
     /// The drifts between which storey k stays on its linear branch, shrunk
     /// by `margin` of its yield drift at both ends (unbounded for an
-    /// elastic law); None where [`linear_force`](Self::linear_force) is.
+    /// elastic law); None off an elastic branch.
     pub fn linear_window(&self, k: usize, margin: f64) -> Option<(f64, f64)> {
         let t = &self.terms[k];
         match (&t.law, &t.branch) {

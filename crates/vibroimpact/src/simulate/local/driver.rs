@@ -667,7 +667,7 @@ impl<'a> Run<'a> {
             let storeys = &run.group_storeys[g];
             let linear = storeys
                 .iter()
-                .all(|&s| run.storeys.linear_force(s).is_some());
+                .all(|&s| run.storeys.linear_branch(s).is_some());
             if !storeys.is_empty() && linear {
                 run.settle_rest(g)
                     .map_err(|e| OptionsError(e.to_string()))?;

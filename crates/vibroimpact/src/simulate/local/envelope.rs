@@ -35,11 +35,8 @@ impl Run<'_> {
             .iter()
             .map(|&(i, c)| c * group.rest(2 * self.free.place(i).1))
             .sum();
-        Some(Side {
-            shift: self.free.envelope(g, x, &at(0))?,
-            rate: self.free.envelope(g, x, &at(1))?,
-            rest,
-        })
+        let [shift, rate] = self.free.envelopes(g, x, [&at(0), &at(1)])?;
+        Some(Side { shift, rate, rest })
     }
 
     /// The latest time, by the modal bound, until which check `k` stays

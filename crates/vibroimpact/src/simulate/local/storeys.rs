@@ -26,6 +26,13 @@ use crate::model::hysteresis::StoreyLaw;
 /// the checks of a storey that swings just below yield do not crawl.
 pub(super) const YIELD_APPROACH: f64 = 0.02;
 
+/// How close to unloading a plastic storey sends its group into the set:
+/// where its outward drift rate could vanish within this many radians of
+/// the group's fastest rate (half the set's release lookahead,
+/// `RELEASE_PERIOD_FRACTION`, so a group released on a plastic branch is
+/// not taken back at its first check).
+const UNLOAD_APPROACH: f64 = 0.025;
+
 /// Where the Bouc–Wen states (z, e) of a set's storeys sit: (index in the
 /// set's state by its terms `set`, index in the whole extended state by
 /// the run's terms `whole`), for the set's `storeys` (model indices).
@@ -70,7 +77,11 @@ impl Run<'_> {
         (horizon, zdd): (f64, f64),
         state: &impl Fn(usize) -> &'s [f64],
     ) -> Option<f64> {
-        let (lo, hi) = self.storeys.linear_window(s, YIELD_APPROACH)?;
+        let window = self.storeys.linear_window(s, YIELD_APPROACH);
+        let plastic = self.storeys.plastic_sign(s);
+        if window.is_none() && plastic.is_none() {
+            return None;
+        }
         let (below, above) = self.storeys.ends(s);
         let (g, ja) = self.free.place(above);
         let jb = below.map(|b| self.free.place(b).1);
@@ -88,30 +99,51 @@ impl Run<'_> {
         if !(d.is_finite() && dd.is_finite() && acc.is_finite()) {
             return None;
         }
+        let Some((lo, hi)) = window else {
+            // On the plastic branch until the drift turns: its outward rate
+            // falls at most at `acc`. Close to the turn (within
+            // `UNLOAD_APPROACH` radians of the group's fastest rate) the
+            // group joins the set, which locates it.
+            let outward = dd * plastic.unwrap_or(1.0);
+            let tau = if acc > 0.0 {
+                outward / acc
+            } else {
+                f64::INFINITY
+            };
+            let soon = UNLOAD_APPROACH / group.rate().max(f64::MIN_POSITIVE);
+            return (outward > 0.0 && tau > soon).then_some(tau.min(horizon));
+        };
         let size = d.abs() + (hi - lo);
         let up = reach_time(hi - d, dd, 0.5 * acc, size)?;
         let down = reach_time(d - lo, -dd, 0.5 * acc, size)?;
         Some(up.min(down).min(horizon))
     }
 
-    /// Sets group `g`'s rest state from its storeys' constant forces (each
-    /// on a linear branch; an elastic law's is zero).
+    /// Gives group `g` the propagators of its storeys' branches and sets
+    /// its rest state from their constant forces (each on a linear branch,
+    /// elastic or plastic; an elastic law's force is zero).
     pub(super) fn settle_rest(&mut self, g: usize) -> Result<(), IntegrationError> {
-        let first = self.free.groups()[g].bodies()[0];
-        let mut f = vec![0.0; self.free.groups()[g].bodies().len()];
-        for &s in &self.group_storeys[g] {
+        let group = &self.free.groups()[g];
+        let first = group.bodies()[0];
+        let mut f = vec![0.0; group.bodies().len()];
+        let mut k = Vec::new();
+        for s in group.storeys() {
             let st = &self.model.storeys()[s];
-            let f0 = self.storeys.linear_force(s).ok_or_else(|| {
+            let (kb, f0) = self.storeys.linear_branch(s).ok_or_else(|| {
                 IntegrationError::InvalidOptions(format!(
                     "storey {}: not on a linear branch where its group was to move exactly (internal error)",
                     s + 1
                 ))
             })?;
+            k.push(kb - st.p_delta);
             f[self.free.place(st.above).1] -= f0;
             if let Some(b) = st.below {
                 f[self.free.place(b).1] += f0;
             }
         }
+        self.free
+            .set_storey_stiffness(g, &k)
+            .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
         self.free.set_rest(g, &f).map_err(|residual| {
             IntegrationError::InvalidOptions(format!(
                 "the rest state of {}'s group: its springs balance its storeys' forces only to {residual:.1e}",
@@ -152,9 +184,10 @@ impl Run<'_> {
     }
 
     /// Whether group `g` of the set must stay for its storeys at `t`: one
-    /// is off a linear branch (plastic, Bouc–Wen), or may come within
-    /// [`YIELD_APPROACH`] of yield within `lookahead` (the group's rest
-    /// state is settled for the judgement). `state` is the group's
+    /// is off a linear branch (Bouc–Wen) or softened past zero stiffness,
+    /// or may come within [`YIELD_APPROACH`] of yield or within
+    /// `UNLOAD_APPROACH` of unloading within `lookahead` (the group's
+    /// propagators and rest state are settled for the judgement). `state` is the group's
     /// interleaved state in the set.
     pub(super) fn storeys_engaged(
         &mut self,
@@ -168,17 +201,31 @@ impl Run<'_> {
         if storeys.is_empty() {
             return Ok(false);
         }
-        if storeys
-            .iter()
-            .any(|&s| self.storeys.linear_force(s).is_none())
-        {
+        // Off a linear branch (Bouc–Wen), or softened past zero stiffness
+        // by P-Δ on a plastic one (the bounds need a positive energy).
+        let model = self.model;
+        if storeys.iter().any(|&s| {
+            self.storeys
+                .linear_branch(s)
+                .is_none_or(|(k, _)| k < model.storeys()[s].p_delta)
+        }) {
             return Ok(true);
         }
         self.settle_rest(g)?;
         let storeys = &self.group_storeys[g];
+        // A plastic storey needs only to stay clear of its reversal's
+        // approach for a while past it (its checks then come down to
+        // it), not the set's whole lookahead: a set's steps may last a
+        // good part of a plastic excursion.
+        let rate = self.free.groups()[g].rate().max(f64::MIN_POSITIVE);
+        let plastic = (2.0 * UNLOAD_APPROACH / rate).min(lookahead);
         Ok(storeys.iter().any(|&s| {
-            self.bound(nc + s, t, lookahead, |_| state)
-                .is_none_or(|until| until - t < lookahead)
+            let need = match self.storeys.plastic_sign(s) {
+                Some(_) => plastic,
+                None => lookahead,
+            };
+            self.bound(nc + s, t, need, |_| state)
+                .is_none_or(|until| until - t < need)
         }))
     }
 

@@ -156,11 +156,17 @@ impl Envelope {
 }
 
 impl FreeMotion {
-    /// The envelope of `q = Σ c x_r` over `rows` (row r of group `g`'s
-    /// interleaved state, coefficient c) from the state `x`; None where
-    /// the group has no modes or harmonic terms (whose steady state the
-    /// envelope leaves out).
-    pub fn envelope(&self, g: usize, x: &[f64], rows: &[(usize, f64)]) -> Option<Envelope> {
+    /// The envelopes of `q = Σ c x_r` over each of `quantities` (rows r
+    /// of group `g`'s interleaved state, coefficient c) from the state
+    /// `x` (one change to modes for all); None where the group has no
+    /// modes or harmonic terms (whose steady state the envelope leaves
+    /// out).
+    pub fn envelopes<const Q: usize>(
+        &self,
+        g: usize,
+        x: &[f64],
+        quantities: [&[(usize, f64)]; Q],
+    ) -> Option<[Envelope; Q]> {
         let group = &self.groups[g];
         let modal = group.modal.as_ref()?;
         if !group.harmonic.is_empty() {
@@ -169,9 +175,9 @@ impl FreeMotion {
         let about: Vec<f64> = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
         let mut z = Vec::with_capacity(x.len());
         modal.to_modes(&about, &mut z);
-        Some(Envelope {
+        Some(quantities.map(|rows| Envelope {
             terms: modal.envelope_terms(&z, rows),
-        })
+        }))
     }
 }
 

@@ -1,7 +1,8 @@
 //! Exact motion between contacts (docs/theory.md §10).
 //!
 //! Files: `mod.rs` (groups and their exact motion), `modal.rs` (complex
-//! modes), `bounds.rs` (bounds on the motion ahead), `tests.rs`.
+//! modes), `branches.rs` (a group's propagators per storey branch),
+//! `bounds.rs` (bounds on the motion ahead), `tests.rs`.
 //!
 //! With every contact open, a model's equations are linear with
 //! time-dependent forcing:
@@ -36,7 +37,7 @@
 //! It also bounds the motion ahead, for the contact scheduler
 //! (`bounds.rs`).
 
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 
 use crate::model::{Accelerogram, BaseExcitation, Model};
 
@@ -102,6 +103,19 @@ pub struct Group {
     /// (interleaved; zero without storeys), and those forces.
     rest: Vec<f64>,
     rest_forces: Vec<f64>,
+    /// Its storeys (model index), where each one's stiffness sits, and
+    /// that stiffness now (its branch's, less its P-Δ stiffness).
+    storeys: Vec<(usize, branches::Slot)>,
+    storey_stiffness: Vec<f64>,
+    /// The harmonic terms b sin(Ω t + φ) per unit mass: (Ω, φ, b).
+    terms: Vec<(f64, f64, Vec<f64>)>,
+    /// The bodies' own springs to the ground (without storeys), and the
+    /// bodies' names (for errors).
+    own_stiffness: Vec<f64>,
+    names: String,
+    /// The propagators of other branches met so far, by their storeys'
+    /// stiffness ([`FreeMotion::set_storey_stiffness`]).
+    cache: Vec<(Vec<f64>, branches::Variant)>,
 }
 
 /// The first-order-hold step of one record sample interval `τ`: `x(b) =
@@ -251,16 +265,7 @@ impl FreeMotion {
             _ => None,
         };
         for g in &mut groups {
-            if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
-                g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
-            }
-            // Without modes every whole step, with modes the short runs of
-            // a few (samples, checks a step apart) take the matrix form.
-            let small = 2 * g.bodies.len() <= HOLD_ROWS;
-            if let (true, Some(Some(tau))) = (g.modal.is_none() || small, record_step) {
-                let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(g), tau);
-                g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
-            }
+            Self::dress(g, record_step);
         }
         Ok(Self {
             groups,
@@ -271,6 +276,23 @@ impl FreeMotion {
         })
     }
 
+    /// Gives group `g` its modes and its whole sample step's matrix, under
+    /// a record sampled every `record_step` (Some(None): not uniformly).
+    fn dress(g: &mut Group, record_step: Option<Option<f64>>) {
+        g.modal = None;
+        g.hold_step = None;
+        if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
+            g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
+        }
+        // Without modes every whole step, with modes the short runs of a
+        // few (samples, checks a step apart) take the matrix form.
+        let small = 2 * g.bodies.len() <= HOLD_ROWS;
+        if let (true, Some(Some(tau))) = (g.modal.is_none() || small, record_step) {
+            let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(g), tau);
+            g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
+        }
+    }
+
     fn group(
         model: &Model,
         place: &[(usize, usize)],
@@ -279,7 +301,8 @@ impl FreeMotion {
         let m = bodies.len();
         let all = model.bodies();
         let mass: Vec<f64> = bodies.iter().map(|&i| all[i].mass).collect();
-        let mut stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let own_stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let mut stiffness = own_stiffness.clone();
         let damping: Vec<f64> = bodies.iter().map(|&i| all[i].damping).collect();
         let here = place[bodies[0]].0;
         let mut couplings: Vec<(usize, usize, f64, f64)> = model
@@ -289,28 +312,30 @@ impl FreeMotion {
             .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
             .collect();
         // A storey is a spring of its initial stiffness less its P-Δ
-        // stiffness (its constant force is the rest state's, `set_rest`).
-        for s in model.storeys().iter().filter(|s| place[s.above].0 == here) {
+        // stiffness (its constant force is the rest state's, `set_rest`);
+        // another branch's stiffness replaces it there
+        // (`set_storey_stiffness`).
+        let mut storeys = Vec::new();
+        let mut storey_stiffness = Vec::new();
+        for (i, s) in model.storeys().iter().enumerate() {
+            if place[s.above].0 != here {
+                continue;
+            }
             let k = s.law.initial_stiffness() - s.p_delta;
-            match s.below {
-                None => stiffness[place[s.above].1] += k,
-                Some(b) => couplings.push((place[b].1, place[s.above].1, k, 0.0)),
-            }
+            let slot = match s.below {
+                None => {
+                    stiffness[place[s.above].1] += k;
+                    branches::Slot::Ground(place[s.above].1)
+                }
+                Some(b) => {
+                    couplings.push((place[b].1, place[s.above].1, k, 0.0));
+                    branches::Slot::Coupling(couplings.len() - 1)
+                }
+            };
+            storeys.push((i, slot));
+            storey_stiffness.push(k);
         }
-        let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
-        for j in 0..m {
-            a[(2 * j, 2 * j + 1)] = 1.0;
-            a[(2 * j + 1, 2 * j)] = -stiffness[j] / mass[j];
-            a[(2 * j + 1, 2 * j + 1)] = -damping[j] / mass[j];
-        }
-        for &(p, q, k, c) in &couplings {
-            for (i, j) in [(p, q), (q, p)] {
-                a[(2 * i + 1, 2 * i)] -= k / mass[i];
-                a[(2 * i + 1, 2 * j)] += k / mass[i];
-                a[(2 * i + 1, 2 * i + 1)] -= c / mass[i];
-                a[(2 * i + 1, 2 * j + 1)] += c / mass[i];
-            }
-        }
+        let a = branches::system_matrix(&mass, &stiffness, &damping, &couplings);
         // Harmonic terms b sin(Ω t + φ) (per unit mass, velocity rows).
         let mut terms: Vec<(f64, f64, Vec<f64>)> = Vec::new();
         if let BaseExcitation::Harmonic {
@@ -338,58 +363,13 @@ impl FreeMotion {
             forces.push((j, f.amplitude, f.frequency, f.phase));
             terms.push((f.frequency, f.phase, b));
         }
-        let names = || {
-            bodies
-                .iter()
-                .map(|&i| all[i].name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let mut harmonic = Vec::with_capacity(terms.len());
-        let mut rate = 0.0f64;
-        for (w, phi, b) in terms {
-            rate = rate.max(w);
-            let mut lhs = DMatrix::<Complex<f64>>::from_fn(2 * m, 2 * m, |i, j| {
-                Complex::new(-a[(i, j)], 0.0)
-            });
-            for i in 0..2 * m {
-                lhs[(i, i)] += Complex::new(0.0, w);
-            }
-            let rhs = DVector::<Complex<f64>>::from_fn(2 * m, |i, _| Complex::new(b[i], 0.0));
-            let scale = a.amax() + w;
-            let x = lhs
-                .lu()
-                .solve(&rhs)
-                .filter(|x| x.iter().all(|z| z.re.is_finite() && z.im.is_finite()))
-                // An exactly singular pivot may still solve to huge values:
-                // resonance shows as a response far beyond any physical one.
-                .filter(|x| {
-                    let bmax = b.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-                    x.iter()
-                        .all(|z| z.norm() * scale * 1e-12 <= bmax.max(1e-300))
-                })
-                .ok_or_else(|| FreeMotionError::Resonant {
-                    bodies: names(),
-                    frequency: w,
-                })?;
-            harmonic.push((
-                w,
-                phi,
-                x.iter().map(|z| z.re).collect(),
-                x.iter().map(|z| z.im).collect(),
-            ));
-        }
-        for j in 0..m {
-            rate = rate.max((-a[(2 * j + 1, 2 * j)]).sqrt());
-        }
-        let propagator = if m == 1 {
-            Propagator::Single {
-                w2: stiffness[0] / mass[0],
-                c2: damping[0] / mass[0],
-            }
-        } else {
-            Propagator::Group(a)
-        };
+        let names = bodies
+            .iter()
+            .map(|&i| all[i].name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let (harmonic, rate) = branches::steady_states(&a, &terms, &names)?;
+        let propagator = branches::propagator(&mass, &stiffness, &damping, a);
         Ok(Group {
             bodies,
             propagator,
@@ -405,6 +385,12 @@ impl FreeMotion {
             hold_step: None,
             rest: vec![0.0; 2 * m],
             rest_forces: vec![0.0; m],
+            storeys,
+            storey_stiffness,
+            terms,
+            own_stiffness,
+            names,
+            cache: Vec::new(),
         })
     }
 
@@ -695,6 +681,7 @@ impl Group {
 }
 
 mod bounds;
+mod branches;
 mod modal;
 
 #[cfg(test)]

@@ -268,7 +268,7 @@ fn the_modal_envelope_bounds_the_motion_over_its_horizon() {
             let peak = free.base_peak(t0, t0 + horizon);
             for rows in [&drift[..], &speed[..]] {
                 let q = |x: &[f64]| rows.iter().map(|&(r, c)| c * x[r]).sum::<f64>();
-                let envelope = free.envelope(0, &x0, rows).unwrap();
+                let [envelope] = free.envelopes(0, &x0, [rows]).unwrap();
                 let reach = envelope.reach(horizon, peak);
                 assert!(q(&x0).abs() <= envelope.reach(0.0, peak) * (1.0 + 1e-12));
                 assert!(envelope.reach(0.0, peak) <= reach);
