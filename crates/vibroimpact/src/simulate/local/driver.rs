@@ -629,6 +629,7 @@ impl<'a> Run<'a> {
             method,
             free,
             exact,
+            boundary_carried: Vec::new(),
             in_set: vec![false; ng],
             joined: vec![0.0; ng],
             defer: false,

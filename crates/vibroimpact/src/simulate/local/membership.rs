@@ -8,10 +8,43 @@ use super::*;
 /// time and the contact.
 pub(super) type Crossing = Option<(f64, usize)>;
 
+/// The exactly moving groups of a set's boundary contacts at the ends of
+/// its last step: (group, state at `ta`, state at `tb`).
+pub(super) struct BoundaryEnds {
+    ta: f64,
+    tb: f64,
+    groups: Vec<(usize, Vec<f64>, Vec<f64>)>,
+}
+
+impl BoundaryEnds {
+    /// Body `i`'s (u, v) at `t` in `[ta, tb]`, if its group is here.
+    fn body(&self, free: &FreeMotion, i: usize, t: f64) -> Option<(f64, f64)> {
+        let (g, j) = free.place(i);
+        let (_, xa, xb) = self.groups.iter().find(|(h, ..)| *h == g)?;
+        Some(if t == self.tb {
+            (xb[2 * j], xb[2 * j + 1])
+        } else if t == self.ta {
+            (xa[2 * j], xa[2 * j + 1])
+        } else {
+            let mut x = xa.clone();
+            free.propagate(g, self.ta, t, &mut x);
+            (x[2 * j], x[2 * j + 1])
+        })
+    }
+}
+
 impl Run<'_> {
     /// Contact k's (s, ṡ) at `t` within the set's last step, for a contact
     /// with one side in the set and the other moving exactly (or a wall).
-    pub(super) fn boundary_state(&mut self, set: &mut ActiveSet, k: usize, t: f64) -> (f64, f64) {
+    /// The exactly moving side's group is read from `ends` (its states at
+    /// the step's ends) at the ends, and propagated from the start inside.
+    pub(super) fn boundary_state(
+        &mut self,
+        set: &mut ActiveSet,
+        ends: &BoundaryEnds,
+        k: usize,
+        t: f64,
+    ) -> (f64, f64) {
         let c = &self.model.contacts()[k];
         let mut s = -c.clearance;
         let mut sd = 0.0;
@@ -28,7 +61,9 @@ impl Run<'_> {
                         )
                     }
                 }
-                None => self.exact_body(i, t),
+                None => ends
+                    .body(&self.free, i, t)
+                    .unwrap_or_else(|| self.exact_body(i, t)),
             };
             s += sign * u;
             sd += sign * v;
@@ -36,19 +71,61 @@ impl Run<'_> {
         (s, sd)
     }
 
+    /// The exactly moving groups of the set's boundary contacts at the
+    /// ends of its last step `[ta, tb]`: the start's carried from the
+    /// previous step's end where the set went on from there.
+    fn boundary_ends(&mut self, set: &ActiveSet) -> BoundaryEnds {
+        let (ta, tb) = (set.saved.0, set.st.t());
+        let carried = std::mem::take(&mut self.boundary_carried);
+        let mut ends = BoundaryEnds {
+            ta,
+            tb,
+            groups: Vec::new(),
+        };
+        for &k in &set.boundary {
+            let c = &self.model.contacts()[k];
+            for i in [c.pair.left(), c.pair.right()].into_iter().flatten() {
+                let g = self.free.place(i).0;
+                if self.slot[i].is_some() || ends.groups.iter().any(|(h, ..)| *h == g) {
+                    continue;
+                }
+                let (t0, x0) = &self.exact[g];
+                let xa = match carried.iter().find(|(h, t, _)| *h == g && *t == ta) {
+                    Some((_, _, x)) => x.clone(),
+                    None => {
+                        let mut x = x0.clone();
+                        self.free.propagate(g, *t0, ta, &mut x);
+                        x
+                    }
+                };
+                let mut xb = xa.clone();
+                self.free.propagate(g, ta, tb, &mut xb);
+                ends.groups.push((g, xa, xb));
+            }
+        }
+        self.boundary_carried = ends
+            .groups
+            .iter()
+            .map(|(g, _, xb)| (*g, tb, xb.clone()))
+            .collect();
+        ends
+    }
+
     /// The first time in the set's last step where a boundary contact
     /// becomes active.
     pub(super) fn boundary_crossing(&mut self, set: &mut ActiveSet) -> Crossing {
         let (ta, tb) = (set.saved.0, set.st.t());
+        let ends = self.boundary_ends(set);
+        let ends = &ends;
         let mut first: Crossing = None;
         for bi in 0..set.boundary.len() {
             let k = set.boundary[bi];
             let act = self.activation[k];
-            let (sa, sda) = self.boundary_state(set, k, ta);
-            let (sb, sdb) = self.boundary_state(set, k, tb);
+            let (sa, sda) = self.boundary_state(set, ends, k, ta);
+            let (sb, sdb) = self.boundary_state(set, ends, k, tb);
             let (ga, gb) = (act.margin(sa, sda), act.margin(sb, sdb));
             let margin = |run: &mut Self, set: &mut ActiveSet, t: f64| {
-                let (s, sd) = run.boundary_state(set, k, t);
+                let (s, sd) = run.boundary_state(set, ends, k, t);
                 act.margin(s, sd)
             };
             let at = if ga > 0.0 {
@@ -61,7 +138,11 @@ impl Run<'_> {
             } else if sda > 0.0 && sdb < 0.0 {
                 // The gap's interior maximum.
                 let tm = EventLocator::FINE
-                    .locate(|t| self.boundary_state(set, k, t).1, (ta, sda), (tb, sdb))
+                    .locate(
+                        |t| self.boundary_state(set, ends, k, t).1,
+                        (ta, sda),
+                        (tb, sdb),
+                    )
                     .unwrap_or(0.5 * (ta + tb));
                 let gm = margin(self, set, tm);
                 (gm > 0.0).then(|| {

@@ -152,6 +152,10 @@ struct Run<'a> {
     free: FreeMotion,
     /// Per group: time and interleaved state of its exact motion.
     exact: Vec<(f64, Vec<f64>)>,
+    /// The exactly moving groups of the set's boundary contacts at the end
+    /// of its last step: (group, time, state), the next step's start
+    /// (cleared when the set changes).
+    boundary_carried: Vec<(usize, f64, Vec<f64>)>,
     /// Per group: in the active set.
     in_set: Vec<bool>,
     /// Per group: when it last joined the set.

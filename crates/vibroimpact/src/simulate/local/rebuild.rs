@@ -45,6 +45,7 @@ impl Run<'_> {
             }
         }
         self.sync_storeys();
+        self.boundary_carried.clear();
         let old = self.retire(&groups, t);
         // Groups leaving move exactly about the rest of their storeys'
         // branches.

@@ -175,8 +175,10 @@ impl FreeMotion {
         let about: Vec<f64> = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
         let mut z = Vec::with_capacity(x.len());
         modal.to_modes(&about, &mut z);
-        Some(quantities.map(|rows| Envelope {
-            terms: modal.envelope_terms(&z, rows),
+        Some(quantities.map(|rows| {
+            let mut terms = Vec::with_capacity(z.len());
+            modal.envelope_terms(&z, rows, &mut terms);
+            Envelope { terms }
         }))
     }
 }
