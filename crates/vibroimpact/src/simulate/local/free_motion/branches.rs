@@ -170,6 +170,9 @@ impl FreeMotion {
         }
         let old = group.take_variant();
         let key = std::mem::replace(&mut group.storey_stiffness, k.to_vec());
+        // The rest state belongs to the stiffness: set again even for the
+        // same forces.
+        group.rest_forces.fill(f64::NAN);
         group.cache.push((key, old));
         if let Some(i) = group.cache.iter().position(|(key, _)| key == k) {
             let (_, v) = group.cache.swap_remove(i);

@@ -412,7 +412,7 @@ impl FreeMotion {
 
     /// Sets group `g`'s rest state to the static displacement under the
     /// constant forces `f` on its bodies (N, the group's order): `K u_s =
-    /// f` (solved again only if `f` changed). A group without ground springs is solved in the least-squares
+    /// f` (solved again only if `f` or the stiffness changed). A group without ground springs is solved in the least-squares
     /// sense (its storeys' forces act in pairs, within the range of `K`).
     /// Errors with the residual if `f` is not balanced by the springs.
     pub fn set_rest(&mut self, g: usize, f: &[f64]) -> Result<(), f64> {
