@@ -490,7 +490,7 @@ fn constant_forces_set_the_rest_state() {
 #[test]
 fn another_branchs_stiffness_moves_as_that_frame() {
     use crate::model::hysteresis::{Bilinear, StoreyLaw};
-    use crate::model::Storey;
+    use crate::simulate::local::tests::storeys::two_storey_frame;
     let bilinear = |k| {
         StoreyLaw::Bilinear(Bilinear {
             stiffness: k,
@@ -502,37 +502,7 @@ fn another_branchs_stiffness_moves_as_that_frame() {
         let times: Vec<f64> = (0..300).map(|k| 0.01 * k as f64).collect();
         let values: Vec<f64> = times.iter().map(|t| 3.0 * (5.0 * t).sin()).collect();
         let base = BaseExcitation::Record(Accelerogram::new(times, values, 1.0).unwrap());
-        let body = |name: &str| Body {
-            name: name.into(),
-            mass: 1e5,
-            stiffness: 0.0,
-            damping: 2e5,
-        };
-        Model::new(
-            vec![body("f1"), body("f2")],
-            vec![],
-            vec![],
-            base,
-            vec![],
-            vec![],
-            vec![],
-        )
-        .unwrap()
-        .with_storeys(vec![
-            Storey {
-                below: None,
-                above: 0,
-                law: first,
-                p_delta: 0.0,
-            },
-            Storey {
-                below: Some(0),
-                above: 1,
-                law: bilinear(3e7),
-                p_delta: 0.0,
-            },
-        ])
-        .unwrap()
+        two_storey_frame([first, bilinear(3e7)], 2e5, base)
     };
     let yielding = frame(bilinear(4e7));
     let soft = frame(StoreyLaw::Elastic { stiffness: 2e6 });

@@ -706,4 +706,4 @@ fn a_long_chain_is_not_taken_for_a_crawl() {
     assert!(sim.local.unwrap().bodies_integrated() < 20);
 }
 
-mod storeys;
+pub(super) mod storeys;

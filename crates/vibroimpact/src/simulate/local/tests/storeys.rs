@@ -392,26 +392,6 @@ fn a_plastic_excursion_moves_exactly() {
             post_yield_ratio: 0.05,
         })
     };
-    let storeys = vec![
-        Storey {
-            below: None,
-            above: 0,
-            law: bilinear(4e7),
-            p_delta: 0.0,
-        },
-        Storey {
-            below: Some(0),
-            above: 1,
-            law: bilinear(3e7),
-            p_delta: 0.0,
-        },
-    ];
-    let body = |name: &str| Body {
-        name: name.into(),
-        mass: 1e5,
-        stiffness: 0.0,
-        damping: 1e5,
-    };
     let times: Vec<f64> = (0..=600).map(|k| 0.01 * k as f64).collect();
     let pulse: Vec<f64> = times
         .iter()
@@ -424,18 +404,7 @@ fn a_plastic_excursion_moves_exactly() {
         })
         .collect();
     let base = BaseExcitation::Record(Accelerogram::new(times, pulse, 1.0).unwrap());
-    let model = Model::new(
-        vec![body("floor 1"), body("floor 2")],
-        vec![],
-        vec![],
-        base,
-        vec![],
-        vec![],
-        vec![],
-    )
-    .unwrap()
-    .with_storeys(storeys)
-    .unwrap();
+    let model = two_storey_frame([bilinear(4e7), bilinear(3e7)], 1e5, base);
     let run = |integrator| {
         let opts = SimulationOptions {
             t_end: 6.0,
@@ -467,4 +436,46 @@ fn a_plastic_excursion_moves_exactly() {
         (stats.body_evaluations[0] as f64) < 0.42 * g.stats.rhs_evaluations as f64,
         "{stats:?}"
     );
+}
+
+/// Two floors of 1e5 kg on the storeys `laws` (the ground's, then the
+/// second), each floor damped by `damping` (N s/m) to the ground, under
+/// `base`.
+pub(in crate::simulate::local) fn two_storey_frame(
+    laws: [StoreyLaw; 2],
+    damping: f64,
+    base: BaseExcitation,
+) -> Model {
+    let body = |name: &str| Body {
+        name: name.into(),
+        mass: 1e5,
+        stiffness: 0.0,
+        damping,
+    };
+    let [first, second] = laws;
+    Model::new(
+        vec![body("floor 1"), body("floor 2")],
+        vec![],
+        vec![],
+        base,
+        vec![],
+        vec![],
+        vec![],
+    )
+    .unwrap()
+    .with_storeys(vec![
+        Storey {
+            below: None,
+            above: 0,
+            law: first,
+            p_delta: 0.0,
+        },
+        Storey {
+            below: Some(0),
+            above: 1,
+            law: second,
+            p_delta: 0.0,
+        },
+    ])
+    .unwrap()
 }
