@@ -4,6 +4,8 @@
 //! ## Files
 //! - `mod.rs` — [`ChainDynamics`]: the right-hand side, banded Jacobian,
 //!   energy audit;
+//! - `jacobian.rs` — the analytic Jacobian and its record for tangent
+//!   replay;
 //! - `storeys.rs` — the hysteretic storeys' terms and states;
 //! - `variational.rs` — the variational equations (sensitivities,
 //!   monodromy matrices, docs/theory.md §5);
@@ -37,9 +39,10 @@
 
 use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::dynamics::variational::Variational;
-use crate::integrate::{BandMatrix, OdeSystem, RecordedJacobian, Recorder};
+use crate::integrate::{BandMatrix, OdeSystem, Recorder};
 use crate::model::{BaseExcitation, Model};
 
+mod jacobian;
 mod storeys;
 pub mod variational;
 pub use storeys::{Branch, StoreyTerms};
@@ -84,14 +87,25 @@ fn apply_contact(
     s: f64,
     sdot: f64,
     energy: bool,
-) -> f64 {
-    let f = law.force(s, sdot, onset_velocity);
+) -> (ContactForce, f64) {
+    let c = law.eval(s, sdot, onset_velocity);
+    let f = c.force;
     force[l] -= ml * f;
     force[r] += mr * f;
-    if energy {
+    let dissipated = if energy {
         (f - law.force(s, 0.0, onset_velocity)) * sdot
     } else {
         0.0
+    };
+    (c, dissipated)
+}
+
+/// The contacts `start..end` that join a chain's neighbours (`0..0`
+/// without one).
+fn chain_range(sc: &ScreenSoA, n: usize) -> (usize, usize) {
+    match sc.chain {
+        Some(fp) => (fp, fp + n - 1),
+        None => (0, 0),
     }
 }
 
@@ -138,6 +152,9 @@ pub struct ChainDynamics {
     energy: bool,
     force: Vec<f64>,
     contact_evaluations: u64,
+    /// The contacts the last right-hand side evaluated, in its order, with
+    /// their forces and partial derivatives (`jacobian.rs`).
+    evaluated: Vec<(usize, ContactForce)>,
     bandwidth: (usize, usize),
     screen: ScreenSoA,
     storeys: StoreyTerms,
@@ -277,6 +294,7 @@ impl ChainDynamics {
             energy,
             force: vec![0.0; n],
             contact_evaluations: 0,
+            evaluated: Vec::new(),
             bandwidth,
             screen,
             storeys,
@@ -526,6 +544,57 @@ impl OdeSystem for ChainDynamics {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        self.rhs_with(t, y, dydt, None);
+    }
+
+    fn rhs_reforced(&mut self, source: &Self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        // The energy audit's contact term is not kept: evaluate.
+        let replay = (!self.energy).then_some(&source.evaluated[..]);
+        self.rhs_with(t, y, dydt, replay);
+    }
+
+    fn jacobian_after_rhs(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        self.jacobian_from(y, jac, true)
+    }
+
+    /// A body's displacement and velocity: the error of the bodies that
+    /// move is not averaged with that of bodies at rest.
+    fn error_block(&self) -> Option<usize> {
+        Some(2)
+    }
+
+    /// Banded for the mechanical state; dense with the energy quadratures
+    /// (their rows depend on every velocity).
+    fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
+        (!self.energy && !self.storeys.integrated()).then_some(self.bandwidth)
+    }
+
+    /// Analytic ∂f/∂y: springs, dampers, couplings and every contact not
+    /// screened out, with the laws' analytic partial derivatives. The energy
+    /// quadratures' rows are left to finite differences (returns false then).
+    fn jacobian(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        self.jacobian_from(y, jac, false)
+    }
+    fn admissible(&self, _t: f64, y: &[f64]) -> bool {
+        self.contacts.iter().enumerate().all(|(k, c)| {
+            let (s, _) = self.approach(k, y);
+            s <= c.absurd
+        })
+    }
+}
+
+impl ChainDynamics {
+    /// The right-hand side; `replay` applies another copy's contact forces,
+    /// evaluated at the same `y` ([`OdeSystem::rhs_reforced`]), in its
+    /// order, instead of evaluating them; otherwise the evaluated contacts
+    /// are kept for [`OdeSystem::jacobian_after_rhs`].
+    fn rhs_with(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        dydt: &mut [f64],
+        replay: Option<&[(usize, ContactForce)]>,
+    ) {
         let zdd = self.base.at_from(t, &mut self.segment);
         let n = self.n;
         for ((((f, uv), k), c), m) in self
@@ -555,66 +624,76 @@ impl OdeSystem for ChainDynamics {
             damper += c * dv * dv;
         }
         self.storeys.apply(y, &mut self.force, dydt);
-        let (sc, contacts, onset, force) = (
+        let (sc, contacts, onset, force, kept) = (
             &self.screen,
             &self.contacts,
             &self.onset_velocity,
             &mut self.force,
+            &mut self.evaluated,
         );
         let energy = self.energy;
         let mut evaluations = 0;
-        let nc = sc.l.len();
-        let (chain_start, chain_end) = match sc.chain {
-            Some(fp) => (fp, fp + n - 1),
-            None => (0, 0),
-        };
-        if chain_end > chain_start {
-            // Neighbour pairs of a chain: contiguous, no gathers.
-            let (g, al, boa, lim) = (
-                &sc.g[chain_start..chain_end],
-                &sc.alpha[chain_start..chain_end],
-                &sc.boa[chain_start..chain_end],
-                &sc.limit[chain_start..chain_end],
-            );
-            for i in 0..n - 1 {
-                let w = &y[2 * i..2 * i + 4];
-                let s = w[0] - w[2] - g[i];
-                let sdot = w[1] - w[3];
-                if al[i] * s + boa[i] * sdot.abs() < lim[i] {
+        if let Some(list) = replay {
+            for &(k, c) in list {
+                force[sc.l[k]] -= sc.ml[k] * c.force;
+                force[sc.r[k]] += sc.mr[k] * c.force;
+            }
+        } else {
+            kept.clear();
+            let nc = sc.l.len();
+            let (chain_start, chain_end) = chain_range(sc, n);
+            if chain_end > chain_start {
+                // Neighbour pairs of a chain: contiguous, no gathers.
+                let (g, al, boa, lim) = (
+                    &sc.g[chain_start..chain_end],
+                    &sc.alpha[chain_start..chain_end],
+                    &sc.boa[chain_start..chain_end],
+                    &sc.limit[chain_start..chain_end],
+                );
+                for i in 0..n - 1 {
+                    let w = &y[2 * i..2 * i + 4];
+                    let s = w[0] - w[2] - g[i];
+                    let sdot = w[1] - w[3];
+                    if al[i] * s + boa[i] * sdot.abs() < lim[i] {
+                        continue;
+                    }
+                    let k = chain_start + i;
+                    evaluations += 1;
+                    let (c, dissipated) = apply_contact(
+                        &contacts[k].law,
+                        onset[k],
+                        force,
+                        (i, i + 1),
+                        (1.0, 1.0),
+                        s,
+                        sdot,
+                        energy,
+                    );
+                    kept.push((k, c));
+                    contact += dissipated;
+                }
+            }
+            for k in (0..chain_start).chain(chain_end..nc) {
+                let (l, r) = (sc.l[k], sc.r[k]);
+                let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - sc.g[k];
+                let sdot = sc.ml[k] * y[2 * l + 1] - sc.mr[k] * y[2 * r + 1];
+                if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
                     continue;
                 }
-                let k = chain_start + i;
                 evaluations += 1;
-                contact += apply_contact(
+                let (c, dissipated) = apply_contact(
                     &contacts[k].law,
                     onset[k],
                     force,
-                    (i, i + 1),
-                    (1.0, 1.0),
+                    (l, r),
+                    (sc.ml[k], sc.mr[k]),
                     s,
                     sdot,
                     energy,
                 );
+                kept.push((k, c));
+                contact += dissipated;
             }
-        }
-        for k in (0..chain_start).chain(chain_end..nc) {
-            let (l, r) = (sc.l[k], sc.r[k]);
-            let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - sc.g[k];
-            let sdot = sc.ml[k] * y[2 * l + 1] - sc.mr[k] * y[2 * r + 1];
-            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
-                continue;
-            }
-            evaluations += 1;
-            contact += apply_contact(
-                &contacts[k].law,
-                onset[k],
-                force,
-                (l, r),
-                (sc.ml[k], sc.mr[k]),
-                s,
-                sdot,
-                energy,
-            );
         }
         self.contact_evaluations += evaluations;
         for i in 0..n {
@@ -631,115 +710,6 @@ impl OdeSystem for ChainDynamics {
             dydt[m] = input;
             dydt[m + 1] = damper;
             dydt[m + 2] = contact;
-        }
-    }
-
-    /// A body's displacement and velocity: the error of the bodies that
-    /// move is not averaged with that of bodies at rest.
-    fn error_block(&self) -> Option<usize> {
-        Some(2)
-    }
-
-    /// Banded for the mechanical state; dense with the energy quadratures
-    /// (their rows depend on every velocity).
-    fn jacobian_bandwidth(&self) -> Option<(usize, usize)> {
-        (!self.energy && !self.storeys.integrated()).then_some(self.bandwidth)
-    }
-
-    /// Analytic ∂f/∂y: springs, dampers, couplings and every contact not
-    /// screened out, with the laws' analytic partial derivatives. The energy
-    /// quadratures' rows are left to finite differences (returns false then).
-    fn jacobian(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
-        // The storeys' hysteretic terms are left to finite differences.
-        if self.energy || !self.storeys.is_empty() {
-            return false;
-        }
-        for i in 0..self.n {
-            let im = self.inv_mass[i];
-            jac.set(2 * i, 2 * i + 1, 1.0);
-            jac.add(2 * i + 1, 2 * i, -self.stiffness[i] * im);
-            jac.add(2 * i + 1, 2 * i + 1, -self.damping[i] * im);
-        }
-        let pair = |jac: &mut BandMatrix, a: usize, b: usize, ds: f64, dv: f64| {
-            // Force +(ds Δu + dv Δv) on a, -(…) on b, with Δ = (b) - (a).
-            let (ia, ib) = (self.inv_mass[a], self.inv_mass[b]);
-            jac.add(2 * a + 1, 2 * a, -ds * ia);
-            jac.add(2 * a + 1, 2 * b, ds * ia);
-            jac.add(2 * a + 1, 2 * a + 1, -dv * ia);
-            jac.add(2 * a + 1, 2 * b + 1, dv * ia);
-            jac.add(2 * b + 1, 2 * a, ds * ib);
-            jac.add(2 * b + 1, 2 * b, -ds * ib);
-            jac.add(2 * b + 1, 2 * a + 1, dv * ib);
-            jac.add(2 * b + 1, 2 * b + 1, -dv * ib);
-        };
-        for &(a, b, k, c) in &self.couplings {
-            pair(jac, a, b, k, c);
-        }
-        for (k, c) in self.evaluated_contacts(y) {
-            match (self.contacts[k].left, self.contacts[k].right) {
-                // -F on l, +F on r, F = F(u_l - u_r - g, v_l - v_r): the same
-                // shape as a coupling of stiffness ∂F/∂s between r and l.
-                (Some(l), Some(r)) => pair(jac, l, r, c.d_ds, c.d_dsdot),
-                (Some(l), None) => {
-                    jac.add(2 * l + 1, 2 * l, -c.d_ds * self.inv_mass[l]);
-                    jac.add(2 * l + 1, 2 * l + 1, -c.d_dsdot * self.inv_mass[l]);
-                }
-                (None, Some(r)) => {
-                    // s = -u_r - g: ∂(+F)/∂u_r = -∂F/∂s.
-                    jac.add(2 * r + 1, 2 * r, -c.d_ds * self.inv_mass[r]);
-                    jac.add(2 * r + 1, 2 * r + 1, -c.d_dsdot * self.inv_mass[r]);
-                }
-                (None, None) => {}
-            }
-        }
-        true
-    }
-
-    fn admissible(&self, _t: f64, y: &[f64]) -> bool {
-        self.contacts.iter().enumerate().all(|(k, c)| {
-            let (s, _) = self.approach(k, y);
-            s <= c.absurd
-        })
-    }
-}
-
-/// The Jacobian recorded for tangent replay: springs, dampers and
-/// couplings are the model's (constant); each contact not screened out
-/// contributes its index and its force's partial derivatives
-/// `(∂F/∂s, ∂F/∂ṡ)`, as in [`OdeSystem::jacobian`].
-impl RecordedJacobian for ChainDynamics {
-    type Entry = (u32, f64, f64);
-
-    fn record_jacobian(&self, y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
-        out.extend(
-            self.evaluated_contacts(y)
-                .map(|(k, c)| (k as u32, c.d_ds, c.d_dsdot)),
-        );
-    }
-
-    fn apply_recorded(&self, entries: &[(u32, f64, f64)], v: &[f64], out: &mut [f64]) {
-        let n = self.n;
-        for i in 0..n {
-            out[2 * i] = v[2 * i + 1];
-            out[2 * i + 1] = -self.stiffness[i] * v[2 * i] - self.damping[i] * v[2 * i + 1];
-        }
-        for &(a, b, k, c) in &self.couplings {
-            let f = k * (v[2 * b] - v[2 * a]) + c * (v[2 * b + 1] - v[2 * a + 1]);
-            out[2 * a + 1] += f;
-            out[2 * b + 1] -= f;
-        }
-        let sc = &self.screen;
-        for &(k, d_ds, d_dsdot) in entries {
-            let k = k as usize;
-            let (l, r, ml, mr) = (sc.l[k], sc.r[k], sc.ml[k], sc.mr[k]);
-            let ds = ml * v[2 * l] - mr * v[2 * r];
-            let dsdot = ml * v[2 * l + 1] - mr * v[2 * r + 1];
-            let f = d_ds * ds + d_dsdot * dsdot;
-            out[2 * l + 1] -= ml * f;
-            out[2 * r + 1] += mr * f;
-        }
-        for i in 0..n {
-            out[2 * i + 1] *= self.inv_mass[i];
         }
     }
 }

@@ -33,8 +33,13 @@ pub struct Variational<S> {
     f0: Vec<f64>,
     f1: Vec<f64>,
     yp: Vec<f64>,
+    /// The shifted system's right-hand side (parameter column).
+    fp: Vec<f64>,
     /// The system at `p + δp` and `δp`, for the parameter column.
     parameter: Option<(S, f64)>,
+    /// Whether p enters through the forcing alone (the shifted system's
+    /// right-hand side then reuses the rest of the system's).
+    forcing_only: bool,
 }
 
 impl<S: OdeSystem> Variational<S> {
@@ -55,7 +60,9 @@ impl<S: OdeSystem> Variational<S> {
             f0: vec![0.0; dim],
             f1: vec![0.0; dim],
             yp: vec![0.0; dim],
+            fp: vec![0.0; dim],
             parameter: None,
+            forcing_only: false,
         }
     }
 
@@ -66,6 +73,17 @@ impl<S: OdeSystem> Variational<S> {
         Self {
             parameter: Some((shifted, dp)),
             ..Self::new(sys, columns)
+        }
+    }
+
+    /// [`with_parameter`](Self::with_parameter) for a parameter of the
+    /// forcing alone (its amplitude or frequency): the shifted system's
+    /// right-hand side takes the rest, contact forces included, from the
+    /// system's ([`OdeSystem::rhs_reforced`]).
+    pub fn with_forcing_parameter(sys: S, columns: usize, shifted: S, dp: f64) -> Self {
+        Self {
+            forcing_only: true,
+            ..Self::with_parameter(sys, columns, shifted, dp)
         }
     }
 
@@ -134,11 +152,12 @@ impl<S: OdeSystem> Variational<S> {
         self.parameter.as_ref().map(|_| &z[start..start + self.dim])
     }
 
-    /// Fills `self.jac` at (t, y): analytic if the system provides it, else
-    /// forward differences.
+    /// Fills `self.jac` at (t, y), the point of the system's last
+    /// right-hand side: analytic if the system provides it, else forward
+    /// differences.
     fn jacobian_at(&mut self, t: f64, y: &[f64]) {
         self.jac.zero();
-        if self.sys.jacobian(t, y, &mut self.jac) {
+        if self.sys.jacobian_after_rhs(t, y, &mut self.jac) {
             return;
         }
         self.sys.rhs(t, y, &mut self.f0);
@@ -168,16 +187,24 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
         if self.carried() == 0 {
             return;
         }
+        // The shifted system reads the system's last right-hand side: before
+        // a Jacobian by differences evaluates others.
+        if let Some((shifted, _)) = &mut self.parameter {
+            if self.forcing_only {
+                shifted.rhs_reforced(&self.sys, t, &z[..d], &mut self.fp);
+            } else {
+                shifted.rhs(t, &z[..d], &mut self.fp);
+            }
+        }
         self.jacobian_at(t, &z[..d]);
         let k = self.carried();
         let columns = d..d * (1 + k);
         self.jac
             .mul_columns(&z[columns.clone()], &mut dzdt[columns], k);
-        if let Some((shifted, dp)) = &mut self.parameter {
-            shifted.rhs(t, &z[..d], &mut self.f1);
+        if let Some((_, dp)) = &self.parameter {
             let (f0, rest) = dzdt.split_at_mut(d);
             let column = &mut rest[d * self.columns..];
-            for ((s, f1), f0) in column.iter_mut().zip(&self.f1).zip(&*f0) {
+            for ((s, f1), f0) in column.iter_mut().zip(&self.fp).zip(&*f0) {
                 *s += (f1 - f0) / *dp;
             }
         }

@@ -181,6 +181,24 @@ pub trait OdeSystem {
     fn jacobian(&mut self, _t: f64, _y: &[f64], _jac: &mut BandMatrix) -> bool {
         false
     }
+
+    /// [`jacobian`](Self::jacobian) at the `(t, y)` of the last
+    /// [`rhs`](Self::rhs) call, which a system may take from what that call
+    /// computed (the same numbers: a row's contact laws are evaluated once).
+    fn jacobian_after_rhs(&mut self, t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        self.jacobian(t, y, jac)
+    }
+
+    /// [`rhs`](Self::rhs) at the `(t, y)` of `source`'s last right-hand
+    /// side, for a copy of `source` that differs from it in its forcing
+    /// alone (functions of time): a system may take the rest from what
+    /// `source` computed (the same numbers).
+    fn rhs_reforced(&mut self, _source: &Self, t: f64, y: &[f64], dydt: &mut [f64])
+    where
+        Self: Sized,
+    {
+        self.rhs(t, y, dydt)
+    }
 }
 
 /// Tolerances and step-size limits of the integrator.

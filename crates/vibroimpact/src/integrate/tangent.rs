@@ -40,6 +40,13 @@ pub trait RecordedJacobian: OdeSystem {
     /// of the Jacobian at `y`.
     fn record_jacobian(&self, y: &[f64], out: &mut Vec<Self::Entry>);
 
+    /// [`record_jacobian`](Self::record_jacobian) at the `y` of the last
+    /// right-hand side, which a system may take from what that call
+    /// computed (the same entries).
+    fn record_jacobian_after_rhs(&self, y: &[f64], out: &mut Vec<Self::Entry>) {
+        self.record_jacobian(y, out)
+    }
+
     /// `out = J v` with the Jacobian recorded as `entries`.
     fn apply_recorded(&self, entries: &[Self::Entry], v: &[f64], out: &mut [f64]);
 }
@@ -83,6 +90,16 @@ impl<S: RecordedJacobian> Recorder<S> {
     /// Whether evaluations are recorded.
     pub fn recording(&self) -> bool {
         self.on
+    }
+
+    /// Records the Jacobian of the right-hand side just evaluated at
+    /// `(t, y)`, if recording.
+    fn record(&mut self, t: f64, y: &[f64]) {
+        if self.on {
+            self.times.push(t);
+            self.sys.record_jacobian_after_rhs(y, &mut self.entries);
+            self.offsets.push(self.entries.len());
+        }
     }
 
     /// Forgets the evaluations recorded so far.
@@ -166,11 +183,12 @@ impl<S: RecordedJacobian> OdeSystem for Recorder<S> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
         self.sys.rhs(t, y, dydt);
-        if self.on {
-            self.times.push(t);
-            self.sys.record_jacobian(y, &mut self.entries);
-            self.offsets.push(self.entries.len());
-        }
+        self.record(t, y);
+    }
+
+    fn rhs_reforced(&mut self, source: &Self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        self.sys.rhs_reforced(&source.sys, t, y, dydt);
+        self.record(t, y);
     }
 
     fn admissible(&self, t: f64, y: &[f64]) -> bool {
@@ -187,6 +205,10 @@ impl<S: RecordedJacobian> OdeSystem for Recorder<S> {
 
     fn jacobian(&mut self, t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
         self.sys.jacobian(t, y, jac)
+    }
+
+    fn jacobian_after_rhs(&mut self, t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
+        self.sys.jacobian_after_rhs(t, y, jac)
     }
 }
 

@@ -149,7 +149,11 @@ pub(crate) fn period_map_with(
         Some((model_p, dp)) => {
             let t_p = map_time(model_p, opts).map_err(invalid)?;
             let shifted_sys = Recorder::new(ChainDynamics::new(model_p, false), false);
-            let var = Variational::with_parameter(sys, columns, shifted_sys, dp);
+            let var = if model.differs_only_in_forcing(model_p) {
+                Variational::with_forcing_parameter(sys, columns, shifted_sys, dp)
+            } else {
+                Variational::with_parameter(sys, columns, shifted_sys, dp)
+            };
             (var, (t_p - t) / dp)
         }
         None => (Variational::new(sys, columns), 0.0),
