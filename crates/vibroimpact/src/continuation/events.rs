@@ -137,7 +137,7 @@ pub struct Observed<'a> {
 /// A condition whose occurrence between consecutive points of a branch is
 /// detected and then located (to the continuation's `locate_tol` in the
 /// parameter) by bisection of the arclength.
-pub trait BranchEvent {
+pub trait BranchEvent: Send {
     /// The kind reported (and the label prefix).
     fn kind(&self) -> SpecialKind;
     /// Whether the event lies between the points `a` and `b`.
@@ -224,7 +224,7 @@ impl BranchEvent for SpecialKind {
 /// value of interest. Reported as [`SpecialKind::User`] (labels `UZ1`, …).
 pub struct UserEvent<G>(pub G);
 
-impl<G: Fn(&BranchPoint) -> f64> BranchEvent for UserEvent<G> {
+impl<G: Fn(&BranchPoint) -> f64 + Send> BranchEvent for UserEvent<G> {
     fn kind(&self) -> SpecialKind {
         SpecialKind::User
     }

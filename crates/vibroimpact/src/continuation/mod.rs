@@ -6,6 +6,8 @@
 //! - `problem.rs` — the extended system in scaled variables, corrector, tangent;
 //! - `events.rs` — special points as events: test values, location;
 //! - `branch.rs` — the [`Continuation`] iterator over a branch's steps;
+//! - `finish.rs` — each point's orbit summary and the special points before
+//!   it, beside the corrector;
 //! - `switching.rs` — starts on crossing and period-doubled branches;
 //! - `start.rs` — the homotopy start on the primary branch;
 //! - `krylov.rs` — the matrix-free extended system for long rows;
@@ -52,6 +54,7 @@ mod branch;
 mod continue_study;
 mod curve;
 mod events;
+mod finish;
 mod krylov;
 mod orbit_study;
 mod problem;
@@ -473,7 +476,7 @@ pub fn continue_branch<F, C>(
     mut on_point: C,
 ) -> Result<Branch, ContinuationError>
 where
-    F: Family,
+    F: Family + Send,
     C: FnMut(&BranchPoint) -> bool,
 {
     let mut steps = Continuation::new(family, p0, x0, p_end, opts)?;

@@ -56,6 +56,7 @@ pub(super) struct Solved {
 /// of two: without it, a parameter step of the same size moved the
 /// arclength √(N/2) times further and the steps `ds_max` allows shrank
 /// with N (docs/decisions.md D20).
+#[derive(Clone)]
 pub(super) struct Problem<F> {
     family: F,
     pub(super) opts: ContinuationOptions,
@@ -91,6 +92,17 @@ impl<F: Family> Problem<F> {
             steps: 0,
             chord_rate: f64::NAN,
         }
+    }
+
+    /// What the last corrections learnt for the next: the map's steps
+    /// and the chord's contraction.
+    pub(super) fn learnt(&self) -> (u64, f64) {
+        (self.steps, self.chord_rate)
+    }
+
+    /// Starts from what another copy's corrections learnt ([`Self::learnt`]).
+    pub(super) fn learn(&mut self, (steps, chord_rate): (u64, f64)) {
+        (self.steps, self.chord_rate) = (steps, chord_rate);
     }
 
     pub(super) fn model(&mut self, p: f64) -> Result<Model, ContinuationError> {
@@ -518,7 +530,7 @@ impl<F: Family> Problem<F> {
         let mut held = vec![0.0; self.d + 1];
         held[self.d] = 1.0;
         let (solved, _) = self.correct(&pred, &held, Some(&a.solved.linear))?;
-        self.evaluate(solved, &a.tangent)
+        self.evaluate_with(solved, &a.tangent, false)
     }
 }
 

@@ -26,7 +26,7 @@ pub fn amplitude_homotopy<F>(
     opts: &ContinuationOptions,
 ) -> Result<Vec<f64>, ContinuationError>
 where
-    F: Family,
+    F: Family + Send,
 {
     if !(amplitude.is_finite() && amplitude != 0.0) {
         return Err(ContinuationError::Invalid(format!(

@@ -234,7 +234,7 @@ impl BranchStudy {
     /// a period multiple ≥ 1, a continuous parameter and a periodic
     /// forcing at the start; the model there and the options for its
     /// size.
-    pub fn check<F: Family>(self, mut family: F) -> Result<CheckedBranch<F>, StudyError> {
+    pub fn check<F: Family + Send>(self, mut family: F) -> Result<CheckedBranch<F>, StudyError> {
         let invalid = |field, message: &str| StudyError::Invalid {
             field,
             message: message.into(),
@@ -311,7 +311,7 @@ pub struct CheckedBranch<F> {
 /// tolerance (at 0.8 ω0 rtol 1e-9 and 1e-8 end on different orbits).
 pub(super) const GUESS_RTOL: f64 = 1e-7;
 
-impl<F: Family> CheckedBranch<F> {
+impl<F: Family + Send> CheckedBranch<F> {
     /// The estimated work of the start guess's simulation (`start` auto or
     /// simulate) on one core, for the faces to announce when long: a
     /// continuation with `--guess-periods 100000` ran silently (the

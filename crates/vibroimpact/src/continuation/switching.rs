@@ -43,7 +43,7 @@ pub fn period_doubled_start<F>(
     opts: &ContinuationOptions,
 ) -> Result<(f64, Vec<f64>), ContinuationError>
 where
-    F: Family,
+    F: Family + Send,
 {
     let model = family.model_at(point.parameter)?;
     let map = period_map(&model, &point.state, &opts.shooting)?;
@@ -113,7 +113,7 @@ pub fn branch_switch_start<F>(
     step: f64,
 ) -> Result<(f64, Vec<f64>), ContinuationError>
 where
-    F: Family,
+    F: Family + Send,
 {
     let model = family.model_at(point.parameter)?;
     // The predictor off the branch is poorer than along it: a larger
@@ -259,7 +259,7 @@ pub fn switch_branch<F, C>(
     progress: C,
 ) -> Result<Branch, SwitchError>
 where
-    F: Family,
+    F: Family + Send,
     C: FnMut(&BranchPoint) -> bool,
 {
     let sp = branch

@@ -725,6 +725,43 @@ fn krylov_branch_is_the_same_on_any_thread_count() {
     }
 }
 
+/// The points are finished (orbit summaries, special points) on one
+/// thread while the corrector runs ahead on another: the same bytes on one
+/// thread and on two, special points and amplitudes included.
+#[test]
+fn a_branch_finished_beside_its_corrector_is_the_same_on_any_thread_count() {
+    let family = of("frequency", |w: f64| r2(2, 1e-3, w));
+    let guess = start_orbit(2, 0.5);
+    let opts = ContinuationOptions::default();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            continue_branch(family, 0.5 * W0, &guess, 0.56 * W0, &opts, |_| true).unwrap()
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.points.len(), two.points.len());
+    assert!(one.special.len() >= 4, "{:?}", one.special.len());
+    for (a, b) in one.points.iter().zip(&two.points) {
+        assert_eq!(a.parameter.to_bits(), b.parameter.to_bits());
+        assert_eq!((&a.state, &a.multipliers), (&b.state, &b.multipliers));
+        assert_eq!(
+            (&a.max_displacement, &a.label),
+            (&b.max_displacement, &b.label)
+        );
+    }
+    assert_eq!(one.special.len(), two.special.len());
+    for (a, b) in one.special.iter().zip(&two.special) {
+        assert_eq!((&a.label, a.after_point), (&b.label, b.after_point));
+        assert_eq!(a.parameter.to_bits(), b.parameter.to_bits());
+        assert_eq!(a.max_displacement, b.max_displacement);
+    }
+    assert_eq!(one.stop, two.stop);
+}
+
 /// A stop requested while a step is being corrected ends the branch as
 /// interrupted, with the points so far, not as a corrector that does not
 /// converge (the request fails every integration).
