@@ -49,10 +49,12 @@ pub struct Continuation<F> {
     finisher: Option<Finisher<Shared<F>>>,
     /// Points corrected ahead of the one being finished, in order, and the
     /// stop that may end them.
-    ahead: VecDeque<Result<Corrected, StopReason>>,
+    ahead: VecDeque<Result<Corrected, Ending>>,
     /// Points finished and not yet yielded, in order, and the stop that
     /// may end them.
-    finished: VecDeque<Result<(Evaluated, Vec<SpecialPoint>), StopReason>>,
+    finished: VecDeque<Result<(Evaluated, Vec<SpecialPoint>), Ending>>,
+    /// Whether the corrector has met the end of the branch.
+    ended: bool,
     /// Parameter interval the branch stays in.
     bounds: (f64, f64),
     /// The bound the branch starts on, if it starts on one other than
@@ -73,7 +75,8 @@ pub struct Continuation<F> {
     /// a mirror-symmetric row (closing a loop onto the mirror image).
     mirrors: Option<(ShootingOptions, Vec<Vec<f64>>)>,
     symmetric: bool,
-    /// The stop reason decided with the last point, yielded next.
+    /// The stop reason decided with the last point corrected: the
+    /// corrector's next step returns it.
     pending: Option<StopReason>,
     /// The change of the unit tangent per arclength over the last step
     /// (second-order predictor).
@@ -83,6 +86,14 @@ pub struct Continuation<F> {
     /// extrapolated to the predicted point.
     jacobian_rate: Option<DMatrix<f64>>,
     done: bool,
+}
+
+/// Why the branch ends, and whether that was decided together with the
+/// point before it (the end of the range, a closed loop:
+/// [`Continuation::pending_stop`]).
+struct Ending {
+    reason: StopReason,
+    with_point: bool,
 }
 
 /// How many points the corrector may run ahead of the points being
@@ -183,6 +194,7 @@ impl<F: Family + Send> Continuation<F> {
             finisher: Some(finisher),
             ahead: VecDeque::new(),
             finished: VecDeque::new(),
+            ended: false,
             bounds,
             start_bound: [bounds.0, bounds.1]
                 .into_iter()
@@ -227,10 +239,12 @@ impl<F: Family + Send> Continuation<F> {
     /// The stop reason decided together with the last point yielded (the
     /// end of the range, a closed loop), if any: the next step yields it.
     pub fn pending_stop(&self) -> Option<&StopReason> {
-        match (self.finished.front(), self.ahead.front()) {
-            (Some(Err(reason)), _) | (None, Some(Err(reason))) => Some(reason),
-            (Some(Ok(_)), _) | (None, Some(Ok(_))) => None,
-            (None, None) => self.pending.as_ref(),
+        let next = (self.finished.front().map(|f| f.as_ref().err()))
+            .or_else(|| self.ahead.front().map(|a| a.as_ref().err()));
+        match next {
+            Some(Some(end)) => end.with_point.then_some(&end.reason),
+            Some(None) => None,
+            None => self.pending.as_ref(),
         }
     }
 
@@ -305,33 +319,46 @@ impl<F: Family + Send> Continuation<F> {
         interrupt.as_ref().is_some_and(|i| i.requested())
     }
 
-    /// One accepted point, or the reason the branch ends.
     /// The next point corrected, not yet finished, or the reason the
     /// branch ends.
-    fn advance(&mut self) -> Result<Corrected, StopReason> {
+    fn advance(&mut self) -> Result<Corrected, Ending> {
+        let step = self.correct_next();
+        self.ended |= step.is_err();
+        step
+    }
+
+    /// [`advance`](Self::advance) itself.
+    fn correct_next(&mut self) -> Result<Corrected, Ending> {
         if let Some(reason) = self.pending.take() {
-            return Err(reason);
+            return Err(Ending {
+                reason,
+                with_point: true,
+            });
         }
+        let end = |reason| Ending {
+            reason,
+            with_point: false,
+        };
         if self.points >= self.problem.opts.max_points {
-            return Err(StopReason::MaxPoints);
+            return Err(end(StopReason::MaxPoints));
         }
         let (next, iterations, factor) = loop {
             match self.try_step(self.ds) {
                 Ok(found) => break found,
                 // A stop request fails every integration, which would read
                 // as a corrector that does not converge at any step.
-                Err(_) if self.interrupted() => return Err(StopReason::Interrupted),
+                Err(_) if self.interrupted() => return Err(end(StopReason::Interrupted)),
                 Err(shrink) => self.ds *= shrink,
             }
             if self.ds < self.problem.opts.ds_min {
                 let p = self.current.point.parameter;
-                return Err(StopReason::CannotContinue(format!(
+                return Err(end(StopReason::CannotContinue(format!(
                     "the corrector does not converge beyond parameter {p} even with step {:e}",
                     self.ds
-                )));
+                ))));
             }
         };
-        let (ds, after) = (self.ds, self.points - 1);
+        let (ds, after, learnt) = (self.ds, self.points - 1, self.problem.learnt());
         let opts = &self.problem.opts;
         self.ds = opts
             .step
@@ -350,7 +377,7 @@ impl<F: Family + Send> Continuation<F> {
             };
             match self.problem.end_point(&self.current, &next, bound) {
                 Some(end) => Some(end),
-                None => return Err(self.left_by(bound)),
+                None => return Err(end(self.left_by(bound))),
             }
         } else {
             None
@@ -361,7 +388,7 @@ impl<F: Family + Send> Continuation<F> {
             end,
             ds,
             after,
-            learnt: self.problem.learnt(),
+            learnt,
         };
         let next = reached;
         self.points += 1;
@@ -402,10 +429,7 @@ impl<F: Family + Send> Continuation<F> {
             None => AHEAD.0,
             Some(_) => AHEAD.1,
         };
-        while !finished.load(Ordering::Acquire)
-            && self.ahead.len() < most
-            && !matches!(self.ahead.back(), Some(Err(_)))
-        {
+        while !finished.load(Ordering::Acquire) && self.ahead.len() < most && !self.ended {
             let step = self.advance();
             self.ahead.push_back(step);
         }
@@ -461,9 +485,9 @@ impl<F: Family + Send> Iterator for Continuation<F> {
                 point.label = special.last().map(|s| s.label.clone());
                 BranchStep::Point { point, special }
             }
-            Err(reason) => {
+            Err(end) => {
                 self.done = true;
-                BranchStep::Stop(reason)
+                BranchStep::Stop(end.reason)
             }
         })
     }
@@ -485,7 +509,12 @@ impl<F: Family + Send> Continuation<F> {
         let finish = || {
             let mut out = Vec::with_capacity(batch.len());
             for step in batch {
-                let finished = step.and_then(|s| finisher.finish(s));
+                let finished = step.and_then(|s| {
+                    finisher.finish(s).map_err(|reason| Ending {
+                        reason,
+                        with_point: false,
+                    })
+                });
                 let stop = finished.is_err();
                 out.push(finished);
                 if stop {

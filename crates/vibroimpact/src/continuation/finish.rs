@@ -3,9 +3,12 @@
 //! located between it and the point before (docs/theory.md §5).
 //!
 //! None of this steers the branch: the corrector's path depends on the
-//! points, tangents and multipliers alone. So a [`Finisher`], with its own
-//! copy of the problem, finishes point k on one thread while the
-//! [`Continuation`](super::Continuation) corrects the points after it on
+//! points, tangents and multipliers alone. (A location's corrections no
+//! longer leave their chord history to the corrector's next step, as they
+//! did when they ran in turn; they start from the corrector's history at
+//! their point.) So a [`Finisher`], with its own copy of the problem,
+//! finishes the points corrected so far on one thread while the
+//! [`Continuation`](super::Continuation) corrects the points after them on
 //! another (docs/decisions.md D38). Each works through its points in order
 //! with its own state, so the numbers are the same on any thread count.
 
@@ -75,7 +78,8 @@ impl<F: Family> Finisher<F> {
 
     /// The point `step` reached, with its orbit summary and the special
     /// points since the point before; or why the branch stops (the orbit
-    /// could not be integrated, a stop request).
+    /// could not be integrated, a stop request: a location it cut short
+    /// would lose its special point).
     pub fn finish(
         &mut self,
         step: Corrected,
@@ -88,6 +92,9 @@ impl<F: Family> Finisher<F> {
             step.next
         };
         let special = self.special_points(&next, step.ds, step.after);
+        if self.interrupted() {
+            return Err(StopReason::Interrupted);
+        }
         let shown = match step.end {
             Some(end) => self.orbit_of(end)?,
             None => next,
@@ -96,18 +103,19 @@ impl<F: Family> Finisher<F> {
         Ok((shown, special))
     }
 
+    /// Whether a stop was requested (`ShootingOptions::interrupt`).
+    fn interrupted(&self) -> bool {
+        let interrupt = &self.problem.opts.shooting.interrupt;
+        interrupt.as_ref().is_some_and(|i| i.requested())
+    }
+
     /// `e` with its orbit summary.
     fn orbit_of(&mut self, e: Evaluated) -> Result<Evaluated, StopReason> {
         let p = e.point.parameter;
         self.problem.add_orbit(e).ok_or_else(|| {
-            let interrupt = &self.problem.opts.shooting.interrupt;
-            if interrupt.as_ref().is_some_and(|i| i.requested()) {
-                StopReason::Interrupted
-            } else {
-                StopReason::CannotContinue(format!(
-                    "the orbit at parameter {p} could not be integrated over its period"
-                ))
-            }
+            StopReason::CannotContinue(format!(
+                "the orbit at parameter {p} could not be integrated over its period"
+            ))
         })
     }
 

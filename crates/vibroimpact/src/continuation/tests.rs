@@ -760,6 +760,27 @@ fn a_branch_finished_beside_its_corrector_is_the_same_on_any_thread_count() {
         assert_eq!(a.max_displacement, b.max_displacement);
     }
     assert_eq!(one.stop, two.stop);
+    // A consumer that stops at a point reads its own stop, however far the
+    // corrector ran ahead.
+    let opts = ContinuationOptions {
+        max_points: 6,
+        ..opts
+    };
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut seen = 0;
+        let b = pool.install(|| {
+            continue_branch(family, 0.5 * W0, &guess, 0.56 * W0, &opts, |_| {
+                seen += 1;
+                seen < 6
+            })
+            .unwrap()
+        });
+        assert_eq!((b.points.len(), &b.stop), (6, &StopReason::Interrupted));
+    }
 }
 
 /// A stop requested while a step is being corrected ends the branch as

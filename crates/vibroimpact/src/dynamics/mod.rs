@@ -301,6 +301,22 @@ impl ChainDynamics {
         }
     }
 
+    /// Whether `other` screens and evaluates its contacts as this does (the
+    /// same laws, gaps and screening limits: a copy in another forcing
+    /// amplitude may screen with another force scale), so that its
+    /// right-hand side may replay this one's ([`OdeSystem::rhs_reforced`]).
+    pub fn same_contact_terms(&self, other: &ChainDynamics) -> bool {
+        let (a, b) = (&self.screen, &other.screen);
+        (a.chain, &a.l, &a.r, &a.ml, &a.mr, &a.g) == (b.chain, &b.l, &b.r, &b.ml, &b.mr, &b.g)
+            && (&a.alpha, &a.boa, &a.limit) == (&b.alpha, &b.boa, &b.limit)
+            && self.contacts.len() == other.contacts.len()
+            && self
+                .contacts
+                .iter()
+                .zip(&other.contacts)
+                .all(|(p, q)| p.law == q.law)
+    }
+
     /// Number of bodies.
     pub fn bodies(&self) -> usize {
         self.n
@@ -638,6 +654,8 @@ impl ChainDynamics {
                 force[sc.l[k]] -= sc.ml[k] * c.force;
                 force[sc.r[k]] += sc.mr[k] * c.force;
             }
+            kept.clear();
+            kept.extend_from_slice(list);
         } else {
             kept.clear();
             let nc = sc.l.len();

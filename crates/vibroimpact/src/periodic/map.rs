@@ -149,7 +149,9 @@ pub(crate) fn period_map_with(
         Some((model_p, dp)) => {
             let t_p = map_time(model_p, opts).map_err(invalid)?;
             let shifted_sys = Recorder::new(ChainDynamics::new(model_p, false), false);
-            let var = if model.differs_only_in_forcing(model_p) {
+            let reforced = model.differs_only_in_forcing(model_p)
+                && sys.system().same_contact_terms(shifted_sys.system());
+            let var = if reforced {
                 Variational::with_forcing_parameter(sys, columns, shifted_sys, dp)
             } else {
                 Variational::with_parameter(sys, columns, shifted_sys, dp)
