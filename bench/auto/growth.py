@@ -3,7 +3,8 @@
 bodies (N = 2, 4, 8, 16), the same task in one run.
 
     python3 bench/auto/growth.py [--n 2,4,8,16,32] [--repeats 2] [--ntst 200,400]
-        [--timeout 900] [--integrators global,local] [--out bench/auto/results/growth-DATE]
+        [--timeout 900] [--integrators global,local] [--threads 1,2]
+        [--out bench/auto/results/growth-DATE]
 
 The task, the same for every N and both tools: from the rest state (exact at
 zero forcing) a homotopy in the forcing amplitude at 0.5 omega0, then the
@@ -20,9 +21,10 @@ piece of the same branch at every N.
   "ours" is the faster integrator.
 - AUTO-07p: run_auto.py --n N (rn.exe) with BP detection off (in-run
   detection leaves the symmetric branch at N = 4, README), DS 0.005, DSMAX
-  0.05, EPSL/EPSU 1e-6, EPSS 1e-5, NCOL 4, OMP_NUM_THREADS=1, for each NTST
-  of --ntst; a run passes if it ends at the user stop (UZ) with every point
-  symmetric; AUTO's time is the fastest passing NTST (best of --repeats,
+  0.05, EPSL/EPSU 1e-6, EPSS 1e-5, NCOL 4, for each NTST of --ntst and
+  each OpenMP thread count of --threads (ours finishes points on a second
+  thread, so AUTO gets its second one too); a run passes if it ends at the user stop (UZ) with every point
+  symmetric; AUTO's time is the fastest passing NTST and thread count (best of --repeats,
   homotopy + branch). These are the N = 2 scan's fastest settings
   (scan_auto.py) with the BP handling that stays on the branch; the scan
   over NTST is repeated per N, the other factors are not (a full scan at
@@ -86,23 +88,25 @@ def ours(n, repeats, workdir, integrator):
     }
 
 
-def auto(n, ntst, repeats, timeout, workdir):
+def auto(n, ntst, threads, repeats, timeout, workdir):
     cmd = [sys.executable, os.path.join(HERE, "run_auto.py"), "--n", str(n), "--exe", "rn",
            "--ntst", str(ntst), "--ncol", "4", "--ds", "0.005", "--dsmax", "0.05",
            "--eps", "1e-6", "--epss", "1e-5", "--wmax", str(W_END), "--no-locate-bp",
-           "--repeats", str(repeats), "--threads", "1", "--no-branch",
-           "--timeout", str(timeout), "--workdir", os.path.join(workdir, f"auto-n{n}-{ntst}")]
+           "--repeats", str(repeats), "--threads", str(threads), "--no-branch",
+           "--timeout", str(timeout),
+           "--workdir", os.path.join(workdir, f"auto-n{n}-{ntst}-{threads}")]
     os.makedirs(cmd[-1], exist_ok=True)
     p = subprocess.run(cmd, capture_output=True, text=True)
     try:
         d = json.loads(p.stdout.strip().splitlines()[-1])
     except (IndexError, json.JSONDecodeError):
-        return {"ntst": ntst, "error": p.stderr.strip()[-500:], "passed": False}
+        return {"ntst": ntst, "threads": threads, "error": p.stderr.strip()[-500:], "passed": False}
     end = d.get("end") or {}
     passed = (not d.get("error") and end.get("type") == "UZ" and d.get("nan_points", 0) == 0
               and d.get("first_asymmetric_omega") is None)
     return {
         "ntst": ntst,
+        "threads": threads,
         "passed": passed,
         "seconds": d.get("seconds"),
         "seconds_all": d.get("seconds_all_repeats"),
@@ -157,6 +161,7 @@ def main(argv):
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=900)
     ap.add_argument("--integrators", default="global,local")
+    ap.add_argument("--threads", default="1,2")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "growth-" + time.strftime("%Y-%m-%d")))
     args = ap.parse_args(argv)
     rows = []
@@ -168,8 +173,8 @@ def main(argv):
             timed = [o for o in row["ours_by_integrator"] if "seconds" in o]
             row["ours"] = (min(timed, key=lambda o: o["seconds"]) if timed
                            else row["ours_by_integrator"][0])
-            row["auto"] = [auto(n, int(t), args.repeats, args.timeout, workdir)
-                           for t in args.ntst.split(",")]
+            row["auto"] = [auto(n, int(t), int(k), args.repeats, args.timeout, workdir)
+                           for t in args.ntst.split(",") for k in args.threads.split(",")]
             passing = [a for a in row["auto"] if a["passed"]]
             row["auto_best"] = min(passing, key=lambda a: a["seconds"]) if passing else None
             if row["auto_best"] and "seconds" in row["ours"]:
@@ -177,15 +182,15 @@ def main(argv):
             row["load_after"] = loadavg()
             rows.append(row)
             print(json.dumps({k: row.get(k) for k in ("n", "ratio")}), file=sys.stderr, flush=True)
-    lines = ["| N | ours (s) | integrator | our points | AUTO best (s) | AUTO NTST | AUTO steps "
-             "| AUTO / ours | load |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| N | ours (s) | integrator | our points | AUTO best (s) | AUTO NTST, threads "
+             "| AUTO steps | AUTO / ours | load |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         o, a = r["ours"], r.get("auto_best") or {}
         lines.append("| %d | %s | %s | %s | %s | %s | %s | %s | %.1f |" % (
             r["n"], "%.3f" % o["seconds"] if "seconds" in o else "error",
             o.get("integrator", "-"),
             o.get("points", "-"), "%.2f" % a["seconds"] if a else "none passed",
-            a.get("ntst", "-"), a.get("steps", "-"),
+            "%s, %s" % (a.get("ntst", "-"), a.get("threads", "-")), a.get("steps", "-"),
             "%.1f" % r["ratio"] if "ratio" in r else "-", r["load_before"][0]))
     table = "\n".join(lines)
     print(table)
