@@ -695,6 +695,15 @@ fn krylov_branch_matches_dense_on_a_longer_row() {
     assert_same_results(&krylov, &dense);
 }
 
+/// `f` run in a pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(f)
+}
+
 /// The matrix-free branch computes a point's tangent and multipliers on
 /// two threads: the same bytes on one thread and on two.
 #[test]
@@ -707,11 +716,7 @@ fn krylov_branch_is_the_same_on_any_thread_count() {
         ..Default::default()
     };
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             continue_branch(family, 0.5 * W0, &guess, 0.6 * W0, &opts, |_| true).unwrap()
         })
     };
@@ -734,11 +739,7 @@ fn a_branch_finished_beside_its_corrector_is_the_same_on_any_thread_count() {
     let guess = start_orbit(2, 0.5);
     let opts = ContinuationOptions::default();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             continue_branch(family, 0.5 * W0, &guess, 0.56 * W0, &opts, |_| true).unwrap()
         })
     };
@@ -767,12 +768,8 @@ fn a_branch_finished_beside_its_corrector_is_the_same_on_any_thread_count() {
         ..opts
     };
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
         let mut seen = 0;
-        let b = pool.install(|| {
+        let b = on_threads(threads, || {
             continue_branch(family, 0.5 * W0, &guess, 0.56 * W0, &opts, |_| {
                 seen += 1;
                 seen < 6
