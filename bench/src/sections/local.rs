@@ -11,7 +11,11 @@
 //!    never reaches its end).
 //! 3. R2, N = 2 and 3, 20 periods at 0.95 ω0: the loosest robust rtol
 //!    reaching 1e-6 against rtol 1e-13, global and local, timed.
-//! 4. Sweeps of the example row (`examples/fujita-row-n2.toml`, its
+//! 4. R2, N = 100 over 50 periods and N = 1000 over 3 periods (issue 39
+//!    item 2, a stepper per cluster): the loosest robust rtol reaching
+//!    1e-5 against the global integrator at rtol 1e-12, timed, with the
+//!    sets formed and the largest.
+//! 5. Sweeps of the example row (`examples/fujita-row-n2.toml`, its
 //!    `count` set to N) over frequency, with and without Lyapunov
 //!    exponents, global and local: the values one after the other (one
 //!    thread), timed, with the largest exponents side by side.
@@ -233,11 +237,58 @@ fn small_rows(repeats: usize) -> Value {
     Value::Array(small)
 }
 
-/// A sweep of section 4: bodies, values, transient and recorded periods,
+/// Section 4 (its own entry, `--only clusters`): long runs of many
+/// clusters, R2 N = 100 over 50 periods and N = 1000 over 3, local at its
+/// robust rtol.
+pub fn clusters_section(_: Option<&Peers>, quick: bool) -> Entries {
+    vec![("clusters", clusters(if quick { 1 } else { 3 }))]
+}
+
+/// The runs of [`clusters_section`], best of `repeats`.
+pub fn clusters(repeats: usize) -> Value {
+    println!("\n== local integrator: many clusters, error <= 1e-5 against global rtol 1e-12 ==");
+    let mut rows = Vec::new();
+    for (n, periods) in [(100usize, 50.0), (1000, 3.0)] {
+        let model = r2(n);
+        let t = t_end(periods);
+        let reference = ours_with(&model, t, 1e-12, 1e-15, 1, Integrator::Global).state;
+        let sweep: Sweep = (6..=11)
+            .map(|k| {
+                let rtol = 10f64.powi(-k);
+                let run = ours_with(&model, t, rtol, rtol * 1e-3, repeats, Integrator::Local);
+                (rtol, error(&run.state, &reference), run)
+            })
+            .collect();
+        for (rtol, err, run) in &sweep {
+            println!(
+                "N = {n:>4}, {periods} periods: rtol {rtol:.0e} error {err:.2e} {:>9.2} ms rhs {} steps {}",
+                run.seconds * 1e3,
+                run.rhs,
+                run.steps
+            );
+        }
+        match robust_to(&sweep, 1e-5) {
+            Some((rtol, err, run)) => {
+                println!(
+                    "N = {n:>4}: robust rtol {rtol:.0e}, error {err:.2e}, {:.2} ms",
+                    run.seconds * 1e3
+                );
+                rows.push(
+                    json!({"n": n, "periods": periods, "rtol": rtol, "error": err,
+                    "seconds": run.seconds, "rhs_evaluations": run.rhs, "steps": run.steps}),
+                );
+            }
+            None => println!("N = {n:>4}: no rtol down to 1e-11 keeps the error below 1e-5"),
+        }
+    }
+    Value::Array(rows)
+}
+
+/// A sweep of section 5: bodies, values, transient and recorded periods,
 /// Lyapunov exponents.
 type SweepCase = (usize, &'static [f64], usize, usize, Option<usize>);
 
-/// Section 4: sweeps of R2 rows, global against local.
+/// Section 5: sweeps of R2 rows, global against local.
 fn sweeps(quick: bool) -> Value {
     use vibroimpact::maps::sweep::{sweep, SweepOptions};
     use vibroimpact::model::file::ModelDocument;

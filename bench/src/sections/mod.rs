@@ -6,7 +6,8 @@
 //! - `n1000.rs` — R2, N = 1000, 1 period at rtol 1e-8 against ARKODE;
 //! - `scaling.rs` — time per period for N = 10 … 10000;
 //! - `shooting.rs` — one period map with the full monodromy, Newton–Krylov;
-//! - `local.rs` — the local integrator against SUNDIALS and the global one;
+//! - `local.rs` — the local integrator against SUNDIALS and the global one,
+//!   and on many clusters;
 //! - `storeys.rs` — the local integrator with yielding storeys.
 
 use serde_json::Value;
@@ -28,11 +29,12 @@ pub type Entries = Vec<(&'static str, Value)>;
 pub type Section = fn(Option<&Peers>, bool) -> Entries;
 
 /// Every section in the order it runs, with the name `--only` takes.
-pub const ALL: [(&str, Section); 6] = [
+pub const ALL: [(&str, Section); 7] = [
     ("n3", n3::run),
     ("n1000", n1000::run),
     ("scaling", scaling::run),
     ("shooting", shooting::run),
     ("local", local::run),
+    ("clusters", local::clusters_section),
     ("storeys", storeys::run),
 ];

@@ -53,8 +53,8 @@ pub(in crate::simulate) struct Tangents<'w> {
 }
 
 impl Run<'_> {
-    /// The tangent columns at `t` (the set's last step ends there): the
-    /// set's rows from its state, the others by their groups' exact
+    /// The tangent columns at `t` (the sets' last steps end there): the
+    /// sets' rows from their states, the others by their groups' exact
     /// homogeneous motion.
     pub(super) fn tangents_at(&mut self, t: f64) -> Vec<f64> {
         let n2 = 2 * self.model.bodies().len();
@@ -71,7 +71,7 @@ impl Run<'_> {
                 put_rows(bodies, rows, &mut w[c * n2..(c + 1) * n2]);
             }
         }
-        if let Some(set) = &self.set {
+        for set in self.set.iter().chain(&self.sets) {
             let b2 = 2 * set.bodies.len();
             let z = set.st.y();
             for c in 0..self.columns {
@@ -95,8 +95,8 @@ impl Run<'_> {
         }
     }
 
-    /// Writes the whole interleaved state at `t` into `out`: the set's
-    /// bodies from its dense output (its last step holds `t`), the others
+    /// Writes the whole interleaved state at `t` into `out`: the sets'
+    /// bodies from their dense output (their last steps hold `t`), the others
     /// from their exact motion; then the Bouc–Wen states, if `out` has
     /// room for them.
     pub(super) fn state_at(&mut self, t: f64, out: &mut [f64]) {
@@ -144,7 +144,7 @@ impl Run<'_> {
         if hysteretic {
             out[n2..].copy_from_slice(&self.hysteretic);
         }
-        if let Some(set) = self.set.as_mut() {
+        for set in self.set.iter_mut().chain(&mut self.sets) {
             let mut y = vec![0.0; set.st.y().len()];
             set.st.dense_output(&mut set.sys, t, &mut y);
             put_rows(&set.bodies, &y, out);
@@ -156,11 +156,11 @@ impl Run<'_> {
         }
     }
 
-    /// One step of the active set, with its events: a boundary contact or
-    /// a due check that becomes active inside the step sends the set back
-    /// to the step's start and on to that time (`pending`); otherwise the
-    /// step's impacts are logged. Returns the activation reached at the
-    /// step's end, if any.
+    /// One step of a set, with its events: a boundary contact or a due
+    /// check that becomes active inside the step sends the set back to the
+    /// step's start and on to that time (`pending`); otherwise the step is
+    /// kept open (its impacts are logged when it closes, [`Run::close`]).
+    /// Returns the activation reached at the step's end, if any.
     pub(super) fn step_set(
         &mut self,
         set: &mut ActiveSet,
@@ -200,8 +200,12 @@ impl Run<'_> {
             None => None,
         };
         let mut first = self.boundary_crossing(set);
-        if let Some(due) = self.due_checks(first.map_or(t1, |f| f.0)) {
-            first = Some(due);
+        // (With clusters the checks are due in the run's loop, in time
+        // order with the sets.)
+        if !self.clustered {
+            if let Some(due) = self.due_checks(first.map_or(t1, |f| f.0)) {
+                first = Some(due);
+            }
         }
         if let Some((ts, k)) = first.filter(|f| f.0 < t1) {
             // Back to the step's start; on to the activation.
@@ -240,10 +244,6 @@ impl Run<'_> {
         }
         if let (Some(tape), Some(first)) = (self.tape.as_mut(), recorded) {
             tape.step(t, h, set.sys.system(), first);
-        }
-        set.scan.scan(&mut set.st, &mut set.sys);
-        if let Some(h) = set.scan.entry_limit(set.st.h_next()) {
-            set.st.limit_next_step(h);
         }
         if let Some(p) = *pending {
             if p.0 <= t1 {
@@ -304,16 +304,14 @@ fn pace(
 /// Why the run ends after the set's `steps`-th step (kept or taken
 /// again) at `t`, if it does: past the step limit, or its pace.
 fn counted(
-    run: &Run,
+    set: &ActiveSet,
     (method, opts): (Method, &SimulationOptions),
     (t, steps): (f64, u64),
 ) -> Option<IntegrationError> {
     if steps > opts.max_steps {
         return Some(IntegrationError::TooManySteps { t, steps });
     }
-    run.set
-        .as_ref()
-        .and_then(|set| pace(set, method, opts, steps))
+    pace(set, method, opts, steps)
 }
 
 /// Simulates `model` over `[0, opts.t_end]` by the local integrator,
@@ -370,13 +368,28 @@ pub(in crate::simulate) fn run(
         }
     };
     out.error = run.first_set().err();
-    let mut pending: Crossing = None;
     let mut t = 0.0;
     let mut steps: u64 = 0;
     let mut next_guard = PROGRESS_CHECK;
     let initial_checks = run.local.contact_checks;
     let mut checks_before = run.checks_per_contact.clone();
-    while out.error.is_none() && out.sink_stopped.is_none() && t < opts.t_end {
+    while out.error.is_none() && out.sink_stopped.is_none() {
+        // The earliest set (its open step first), unless a check of two
+        // exactly moving groups is due before it (or there is no set).
+        let mut earliest = run.earliest();
+        let due = run.next_check().map(|c| c.0);
+        if due.is_some_and(|tq| earliest.is_some_and(|e| tq < e.0)) {
+            earliest = None;
+        }
+        if let Some((te, open, _)) = earliest {
+            t = te;
+            emit(&mut run, t, &mut out.sink_stopped);
+            if !open && t >= opts.t_end {
+                break;
+            }
+        } else if due.is_none() && t >= opts.t_end {
+            break;
+        }
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
                 out.error = Some(e);
@@ -395,70 +408,53 @@ pub(in crate::simulate) fn run(
             }
             checks_before.clone_from(&run.checks_per_contact);
         }
-        if run.set.is_none() {
-            let next = run.next_check().map_or(opts.t_end, |c| c.0.min(opts.t_end));
+        let Some((_, open, which)) = earliest else {
+            let next = due.map_or(opts.t_end, |c| c.min(opts.t_end));
             emit(&mut run, next, &mut out.sink_stopped);
             t = next;
             if next >= opts.t_end {
                 break;
             }
+            // (Every set then waits at its time, its open step taken back
+            // to the check if it joins there.)
+            run.park_current();
             if let Some(at) = run.due_checks(next) {
                 if let Err(e) = run.join(at.1, at.0) {
                     out.error = Some(e);
                 }
             }
             continue;
+        };
+        run.make_current(which);
+        if open {
+            if let Err(e) = run.close(t) {
+                out.error = Some(e);
+            }
+            continue;
         }
         let Some(mut set) = run.set.take() else {
             continue;
         };
+        let mut pending = set.pending;
         run.defer = true;
         let stepped = run.step_set(&mut set, &mut pending);
         run.defer = false;
+        set.pending = pending;
         t = set.st.t();
-        run.set = Some(set);
         match stepped {
-            Err(e) => {
-                out.error = Some(e);
-                break;
-            }
+            Err(e) => out.error = Some(e),
             Ok(Stepped::RolledBack) => {}
             Ok(Stepped::Retaken) => {
                 steps += 1;
-                if let Some(e) = counted(&run, (method, opts), (t, steps)) {
-                    out.error = Some(e);
-                    break;
-                }
+                out.error = counted(&set, (method, opts), (t, steps));
             }
             Ok(Stepped::Kept(reached)) => {
                 steps += 1;
-                if let Some(e) = counted(&run, (method, opts), (t, steps)) {
-                    out.error = Some(e);
-                    break;
-                }
-                run.scan_set_step();
-                emit(&mut run, t, &mut out.sink_stopped);
-                run.apply_deferred(t);
-                if let Err(e) = run.apply_set_event() {
-                    out.error = Some(e);
-                    break;
-                }
-                let result = match reached {
-                    Some((_, k)) => run.join(k, t).map(|_| None),
-                    None if pending.is_none() => run.release(),
-                    None => Ok(None),
-                };
-                match result {
-                    Err(e) => out.error = Some(e),
-                    Ok(Some((ta, k))) => {
-                        if let Err(e) = run.join(k, ta) {
-                            out.error = Some(e);
-                        }
-                    }
-                    Ok(None) => {}
-                }
+                out.error = counted(&set, (method, opts), (t, steps));
+                set.open = Some(reached);
             }
         }
+        run.set = Some(set);
     }
     Ok(run.finish(out, t))
 }
@@ -629,7 +625,6 @@ impl<'a> Run<'a> {
             method,
             free,
             exact,
-            boundary_carried: Vec::new(),
             in_set: vec![false; ng],
             joined: vec![0.0; ng],
             defer: false,
@@ -643,6 +638,9 @@ impl<'a> Run<'a> {
             generation: vec![0; nc + ns],
             queue: BinaryHeap::new(),
             set: None,
+            sets: Vec::new(),
+            merging: Vec::new(),
+            clustered: clustered(model, opts, tape, columns),
             impacts: Vec::new(),
             onset: vec![(None, 0.0); nc],
             stats: Stats::default(),
@@ -721,9 +719,9 @@ impl<'a> Run<'a> {
         let mut run = self;
         let n = run.model.bodies().len();
         let opts = run.opts;
-        // The state at the end (or where it stopped).
-        let t_final = match &run.set {
-            Some(set) => set.st.t(),
+        // The state at the end (or where it stopped: the earliest set).
+        let t_final = match run.earliest() {
+            Some((te, ..)) => te,
             None => t.min(opts.t_end),
         };
         let mut y = vec![0.0; 2 * n + run.hysteretic.len()];
@@ -739,14 +737,26 @@ impl<'a> Run<'a> {
                 run.before_move(g, t_final);
             }
         }
-        if let Some(mut set) = run.set.take() {
+        run.park_current();
+        for mut set in std::mem::take(&mut run.sets) {
+            // An open step at the end logs its impacts (one past where the
+            // run stopped does not).
+            if set.open.take().is_some() && set.st.t() <= t_final {
+                std::mem::swap(&mut run.impacts, &mut set.scan.impacts);
+                set.scan.scan(&mut set.st, &mut set.sys);
+                std::mem::swap(&mut run.impacts, &mut set.scan.impacts);
+            }
             run.energy_of_set(set.st.y(), set.sys.chain().audit_index());
             run.absorb(&mut set);
             if let (Some(ex), Some(scan)) = (run.extrema.as_mut(), &set.extrema) {
                 ex.merge(&set, scan);
             }
             run.contact_evaluations += set.sys.chain().contact_evaluations();
-            run.impacts = set.scan.impacts;
+        }
+        if run.clustered {
+            // Each set logged its impacts as it went: in time order.
+            run.impacts
+                .sort_by(|a, b| a.start_time.total_cmp(&b.start_time));
         }
         out.t = t_final;
         out.y = y;

@@ -34,7 +34,6 @@ impl Run<'_> {
     /// Rebuilds the active set with `groups` at time `t`, from the current
     /// set's state and the exact motion of the others.
     pub(super) fn rebuild(&mut self, groups: Vec<usize>, t: f64) -> Result<(), IntegrationError> {
-        let model = self.model;
         // Groups joining leave their exact motion: scanned up to here, and
         // their deferred reference states (of the motion before they
         // joined) lapse.
@@ -45,8 +44,7 @@ impl Run<'_> {
             }
         }
         self.sync_storeys();
-        self.boundary_carried.clear();
-        let old = self.retire(&groups, t);
+        let mut old = self.retire(&groups, t);
         // Groups leaving move exactly about the rest of their storeys'
         // branches.
         for &g in &old.groups {
@@ -62,7 +60,36 @@ impl Run<'_> {
             }
             return Ok(());
         }
-        let (bodies, mut y) = self.enter(&groups, &old, t);
+        // With clusters, each cluster is a set of its own.
+        let parts = if self.clustered {
+            self.components(&groups)
+        } else {
+            vec![groups]
+        };
+        let mut impacts = Some(std::mem::take(&mut old.impacts));
+        for (p, part) in parts.into_iter().enumerate() {
+            let set = self.form(part, &old, impacts.take().unwrap_or_default(), t)?;
+            if p == 0 {
+                self.set = Some(Box::new(set));
+            } else {
+                self.sets.push(Box::new(set));
+            }
+        }
+        Ok(())
+    }
+
+    /// A new set of `groups` at `t` (what the old sets hand over in
+    /// `old`), with the impact log `impacts` (the run's, or empty: one set
+    /// holds it).
+    fn form(
+        &mut self,
+        groups: Vec<usize>,
+        old: &Retired,
+        impacts: Vec<ImpactRecord>,
+        t: f64,
+    ) -> Result<ActiveSet, IntegrationError> {
+        let model = self.model;
+        let (bodies, mut y) = self.enter(&groups, old, t);
         let SubModel {
             model: sub,
             contacts: ids,
@@ -144,7 +171,7 @@ impl Run<'_> {
         let mut scan = StepScan {
             ids,
             trackers,
-            impacts: old.impacts,
+            impacts,
             previous,
         };
         // A contact that enters past its impact threshold (the power laws'
@@ -163,7 +190,7 @@ impl Run<'_> {
             .extrema
             .as_ref()
             .map(|ex| ex.set_scan(&scan.ids, bodies.len(), &st, &sys));
-        self.set = Some(ActiveSet {
+        Ok(ActiveSet {
             groups,
             bodies,
             boundary,
@@ -176,20 +203,34 @@ impl Run<'_> {
             storeys,
             switches,
             event: None,
-        });
-        Ok(())
+            carried: Vec::new(),
+            pending: None,
+            open: None,
+        })
     }
 
-    /// Takes the current set apart at `t`: its results return to the run,
-    /// its groups that are not in `groups` move exactly from here, and
-    /// what the next set needs of it is returned.
+    /// Takes the current set (and the sets merging with it) apart at `t`:
+    /// their results return to the run, their groups that are not in
+    /// `groups` move exactly from here, and what the next sets need of
+    /// them is returned.
     fn retire(&mut self, groups: &[usize], t: f64) -> Retired {
         let mut out = Retired {
             impacts: std::mem::take(&mut self.impacts),
             ..Retired::default()
         };
-        if let Some(mut old) = self.set.take() {
-            out.h_prev = Some(old.st.h_next());
+        let sets: Vec<Box<ActiveSet>> = self
+            .set
+            .take()
+            .into_iter()
+            .chain(std::mem::take(&mut self.merging))
+            .collect();
+        // Several sets hand over their bodies' states alone (no tangent
+        // columns, storeys or audit with clusters), in body order.
+        let several = sets.len() > 1;
+        let mut rows: Vec<(usize, [f64; 2])> = Vec::new();
+        for mut old in sets {
+            let h = old.st.h_next();
+            out.h_prev = Some(out.h_prev.map_or(h, |p: f64| p.min(h)));
             self.absorb(&mut old);
             if let (Some(ex), Some(scan)) = (self.extrema.as_mut(), &old.extrema) {
                 ex.merge(&old, scan);
@@ -207,12 +248,12 @@ impl Run<'_> {
                     old.sys.chain().onset_velocity(kl),
                 );
             }
-            out.impacts = old.scan.impacts;
+            out.impacts.append(&mut old.scan.impacts);
             for &g in &old.groups {
                 self.in_set[g] = false;
             }
-            out.groups.clone_from(&old.groups);
-            out.contacts.clone_from(&old.scan.ids);
+            out.groups.extend_from_slice(&old.groups);
+            out.contacts.extend_from_slice(&old.scan.ids);
             // Groups leaving move exactly from here.
             for &g in &old.groups {
                 if !groups.contains(&g) {
@@ -242,7 +283,21 @@ impl Run<'_> {
                     self.tangents[g] = (t, w);
                 }
             }
-            (out.bodies, out.y) = (old_bodies, old_y);
+            if several {
+                rows.extend(
+                    (old_bodies.iter().enumerate())
+                        .map(|(j, &i)| (i, [old_y[2 * j], old_y[2 * j + 1]])),
+                );
+            } else {
+                (out.bodies, out.y) = (old_bodies, old_y);
+            }
+        }
+        if several {
+            rows.sort_unstable_by_key(|r| r.0);
+            out.bodies = rows.iter().map(|r| r.0).collect();
+            out.y = rows.iter().flat_map(|r| r.1).collect();
+            out.groups.sort_unstable();
+            out.contacts.sort_unstable();
         }
         out
     }
