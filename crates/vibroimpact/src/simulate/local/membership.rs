@@ -295,6 +295,10 @@ impl Run<'_> {
                 }
             }
         }
+        // (Most steps: every group still engaged, nothing more to judge.)
+        if engaged.iter().all(|&e| e) {
+            return Ok(None);
+        }
         // A group leaves only if its contacts that would join two exactly
         // moving groups (or a wall) stay safe for a while by the bound: no
         // release that the next check would undo at once.

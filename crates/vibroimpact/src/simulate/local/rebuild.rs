@@ -248,6 +248,10 @@ impl Run<'_> {
                     old.sys.chain().onset_velocity(kl),
                 );
             }
+            // (One set holds the log, the others none: a move, not a copy.)
+            if old.scan.impacts.len() > out.impacts.len() {
+                std::mem::swap(&mut out.impacts, &mut old.scan.impacts);
+            }
             out.impacts.append(&mut old.scan.impacts);
             for &g in &old.groups {
                 self.in_set[g] = false;
