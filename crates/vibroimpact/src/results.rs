@@ -657,6 +657,9 @@ pub struct LocalSummary {
     pub set_changes: u64,
     /// Most bodies integrated at once.
     pub largest_set: usize,
+    /// Most sets integrated side by side at once (clusters that no contact
+    /// joins, each with its own stepper).
+    pub most_sets: usize,
     /// Bodies integrated at some time (the others moved exactly
     /// throughout and were never evaluated).
     pub bodies_integrated: usize,
@@ -723,6 +726,7 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
             contact_checks: l.contact_checks,
             set_changes: l.set_changes,
             largest_set: l.largest_set,
+            most_sets: l.most_sets,
             bodies_integrated: l.bodies_integrated(),
         }),
         energy: sim.energy.map(|e| EnergySummary {

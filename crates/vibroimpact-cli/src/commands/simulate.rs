@@ -286,8 +286,8 @@ pub fn summary_text(s: &SimulationSummary) -> String {
     }
     if let Some(l) = &s.local {
         t.push_str(&format!(
-            "local integrator: {} bodies integrated (at most {} at once), {} set changes, {} contact checks\n",
-            l.bodies_integrated, l.largest_set, l.set_changes, l.contact_checks
+            "local integrator: {} bodies integrated (at most {} at once, in at most {} sets), {} set changes, {} contact checks\n",
+            l.bodies_integrated, l.largest_set, l.most_sets, l.set_changes, l.contact_checks
         ));
     }
     if let Some(r) = &s.record {

@@ -88,6 +88,9 @@ pub struct LocalStats {
     pub set_changes: u64,
     /// Largest number of bodies integrated at once.
     pub largest_set: usize,
+    /// Most sets integrated side by side (clusters, each with its own
+    /// stepper) at once.
+    pub most_sets: usize,
     /// Right-hand-side evaluations of each body (0: the body moved exactly
     /// for the whole run and was never evaluated).
     pub body_evaluations: Vec<u64>,

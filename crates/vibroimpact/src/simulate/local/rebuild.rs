@@ -75,6 +75,7 @@ impl Run<'_> {
                 self.sets.push(Box::new(set));
             }
         }
+        self.local.most_sets = self.local.most_sets.max(1 + self.sets.len());
         Ok(())
     }
 

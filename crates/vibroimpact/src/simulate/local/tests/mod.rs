@@ -707,3 +707,50 @@ fn a_long_chain_is_not_taken_for_a_crawl() {
 }
 
 pub(super) mod storeys;
+
+/// Clusters of a long row step side by side, each with its own step, and
+/// end where the global run ends: R2 N = 100 at 0.95 ω0 over 5 periods
+/// (before its motion turns chaotic; 1.3e-7 of the state apart), the same
+/// 694 impacts, logged in time order.
+#[test]
+fn clusters_step_side_by_side_and_end_where_the_global_run_ends() {
+    let omega = 0.95 * W0;
+    let model = r2(100, omega);
+    let t_end = 5.0 * 2.0 * std::f64::consts::PI / omega;
+    let global = run(&model, t_end, 1e-10, Integrator::Global);
+    let local = run(&model, t_end, 1e-10, Integrator::Local);
+    let stats = local.local.clone().unwrap();
+    // (16 at once here.)
+    assert!(stats.most_sets >= 8, "{stats:?}");
+    let d = difference(&global, &local);
+    assert!(d < 1e-6, "{d:e}");
+    assert_eq!(global.impacts.len(), local.impacts.len());
+    assert!(local
+        .impacts
+        .windows(2)
+        .all(|w| w[0].start_time <= w[1].start_time));
+    // The history, sampled from the sets' open steps and the exact motion:
+    // every displacement within 1e-6 of the largest (6e-8 here).
+    let sampled = |integrator| {
+        let opts = SimulationOptions {
+            t_end,
+            rtol: 1e-10,
+            atol: 1e-13,
+            output_step: Some(0.005),
+            integrator,
+            ..Default::default()
+        };
+        simulate(&model, &opts).unwrap()
+    };
+    let (g, l) = (sampled(Integrator::Global), sampled(Integrator::Local));
+    assert_eq!(g.times, l.times);
+    let n = model.bodies().len();
+    let (mut worst, mut largest) = (0.0f64, 0.0f64);
+    for (a, b) in g.states.chunks(2 * n).zip(l.states.chunks(2 * n)) {
+        for i in 0..n {
+            worst = worst.max((a[i] - b[i]).abs());
+            largest = largest.max(a[i].abs());
+        }
+    }
+    assert!(worst < 1e-6 * largest, "{worst:e} of {largest:e}");
+}
