@@ -243,9 +243,11 @@ impl Simulation {
 
 /// Why and where a simulation stopped early.
 #[derive(Clone, Debug, thiserror::Error)]
-#[error("{source}{}", contact_text(.contact, .approach))]
+#[error("{source}{}{}", contact_text(.contact, .approach), cluster_text(.cluster))]
 pub struct SimulationFailure {
-    /// The integrator's error (time, step size, state and reason).
+    /// The integrator's error (time, step size, state and reason; the
+    /// state of the bodies integrated, `cluster`'s under the local
+    /// integrator).
     #[source]
     pub source: IntegrationError,
     /// The contact engaged deepest at the failure (relative to its impact
@@ -253,12 +255,23 @@ pub struct SimulationFailure {
     pub contact: Option<String>,
     /// Its approach coordinate s (m).
     pub approach: f64,
+    /// Under the local integrator, the bodies of the set whose step
+    /// failed, by name (empty: the whole model was integrated).
+    pub cluster: Vec<String>,
 }
 
 fn contact_text(contact: &Option<String>, approach: &f64) -> String {
     match contact {
         Some(c) => format!("; deepest contact {c} at s = {approach:e} m"),
         None => String::new(),
+    }
+}
+
+fn cluster_text(cluster: &[String]) -> String {
+    if cluster.is_empty() {
+        String::new()
+    } else {
+        format!("; the failing set integrated {}", cluster.join(", "))
     }
 }
 
@@ -433,6 +446,7 @@ fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> 
         source,
         contact: deepest.map(|(k, _)| model.contact_name(k)),
         approach: deepest.map_or(f64::NAN, |d| d.1),
+        cluster: Vec::new(),
     }
 }
 
@@ -520,18 +534,25 @@ fn simulate_local(
         .iter()
         .map(|c| c.law.onset_approach(opts.impact_force_threshold))
         .collect();
-    let error = error.map(|source| match run.crawling {
-        // The contact whose checks crawl, not the deepest one.
-        Some(k) => {
-            let u: Vec<f64> = (0..n).map(|i| run.y[2 * i]).collect();
-            SimulationFailure {
-                source,
-                contact: Some(model.contact_name(k)),
-                approach: model.approach(k, &u),
+    let error = error
+        .map(|source| match run.crawling {
+            // The contact whose checks crawl, not the deepest one.
+            Some(k) => {
+                let u: Vec<f64> = (0..n).map(|i| run.y[2 * i]).collect();
+                SimulationFailure {
+                    source,
+                    contact: Some(model.contact_name(k)),
+                    approach: model.approach(k, &u),
+                    cluster: Vec::new(),
+                }
             }
-        }
-        None => failure(model, source, &run.y, &s_on),
-    });
+            None => failure(model, source, &run.y, &s_on),
+        })
+        .map(|mut f| {
+            let names = run.failed_set.iter();
+            f.cluster = names.map(|&i| model.bodies()[i].name.clone()).collect();
+            f
+        });
     Ok(Simulation {
         times: Vec::new(),
         states: Vec::new(),

@@ -235,16 +235,7 @@ impl Run<'_> {
         }
         groups.sort_unstable();
         groups.dedup();
-        let nc = self.model.contacts().len();
-        for g in self.groups_of(k) {
-            let checks = self.group_contacts[g]
-                .iter()
-                .copied()
-                .chain(self.group_storeys[g].iter().map(|s| nc + s));
-            for kk in checks {
-                self.generation[kk] += 1;
-            }
-        }
+        self.lapse_checks_of(k);
         self.merging = merging;
         self.rebuild(groups, t)
     }

@@ -42,6 +42,9 @@ pub(in crate::simulate) struct LocalRun {
     /// states after the interleaved state).
     pub storeys: StoreyTerms,
     pub sink_stopped: Option<f64>,
+    /// The bodies of the set whose step failed or passed a limit (model
+    /// indices), if one did.
+    pub failed_set: Vec<usize>,
 }
 
 /// Tangent columns carried by a run: `columns` vectors of the interleaved
@@ -343,6 +346,7 @@ pub(in crate::simulate) fn run(
         energy: None,
         storeys: StoreyTerms::default(),
         sink_stopped: None,
+        failed_set: Vec::new(),
     };
     // The whole state, and the storeys' Bouc–Wen states after it.
     let mut sample = vec![0.0; 2 * n + run.hysteretic.len()];
@@ -453,6 +457,9 @@ pub(in crate::simulate) fn run(
                 out.error = counted(&set, (method, opts), (t, steps));
                 set.open = Some(reached);
             }
+        }
+        if out.error.is_some() {
+            out.failed_set.clone_from(&set.bodies);
         }
         run.set = Some(set);
     }

@@ -237,6 +237,13 @@ impl Run<'_> {
             }
         }
         groups.sort_unstable();
+        self.lapse_checks_of(k);
+        self.rebuild(groups, t)
+    }
+
+    /// The checks of the contacts and storeys of check k's groups lapse
+    /// (the groups join a set).
+    pub(super) fn lapse_checks_of(&mut self, k: usize) {
         let nc = self.model.contacts().len();
         for g in self.groups_of(k) {
             let checks = self.group_contacts[g]
@@ -247,7 +254,6 @@ impl Run<'_> {
                 self.generation[kk] += 1;
             }
         }
-        self.rebuild(groups, t)
     }
 
     /// Whether contact `kl` of the set is engaged at the set's current

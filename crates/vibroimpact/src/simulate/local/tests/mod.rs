@@ -754,3 +754,36 @@ fn clusters_step_side_by_side_and_end_where_the_global_run_ends() {
     }
     assert!(worst < 1e-6 * largest, "{worst:e} of {largest:e}");
 }
+
+/// A set whose stepping fails names its bodies: R2 N = 100 with a limit
+/// of 200 steps stops inside a cluster of a few of them; the global run's
+/// failure names none (it integrates them all).
+#[test]
+fn a_failing_set_names_its_bodies() {
+    let omega = 0.95 * W0;
+    let model = r2(100, omega);
+    let opts = |integrator| SimulationOptions {
+        t_end: 5.0 * 2.0 * std::f64::consts::PI / omega,
+        max_steps: 200,
+        integrator,
+        ..Default::default()
+    };
+    let local = simulate(&model, &opts(Integrator::Local)).unwrap();
+    let failure = local.error.expect("the step limit");
+    assert!(
+        matches!(failure.source, IntegrationError::TooManySteps { .. }),
+        "{failure}"
+    );
+    assert!((1..100).contains(&failure.cluster.len()), "{failure}");
+    let names: Vec<&str> = model.bodies().iter().map(|b| b.name.as_str()).collect();
+    assert!(failure.cluster.iter().all(|c| names.contains(&c.as_str())));
+    assert!(
+        failure.to_string().contains(&format!(
+            "the failing set integrated {}",
+            failure.cluster.join(", ")
+        )),
+        "{failure}"
+    );
+    let global = simulate(&model, &opts(Integrator::Global)).unwrap();
+    assert!(global.error.expect("the step limit").cluster.is_empty());
+}
