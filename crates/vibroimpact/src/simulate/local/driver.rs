@@ -760,11 +760,6 @@ impl<'a> Run<'a> {
             }
             run.contact_evaluations += set.sys.chain().contact_evaluations();
         }
-        if run.clustered {
-            // Each set logged its impacts as it went: in time order.
-            run.impacts
-                .sort_by(|a, b| a.start_time.total_cmp(&b.start_time));
-        }
         out.t = t_final;
         out.y = y;
         out.impacts = std::mem::take(&mut run.impacts);
