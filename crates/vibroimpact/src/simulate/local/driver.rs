@@ -379,10 +379,11 @@ pub(in crate::simulate) fn run(
     let mut checks_before = run.checks_per_contact.clone();
     while out.error.is_none() && out.sink_stopped.is_none() {
         // The earliest set (its open step first), unless a check of two
-        // exactly moving groups is due before it (or there is no set).
+        // exactly moving groups is due before it (or there is no set). (One
+        // set's steps take the checks due inside them.)
         let mut earliest = run.earliest();
         let due = run.next_check().map(|c| c.0);
-        if due.is_some_and(|tq| earliest.is_some_and(|e| tq < e.0)) {
+        if run.clustered && due.is_some_and(|tq| earliest.is_some_and(|e| tq < e.0)) {
             earliest = None;
         }
         if let Some((te, open, _)) = earliest {
