@@ -1,4 +1,4 @@
-//! A stepper per cluster (docs/theory.md §10, D24 in docs/decisions.md):
+//! A stepper per cluster (docs/theory.md §10, D39 in docs/decisions.md):
 //! each cluster of integrated groups is a set of its own, stepped with
 //! its own step and error control.
 //!
@@ -8,8 +8,10 @@
 //! set's last step holds that time: a set at `t_B` last stepped from a
 //! time at or before the earliest. That last step stays *open* — its
 //! impacts unlogged, its membership unsettled — until its set is the
-//! earliest again ([`Run::close`]). Samples are taken up to the earliest
-//! set's time, from the open steps.
+//! earliest again ([`Run::close`]). A check of two exactly moving groups
+//! is due in the run's loop when it comes before the earliest set (a
+//! set's steps do not take it: another set may have run past it).
+//! Samples are taken up to the earliest of both, from the open steps.
 //!
 //! A join at `t` (the joining set is the earliest, at `t`) merges every
 //! set the joining groups touch: each is taken back to `t` — its open
