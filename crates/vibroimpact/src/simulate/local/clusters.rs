@@ -89,12 +89,8 @@ impl Run<'_> {
         let Some(reached) = set.open.take() else {
             return Ok(());
         };
-        set.scan.scan(&mut set.st, &mut set.sys);
-        if let Some(h) = set.scan.entry_limit(set.st.h_next()) {
-            set.st.limit_next_step(h);
-        }
         let pending = set.pending;
-        self.scan_set_step();
+        self.scan_open();
         self.apply_deferred(t);
         self.apply_set_event()?;
         let next = match reached {
@@ -105,6 +101,26 @@ impl Run<'_> {
         match next {
             Some((ta, k)) => self.join(k, ta),
             None => Ok(()),
+        }
+    }
+
+    /// Logs the current set's open step's impacts and scans its extrema,
+    /// once: before the step's samples are taken (under a record they move
+    /// the exactly moving groups' references up to the sample).
+    pub(super) fn scan_open(&mut self) {
+        let Some(set) = self.set.as_mut() else {
+            return;
+        };
+        if set.open.is_none() && set.scanned {
+            return;
+        }
+        if !set.scanned {
+            set.scanned = true;
+            set.scan.scan(&mut set.st, &mut set.sys);
+            if let Some(h) = set.scan.entry_limit(set.st.h_next()) {
+                set.st.limit_next_step(h);
+            }
+            self.scan_set_step();
         }
     }
 
@@ -171,14 +187,18 @@ impl Run<'_> {
         std::mem::swap(self.impact_log(), &mut b.scan.impacts);
         let result = (|| {
             if b.st.t() > t {
+                // (Only the current set's open step is scanned before it
+                // closes, and a join closes it.)
+                debug_assert!(!b.scanned);
                 b.st.reset(&mut b.sys, b.saved.0, &b.saved.1)?;
                 while b.st.t() < t {
                     b.st.step(&mut b.sys, t)?;
                     b.scan.scan(&mut b.st, &mut b.sys);
                 }
-            } else if open.is_some() {
+            } else if open.is_some() && !b.scanned {
                 b.scan.scan(&mut b.st, &mut b.sys);
             }
+            b.scanned = true;
             Ok(())
         })();
         std::mem::swap(self.impact_log(), &mut b.scan.impacts);

@@ -386,8 +386,13 @@ pub(in crate::simulate) fn run(
         if run.clustered && due.is_some_and(|tq| earliest.is_some_and(|e| tq < e.0)) {
             earliest = None;
         }
-        if let Some((te, open, _)) = earliest {
+        if let Some((te, open, which)) = earliest {
             t = te;
+            // Its open step's scans come before its samples.
+            if open {
+                run.make_current(which);
+                run.scan_open();
+            }
             emit(&mut run, t, &mut out.sink_stopped);
             if !open && t >= opts.t_end {
                 break;
@@ -430,7 +435,7 @@ pub(in crate::simulate) fn run(
             }
             continue;
         };
-        run.make_current(which);
+        run.make_current(if open { None } else { which });
         if open {
             if let Err(e) = run.close(t) {
                 out.error = Some(e);
@@ -457,6 +462,7 @@ pub(in crate::simulate) fn run(
                 steps += 1;
                 out.error = counted(&set, (method, opts), (t, steps));
                 set.open = Some(reached);
+                set.scanned = false;
             }
         }
         if out.error.is_some() {
@@ -749,7 +755,7 @@ impl<'a> Run<'a> {
         for mut set in std::mem::take(&mut run.sets) {
             // An open step at the end logs its impacts (one past where the
             // run stopped does not).
-            if set.open.take().is_some() && set.st.t() <= t_final {
+            if set.open.take().is_some() && !set.scanned && set.st.t() <= t_final {
                 std::mem::swap(&mut run.impacts, &mut set.scan.impacts);
                 set.scan.scan(&mut set.st, &mut set.sys);
                 std::mem::swap(&mut run.impacts, &mut set.scan.impacts);

@@ -158,6 +158,9 @@ struct ActiveSet {
     /// its membership not yet settled), with the activation reached at
     /// its end if any; None once closed.
     open: Option<Crossing>,
+    /// Whether its open step's impacts are logged and its extrema
+    /// scanned (that comes before the step's samples are taken).
+    scanned: bool,
 }
 
 /// The local integrator's run.

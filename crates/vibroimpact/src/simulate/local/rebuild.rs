@@ -207,6 +207,7 @@ impl Run<'_> {
             carried: Vec::new(),
             pending: None,
             open: None,
+            scanned: true,
         })
     }
 
@@ -230,6 +231,11 @@ impl Run<'_> {
         let several = sets.len() > 1;
         let mut rows: Vec<(usize, [f64; 2])> = Vec::new();
         for mut old in sets {
+            // An activation it was heading for is checked again.
+            if let Some((tp, k)) = old.pending.take() {
+                self.generation[k] += 1;
+                self.queue.push(Reverse((Time(tp), k, self.generation[k])));
+            }
             let h = old.st.h_next();
             out.h_prev = Some(out.h_prev.map_or(h, |p: f64| p.min(h)));
             self.absorb(&mut old);
