@@ -20,11 +20,14 @@
 //! clusters that no model contact joins, each its own set.
 
 use super::*;
+use crate::model::hysteresis::StoreyLaw;
 
 /// Whether a run may step each cluster on its own: not with a tape or
-/// tangent columns (one record in time order), the energy audit, storeys
-/// or extrema (their scans follow one set), or a law that needs the
-/// onset velocity (its events follow one set).
+/// tangent columns (one record in time order), the energy audit, a
+/// Bouc–Wen storey (its states ride in one set's state) or extrema (their
+/// scans follow one set), or a law that needs the onset velocity (its
+/// events follow one set). Switching storeys (bilinear, IMK) may: their
+/// memory is each set's, synced into the run's ([`Run::sync_storeys`]).
 pub(super) fn clustered(
     model: &Model,
     opts: &SimulationOptions,
@@ -35,7 +38,10 @@ pub(super) fn clustered(
         && columns == 0
         && !opts.energy
         && opts.extrema_window.is_none()
-        && model.storeys().is_empty()
+        && !model
+            .storeys()
+            .iter()
+            .any(|s| matches!(s.law, StoreyLaw::BoucWen(_)))
         && !model
             .contacts()
             .iter()
@@ -188,8 +194,10 @@ impl Run<'_> {
         let result = (|| {
             if b.st.t() > t {
                 // (Only the current set's open step is scanned before it
-                // closes, and a join closes it.)
+                // closes, and a join closes it.) An event at the step's
+                // end lies past `t`: its branches stay as at the start.
                 debug_assert!(!b.scanned);
+                b.event = None;
                 b.st.reset(&mut b.sys, b.saved.0, &b.saved.1)?;
                 while b.st.t() < t {
                     b.st.step(&mut b.sys, t)?;
@@ -199,6 +207,9 @@ impl Run<'_> {
                 b.scan.scan(&mut b.st, &mut b.sys);
             }
             b.scanned = true;
+            if let Some(e) = b.event.take() {
+                apply_event(&mut b.st, &mut b.sys, e)?;
+            }
             Ok(())
         })();
         std::mem::swap(self.impact_log(), &mut b.scan.impacts);
@@ -207,7 +218,7 @@ impl Run<'_> {
 
     /// The impact log, wherever it is: with the current set, else the
     /// run.
-    fn impact_log(&mut self) -> &mut Vec<ImpactRecord> {
+    pub(super) fn impact_log(&mut self) -> &mut Vec<ImpactRecord> {
         match self.set.as_mut() {
             Some(set) => &mut set.scan.impacts,
             None => &mut self.impacts,

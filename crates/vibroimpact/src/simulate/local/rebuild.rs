@@ -66,27 +66,39 @@ impl Run<'_> {
         } else {
             vec![groups]
         };
-        let mut impacts = Some(std::mem::take(&mut old.impacts));
+        // The log passes through every part as it forms (an impact that
+        // begins as its contact enters is logged there), and stays with
+        // the first, the current set.
+        // (A part that fails leaves the log where it was.)
+        let mut log = std::mem::take(&mut old.impacts);
+        let mut formed = Ok(());
         for (p, part) in parts.into_iter().enumerate() {
-            let set = self.form(part, &old, impacts.take().unwrap_or_default(), t)?;
+            let mut set = match self.form(part, &old, &mut log, t) {
+                Ok(set) => Box::new(set),
+                Err(e) => {
+                    formed = Err(e);
+                    break;
+                }
+            };
+            log = std::mem::take(&mut set.scan.impacts);
             if p == 0 {
-                self.set = Some(Box::new(set));
+                self.set = Some(set);
             } else {
-                self.sets.push(Box::new(set));
+                self.sets.push(set);
             }
         }
+        *self.impact_log() = log;
         self.local.most_sets = self.local.most_sets.max(1 + self.sets.len());
-        Ok(())
+        formed
     }
 
     /// A new set of `groups` at `t` (what the old sets hand over in
-    /// `old`), with the impact log `impacts` (the run's, or empty: one set
-    /// holds it).
+    /// `old`), taking the run's impact log `log` once nothing can fail.
     fn form(
         &mut self,
         groups: Vec<usize>,
         old: &Retired,
-        impacts: Vec<ImpactRecord>,
+        log: &mut Vec<ImpactRecord>,
         t: f64,
     ) -> Result<ActiveSet, IntegrationError> {
         let model = self.model;
@@ -172,7 +184,7 @@ impl Run<'_> {
         let mut scan = StepScan {
             ids,
             trackers,
-            impacts,
+            impacts: std::mem::take(log),
             previous,
         };
         // A contact that enters past its impact threshold (the power laws'
@@ -433,7 +445,7 @@ impl Run<'_> {
             })
             .collect();
         let storey_ids: Vec<usize> = (0..model.storeys().len())
-            .filter(|&s| self.slot[model.storeys()[s].above].is_some())
+            .filter(|&s| bodies.binary_search(&model.storeys()[s].above).is_ok())
             .collect();
         // A storey joins bodies of one group: both in the set.
         let slot = |i: usize| {

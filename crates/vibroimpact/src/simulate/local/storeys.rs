@@ -152,19 +152,21 @@ impl Run<'_> {
         })
     }
 
-    /// Copies the set's storeys' memory (branches, Bouc–Wen states at its
-    /// current point) into the run's.
+    /// Copies every set's storeys' memory (branches, Bouc–Wen states at
+    /// its current point) into the run's: the current set's, the parked
+    /// ones' and those merging (their branches hold over their open
+    /// steps: an event at a step's end applies when it closes).
     pub(super) fn sync_storeys(&mut self) {
-        let Some(set) = self.set.as_ref() else {
-            return;
-        };
-        let (terms, y) = (set.sys.chain().storeys(), set.st.y());
         let first = 2 * self.model.bodies().len();
-        for (ks, &s) in set.storeys.iter().enumerate() {
-            self.storeys.set_branch(s, terms.branch(ks));
-        }
-        for (i, w) in hysteretic_places(terms, &self.storeys, &set.storeys) {
-            self.hysteretic[w - first..w - first + 2].copy_from_slice(&y[i..i + 2]);
+        let sets = self.set.iter().chain(&self.sets).chain(&self.merging);
+        for set in sets.filter(|s| !s.storeys.is_empty()) {
+            let (terms, y) = (set.sys.chain().storeys(), set.st.y());
+            for (ks, &s) in set.storeys.iter().enumerate() {
+                self.storeys.set_branch(s, terms.branch(ks));
+            }
+            for (i, w) in hysteretic_places(terms, &self.storeys, &set.storeys) {
+                self.hysteretic[w - first..w - first + 2].copy_from_slice(&y[i..i + 2]);
+            }
         }
     }
 
