@@ -371,8 +371,10 @@ impl StoreyTerms {
 
     /// Sets bilinear storey k's branch (carried from another run's terms).
     pub fn set_branch(&mut self, k: usize, branch: Branch) {
-        self.stamp = new_stamp();
-        self.terms[k].branch = branch;
+        if self.terms[k].branch != branch {
+            self.stamp = new_stamp();
+            self.terms[k].branch = branch;
+        }
     }
 
     /// Where storey k's Bouc–Wen state (z, e) sits in the state, if it has

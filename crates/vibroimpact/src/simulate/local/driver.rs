@@ -363,7 +363,11 @@ pub(in crate::simulate) fn run(
                 break;
             }
             run.state_at(ts, &mut sample);
-            run.sync_storeys();
+            // (The sample reads the storeys' memory for its accelerations
+            // and storey forces alone.)
+            if opts.accelerations || opts.storey_forces {
+                run.sync_storeys(true);
+            }
             let body = body_sample(run, ts, &sample, whole.as_mut());
             next_sample += 1;
             if !record(ts, &body) {
@@ -740,7 +744,7 @@ impl<'a> Run<'a> {
         };
         let mut y = vec![0.0; 2 * n + run.hysteretic.len()];
         run.state_at(t_final, &mut y);
-        run.sync_storeys();
+        run.sync_storeys(true);
         if run.columns > 0 {
             out.tangents = Some(run.tangents_at(t_final));
         }

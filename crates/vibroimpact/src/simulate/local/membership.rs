@@ -273,7 +273,7 @@ impl Run<'_> {
     /// exactly again; their contacts with other exact groups or walls are
     /// scheduled. Returns a contact that is active at once, if any.
     pub(super) fn release(&mut self) -> Result<Crossing, IntegrationError> {
-        self.sync_storeys();
+        self.sync_storeys(false);
         let Some(set) = self.set.as_ref() else {
             return Ok(None);
         };

@@ -43,7 +43,7 @@ impl Run<'_> {
                 self.deferred.retain(|(h, ..)| *h != g);
             }
         }
-        self.sync_storeys();
+        self.sync_storeys(true);
         let mut old = self.retire(&groups, t);
         // Groups leaving move exactly about the rest of their storeys'
         // branches.

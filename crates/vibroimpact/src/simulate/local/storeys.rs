@@ -155,11 +155,17 @@ impl Run<'_> {
     /// Copies every set's storeys' memory (branches, Bouc–Wen states at
     /// its current point) into the run's: the current set's, the parked
     /// ones' and those merging (their branches hold over their open
-    /// steps: an event at a step's end applies when it closes).
-    pub(super) fn sync_storeys(&mut self) {
+    /// steps: an event at a step's end applies when it closes); only the
+    /// current set's if not `all`.
+    pub(super) fn sync_storeys(&mut self, all: bool) {
         let first = 2 * self.model.bodies().len();
-        let sets = self.set.iter().chain(&self.sets).chain(&self.merging);
-        for set in sets.filter(|s| !s.storeys.is_empty()) {
+        let others = self.sets.iter().chain(&self.merging).filter(|_| all);
+        for set in self
+            .set
+            .iter()
+            .chain(others)
+            .filter(|s| !s.storeys.is_empty())
+        {
             let (terms, y) = (set.sys.chain().storeys(), set.st.y());
             for (ks, &s) in set.storeys.iter().enumerate() {
                 self.storeys.set_branch(s, terms.branch(ks));

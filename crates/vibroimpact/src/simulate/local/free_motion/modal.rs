@@ -28,7 +28,10 @@ const MAX_CONDITION: f64 = 1e6;
 pub(super) struct Modal {
     lambda: Vec<C64>,
     v: DMatrix<C64>,
-    v_inv: DMatrix<C64>,
+    /// `V` and `V⁻¹` by rows (each row contiguous: the transforms run
+    /// along rows; nalgebra stores columns).
+    v_rows: Vec<C64>,
+    v_inv_rows: Vec<C64>,
     /// `V⁻¹ e` (`e`: ones in the velocity rows).
     beta: Vec<C64>,
     /// A record's whole sample step: τ and per mode `e^{λτ}`, `β τ φ₁`, `β
@@ -38,12 +41,21 @@ pub(super) struct Modal {
 
 /// `e^s`, `φ₁(s) = (e^s − 1)/s` and `φ₂(s) = (e^s − 1 − s)/s²`. For |s| ≤
 /// 1 from the series of φ₂ (`φ₁ = 1 + s φ₂`, `e^s = 1 + s φ₁`: no
-/// cancellation, no transcendental call; 19 terms leave < 1e-19).
-fn phi(s: C64) -> (C64, C64, C64) {
-    if s.norm_sqr() <= 1.0 {
-        // φ₂ = (1/2)(1 + s/3 (1 + s/4 (1 + … (1 + s/20)))).
+/// cancellation, no transcendental call), to the term `s^{M−2}/M!`
+/// where the first one left, `|s|^{M−1}/(M+1)!`, is below 1e-18.
+pub(super) fn phi(s: C64) -> (C64, C64, C64) {
+    let r2 = s.norm_sqr();
+    if r2 <= 1.0 {
+        // φ₂ = (1/2)(1 + s/3 (1 + s/4 (1 + … (1 + s/M)))).
+        let top = match r2 {
+            r if r <= 1e-4 => 8,
+            r if r <= 1e-2 => 11,
+            r if r <= 0.0625 => 13,
+            r if r <= 0.25 => 16,
+            _ => 20,
+        };
         let mut q = C64::new(1.0, 0.0);
-        for m in (3..=20).rev() {
+        for m in (3..=top).rev() {
             q = q * s * (1.0 / m as f64) + 1.0;
         }
         let p2 = q * 0.5;
@@ -101,10 +113,13 @@ impl Modal {
         let beta: Vec<C64> = (0..d)
             .map(|k| (0..d / 2).map(|j| v_inv[(k, 2 * j + 1)]).sum())
             .collect();
+        let v_rows = v.transpose().as_slice().to_vec();
+        let v_inv_rows = v_inv.transpose().as_slice().to_vec();
         let mut modal = Self {
             lambda,
             v,
-            v_inv,
+            v_rows,
+            v_inv_rows,
             beta,
             step: None,
         };
@@ -132,18 +147,26 @@ impl Modal {
 
     /// `z = V⁻¹ x`.
     pub(super) fn to_modes(&self, x: &[f64], z: &mut Vec<C64>) {
+        let d = x.len();
         z.clear();
-        z.extend(
-            self.v_inv
-                .row_iter()
-                .map(|r| r.iter().zip(x).map(|(a, &b)| a * b).sum::<C64>()),
-        );
+        z.extend(self.v_inv_rows.chunks_exact(d).map(|r| {
+            let (mut re, mut im) = (0.0, 0.0);
+            for (a, &b) in r.iter().zip(x) {
+                re += a.re * b;
+                im += a.im * b;
+            }
+            C64::new(re, im)
+        }));
     }
 
     /// `x = Re(V z)`.
     pub(super) fn to_state(&self, z: &[C64], x: &mut [f64]) {
-        for (xi, r) in x.iter_mut().zip(self.v.row_iter()) {
-            *xi = r.iter().zip(z).map(|(a, b)| (a * b).re).sum();
+        for (xi, r) in x.iter_mut().zip(self.v_rows.chunks_exact(z.len())) {
+            *xi = r
+                .iter()
+                .zip(z)
+                .map(|(a, b)| a.re * b.re - a.im * b.im)
+                .sum();
         }
     }
 
@@ -181,7 +204,13 @@ impl Modal {
             // A whole sample step (to rounding of the sample times: 1e-12 of
             // a step moves the state by far less than any tolerance).
             Some((h, c)) if (tau - h).abs() <= 1e-12 * h => apply(z, c),
-            _ => apply(z, &self.coefficients(tau)),
+            // A partial one: each mode's coefficients as they are used.
+            _ => {
+                for ((zk, &l), &b) in z.iter_mut().zip(&self.lambda).zip(&self.beta) {
+                    let (e, p1, p2) = phi(l * tau);
+                    *zk = e * *zk + b * p1 * (tau * fa) + b * p2 * (tau * tau * slope);
+                }
+            }
         }
     }
 }
