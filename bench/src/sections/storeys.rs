@@ -14,8 +14,12 @@
 //!    at DOP853 rtol 1e-8 beside it (the local run's error where nothing
 //!    yields). At 0.1 the local run is exact and the faster (modal
 //!    envelopes, docs/decisions.md D37); at full scale, where buildings
-//!    yield and pound, the global one: why `auto` runs such rows
-//!    globally.
+//!    yield and pound, the two are close (a stepper per cluster, D39;
+//!    D40).
+//! 3. The pounding study of those rows at full scale (`Row::respond`:
+//!    exact peaks by gauges, one set), DOP853 rtol 1e-8, local against
+//!    global, with the largest difference of a peak drift: why `auto`
+//!    runs rows under records globally.
 
 use std::time::Instant;
 
@@ -25,7 +29,7 @@ use vibroimpact::integrate::Method;
 use vibroimpact::model::hysteresis::{Bilinear, StoreyLaw};
 use vibroimpact::model::record::{parse_record, Units};
 use vibroimpact::model::{BaseExcitation, Body, Contact, ContactPair, Model, Storey};
-use vibroimpact::seismic::pounding::parse_row;
+use vibroimpact::seismic::pounding::{parse_row, RunSettings};
 use vibroimpact::simulate::{Integrator, Simulation, SimulationOptions};
 
 use super::Entries;
@@ -255,8 +259,53 @@ pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
             );
         }
     }
+    println!(
+        "\n== storeys: the pounding study (exact peaks by gauges) of the rows at full scale, DOP853 rtol 1e-8 =="
+    );
+    let mut study = Vec::new();
+    for &k in counts {
+        let row = parse_row(&row_text(k), "row.toml").expect("valid row");
+        let respond = |integrator| {
+            let settings = RunSettings {
+                integrator,
+                ..RunSettings::new(0.01, 1e-8)
+            };
+            let mut best = (f64::INFINITY, None);
+            for _ in 0..repeats {
+                let start = Instant::now();
+                let r = row
+                    .respond(&record, 1.0, true, &settings)
+                    .expect("a response");
+                best = (best.0.min(start.elapsed().as_secs_f64()), Some(r));
+            }
+            (best.0, best.1.expect("one run"))
+        };
+        let (tg, global) = respond(Integrator::Global);
+        let (tl, local) = respond(Integrator::Local);
+        // The largest difference of a peak drift, relative to the row's
+        // largest.
+        let largest = global
+            .drift
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, d| m.max(d.abs()));
+        let difference = (global.drift.iter().flatten())
+            .zip(local.drift.iter().flatten())
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+            / largest;
+        println!(
+            "K = {k:>3}: global {:>8.2} ms, local {:>8.2} ms (local / global {:.2}); peak drifts differ by {difference:.1e} of the largest",
+            tg * 1e3,
+            tl * 1e3,
+            tl / tg
+        );
+        study.push(
+            json!({"buildings": k, "global_seconds": tg, "local_seconds": tl,
+            "peak_drift_difference": difference}),
+        );
+    }
     vec![(
         "storeys",
-        json!({"struck_row": struck, "rows_under_a_record": rows}),
+        json!({"struck_row": struck, "rows_under_a_record": rows, "pounding_study": study}),
     )]
 }

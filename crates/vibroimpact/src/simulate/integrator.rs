@@ -40,8 +40,10 @@ impl Integrator {
     /// has a bounded steady state under its forcing (no undamped group
     /// under harmonic forcing) and no recorded base motion, global
     /// otherwise; the others are themselves. (A record moves every group
-    /// and the global integrator steps at its samples anyway: rows of 16
-    /// and 64 buildings ran 3.9–6.6× slower locally, docs/decisions.md D26.)
+    /// and the global integrator steps at its samples anyway: at full
+    /// scale rows of 16 and 64 yielding buildings take 1.5 and 0.8 times
+    /// the global run's time locally, their pounding study with exact
+    /// peaks 3.6 and 2.3 times; docs/decisions.md D40.)
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
             Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {

@@ -160,22 +160,40 @@ struct Carried {
     j: usize,
     t: f64,
     x: Vec<f64>,
+    /// The furthest state read ahead of `t` since it moved, and its time
+    /// (NaN: none): a piece's end is read first, then carried to.
+    ahead: (f64, Vec<f64>),
 }
 
 impl Carried {
     /// The state moved on to `t`.
     fn advance(&mut self, free: &FreeMotion, t: f64) {
-        free.propagate(self.g, self.t, t, &mut self.x);
+        if self.ahead.0 == t {
+            std::mem::swap(&mut self.x, &mut self.ahead.1);
+        } else {
+            free.propagate(self.g, self.t, t, &mut self.x);
+        }
         self.t = t;
+        self.ahead.0 = f64::NAN;
     }
 
     /// The side's (u, v) at `t` (from the carried state).
-    fn at(&self, free: &FreeMotion, t: f64) -> (f64, f64) {
+    fn at(&mut self, free: &FreeMotion, t: f64) -> (f64, f64) {
         if t == self.t {
             return (self.x[2 * self.j], self.x[2 * self.j + 1]);
         }
-        let mut y = self.x.clone();
-        free.propagate(self.g, self.t, t, &mut y);
+        if t == self.ahead.0 {
+            return (self.ahead.1[2 * self.j], self.ahead.1[2 * self.j + 1]);
+        }
+        let mut inside = Vec::new();
+        let y = if self.ahead.0.is_nan() || t > self.ahead.0 {
+            self.ahead.0 = t;
+            &mut self.ahead.1
+        } else {
+            &mut inside
+        };
+        y.clone_from(&self.x);
+        free.propagate(self.g, self.t, t, y);
         (y[2 * self.j], y[2 * self.j + 1])
     }
 }
@@ -246,10 +264,87 @@ impl Run<'_> {
                 ex.gauge_scanned[w] = ex.gauge_scanned[w].max(t);
             }
         }
+        // The others by the group they read besides `g` (and where they
+        // were scanned to): each such batch in one pass over both motions.
+        let other = |w: usize| {
+            let sides = ex.gauges[w].gauge.sides();
+            let groups = sides.into_iter().flatten().map(|i| self.free.place(i).0);
+            groups.filter(|&h| h != g).min()
+        };
+        let mut batches: Vec<(Option<usize>, f64, Vec<usize>)> = Vec::new();
         for w in across {
-            self.gauge_to(&mut ex, w, t);
+            let key = (other(w), ex.gauge_scanned[w]);
+            match batches.iter_mut().find(|b| (b.0, b.1) == key) {
+                Some(b) => b.2.push(w),
+                None => batches.push((key.0, key.1, vec![w])),
+            }
+        }
+        for (h, from, ws) in batches {
+            match (h, ex.span(from, t)) {
+                (Some(h), Some((a, b))) => self.scan_pair_gauges(&mut ex, [g, h], &ws, a, b),
+                (None, _) => ws.iter().for_each(|&w| self.gauge_to(&mut ex, w, t)),
+                (Some(_), None) => {}
+            }
+            for w in ws {
+                ex.gauge_scanned[w] = ex.gauge_scanned[w].max(t);
+            }
         }
         self.extrema = Some(ex);
+    }
+
+    /// Separations `ws` between exact groups `gs` (scanned up to the same
+    /// time) on `[a, b]`: per piece of the finer of their grids both
+    /// states at the ends once, the values and rates exact, the interior
+    /// by propagation from the piece's start.
+    fn scan_pair_gauges(
+        &self,
+        ex: &mut LocalExtrema,
+        gs: [usize; 2],
+        ws: &[usize],
+        a: f64,
+        b: f64,
+    ) {
+        let free = &self.free;
+        let mut xa = gs.map(|g| {
+            let (t0, x0) = &self.exact[g];
+            let mut x = x0.clone();
+            free.propagate(g, *t0, a, &mut x);
+            x
+        });
+        let step = ex.grid[gs[0]].min(ex.grid[gs[1]]);
+        // The gauge's value and rate in the groups' states x.
+        let read = |gauge: &Gauge, x: &[Vec<f64>; 2]| -> (f64, f64) {
+            let side = |i: Option<usize>| {
+                i.map_or((0.0, 0.0), |i| {
+                    let (h, j) = free.place(i);
+                    let x = &x[usize::from(h != gs[0])];
+                    (x[2 * j], x[2 * j + 1])
+                })
+            };
+            let [l, r] = gauge.sides().map(side);
+            (l.0 - r.0, l.1 - r.1)
+        };
+        let mut xb = xa.clone();
+        let mut ta = a;
+        for tb in grid(a, b, step) {
+            for (k, &g) in gs.iter().enumerate() {
+                xb[k].copy_from_slice(&xa[k]);
+                free.propagate(g, ta, tb, &mut xb[k]);
+            }
+            for &w in ws {
+                let gauge = ex.gauges[w].gauge;
+                let ends = (read(&gauge, &xa), read(&gauge, &xb));
+                ex.gauges[w].scan_ends((ta, tb), ends, |t| {
+                    let mut x = xa.clone();
+                    for (k, &g) in gs.iter().enumerate() {
+                        free.propagate(g, ta, t, &mut x[k]);
+                    }
+                    read(&gauge, &x)
+                });
+            }
+            std::mem::swap(&mut xa, &mut xb);
+            ta = tb;
+        }
     }
 
     /// Group `g`'s own gauges `ws` (scanned up to the same time) on
@@ -391,7 +486,13 @@ impl Run<'_> {
             let (t0, x0) = &self.exact[g];
             let mut x = x0.clone();
             self.free.propagate(g, *t0, a, &mut x);
-            Some(Carried { g, j, t: a, x })
+            Some(Carried {
+                g,
+                j,
+                t: a,
+                ahead: (f64::NAN, x.clone()),
+                x,
+            })
         });
         let (free, set, slot) = (&self.free, &mut self.set, &self.slot);
         let ground = |t| self.model.base().at(t);
@@ -400,7 +501,7 @@ impl Run<'_> {
             let reading = &mut ex.gauges[w];
             // A side's (u, v) at t: carried exactly, or the set's dense
             // output.
-            let mut side = |k: usize, t: f64| match (sides[k], &carried[k]) {
+            let mut side = |k: usize, t: f64| match (sides[k], &mut carried[k]) {
                 (None, _) => (0.0, 0.0),
                 (Some(_), Some(c)) => c.at(free, t),
                 (Some(i), None) => match (slot[i], set.as_mut()) {
