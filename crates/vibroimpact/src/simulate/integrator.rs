@@ -43,7 +43,7 @@ impl Integrator {
     /// and the global integrator steps at its samples anyway: at full
     /// scale rows of 16 and 64 yielding buildings take 1.5 and 0.8 times
     /// the global run's time locally, their pounding study with exact
-    /// peaks 3.6 and 2.3 times; docs/decisions.md D40.)
+    /// peaks 3.3 and 2.2 times; docs/decisions.md D40.)
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
             Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {

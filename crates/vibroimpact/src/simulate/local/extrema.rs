@@ -69,14 +69,7 @@ impl LocalExtrema {
         let grid = free
             .groups()
             .iter()
-            .map(|g| {
-                let natural = if g.rate() > 0.0 {
-                    std::f64::consts::PI / (8.0 * g.rate())
-                } else {
-                    f64::INFINITY
-                };
-                natural.min(record_step)
-            })
+            .map(|g| FreeMotion::natural_piece(g.rate()).min(record_step))
             .collect();
         Self {
             window,
@@ -311,7 +304,12 @@ impl Run<'_> {
             free.propagate(g, *t0, a, &mut x);
             x
         });
-        let step = ex.grid[gs[0]].min(ex.grid[gs[1]]);
+        // (On the finer grid's parts: those cost the finer group nothing.)
+        let finer = if ex.grid[gs[0]] <= ex.grid[gs[1]] {
+            gs[0]
+        } else {
+            gs[1]
+        };
         // The gauge's value and rate in the groups' states x.
         let read = |gauge: &Gauge, x: &[Vec<f64>; 2]| -> (f64, f64) {
             let side = |i: Option<usize>| {
@@ -326,7 +324,7 @@ impl Run<'_> {
         };
         let mut xb = xa.clone();
         let mut ta = a;
-        for tb in grid(a, b, step) {
+        for tb in free.grid(finer, a, b, ex.grid[finer]) {
             for (k, &g) in gs.iter().enumerate() {
                 xb[k].copy_from_slice(&xa[k]);
                 free.propagate(g, ta, tb, &mut xb[k]);
@@ -388,7 +386,7 @@ impl Run<'_> {
         accelerations(a, &xa, &mut acc_a);
         let mut xb = xa.clone();
         let mut ta = a;
-        for tb in grid(a, b, ex.grid[g]) {
+        for tb in free.grid(g, a, b, ex.grid[g]) {
             xb.copy_from_slice(&xa);
             free.propagate(g, ta, tb, &mut xb);
             accelerations(tb, &xb, &mut acc_b);
@@ -564,7 +562,7 @@ impl Run<'_> {
             ex.note_body(i, xa[2 * j], xa[2 * j + 1]);
         }
         let mut ta = a;
-        for tb in grid(a, b, ex.grid[g]) {
+        for tb in free.grid(g, a, b, ex.grid[g]) {
             let mut xb = xa.clone();
             free.propagate(g, ta, tb, &mut xb);
             let at = |t: f64| {

@@ -171,6 +171,25 @@ fn record_intervals(rec: &Accelerogram, t0: f64, t1: f64, mut step: impl FnMut(f
     }
 }
 
+/// The ends of the equal pieces of `(a, b]` no longer than `step`, into
+/// `out` (at least one; the last exactly `b`; none that does not
+/// advance).
+fn equal_pieces(a: f64, b: f64, step: f64, out: &mut Vec<f64>) {
+    let pieces = ((b - a) / step).ceil().clamp(1.0, 1e9) as usize;
+    let mut last = a;
+    for p in 1..=pieces {
+        let t = if p == pieces {
+            b
+        } else {
+            a + (b - a) * p as f64 / pieces as f64
+        };
+        if t > last {
+            out.push(t);
+            last = t;
+        }
+    }
+}
+
 /// The typical sample step of `times`: the median of its steps. Whole
 /// steps of that length are computed once; a record need not be uniform
 /// for that to pay (a pounding row appends a free-vibration tail, two
@@ -283,6 +302,14 @@ impl FreeMotion {
         g.hold_step = None;
         if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
             g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
+        }
+        // The exact extrema's grid parts a whole step into pieces of at
+        // most a sixteenth of the fastest period ([`FreeMotion::grid`]).
+        if let (Some(modal), Some(Some(tau))) = (g.modal.as_mut(), record_step) {
+            let parts = (tau / Self::natural_piece(g.rate)).ceil();
+            if (2.0..=1e3).contains(&parts) {
+                modal.keep_part(tau / parts);
+            }
         }
         // Without modes every whole step, with modes the short runs of a
         // few (samples, checks a step apart) take the matrix form.
@@ -398,6 +425,77 @@ impl FreeMotion {
     /// record.
     pub fn record_step(&self) -> Option<f64> {
         self.record_step
+    }
+
+    /// The longest piece of the exact extrema's grid for a group of
+    /// fastest rate `rate`: a sixteenth of its period (∞ at rest).
+    pub fn natural_piece(rate: f64) -> f64 {
+        if rate > 0.0 {
+            std::f64::consts::PI / (8.0 * rate)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The ends of the exact extrema's pieces of `(a, b]` for group `g`,
+    /// none longer than `step`, the last `b`: under a record each sample
+    /// interval in equal parts (a typical one in the parts whose
+    /// coefficients the group keeps, so a piece costs no exponential);
+    /// otherwise `[a, b]` in equal pieces.
+    pub fn grid(&self, g: usize, a: f64, b: f64, step: f64) -> Vec<f64> {
+        let mut out = Vec::new();
+        let part = self.groups[g].modal.as_ref().and_then(|m| m.part());
+        let (BaseExcitation::Record(rec), Some(part), Some(whole)) =
+            (&self.base, part, self.record_step)
+        else {
+            equal_pieces(a, b, step, &mut out);
+            return out;
+        };
+        let times = rec.times();
+        let mut k = times.partition_point(|&s| s <= a).saturating_sub(1);
+        let mut last = a;
+        while last < b {
+            let (s0, s1) = match (times.get(k), times.get(k + 1)) {
+                (Some(&s0), Some(&s1)) if s0 <= last => (s0, s1),
+                _ => {
+                    equal_pieces(last, b, step, &mut out);
+                    return out;
+                }
+            };
+            let len = s1 - s0;
+            if len <= 0.0 {
+                k += 1;
+                continue;
+            }
+            let piece = if (len - whole).abs() <= 1e-12 * whole {
+                part
+            } else {
+                len / (len / step).ceil().max(1.0)
+            };
+            // The interval's part ends after `last`, up to b.
+            let mut i = ((last - s0) / piece).floor() + 1.0;
+            loop {
+                let t = if s0 + i * piece >= s1 - 1e-12 * len {
+                    s1
+                } else {
+                    s0 + i * piece
+                };
+                if t >= b {
+                    out.push(b);
+                    return out;
+                }
+                if t > last {
+                    out.push(t);
+                    last = t;
+                }
+                if t == s1 {
+                    break;
+                }
+                i += 1.0;
+            }
+            k += 1;
+        }
+        out
     }
 
     /// The groups.

@@ -37,6 +37,9 @@ pub(super) struct Modal {
     /// A record's whole sample step: τ and per mode `e^{λτ}`, `β τ φ₁`, `β
     /// τ² φ₂`.
     step: Option<(f64, Vec<[C64; 3]>)>,
+    /// A whole step's equal part that the exact extrema's grid steps by
+    /// (`FreeMotion::grid`), and its coefficients as for `step`.
+    part: Option<(f64, Vec<[C64; 3]>)>,
 }
 
 /// `e^s`, `φ₁(s) = (e^s − 1)/s` and `φ₂(s) = (e^s − 1 − s)/s²`. For |s| ≤
@@ -122,6 +125,7 @@ impl Modal {
             v_inv_rows,
             beta,
             step: None,
+            part: None,
         };
         modal.step = record_step.map(|tau| (tau, modal.coefficients(tau)));
         Some(modal)
@@ -137,6 +141,16 @@ impl Modal {
                 [e, b * p1 * tau, b * p2 * tau * tau]
             })
             .collect()
+    }
+
+    /// Keeps the coefficients of `tau`, a whole step's equal part.
+    pub(super) fn keep_part(&mut self, tau: f64) {
+        self.part = Some((tau, self.coefficients(tau)));
+    }
+
+    /// The whole step's equal part whose coefficients are kept (s).
+    pub(super) fn part(&self) -> Option<f64> {
+        self.part.as_ref().map(|(h, _)| *h)
     }
 
     /// The whole sample step whose coefficients are kept (s).
@@ -200,16 +214,25 @@ impl Modal {
                 *zk = *e * *zk + g0 * fa + g1 * slope;
             }
         };
-        match &self.step {
-            // A whole sample step (to rounding of the sample times: 1e-12 of
-            // a step moves the state by far less than any tolerance).
-            Some((h, c)) if (tau - h).abs() <= 1e-12 * h => apply(z, c),
-            // A partial one: each mode's coefficients as they are used.
-            _ => {
-                for ((zk, &l), &b) in z.iter_mut().zip(&self.lambda).zip(&self.beta) {
-                    let (e, p1, p2) = phi(l * tau);
-                    *zk = e * *zk + b * p1 * (tau * fa) + b * p2 * (tau * tau * slope);
-                }
+        // A whole sample step (to rounding of the sample times: 1e-12 of a
+        // step moves the state by far less than any tolerance); a part of
+        // the extrema's grid (to rounding of its times, a few ulps of the
+        // time over the part: 1e-10 of it).
+        let whole = self
+            .step
+            .as_ref()
+            .filter(|(h, _)| (tau - h).abs() <= 1e-12 * h);
+        let part = self
+            .part
+            .as_ref()
+            .filter(|(h, _)| (tau - h).abs() <= 1e-10 * h);
+        if let Some((_, c)) = whole.or(part) {
+            apply(z, c);
+        } else {
+            // Any other: each mode's coefficients as they are used.
+            for ((zk, &l), &b) in z.iter_mut().zip(&self.lambda).zip(&self.beta) {
+                let (e, p1, p2) = phi(l * tau);
+                *zk = e * *zk + b * p1 * (tau * fa) + b * p2 * (tau * tau * slope);
             }
         }
     }

@@ -558,3 +558,60 @@ fn phi_series_to_rounding() {
         }
     }
 }
+
+/// The exact extrema's grid under a record with a tail: every sample in
+/// `(a, b)` is a piece's end, the pieces of a whole step are its kept
+/// equal parts (to 1e-10: their coefficients serve them), none longer
+/// than a sixteenth of the fastest period, the last ends at b; and the
+/// motion carried piece by piece along it equals the integration to
+/// 1e-9 (the parts' coefficients are the motion's).
+#[test]
+fn the_extrema_grid_parts_whole_steps() {
+    let mut times: Vec<f64> = (0..150).map(|k| 0.01 * k as f64).collect();
+    let mut values: Vec<f64> = times.iter().map(|t| (8.0 * t).sin()).collect();
+    times.extend([1.5, 3.0]);
+    values.extend([0.0, 0.0]);
+    let rec = Accelerogram::new(times.clone(), values, 0.4).unwrap();
+    let m = free_model(
+        vec![body("a", 1.0, 120.0, 0.02), body("b", 1.2, 90.0, 0.02)],
+        vec![Coupling {
+            a: 0,
+            b: 1,
+            stiffness: 4000.0,
+            damping: 0.3,
+        }],
+        BaseExcitation::Record(rec),
+        vec![],
+    );
+    let free = FreeMotion::new(&m).unwrap();
+    let group = &free.groups()[0];
+    let natural = FreeMotion::natural_piece(group.rate());
+    let part = group.modal.as_ref().and_then(|m| m.part()).expect("parts");
+    assert!((2.0..=8.0).contains(&(0.01 / part).round()), "{part}");
+    assert!(part <= natural * (1.0 + 1e-12));
+    let (a, b) = (0.0137, 2.2);
+    let grid = free.grid(0, a, b, natural);
+    assert_eq!(*grid.last().unwrap(), b);
+    let mut last = a;
+    for &t in &grid {
+        assert!(t > last && t - last <= natural * (1.0 + 1e-9), "{last} {t}");
+        let inside = times.iter().any(|&s| s <= last) && t <= 1.49;
+        let starts_on_sample = times.iter().any(|&s| (s - last).abs() < 1e-12);
+        if inside && starts_on_sample {
+            assert!((t - last - part).abs() <= 1e-10 * part, "{last} {t}");
+        }
+        last = t;
+    }
+    for &s in times.iter().filter(|&&s| s > a && s < b) {
+        assert!(grid.iter().any(|&t| (t - s).abs() < 1e-12), "{s}");
+    }
+    let mut x: Vec<f64> = (0..2)
+        .flat_map(|i| [m.initial_displacement()[i], m.initial_velocity()[i]])
+        .collect();
+    let mut t0 = 0.0;
+    for t in std::iter::once(a).chain(grid) {
+        free.propagate(0, t0, t, &mut x);
+        t0 = t;
+    }
+    assert_close(&x, &integrated(&m, b), 1e-9);
+}
