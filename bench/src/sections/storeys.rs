@@ -19,15 +19,19 @@
 //! 3. The pounding study of those rows at full scale (`Row::respond`:
 //!    exact peaks by gauges, one set), DOP853 rtol 1e-8, local against
 //!    global, with the largest difference of a peak drift: why `auto`
-//!    runs rows under records globally.
+//!    runs a study with exact peaks globally.
+//! 4. The rows at full scale at equal error: each integrator's fastest
+//!    run (DOPRI5 or DOP853, rtol 1e-4 … 1e-11) within 1e-5, 1e-7 and
+//!    1e-9 of global DOP853 at rtol 1e-12: where `auto` runs the local
+//!    one under a record (docs/decisions.md D41).
 
 use std::time::Instant;
 
-use serde_json::json;
+use serde_json::{json, Value};
 use vibroimpact::contact::ContactLaw;
 use vibroimpact::integrate::Method;
 use vibroimpact::model::hysteresis::{Bilinear, StoreyLaw};
-use vibroimpact::model::record::{parse_record, Units};
+use vibroimpact::model::record::{parse_record, Record, Units};
 use vibroimpact::model::{BaseExcitation, Body, Contact, ContactPair, Model, Storey};
 use vibroimpact::seismic::pounding::{parse_row, RunSettings};
 use vibroimpact::simulate::{Integrator, Simulation, SimulationOptions};
@@ -304,8 +308,67 @@ pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
             "peak_drift_difference": difference}),
         );
     }
+    let equal = equal_error(&record, counts, repeats);
     vec![(
         "storeys",
-        json!({"struck_row": struck, "rows_under_a_record": rows, "pounding_study": study}),
+        json!({"struck_row": struck, "rows_under_a_record": rows, "pounding_study": study,
+            "equal_error": equal}),
     )]
+}
+
+/// Part 4: the rows at full scale, each integrator at its fastest for an
+/// error: DOPRI5 and DOP853 at rtol 1e-4 … 1e-11, errors against global
+/// DOP853 rtol 1e-12; per error bound the fastest run of each within it
+/// (docs/decisions.md D41).
+fn equal_error(record: &Record, counts: &[usize], repeats: usize) -> Vec<Value> {
+    println!(
+        "\n== storeys: the rows at full scale at equal error, each integrator at its fastest (DOPRI5 or DOP853, rtol 1e-4 … 1e-11) =="
+    );
+    let mut out = Vec::new();
+    for &k in counts {
+        let row = parse_row(&row_text(k), "row.toml").expect("valid row");
+        let model = row.model(record, 1.0, true).expect("the row's model").model;
+        let opts = |integrator, method, rtol: f64| SimulationOptions {
+            t_end: record.duration(),
+            rtol,
+            atol: 1e-4 * rtol,
+            output_step: Some(0.01),
+            method,
+            integrator,
+            ..SimulationOptions::default()
+        };
+        let reference = timed(&model, &opts(Integrator::Global, Method::Dop853, 1e-12), 1).1;
+        let bodies = model.bodies().len();
+        let mut runs = Vec::new();
+        for integrator in [Integrator::Global, Integrator::Local] {
+            for (name, method) in [("DOPRI5", Method::Dopri5), ("DOP853", Method::Dop853)] {
+                for e in 4..=11 {
+                    let rtol = 10f64.powi(-e);
+                    let (t, sim) = timed(&model, &opts(integrator, method, rtol), repeats);
+                    let err = difference(&sim, &reference, bodies);
+                    runs.push((integrator, name, rtol, t, err));
+                }
+            }
+        }
+        for bound in [1e-5, 1e-7, 1e-9] {
+            let fastest = |which| {
+                runs.iter()
+                    .filter(|r| r.0 == which && r.4 <= bound)
+                    .min_by(|a, b| a.3.total_cmp(&b.3))
+            };
+            let (Some(g), Some(l)) = (fastest(Integrator::Global), fastest(Integrator::Local))
+            else {
+                println!("K = {k:>3}, error <= {bound:.0e}: not reached by both");
+                continue;
+            };
+            println!(
+                "K = {k:>3}, error <= {bound:.0e}: global {} rtol {:.0e} {:>8.2} ms ({:.1e}), local {} rtol {:.0e} {:>8.2} ms ({:.1e}); local / global {:.2}",
+                g.1, g.2, g.3 * 1e3, g.4, l.1, l.2, l.3 * 1e3, l.4, l.3 / g.3
+            );
+            out.push(json!({"buildings": k, "error_bound": bound,
+                "global": {"method": g.1, "rtol": g.2, "seconds": g.3, "error": g.4},
+                "local": {"method": l.1, "rtol": l.2, "seconds": l.3, "error": l.4}}));
+        }
+    }
+    out
 }

@@ -191,7 +191,7 @@ pub fn estimate_work(model: &Model, opts: &SimulationOptions) -> Option<WorkEsti
     // reached.
     // The bound prices the global integrator: the local one moves free
     // bodies exactly, so its probe covers at least a hundredth of the run.
-    let local = opts.integrator.resolve(model) == Integrator::Local;
+    let local = opts.integrator.resolve_run(model, opts) == Integrator::Local;
     let priced = (PROBE_SECONDS / (parts * SECONDS_PER_STEP_AND_PART)).ceil() as u64;
     let mut t_probe = opts.t_end * PROBE_SECONDS / (bound.seconds - sampling);
     if local {

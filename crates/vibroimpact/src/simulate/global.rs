@@ -35,7 +35,7 @@ pub fn simulate_streaming(
     let mut st =
         Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
     let breakpoints = breakpoints(model, opts.t_end);
-    if opts.integrator.resolve(model) == Integrator::Local {
+    if opts.integrator.resolve_run(model, opts) == Integrator::Local {
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
     let mut next_break = 0;

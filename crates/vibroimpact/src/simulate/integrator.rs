@@ -1,7 +1,8 @@
 //! Which integrator runs a simulation: the global one, the local one
 //! (docs/theory.md §10), or the one of the two that pays for the model.
 
-use super::OptionsError;
+use super::{OptionsError, SimulationOptions};
+use crate::integrate::Method;
 use crate::model::{BaseExcitation, Model};
 
 /// How a simulation advances the state.
@@ -35,15 +36,45 @@ impl Integrator {
         }
     }
 
+    /// The integrator that runs `model` with `opts`: as
+    /// [`Integrator::resolve`], except that under a record `auto` is local
+    /// for at least [`AUTO_LOCAL_GROUPS`] groups where that was measured
+    /// to pay (docs/decisions.md D41): no exact peaks asked for (their
+    /// scans of every exactly moving group cost the local run 2.2–3.3
+    /// times the global one's in the pounding study), and DOP853, or
+    /// DOPRI5 at rtol 1e-7 or tighter (looser, DOPRI5's steps are the
+    /// record's samples and the global run is the faster).
+    pub fn resolve_run(self, model: &Model, opts: &SimulationOptions) -> Integrator {
+        let record = matches!(model.base(), BaseExcitation::Record(_));
+        if self != Integrator::Auto || !record {
+            return self.resolve(model);
+        }
+        let groups = crate::simulate::local::free_motion::spring_groups(model)
+            .1
+            .len();
+        let pays = match opts.method {
+            Method::Dop853 => true,
+            Method::Dopri5 => opts.rtol <= 1e-7,
+            Method::Rodas | Method::Auto => false,
+        };
+        if groups >= AUTO_LOCAL_GROUPS && pays && opts.extrema_window.is_none() {
+            Integrator::Local
+        } else {
+            Integrator::Global
+        }
+    }
+
     /// The integrator that runs `model`: [`Integrator::Auto`] is local for
     /// a model of at least [`AUTO_LOCAL_GROUPS`] groups whose free motion
     /// has a bounded steady state under its forcing (no undamped group
     /// under harmonic forcing) and no recorded base motion, global
     /// otherwise; the others are themselves. (A record moves every group
     /// and the global integrator steps at its samples anyway: at full
-    /// scale rows of 16 and 64 yielding buildings take 1.5 and 0.8 times
-    /// the global run's time locally, their pounding study with exact
-    /// peaks 3.3 and 2.2 times; docs/decisions.md D40.)
+    /// scale rows of 16 and 64 yielding buildings at DOPRI5 rtol 1e-4
+    /// take 1.5 and 0.8 times the global run's time locally, their
+    /// pounding study with exact peaks 3.3 and 2.2 times; docs/decisions.md
+    /// D40. [`Integrator::resolve_run`] knows the run's options and picks
+    /// local where it pays.)
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
             Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {

@@ -471,7 +471,8 @@ fn stiff_models_end_early_with_the_reason() {
 /// `Integrator::Auto` is the local integrator from [`AUTO_LOCAL_GROUPS`]
 /// groups up (the same bytes as asking for it) and the global one below,
 /// where an undamped group is forced harmonically (its free motion may
-/// have no steady state) or under a record.
+/// have no steady state), or under a record unless the run's options are
+/// those where the local one pays.
 #[test]
 fn auto_chooses_the_integrator_by_groups() {
     let auto = |m: &Model| Integrator::Auto.resolve(m);
@@ -503,11 +504,60 @@ fn auto_chooses_the_integrator_by_groups() {
     };
     assert_eq!(auto(&undamped(harmonic)), Integrator::Global);
     assert_eq!(auto(&undamped(BaseExcitation::None)), Integrator::Local);
-    // A record moves every group: global (docs/decisions.md D26).
+    // A record moves every group: global by the model alone (docs/
+    // decisions.md D26); with the run's options local from 16 groups
+    // without exact peaks, with DOP853 or DOPRI5 at rtol 1e-7 or tighter
+    // (D41).
     let record =
         crate::model::Accelerogram::new(vec![0.0, 0.01, 0.02], vec![0.0, 1.0, 0.0], 1.0).unwrap();
+    let shaken = undamped(BaseExcitation::Record(record.clone()));
+    assert_eq!(auto(&shaken), Integrator::Global);
+    let run = |method, rtol, extrema_window| SimulationOptions {
+        method,
+        rtol,
+        extrema_window,
+        ..SimulationOptions::default()
+    };
+    let on = |m: &Model, o: &SimulationOptions| Integrator::Auto.resolve_run(m, o);
     assert_eq!(
-        auto(&undamped(BaseExcitation::Record(record))),
+        on(&shaken, &SimulationOptions::default()),
+        Integrator::Local
+    );
+    assert_eq!(
+        on(&shaken, &run(Method::Dop853, 1e-4, None)),
+        Integrator::Local
+    );
+    assert_eq!(
+        on(&shaken, &run(Method::Dopri5, 1e-7, None)),
+        Integrator::Local
+    );
+    assert_eq!(
+        on(&shaken, &run(Method::Dopri5, 1e-6, None)),
+        Integrator::Global
+    );
+    assert_eq!(
+        on(&shaken, &run(Method::Rodas, 1e-8, None)),
+        Integrator::Global
+    );
+    let peaks = run(Method::Dop853, 1e-8, Some((0.0, 1.0)));
+    assert_eq!(on(&shaken, &peaks), Integrator::Global);
+    let smaller = Model::row(
+        AUTO_LOCAL_GROUPS - 1,
+        0.227,
+        12.5,
+        0.0,
+        1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::Record(record),
+    )
+    .unwrap();
+    assert_eq!(
+        on(&smaller, &SimulationOptions::default()),
+        Integrator::Global
+    );
+    assert_eq!(
+        Integrator::Global.resolve_run(&shaken, &SimulationOptions::default()),
         Integrator::Global
     );
     let chain = crate::model::reference::struck_chain(AUTO_LOCAL_GROUPS, 1.0).unwrap();
