@@ -489,77 +489,45 @@ fn auto_chooses_the_integrator_by_groups() {
         Integrator::Local
     );
     let harmonic = large.base().clone();
-    let undamped = |base: BaseExcitation| {
-        Model::row(
-            AUTO_LOCAL_GROUPS,
-            0.227,
-            12.5,
-            0.0,
-            1e-3,
-            law(),
-            (true, true),
-            base,
-        )
-        .unwrap()
+    let row = |groups: usize, base: BaseExcitation| {
+        Model::row(groups, 0.227, 12.5, 0.0, 1e-3, law(), (true, true), base).unwrap()
     };
+    let undamped = |base| row(AUTO_LOCAL_GROUPS, base);
     assert_eq!(auto(&undamped(harmonic)), Integrator::Global);
     assert_eq!(auto(&undamped(BaseExcitation::None)), Integrator::Local);
     // A record moves every group: global by the model alone (docs/
     // decisions.md D26); with the run's options local from 16 groups
     // without exact peaks, with DOP853 or DOPRI5 at rtol 1e-7 or tighter
     // (D41).
-    let record =
-        crate::model::Accelerogram::new(vec![0.0, 0.01, 0.02], vec![0.0, 1.0, 0.0], 1.0).unwrap();
-    let shaken = undamped(BaseExcitation::Record(record.clone()));
+    let record = BaseExcitation::Record(
+        crate::model::Accelerogram::new(vec![0.0, 0.01, 0.02], vec![0.0, 1.0, 0.0], 1.0).unwrap(),
+    );
+    let shaken = undamped(record.clone());
     assert_eq!(auto(&shaken), Integrator::Global);
-    let run = |method, rtol, extrema_window| SimulationOptions {
-        method,
-        rtol,
-        extrema_window,
-        ..SimulationOptions::default()
-    };
-    let on = |m: &Model, o: &SimulationOptions| Integrator::Auto.resolve_run(m, o);
-    assert_eq!(
-        on(&shaken, &SimulationOptions::default()),
-        Integrator::Local
-    );
-    assert_eq!(
-        on(&shaken, &run(Method::Dop853, 1e-4, None)),
-        Integrator::Local
-    );
-    assert_eq!(
-        on(&shaken, &run(Method::Dopri5, 1e-7, None)),
-        Integrator::Local
-    );
-    assert_eq!(
-        on(&shaken, &run(Method::Dopri5, 1e-6, None)),
-        Integrator::Global
-    );
-    assert_eq!(
-        on(&shaken, &run(Method::Rodas, 1e-8, None)),
-        Integrator::Global
-    );
-    let peaks = run(Method::Dop853, 1e-8, Some((0.0, 1.0)));
-    assert_eq!(on(&shaken, &peaks), Integrator::Global);
-    let smaller = Model::row(
-        AUTO_LOCAL_GROUPS - 1,
-        0.227,
-        12.5,
-        0.0,
-        1e-3,
-        law(),
-        (true, true),
-        BaseExcitation::Record(record),
-    )
-    .unwrap();
-    assert_eq!(
-        on(&smaller, &SimulationOptions::default()),
-        Integrator::Global
-    );
-    assert_eq!(
-        Integrator::Global.resolve_run(&shaken, &SimulationOptions::default()),
-        Integrator::Global
-    );
+    let smaller = row(AUTO_LOCAL_GROUPS - 1, record);
+    let peaks = Some((0.0, 1.0));
+    for (model, method, rtol, extrema_window, chosen) in [
+        (&shaken, Method::Dop853, 1e-8, None, Integrator::Local),
+        (&shaken, Method::Dop853, 1e-4, None, Integrator::Local),
+        (&shaken, Method::Dopri5, 1e-7, None, Integrator::Local),
+        (&shaken, Method::Dopri5, 1e-6, None, Integrator::Global),
+        (&shaken, Method::Rodas, 1e-8, None, Integrator::Global),
+        (&shaken, Method::Dop853, 1e-8, peaks, Integrator::Global),
+        (&smaller, Method::Dop853, 1e-8, None, Integrator::Global),
+    ] {
+        let opts = SimulationOptions {
+            method,
+            rtol,
+            extrema_window,
+            ..SimulationOptions::default()
+        };
+        let got = Integrator::Auto.resolve_run(model, &opts);
+        assert_eq!(got, chosen, "{method:?} {rtol:e} {extrema_window:?}");
+        assert_eq!(
+            Integrator::Global.resolve_run(model, &opts),
+            Integrator::Global
+        );
+    }
     let chain = crate::model::reference::struck_chain(AUTO_LOCAL_GROUPS, 1.0).unwrap();
     assert_eq!(auto(&chain), Integrator::Local);
     let opts = |integrator| SimulationOptions {

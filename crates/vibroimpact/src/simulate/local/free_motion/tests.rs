@@ -85,17 +85,29 @@ fn free_model(
 
 /// Two bodies joined by a spring and a damper under `base`.
 fn coupled_pair(base: BaseExcitation) -> Model {
-    free_model(
-        vec![body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 40.0,
-            damping: 0.3,
-        }],
+    joined(
+        [body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
+        (40.0, 0.3),
         base,
         vec![],
     )
+}
+
+/// `bodies` joined by a spring and a damper `(stiffness, damping)`, under
+/// `base` and `forces`.
+fn joined(
+    bodies: [Body; 2],
+    (stiffness, damping): (f64, f64),
+    base: BaseExcitation,
+    forces: Vec<HarmonicForce>,
+) -> Model {
+    let coupling = Coupling {
+        a: 0,
+        b: 1,
+        stiffness,
+        damping,
+    };
+    free_model(bodies.to_vec(), vec![coupling], base, forces)
 }
 
 fn harmonic(amplitude: f64, frequency: f64, phase: f64) -> BaseExcitation {
@@ -212,6 +224,16 @@ fn a_record_is_exact_under_first_order_hold() {
     }
 }
 
+/// A record's times and values, 1.5 s at 0.01 s, with a free-vibration
+/// tail appended as a pounding row's: 1.5 s, then 3 s.
+fn record_with_a_tail() -> (Vec<f64>, Vec<f64>) {
+    let mut times: Vec<f64> = (0..150).map(|k| 0.01 * k as f64).collect();
+    let mut values: Vec<f64> = times.iter().map(|t| (8.0 * t).sin()).collect();
+    times.extend([1.5, 3.0]);
+    values.extend([0.0, 0.0]);
+    (times, values)
+}
+
 /// A record with a free-vibration tail appended (one sample step down to
 /// rest, then one long interval, as a pounding row's): its typical step is
 /// the record's own, whole steps take the precomputed coefficients (modes,
@@ -220,10 +242,7 @@ fn a_record_is_exact_under_first_order_hold() {
 /// samples or on them, equals the integration to 1e-9.
 #[test]
 fn a_record_with_a_tail_keeps_its_whole_steps() {
-    let mut times: Vec<f64> = (0..150).map(|k| 0.01 * k as f64).collect();
-    let mut values: Vec<f64> = times.iter().map(|t| (8.0 * t).sin()).collect();
-    times.extend([1.5, 3.0]);
-    values.extend([0.0, 0.0]);
+    let (times, values) = record_with_a_tail();
     let near = |h: Option<f64>| h.is_some_and(|h| (h - 0.01).abs() < 1e-15);
     assert!(near(typical_step(&times)));
     let rec = BaseExcitation::Record(Accelerogram::new(times, values, 0.4).unwrap());
@@ -349,14 +368,9 @@ fn energy_and_acceleration_bounds_hold() {
         frequency: 4.0,
         phase: 0.0,
     };
-    let m = free_model(
-        vec![body("a", 0.2, 7.0, 0.01), body("b", 0.3, 5.0, 0.0)],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 3.0,
-            damping: 0.1,
-        }],
+    let m = joined(
+        [body("a", 0.2, 7.0, 0.01), body("b", 0.3, 5.0, 0.0)],
+        (3.0, 0.1),
         harmonic(0.5, 6.0, 0.0),
         vec![force],
     );
@@ -567,19 +581,11 @@ fn phi_series_to_rounding() {
 /// 1e-9 (the parts' coefficients are the motion's).
 #[test]
 fn the_extrema_grid_parts_whole_steps() {
-    let mut times: Vec<f64> = (0..150).map(|k| 0.01 * k as f64).collect();
-    let mut values: Vec<f64> = times.iter().map(|t| (8.0 * t).sin()).collect();
-    times.extend([1.5, 3.0]);
-    values.extend([0.0, 0.0]);
+    let (times, values) = record_with_a_tail();
     let rec = Accelerogram::new(times.clone(), values, 0.4).unwrap();
-    let m = free_model(
-        vec![body("a", 1.0, 120.0, 0.02), body("b", 1.2, 90.0, 0.02)],
-        vec![Coupling {
-            a: 0,
-            b: 1,
-            stiffness: 4000.0,
-            damping: 0.3,
-        }],
+    let m = joined(
+        [body("a", 1.0, 120.0, 0.02), body("b", 1.2, 90.0, 0.02)],
+        (4000.0, 0.3),
         BaseExcitation::Record(rec),
         vec![],
     );
