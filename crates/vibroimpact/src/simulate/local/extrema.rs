@@ -191,24 +191,6 @@ impl Carried {
     }
 }
 
-/// The ends of the equal pieces of `[a, b]` no longer than `step` (at
-/// least one; the last exactly `b`; none that does not advance).
-fn grid(a: f64, b: f64, step: f64) -> impl Iterator<Item = f64> {
-    let pieces = ((b - a) / step).ceil().clamp(1.0, 1e9) as usize;
-    let mut last = a;
-    (1..=pieces).filter_map(move |p| {
-        let t = if p == pieces {
-            b
-        } else {
-            a + (b - a) * p as f64 / pieces as f64
-        };
-        (t > last).then(|| {
-            last = t;
-            t
-        })
-    })
-}
-
 impl Run<'_> {
     /// Scans group `g`'s exact motion, and its contacts with other exact
     /// groups or walls, up to `t`: called before its reference state moves
@@ -495,7 +477,7 @@ impl Run<'_> {
         let (free, set, slot) = (&self.free, &mut self.set, &self.slot);
         let ground = |t| self.model.base().at(t);
         let mut ta = a;
-        for tb in grid(a, b, step) {
+        for tb in FreeMotion::equal_pieces(a, b, step) {
             let reading = &mut ex.gauges[w];
             // A side's (u, v) at t: carried exactly, or the set's dense
             // output.
@@ -604,7 +586,7 @@ impl Run<'_> {
             .fold(f64::INFINITY, f64::min);
         let (mut ta, mut sa) = (a, self.approach(k, a));
         ex.note_margin(k, sa.0);
-        for tb in grid(a, b, step) {
+        for tb in FreeMotion::equal_pieces(a, b, step) {
             let sb = self.approach(k, tb);
             ex.note_margin(k, sb.0);
             if sa.1 > 0.0 && sb.1 < 0.0 {

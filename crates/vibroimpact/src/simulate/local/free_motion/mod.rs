@@ -171,25 +171,6 @@ fn record_intervals(rec: &Accelerogram, t0: f64, t1: f64, mut step: impl FnMut(f
     }
 }
 
-/// The ends of the equal pieces of `(a, b]` no longer than `step`, into
-/// `out` (at least one; the last exactly `b`; none that does not
-/// advance).
-fn equal_pieces(a: f64, b: f64, step: f64, out: &mut Vec<f64>) {
-    let pieces = ((b - a) / step).ceil().clamp(1.0, 1e9) as usize;
-    let mut last = a;
-    for p in 1..=pieces {
-        let t = if p == pieces {
-            b
-        } else {
-            a + (b - a) * p as f64 / pieces as f64
-        };
-        if t > last {
-            out.push(t);
-            last = t;
-        }
-    }
-}
-
 /// The typical sample step of `times`: the median of its steps. Whole
 /// steps of that length are computed once; a record need not be uniform
 /// for that to pay (a pounding row appends a free-vibration tail, two
@@ -427,6 +408,24 @@ impl FreeMotion {
         self.record_step
     }
 
+    /// The ends of the equal pieces of `(a, b]` no longer than `step` (at
+    /// least one; the last exactly `b`; none that does not advance).
+    pub fn equal_pieces(a: f64, b: f64, step: f64) -> impl Iterator<Item = f64> {
+        let pieces = ((b - a) / step).ceil().clamp(1.0, 1e9) as usize;
+        let mut last = a;
+        (1..=pieces).filter_map(move |p| {
+            let t = if p == pieces {
+                b
+            } else {
+                a + (b - a) * p as f64 / pieces as f64
+            };
+            (t > last).then(|| {
+                last = t;
+                t
+            })
+        })
+    }
+
     /// The longest piece of the exact extrema's grid for a group of
     /// fastest rate `rate`: a sixteenth of its period (∞ at rest).
     pub fn natural_piece(rate: f64) -> f64 {
@@ -448,8 +447,7 @@ impl FreeMotion {
         let (BaseExcitation::Record(rec), Some(part), Some(whole)) =
             (&self.base, part, self.record_step)
         else {
-            equal_pieces(a, b, step, &mut out);
-            return out;
+            return Self::equal_pieces(a, b, step).collect();
         };
         let times = rec.times();
         let mut k = times.partition_point(|&s| s <= a).saturating_sub(1);
@@ -458,7 +456,7 @@ impl FreeMotion {
             let (s0, s1) = match (times.get(k), times.get(k + 1)) {
                 (Some(&s0), Some(&s1)) if s0 <= last => (s0, s1),
                 _ => {
-                    equal_pieces(last, b, step, &mut out);
+                    out.extend(Self::equal_pieces(last, b, step));
                     return out;
                 }
             };
