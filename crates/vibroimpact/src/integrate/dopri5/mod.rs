@@ -117,6 +117,9 @@ pub struct Dopri5Method {
     k_acc: Vec<f64>,
     /// The attempt's error estimate per component.
     err: Vec<f64>,
+    /// The last accepted step's dense coefficient `Σ_j D_j k_j` per
+    /// component (`CONTD5`'s fifth), summed once when the step is accepted.
+    c5: Vec<f64>,
 }
 
 impl StepMethod for Dopri5Method {
@@ -130,6 +133,7 @@ impl StepMethod for Dopri5Method {
             k: vec![0.0; N_STAGES * dim],
             k_acc: vec![0.0; N_STAGES * dim],
             err: vec![0.0; dim],
+            c5: vec![0.0; dim],
         }
     }
 
@@ -166,15 +170,14 @@ impl StepMethod for Dopri5Method {
         if !all_finite(last) {
             return Err(NON_FINITE);
         }
+        // Summed stage by stage over contiguous stages (the same order per
+        // component as one component at a time: the same bits).
         let m = at.error_components();
-        for (i, e_i) in self.err[..m].iter_mut().enumerate() {
-            let mut e = 0.0;
-            for (j, &ej) in E.iter().enumerate() {
-                if ej != 0.0 {
-                    e += ej * self.k[j * n + i];
-                }
-            }
-            *e_i = h * e;
+        let err = &mut self.err[..m];
+        err.fill(0.0);
+        stage_sum(err, &self.k, &E, n);
+        for e in err.iter_mut() {
+            *e *= h;
         }
         Ok(at.error_norm(&self.err, y_new))
     }
@@ -197,6 +200,9 @@ impl StepMethod for Dopri5Method {
             self.stiffness.record(h_rho > STIFF_H_RHO);
         }
         std::mem::swap(&mut self.k, &mut self.k_acc);
+        let n = y_new.len();
+        self.c5.fill(0.0);
+        stage_sum(&mut self.c5, &self.k_acc, &D, n);
     }
 
     fn end_derivative(&self) -> &[f64] {
@@ -219,14 +225,21 @@ impl StepMethod for Dopri5Method {
         let ydiff = at.y[i] - at.y_prev[i];
         let bspl = h * k(0) - ydiff;
         let c4 = ydiff - h * k(N_STAGES - 1) - bspl;
-        let mut c5 = 0.0;
-        for (j, &dj) in D.iter().enumerate() {
-            if dj != 0.0 {
-                c5 += dj * k(j);
-            }
-        }
+        let c5 = self.c5[i];
         let s1 = 1.0 - s;
         at.y_prev[i] + s * (ydiff + s1 * (bspl + s * (c4 + s1 * h * c5)))
+    }
+}
+
+/// Adds `Σ_j w_j k_j` (stages `j` of `k`, each `n` long, zero weights
+/// skipped) to the leading components of `out`, stage by stage.
+fn stage_sum(out: &mut [f64], k: &[f64], w: &[f64], n: usize) {
+    for (j, &wj) in w.iter().enumerate() {
+        if wj != 0.0 {
+            for (o, &kj) in out.iter_mut().zip(&k[j * n..]) {
+                *o += wj * kj;
+            }
+        }
     }
 }
 

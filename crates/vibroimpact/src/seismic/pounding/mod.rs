@@ -442,7 +442,6 @@ impl Row {
     ) -> Result<Option<WorkEstimate>, PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
-            accelerations: true,
             storey_forces: true,
             ..self.options(record, run)?
         };
@@ -466,7 +465,6 @@ impl Row {
     ) -> Result<(Response, Stop), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let mut opts = SimulationOptions {
-            accelerations: true,
             storey_forces: true,
             ..self.options(record, run)?
         };
@@ -559,7 +557,6 @@ impl Row {
     ) -> Result<History, PoundingError> {
         let rm = self.model(record, scale, true)?;
         let opts = SimulationOptions {
-            accelerations: true,
             storey_forces: true,
             ..self.options(record, run)?
         };

@@ -117,8 +117,8 @@ impl Peaks {
 
     /// A sample of the loops: each hysteretic storey's drift and force.
     pub(super) fn sample(&mut self, row: &[f64]) {
-        let n = (row.len() - self.loops.len()) / 3;
-        let (u, forces) = (&row[..n], &row[3 * n..]);
+        let n = (row.len() - self.loops.len()) / 2;
+        let (u, forces) = (&row[..n], &row[2 * n..]);
         for ((below, above, l), &f) in self.loops.iter_mut().zip(forces) {
             l.drift.push(u[*above] - below.map_or(0.0, |b| u[b]));
             l.force.push(f);
@@ -129,7 +129,7 @@ impl Peaks {
     /// storey): the largest drift over its bound, with its building and
     /// storey.
     pub(super) fn check(&self, row: &[f64], bounds: &[Vec<f64>]) -> (f64, usize, usize) {
-        let u = &row[..(row.len() - self.loops.len()) / 3];
+        let u = &row[..(row.len() - self.loops.len()) / 2];
         let mut worst = (0.0f64, 0, 0);
         for (k, (&(first, base, floors), bound)) in self.layout.iter().zip(bounds).enumerate() {
             for i in 0..floors {
