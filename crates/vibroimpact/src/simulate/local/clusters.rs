@@ -259,7 +259,13 @@ impl Run<'_> {
         // Descending: each removal leaves the smaller places as they were.
         for p in parked.into_iter().rev() {
             let mut b = self.sets.swap_remove(p);
-            self.bring_to(&mut b, t)?;
+            if let Err(e) = self.bring_to(&mut b, t) {
+                // The run ends here: every set taken out goes back, so
+                // that the failure's state holds their bodies.
+                self.sets.push(b);
+                self.sets.append(&mut merging);
+                return Err(e);
+            }
             merging.push(b);
         }
         let mut groups = new;
