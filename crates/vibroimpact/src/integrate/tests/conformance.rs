@@ -1,7 +1,8 @@
 //! Conformance suite: the same checks for every method plugged into the
 //! [`Driver`]: observed order of the solution and of the dense output,
 //! dense-output accuracy under adaptive control, the exact end time, NaN
-//! rejection with recovery, admissibility, the step limit and the interrupt.
+//! rejection with recovery, admissibility, the step limit and the interrupt,
+//! and a restart keeping the step size.
 
 use super::systems::{fixed, tol, Decay, Harmonic};
 use crate::integrate::{
@@ -127,6 +128,35 @@ fn check_adaptive_accuracy_and_end_time<M: StepMethod>(dense_factor: f64) {
         worst_dense < dense_factor * tolerance,
         "dense error {worst_dense:e}"
     );
+}
+
+/// `restart` after a change of state (an impulse, columns made
+/// orthonormal again) evaluates `f` once, keeps the proposed step, and the
+/// run continues on the exact solution through the new state (within
+/// 100× the tolerance).
+fn check_restart<M: StepMethod>() {
+    let tolerance = 1e-9;
+    let mut s = Driver::<M>::new(2, tol(tolerance)).unwrap();
+    let mut sys = Forced;
+    s.reset(&mut sys, 0.0, &[1.0, 0.0]).unwrap();
+    s.step(&mut sys, 10.0).unwrap();
+    let (h, evaluations, t) = (s.h_next(), s.stats().rhs_evaluations, s.t());
+    let kicked = [s.y()[0] + 0.25, s.y()[1] - 0.5];
+    s.restart(&mut sys, &kicked).unwrap();
+    assert_eq!(s.stats().rhs_evaluations, evaluations + 1);
+    assert_eq!((s.t(), s.h_next(), s.y()), (t, h, &kicked[..]));
+    let t_end = t + 2.0;
+    while s.t() < t_end {
+        s.step(&mut sys, t_end).unwrap();
+    }
+    let exact = Forced::exact_from(t, &kicked, t_end);
+    let err = s
+        .y()
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(err < 100.0 * tolerance, "error {err:e} after the restart");
 }
 
 /// A first step of 10 (far outside DOP853's stability region; for RODAS
@@ -375,6 +405,7 @@ fn dop853_conforms() {
     check_admissibility::<Dop853Method>();
     check_limits::<Dop853Method>();
     check_misuse::<Dop853Method>();
+    check_restart::<Dop853Method>();
 }
 
 #[test]
@@ -388,6 +419,7 @@ fn dopri5_conforms() {
     check_admissibility::<Dopri5Method>();
     check_limits::<Dopri5Method>();
     check_misuse::<Dopri5Method>();
+    check_restart::<Dopri5Method>();
 }
 
 #[test]
@@ -402,4 +434,5 @@ fn rodas_conforms() {
     check_admissibility::<RodasMethod>();
     check_limits::<RodasMethod>();
     check_misuse::<RodasMethod>();
+    check_restart::<RodasMethod>();
 }

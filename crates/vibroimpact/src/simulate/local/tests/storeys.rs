@@ -192,7 +192,10 @@ fn rows_and_isolated_buildings_as_the_global_integrator_runs_them() {
 /// record: the pounding pairs step as sets of their own (D39; at least
 /// two at once), with the global integrator's impacts (contacts, start
 /// times to 1e-6 s: measured 1.4e-7 for one met at 0.019 m/s, 2.6e-9 m
-/// of approach), hysteretic energies (1e-7) and final state (1e-6).
+/// of approach) and final state (1e-6); each one's hysteretic energies
+/// within 1e-6 of the global run's at rtol 1e-13 (measured: 4.7e-7 global,
+/// 3.4e-7 local, both at rtol 1e-10, in the 1130 J storey; the two runs'
+/// errors are alike, but not to below their size).
 #[test]
 fn clusters_of_yielding_frames_as_the_global_integrator_runs_them() {
     const IMK: &str =
@@ -227,8 +230,17 @@ fn clusters_of_yielding_frames_as_the_global_integrator_runs_them() {
         assert_eq!(a.contact, b.contact);
         assert!((a.start_time - b.start_time).abs() < 1e-6, "{a:?} {b:?}");
     }
-    for (a, b) in g.hysteretic_energy.iter().zip(&l.hysteretic_energy) {
-        assert!((a - b).abs() <= 1e-7 * a.abs(), "{a} vs {b}");
+    let (reference, _) = both(&model(&row), 1e-13);
+    for (k, c) in reference.hysteretic_energy.iter().enumerate() {
+        for (run, e) in [
+            ("global", g.hysteretic_energy[k]),
+            ("local", l.hysteretic_energy[k]),
+        ] {
+            assert!(
+                (e - c).abs() <= 1e-6 * c.abs() + 1e-12,
+                "storey {k}: {run} {e} vs {c}"
+            );
+        }
     }
     let yielded = g.hysteretic_energy.iter().filter(|e| **e > 0.0).count();
     assert!(yielded >= 6, "{:?}", g.hysteretic_energy);
