@@ -154,7 +154,7 @@ impl StoreyTerms {
 
     /// Storey k's drift and drift rate in the interleaved state `y`.
     #[inline]
-    fn drift(&self, k: usize, y: &[f64]) -> (f64, f64) {
+    pub(crate) fn drift(&self, k: usize, y: &[f64]) -> (f64, f64) {
         let t = &self.terms[k];
         let (u, v) = (y[2 * t.above], y[2 * t.above + 1]);
         match t.below {

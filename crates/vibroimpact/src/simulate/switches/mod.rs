@@ -54,6 +54,9 @@ pub(super) struct Switches {
     /// step's inside is looked at (kept between steps: no allocation).
     ends: Vec<(f64, f64)>,
     look: Vec<bool>,
+    /// Per storey event, the bound on its drift terms' rate over the
+    /// last step ([`crate::dynamics::storeys::StoreyTerms::switch_rate_bounds`]).
+    drift_rate: Vec<f64>,
     /// The storeys' two switch parts at the last step's end (NaN where
     /// not computed), the state there and the branches' stamp: the next
     /// step's start, while both hold.
@@ -83,6 +86,7 @@ impl Switches {
             armed: vec![true; events.len()],
             ends: vec![(0.0, 0.0); events.len()],
             look: vec![false; events.len()],
+            drift_rate: vec![0.0; events.len()],
             carried: vec![(f64::NAN, f64::NAN); events.len()],
             carried_y: vec![0.0; dim],
             carried_stamp: None,
@@ -195,6 +199,7 @@ impl Switches {
             let (ld, lr) =
                 storeys.switch_rate_bounds(k, (&self.y_prev, &self.f_prev), (st.y(), st.dydt()), h);
             self.ends[i] = (g0, d1.min(r1));
+            self.drift_rate[i] = ld;
             self.look[i] =
                 d1.min(r1) <= 0.0 || d0.min(d1) <= 2.0 * ld * h || r0.min(r1) <= 2.0 * lr * h;
             any |= self.look[i];
@@ -222,8 +227,39 @@ impl Switches {
                     3 => self.ends[i].1,
                     _ => self.value(sys.chain(), e, &self.inside[j]),
                 };
-                if gb <= 0.0 {
-                    let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
+                // Positive at both ends, a storey's switch can still dip
+                // below zero between them (unless twice its rate bound
+                // forbids: ga + gb > 2 bound (tb − ta)): a yield that
+                // grazes, where the drift turns. Its drift terms are
+                // concave in the drift (a bilinear storey's, and an IMK
+                // storey's but at the corner where its backbone meets the
+                // residual), so least at the drift's extremes: the dip is
+                // tested where the drift rate vanishes (Brent), and the
+                // root sought before it.
+                let (tb_root, gb_root) = match e {
+                    Event::Storey(k)
+                        if gb > 0.0 && ga + gb <= 2.0 * self.drift_rate[i] * (tb - ta) =>
+                    {
+                        let before = if j == 0 {
+                            &self.y_prev
+                        } else {
+                            &self.inside[j - 1]
+                        };
+                        let after = if j == 3 { st.y() } else { &self.inside[j] };
+                        let rate = |y: &[f64]| sys.chain().storeys().drift(k, y).1;
+                        let (ra, rb) = (rate(before), rate(after));
+                        if ra * rb < 0.0 {
+                            let turn = self.turn(st, sys, k, (ta, tb), (ra, rb));
+                            st.dense_output(sys, turn, &mut self.buf);
+                            (turn, self.value(sys.chain(), e, &self.buf))
+                        } else {
+                            (tb, gb)
+                        }
+                    }
+                    _ => (tb, gb),
+                };
+                if gb_root <= 0.0 {
+                    let xtol = 4.0 * f64::EPSILON * tb_root.abs().max(1e-300);
                     let mut buf = std::mem::take(&mut self.buf);
                     let root = brent(
                         |t| {
@@ -231,14 +267,14 @@ impl Switches {
                             self.value(sys.chain(), e, &buf)
                         },
                         ta,
-                        tb,
+                        tb_root,
                         ga,
-                        gb,
+                        gb_root,
                         xtol,
                         200,
                     );
                     self.buf = buf;
-                    let t = root.unwrap_or(tb);
+                    let t = root.unwrap_or(tb_root);
                     if first.is_none_or(|(tf, _)| t < tf) {
                         first = Some((t, e));
                     }
@@ -262,6 +298,36 @@ impl Switches {
                 Ok(Verdict::Retake)
             }
         }
+    }
+}
+
+impl Switches {
+    /// Where storey k's drift rate vanishes inside `(ta, tb)` (its values
+    /// `ra`, `rb` at the ends of opposite signs), on the step's dense
+    /// output, by Brent.
+    fn turn<S: Chain>(
+        &mut self,
+        st: &mut Stepper,
+        sys: &mut S,
+        k: usize,
+        (ta, tb): (f64, f64),
+        (ra, rb): (f64, f64),
+    ) -> f64 {
+        let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
+        let buf = &mut self.buf;
+        brent(
+            |t| {
+                st.dense_output(sys, t, buf);
+                sys.chain().storeys().drift(k, buf).1
+            },
+            ta,
+            tb,
+            ra,
+            rb,
+            xtol,
+            200,
+        )
+        .unwrap_or(0.5 * (ta + tb))
     }
 }
 
