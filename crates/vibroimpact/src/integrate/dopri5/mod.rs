@@ -120,6 +120,8 @@ pub struct Dopri5Method {
     /// The last accepted step's dense coefficient `Σ_j D_j k_j` per
     /// component (`CONTD5`'s fifth), summed once when the step is accepted.
     c5: Vec<f64>,
+    /// Zeros to combine the error estimate and `c5` from.
+    zeros: Vec<f64>,
 }
 
 impl StepMethod for Dopri5Method {
@@ -134,6 +136,7 @@ impl StepMethod for Dopri5Method {
             k_acc: vec![0.0; N_STAGES * dim],
             err: vec![0.0; dim],
             c5: vec![0.0; dim],
+            zeros: vec![0.0; dim],
         }
     }
 
@@ -170,13 +173,10 @@ impl StepMethod for Dopri5Method {
         if !all_finite(last) {
             return Err(NON_FINITE);
         }
-        // Summed stage by stage over contiguous stages (the same order per
-        // component as one component at a time: the same bits).
-        let m = at.error_components();
-        let err = &mut self.err[..m];
-        err.fill(0.0);
-        stage_sum(err, &self.k, &E, n);
-        for e in err.iter_mut() {
+        // Combined over contiguous stages (the same order per component
+        // as one component at a time: the same bits).
+        combine(&self.zeros, &self.k, &E, 1.0, &mut self.err);
+        for e in self.err[..at.error_components()].iter_mut() {
             *e *= h;
         }
         Ok(at.error_norm(&self.err, y_new))
@@ -200,9 +200,7 @@ impl StepMethod for Dopri5Method {
             self.stiffness.record(h_rho > STIFF_H_RHO);
         }
         std::mem::swap(&mut self.k, &mut self.k_acc);
-        let n = y_new.len();
-        self.c5.fill(0.0);
-        stage_sum(&mut self.c5, &self.k_acc, &D, n);
+        combine(&self.zeros, &self.k_acc, &D, 1.0, &mut self.c5);
     }
 
     fn end_derivative(&self) -> &[f64] {
@@ -228,18 +226,6 @@ impl StepMethod for Dopri5Method {
         let c5 = self.c5[i];
         let s1 = 1.0 - s;
         at.y_prev[i] + s * (ydiff + s1 * (bspl + s * (c4 + s1 * h * c5)))
-    }
-}
-
-/// Adds `Σ_j w_j k_j` (stages `j` of `k`, each `n` long, zero weights
-/// skipped) to the leading components of `out`, stage by stage.
-fn stage_sum(out: &mut [f64], k: &[f64], w: &[f64], n: usize) {
-    for (j, &wj) in w.iter().enumerate() {
-        if wj != 0.0 {
-            for (o, &kj) in out.iter_mut().zip(&k[j * n..]) {
-                *o += wj * kj;
-            }
-        }
     }
 }
 
