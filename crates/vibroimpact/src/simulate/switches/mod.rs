@@ -299,9 +299,7 @@ impl Switches {
             }
         }
     }
-}
 
-impl Switches {
     /// Where storey k's drift rate vanishes inside `(ta, tb)` (its values
     /// `ra`, `rb` at the ends of opposite signs), on the step's dense
     /// output, by Brent.
