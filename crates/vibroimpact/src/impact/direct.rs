@@ -20,7 +20,7 @@
 //! - maximum penetration: the root of `ṡ` (+ to -);
 //! - contact duration: the time during which the contact is active, i.e.
 //!   `s > 0` and `|F| > η F_max` for laws with compact support (η = 0 by
-//!   default: exactly while they touch and interact), and `|F| > η F_max`
+//!   default: exactly while they touch), and `|F| > η F_max`
 //!   for the exponential law, whose force never vanishes (η = 1e-3 by
 //!   default). In the non-negative form the contact also ends where the
 //!   published force drops to η F_max (the clamp separates the bodies). A
@@ -160,8 +160,12 @@ fn walk(
     let clamped = sys.law.form() == ForceForm::NonNegative;
     let raw = sys.law.with_form(ForceForm::Published);
     // Contact indicator: > 0 while the contact is active at `level`.
+    // (At level 0 a published law's contact lasts while the bodies
+    // touch: a Hunt–Crossley force that tends to zero as ṡ → −1/χ rounds
+    // to exactly 0 while s > 0, which ended its contact at a time that
+    // depended on rounding, 9 % apart at χU = 42.)
     let indicator = |sys: &RelativeMotion, y: &[f64], l: f64| {
-        if compact && y[0] <= 0.0 {
+        if compact && (y[0] <= 0.0 || (l == 0.0 && !clamped)) {
             y[0]
         } else {
             let f = raw.force(sys.s(y[0]), sys.sdot(y[1]), sys.velocity);

@@ -2,7 +2,11 @@
 //!
 //! ## Files
 //! - `closed_form.rs` — seed eqs. 8–18 in closed form;
-//! - `direct.rs` — impacts by direct integration, any law.
+//! - `direct.rs` — impacts by direct integration, any law;
+//! - `rigid/` — the rigid limit: an impact as a velocity jump with the
+//!   pair's e(U) (docs/theory.md §12);
+//! - `table.rs` — functions of one variable tabulated once (piecewise
+//!   Chebyshev), for `rigid/`.
 //!
 //! Two bodies on a line (or a body and a wall, `m2 = ∞`) collide through a
 //! contact law. Their relative motion `x = s` obeys
@@ -17,6 +21,8 @@
 
 pub mod closed_form;
 pub mod direct;
+pub mod rigid;
+mod table;
 
 use crate::numeric::RootError;
 
