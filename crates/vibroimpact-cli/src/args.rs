@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use vibroimpact::continuation::{Linear, Start};
 use vibroimpact::integrate::Method;
+use vibroimpact::model::Model;
 use vibroimpact::simulate::Integrator;
 
 use crate::error::CliError;
@@ -32,6 +33,45 @@ impl MethodName {
             MethodName::Rodas => Method::Rodas,
             MethodName::Auto => Method::Auto,
         }
+    }
+}
+
+/// `--impacts`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ImpactsName {
+    /// The contact law, integrated through every contact.
+    Soft,
+    /// Instantaneous velocity jumps with the law's e(U) (docs/theory.md §12).
+    Rigid,
+}
+
+/// `--impacts` and `--restitution`: every contact's impacts, over the
+/// model file's.
+#[derive(Args, Debug)]
+pub struct ImpactArgs {
+    /// Every contact's impacts: `soft` (the law integrated through the
+    /// contact) or `rigid` (velocity jumps with the law's e(U));
+    /// default: the model file's (`impacts`), else soft.
+    #[arg(long, value_enum)]
+    pub impacts: Option<ImpactsName>,
+    /// For rigid impacts (`--impacts rigid`, or the model file's): a
+    /// constant coefficient of restitution in (0, 1] in place of the
+    /// law's e(U).
+    #[arg(long)]
+    pub restitution: Option<f64>,
+}
+
+impl ImpactArgs {
+    /// `model` with the impacts asked for (`--restitution` alone: on the
+    /// model file's rigid contacts).
+    pub fn apply(&self, model: Model) -> Result<Model, CliError> {
+        let name = self.impacts.map(|i| match i {
+            ImpactsName::Soft => "soft",
+            ImpactsName::Rigid => "rigid",
+        });
+        model
+            .with_impact_options(name, self.restitution)
+            .map_err(|e| CliError::new(e.spelled(&format!("--{}", e.field), " ")))
     }
 }
 

@@ -137,7 +137,7 @@ fn simulate_example_row_json_and_outputs() {
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
     assert!(history.starts_with("t,u_p1,u_p2,u_p3,v_p1,v_p2,v_p3\n"));
     let log = std::fs::read_to_string(dir.join("impacts.csv")).unwrap();
-    assert!(log.starts_with("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration\n"));
+    assert!(log.starts_with("start_time,end_time,pair,impact_velocity,rebound_velocity,restitution,peak_force,duration,impacts,impulse,energy_lost\n"));
     assert!(log.lines().count() > 5);
 }
 
@@ -282,4 +282,78 @@ fn a_long_run_is_announced_up_front() {
     );
     let short = run(&["simulate", &row, "--periods", "20"]);
     assert!(short.status.success() && short.stderr.is_empty());
+}
+
+/// Rigid impacts from the command line (docs/theory.md §12): the shipped
+/// impact oscillator settles on its closed-form orbit (U = 2.50361 m/s,
+/// e = 0.8), logged as rigid with its impulse and loss; `--impacts soft`
+/// integrates the wall's law instead; bad flags are refused by name.
+#[test]
+fn rigid_impacts_from_the_command_line() {
+    let model = repo_file("examples/impact-oscillator.toml");
+    let dir = temp_dir("rigid-impacts");
+    let out = run(&[
+        "simulate",
+        &model,
+        "--periods",
+        "40",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = std::fs::read_to_string(dir.join("impacts.csv")).unwrap();
+    let header: Vec<&str> = log.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
+    let col = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    assert_eq!(log.lines().count(), 41);
+    assert_eq!(col("impacts"), "rigid");
+    let u: f64 = col("impact_velocity").parse().unwrap();
+    assert!((u / 2.503614666 - 1.0).abs() < 1e-6, "{u}");
+    let impulse: f64 = col("impulse").parse().unwrap();
+    assert!((impulse / (1.8 * u) - 1.0).abs() < 1e-12, "{impulse}");
+    let lost: f64 = col("energy_lost").parse().unwrap();
+    assert!((lost / (0.5 * u * u * 0.36) - 1.0).abs() < 1e-12, "{lost}");
+    let soft = json(&[
+        "simulate",
+        &model,
+        "--periods",
+        "4",
+        "--impacts",
+        "soft",
+        "--format",
+        "json",
+    ]);
+    assert!(soft["contact_evaluations"].as_u64().unwrap() > 0, "{soft}");
+    assert_clean_error(
+        &[
+            "simulate",
+            &model,
+            "--periods",
+            "4",
+            "--impacts",
+            "soft",
+            "--restitution",
+            "0.5",
+        ],
+        "--restitution 0.5: a coefficient of restitution is for rigid impacts",
+    );
+    assert_clean_error(
+        &["simulate", &model, "--periods", "4", "--restitution", "1.5"],
+        "restitution = 1.5 is invalid: must lie in (0, 1]",
+    );
+    assert_clean_error(
+        &[
+            "simulate",
+            &model,
+            "--periods",
+            "4",
+            "--integrator",
+            "local",
+        ],
+        "contact m|wall: rigid impacts run on the global integrator",
+    );
 }

@@ -12,7 +12,7 @@ use crate::monitor::{self, Progress};
 /// A time history: the `simulate` summary plus `t`, `displacement`,
 /// `velocity` (rows per output time) and the impact log as arrays.
 #[pyfunction]
-#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, integrator, progress = None))]
+#[pyo3(signature = (model, duration, rtol, atol, method_name, output_step, energy, impact_force_threshold, integrator, impacts, restitution, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -25,9 +25,16 @@ pub fn simulate<'py>(
     energy: bool,
     impact_force_threshold: Option<f64>,
     integrator: &str,
+    impacts: Option<&str>,
+    restitution: Option<f64>,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = &model.loaded.model;
+    let mut job = vibroimpact::model::file::LoadedModel::clone(&model.loaded);
+    job.model = job
+        .model
+        .with_impact_options(impacts, restitution)
+        .map_err(|e| value_error(e.spelled(e.field, " = ")))?;
+    let m = &job.model;
     let settings = &model.loaded.simulation;
     let method = method(method_name)?;
     let integrator: vibroimpact::simulate::Integrator = integrator.parse().map_err(value_error)?;
@@ -59,7 +66,7 @@ pub fn simulate<'py>(
     let work = py.detach(|| estimate_work(m, &opts));
     warn_if_long(py, work)?;
     let provenance = Provenance::new(&model.document, &opts);
-    let job = model.loaded.clone();
+    let effective = job.model.clone();
     let result = monitor::run_keeping(py, progress, move |p: &Progress| {
         p.track_time(duration);
         let opts = SimulationOptions {
@@ -73,24 +80,25 @@ pub fn simulate<'py>(
         // KeyboardInterrupt keeps the history up to the stop, as the
         // command line does: `result`.
         Err((e, Some(Ok(sim)))) => {
-            e.value(py)
-                .setattr("result", history(py, model, sim, &provenance)?)?;
+            e.value(py).setattr(
+                "result",
+                history(py, (model, &effective), sim, &provenance)?,
+            )?;
             return Err(e);
         }
         Err((e, _)) => return Err(e),
     };
-    history(py, model, sim, &provenance)
+    history(py, (model, &effective), sim, &provenance)
 }
 
 /// The `simulate` document of `sim`: the summary (with its provenance),
 /// the history's arrays and the impact log.
 fn history<'py>(
     py: Python<'py>,
-    model: &PyModel,
+    (model, m): (&PyModel, &vibroimpact::model::Model),
     sim: vibroimpact::simulate::Simulation,
     provenance: &Provenance,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = &model.loaded.model;
     let n = m.bodies().len();
     let mut summary = simulation_summary(m, &sim);
     summary.record = model.loaded.record.clone();
@@ -112,7 +120,21 @@ fn history<'py>(
     log.set_item("rebound_velocity", array1(py, col(&|i| i.rebound_velocity)))?;
     log.set_item("restitution", array1(py, col(&|i| i.restitution())))?;
     log.set_item("peak_force", array1(py, col(&|i| i.peak_force)))?;
-    log.set_item("duration", array1(py, col(&|i| i.duration())))?;
+    // A rigid impact's peak force and duration are the soft law's
+    // estimates; its impulse and loss exact (NaN for a soft impact).
+    let rigid = |f: &dyn Fn(&vibroimpact::impact::rigid::RigidImpact) -> f64| {
+        col(&|i| i.rigid.as_ref().map_or(f64::NAN, f))
+    };
+    let duration = col(&|i| i.rigid.as_ref().map_or(i.duration(), |r| r.duration));
+    log.set_item("duration", array1(py, duration))?;
+    let kinds: Vec<&str> = sim
+        .impacts
+        .iter()
+        .map(|i| if i.rigid.is_some() { "rigid" } else { "soft" })
+        .collect();
+    log.set_item("impacts", kinds)?;
+    log.set_item("impulse", array1(py, rigid(&|r| r.impulse)))?;
+    log.set_item("energy_lost", array1(py, rigid(&|r| r.energy_lost)))?;
     d.set_item("impacts", log)?;
     Ok(d)
 }

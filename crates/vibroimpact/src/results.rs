@@ -15,7 +15,7 @@ use crate::impact::direct::{integrate_impact, DirectOptions};
 use crate::impact::{ImpactError, TwoBodies};
 use crate::model::file::ModelDocument;
 use crate::model::parameter::ModelParameter;
-use crate::model::Model;
+use crate::model::{Impacts, Model};
 use crate::periodic::{OrbitSummary, PeriodicSolution};
 use crate::simulate::Simulation;
 
@@ -580,7 +580,8 @@ pub struct SimulationSummary {
     pub rejected_steps: u64,
     /// Contact-law evaluations (far contacts are skipped).
     pub contact_evaluations: u64,
-    /// The contact laws and their force forms.
+    /// The contact laws and their force forms (and rigid impacts, where
+    /// a contact's are: docs/theory.md §12).
     pub contact_laws: Vec<String>,
     /// `global` or `local` (docs/theory.md §10).
     pub integrator: &'static str,
@@ -694,7 +695,19 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
     let mut laws: Vec<String> = model
         .contacts()
         .iter()
-        .map(|c| format!("{} ({})", c.law.name(), c.law.form().name()))
+        .enumerate()
+        .map(|(k, c)| {
+            let law = format!("{} ({})", c.law.name(), c.law.form().name());
+            match model.impacts(k) {
+                Impacts::Soft => law,
+                Impacts::Rigid { restitution: None } => {
+                    format!("{law}, rigid impacts with its e(U)")
+                }
+                Impacts::Rigid {
+                    restitution: Some(e),
+                } => format!("{law}, rigid impacts with e = {e}"),
+            }
+        })
         .collect();
     laws.dedup();
     SimulationSummary {

@@ -6,7 +6,7 @@ use clap::Args;
 use vibroimpact::model::Model;
 use vibroimpact::simulate::{estimate_work, simulate_streaming, Simulation, SimulationOptions};
 
-use crate::args::{IntegratorName, MethodName};
+use crate::args::{ImpactArgs, IntegratorName, MethodName};
 use crate::error::CliError;
 use crate::format::{history_header, number, CsvText, SummaryFormat};
 use crate::model_io::read_document;
@@ -61,6 +61,8 @@ pub struct SimulateArgs {
     /// (default: [simulation] impact_force_threshold, else 1e-3 N).
     #[arg(long)]
     impact_force_threshold: Option<f64>,
+    #[command(flatten)]
+    impacts: ImpactArgs,
 }
 
 /// Simulation options from the command line and the model file.
@@ -129,6 +131,9 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
         "restitution",
         "peak_force",
         "duration",
+        "impacts",
+        "impulse",
+        "energy_lost",
     ])?;
     let f = |x: f64| {
         if x.is_finite() {
@@ -137,7 +142,13 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
             String::new()
         }
     };
+    // A rigid impact's peak force and duration are the soft law's
+    // estimates (docs/theory.md §12); its impulse and loss are exact.
     for i in &sim.impacts {
+        let (duration, kind, impulse, lost) = match &i.rigid {
+            Some(r) => (r.duration, "rigid", r.impulse, r.energy_lost),
+            None => (i.duration(), "soft", f64::NAN, f64::NAN),
+        };
         w.row([
             f(i.start_time),
             f(i.end_time),
@@ -146,7 +157,10 @@ fn impact_log_csv(model: &Model, sim: &Simulation) -> Result<String, CliError> {
             f(i.rebound_velocity),
             f(i.restitution()),
             f(i.peak_force),
-            f(i.duration()),
+            f(duration),
+            kind.to_string(),
+            f(impulse),
+            f(lost),
         ])?;
     }
     w.finish()
@@ -316,7 +330,8 @@ pub fn summary_text(s: &SimulationSummary) -> String {
 /// Runs `vibroimpact simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let document = read_document(&args.model)?;
-    let loaded = document.build()?;
+    let mut loaded = document.build()?;
+    loaded.model = args.impacts.apply(loaded.model)?;
     let opts = options(args, &loaded)?;
     let model = &loaded.model;
     let phase_body = match &args.body {

@@ -60,7 +60,8 @@ def identify(
 def simulate(
     model: Model, duration: float, rtol: Optional[float], atol: Optional[float],
     method_name: str, output_step: Optional[float], energy: bool,
-    impact_force_threshold: Optional[float], integrator: str, progress: Progress = None,
+    impact_force_threshold: Optional[float], integrator: str, impacts: Optional[str],
+    restitution: Optional[float], progress: Progress = None,
 ) -> dict[str, Any]: ...
 def periodic(
     model: Model, subharmonic: int, guess: Optional[F64], guess_periods: float, rtol: float,

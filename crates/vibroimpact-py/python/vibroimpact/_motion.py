@@ -24,6 +24,8 @@ def simulate(
     energy: bool = False,
     impact_force_threshold: Optional[float] = None,
     integrator: str = "auto",
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
     progress: Progress = None,
 ) -> Result:
     """A time history with its impact log (``vibroimpact simulate``).
@@ -36,7 +38,11 @@ def simulate(
     ``integrator``: "auto" (local from 16 groups of bodies up, global
     below), "global" (every body integrated at every step) or "local"
     (exact motion between contacts, only bodies in touch integrated; the
-    summary then has ``local`` with its work counters).
+    summary then has ``local`` with its work counters). ``impacts``:
+    every contact's, "soft" (the law integrated) or "rigid" (velocity
+    jumps with the law's e(U), docs/theory.md §12; the global
+    integrator); default the model file's. ``restitution``: a constant
+    coefficient in (0, 1] for rigid impacts in place of the law's.
 
     Returns the CLI's summary fields (``completed``, ``error``,
     ``final_time``, ``final_displacement``, ``final_velocity``,
@@ -46,7 +52,9 @@ def simulate(
     and ``velocity`` (one row per time, one column per body) and
     ``impacts`` (``contact``, ``start_time``, ``end_time``,
     ``impact_velocity``, ``rebound_velocity``, ``restitution``,
-    ``peak_force``, ``duration``). An integration failure keeps what was
+    ``peak_force``, ``duration``, ``impacts`` ("soft" or "rigid"),
+    ``impulse`` and ``energy_lost``; a rigid impact's peak force and
+    duration are its soft law's estimates). An integration failure keeps what was
     computed: ``completed`` is False and ``error`` says where. The
     counters (``rhs_evaluations``, ``steps``) include the dense-output
     evaluations of the history, as the CLI's with ``--out``; with
@@ -78,6 +86,8 @@ def simulate(
             _flag(energy, "energy"),
             _real(impact_force_threshold, "impact_force_threshold", positive=True, optional=True),
             _method(integrator, ("auto", "global", "local"), "integrator"),
+            None if impacts is None else _method(impacts, ("soft", "rigid"), "impacts"),
+            _real(restitution, "restitution", optional=True),
             _progress(progress),
         )
     return Result(d)

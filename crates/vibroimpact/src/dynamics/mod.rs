@@ -39,6 +39,7 @@
 
 use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::dynamics::variational::Variational;
+use crate::impact::rigid::RigidLaw;
 use crate::integrate::{BandMatrix, OdeSystem, Recorder};
 use crate::model::{BaseExcitation, Model};
 
@@ -120,6 +121,8 @@ enum Screen {
     },
     /// Skip when `s <= 0`.
     CompactSupport,
+    /// Always skip: rigid impacts.
+    Never,
 }
 
 #[derive(Clone, Debug)]
@@ -130,6 +133,9 @@ struct ContactTerm {
     law: ContactLaw,
     screen: Screen,
     absurd: f64,
+    /// Rigid impacts (docs/theory.md §12): never evaluated; the run
+    /// applies each impact as a velocity jump by this map.
+    rigid: Option<RigidLaw>,
 }
 
 /// Equations of motion of a model, ready for an integrator.
@@ -211,6 +217,14 @@ impl ChainDynamics {
                     }
                     _ => (Screen::CompactSupport, f64::INFINITY),
                 };
+                // (A rigid contact's law was checked when it was set:
+                // Model::with_impacts.)
+                let rigid = model.rigid_law(k).ok().flatten();
+                let (screen, absurd) = if rigid.is_some() {
+                    (Screen::Never, f64::INFINITY)
+                } else {
+                    (screen, absurd)
+                };
                 ContactTerm {
                     left: c.pair.left(),
                     right: c.pair.right(),
@@ -218,6 +232,7 @@ impl ChainDynamics {
                     law: c.law,
                     screen,
                     absurd,
+                    rigid,
                 }
             })
             .collect::<Vec<_>>();
@@ -252,6 +267,7 @@ impl ChainDynamics {
                     limit,
                 } => (alpha, b_over_a, limit),
                 Screen::CompactSupport => (1.0, 0.0, 0.0),
+                Screen::Never => (0.0, 0.0, f64::INFINITY),
             };
             screen.alpha.push(alpha);
             screen.boa.push(boa);
@@ -393,6 +409,21 @@ impl ChainDynamics {
         ]
     }
 
+    /// Body i's mass (kg).
+    pub fn mass(&self, i: usize) -> f64 {
+        self.mass[i]
+    }
+
+    /// Whether the state carries the energy audit's quadratures.
+    pub fn audits_energy(&self) -> bool {
+        self.energy
+    }
+
+    /// Contact k's rigid impact map (None: its soft law is integrated).
+    pub fn rigid_law(&self, k: usize) -> Option<&RigidLaw> {
+        self.contacts[k].rigid.as_ref()
+    }
+
     /// Force of contact k at approach s and rate ṡ (N), as used in the
     /// equations of motion.
     #[inline]
@@ -490,7 +521,12 @@ impl ChainDynamics {
             let du = y[2 * b] - y[2 * a];
             e += 0.5 * k * du * du;
         }
-        for (k, c) in self.contacts.iter().enumerate() {
+        for (k, c) in self
+            .contacts
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.rigid.is_none())
+        {
             let (s, _) = self.approach(k, y);
             e += c.law.potential(s);
         }
@@ -506,6 +542,7 @@ impl ChainDynamics {
                 limit,
             } => alpha * s + b_over_a * sdot.abs() < limit,
             Screen::CompactSupport => s <= 0.0,
+            Screen::Never => true,
         }
     }
 }

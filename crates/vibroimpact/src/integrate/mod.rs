@@ -447,6 +447,18 @@ pub enum IntegrationError {
     /// mismatch, non-finite or out-of-order times, stepping before `reset`).
     #[error("invalid integrator options or arguments: {0}")]
     InvalidOptions(String),
+    /// A rigid impact the run cannot take (docs/theory.md §12): impacts
+    /// that accumulate into a resting contact, or a law's e(U) that
+    /// failed.
+    #[error("rigid impact of contact {contact} at t = {t:e}: {reason}")]
+    RigidImpact {
+        /// Time of the impact.
+        t: f64,
+        /// The model's contact index.
+        contact: usize,
+        /// What stopped it.
+        reason: String,
+    },
     /// The initial state or its derivative `f(t0, y0)` is not finite.
     #[error("non-finite initial state or derivative at t = {t:e}")]
     NonFiniteInitialState {

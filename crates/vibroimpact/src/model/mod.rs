@@ -5,6 +5,8 @@
 //! ## Files
 //! - `mod.rs` — [`Model`]: bodies, couplings, contacts, walls;
 //! - `excitation.rs` — what drives it: base motion, forces, accelerograms;
+//! - `impacts.rs` — a contact's impacts, soft or rigid (docs/theory.md
+//!   §12);
 //! - `record/` — recorded ground motions (AT2, columns, units);
 //! - `storey.rs`, `hysteresis/` — storeys and their force–drift laws
 //!   (bilinear, Bouc–Wen; docs/theory.md §11);
@@ -188,6 +190,8 @@ pub struct Model {
     initial_displacement: Vec<f64>,
     initial_velocity: Vec<f64>,
     storeys: Vec<Storey>,
+    /// Per contact, its impacts (soft unless set).
+    impacts: Vec<Impacts>,
 }
 
 /// `v` must be finite and >= 0; `key` is its path, `what` names it (both
@@ -250,6 +254,7 @@ impl Model {
         check_contacts(&contacts, &bodies)?;
         check_forces(&forces, &bodies)?;
         check_base(&base)?;
+        let impacts = vec![Impacts::Soft; contacts.len()];
         let model = Self {
             initial_displacement: initial_values(initial_displacement, "displacement", n)?,
             initial_velocity: initial_values(initial_velocity, "velocity", n)?,
@@ -257,6 +262,7 @@ impl Model {
             couplings,
             contacts,
             base,
+            impacts,
             forces,
             storeys: Vec::new(),
         };
@@ -329,12 +335,14 @@ impl Model {
         )
     }
 
-    /// Replaces the initial state (validated like [`Model::new`]).
+    /// Replaces the initial state (validated like [`Model::new`]; the
+    /// contacts' impacts kept).
     pub fn with_initial_state(
         self,
         displacement: Vec<f64>,
         velocity: Vec<f64>,
     ) -> Result<Self, ModelError> {
+        let impacts = self.impacts;
         Self::new(
             self.bodies,
             self.couplings,
@@ -344,6 +352,7 @@ impl Model {
             displacement,
             velocity,
         )
+        .map(|m| Self { impacts, ..m })
     }
 
     /// The model whose time 0 is this model's time `t0`: every harmonic
@@ -563,6 +572,7 @@ mod excitation;
 pub mod family;
 pub mod file;
 pub mod hysteresis;
+mod impacts;
 pub mod parameter;
 pub mod record;
 pub mod reference;
@@ -570,6 +580,7 @@ mod scales;
 mod storey;
 
 pub use excitation::{Accelerogram, BaseExcitation, HarmonicForce};
+pub use impacts::Impacts;
 pub use storey::Storey;
 
 /// Every body's mass finite and positive, its support's stiffness and

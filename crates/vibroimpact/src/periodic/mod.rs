@@ -301,6 +301,12 @@ pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
     if !model.storeys().is_empty() {
         return Err("hysteretic storeys: their history is not part of the period map's state: no shooting, continuation or Lyapunov exponents with them (simulations and pounding runs are fine)".into());
     }
+    if let Some(k) = (0..model.contacts().len()).find(|&k| model.impacts(k).is_rigid()) {
+        return Err(format!(
+            "contact {}: rigid impacts: the period map's derivatives need their saltation, which is not in yet: no shooting, continuation or Lyapunov exponents with them (simulations are fine)",
+            model.contact_name(k)
+        ));
+    }
     match (0..model.contacts().len()).find(|&k| model.contacts()[k].law.needs_impact_velocity()) {
         Some(k) => Err(format!(
             "contact {}: its law needs the impact's onset velocity, whose dependence on the state the period map and its derivatives do not carry yet: no shooting, continuation or Lyapunov exponents with it (simulations, sweeps and pounding runs are fine)",

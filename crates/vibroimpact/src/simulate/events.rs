@@ -22,6 +22,16 @@ impl Tracker {
             active: None,
         }
     }
+
+    /// A rigid contact's: never engaged (s_on = ∞; its impacts are
+    /// events, [`crate::simulate::switches`]).
+    pub(super) fn never() -> Self {
+        Self {
+            s_on: f64::INFINITY,
+            entry_margin: 0.0,
+            active: None,
+        }
+    }
 }
 
 /// Scans one step for events and samples.
@@ -113,6 +123,7 @@ impl StepScan {
         }
         self.trackers[k].active = Some(self.impacts.len());
         self.impacts.push(ImpactRecord {
+            rigid: None,
             contact: self.ids[k],
             start_time: t,
             end_time: f64::NAN,
@@ -178,10 +189,14 @@ impl StepScan {
     pub(super) fn scan<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S) {
         let (t0, t1) = (st.t_prev(), st.t());
         for k in 0..self.trackers.len() {
+            let s_on = self.trackers[k].s_on;
+            // (A rigid contact's impacts are events, logged where applied.)
+            if s_on == f64::INFINITY {
+                continue;
+            }
             let (s0, sd0, r0) = self.previous[k];
             let (s1, sd1, r1) = contact_end(sys.chain(), k, st.y(), st.dydt());
             self.previous[k] = (s1, sd1, r1);
-            let s_on = self.trackers[k].s_on;
             let (g0, g1) = (s0 - s_on, s1 - s_on);
             let active = self.trackers[k].active.is_some();
             if !active && g1 > 0.0 && g0 <= 0.0 {

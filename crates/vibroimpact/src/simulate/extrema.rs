@@ -250,10 +250,21 @@ impl ExtremaScan {
 
     /// The right-hand side changed where the last step ended (an event: a
     /// storey's branch, a contact's onset): the jerk there is one-sided,
-    /// so the next step reads its accelerations on the dense output.
-    pub(super) fn restarted(&mut self) {
+    /// so the next step reads its accelerations on the dense output. Where
+    /// the state `jumped` there too (a rigid impact), the next step starts
+    /// from the stepper's state, and the velocities after the jump count.
+    pub(super) fn restarted(&mut self, st: &Stepper, jumped: bool) {
         if let Some(jerk) = self.jerk.as_mut() {
             jerk.at_end.fill(f64::NAN);
+        }
+        if jumped {
+            self.y.copy_from_slice(st.y());
+            self.dydt.copy_from_slice(st.dydt());
+            if self.from <= self.t && self.t <= self.to {
+                for (i, m) in self.found.max_velocity.iter_mut().enumerate() {
+                    *m = m.max(self.y[2 * i + 1].abs());
+                }
+            }
         }
     }
 

@@ -4,7 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
-use super::switches::{apply_event, Switches, Verdict};
+use super::switches::{apply_event, Event, Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -52,7 +52,18 @@ pub fn simulate_streaming(
     let mut scan = start_scan(model, opts, (&mut st, &mut sys), error.is_none());
     let mut extrema = match (opts.extrema_window, &error) {
         (Some(window), None) => {
-            let s_on = scan.trackers.iter().map(|tr| tr.s_on).collect();
+            // (A rigid contact's margin is its approach itself.)
+            let s_on = scan
+                .trackers
+                .iter()
+                .map(|tr| {
+                    if tr.s_on == f64::INFINITY {
+                        0.0
+                    } else {
+                        tr.s_on
+                    }
+                })
+                .collect();
             Some(ExtremaScan::new(
                 window,
                 n2 / 2,
@@ -78,11 +89,7 @@ pub fn simulate_streaming(
                 // (counted as a step: events alone cannot run forever).
                 Err(event) => {
                     steps += 1;
-                    if let Some(x) = extrema.as_mut() {
-                        x.restarted();
-                    }
-                    error = apply_event(&mut st, &mut sys, event)
-                        .err()
+                    error = applied(event, (&mut st, &mut sys), &mut scan, extrema.as_mut())
                         .or_else(|| early_end(&st, method, opts, steps));
                     if error.is_some() {
                         break;
@@ -149,11 +156,8 @@ pub fn simulate_streaming(
         // velocity is set, where the step ended; the right-hand side
         // changes there, so the stepper restarts.
         if let Some(event) = switch_here {
-            if let Some(x) = extrema.as_mut() {
-                x.restarted();
-            }
-            if let Err(e) = apply_event(&mut st, &mut sys, event) {
-                error = Some(e);
+            error = applied(event, (&mut st, &mut sys), &mut scan, extrema.as_mut());
+            if error.is_some() {
                 break;
             }
         }
@@ -173,6 +177,38 @@ pub fn simulate_streaming(
     ))
 }
 
+/// Applies `event` where the stepper stands ([`apply_event`]): the extrema
+/// scan restarts there (and takes a rigid impact's velocity jump); a rigid
+/// impact enters the impact log.
+fn applied(
+    event: Event,
+    (st, sys): (&mut Stepper, &mut ChainDynamics),
+    scan: &mut StepScan,
+    extrema: Option<&mut ExtremaScan>,
+) -> Option<IntegrationError> {
+    let impact = match apply_event(st, sys, event) {
+        Ok(impact) => impact,
+        Err(e) => return Some(e),
+    };
+    if let Some(x) = extrema {
+        x.restarted(st, impact.is_some());
+    }
+    if let Some((contact, r)) = impact {
+        let t = st.t();
+        scan.impacts.push(ImpactRecord {
+            contact,
+            start_time: t,
+            end_time: t,
+            impact_velocity: r.impact_velocity,
+            rebound_velocity: r.rebound_velocity,
+            peak_force: r.peak_force,
+            peak_time: t,
+            rigid: Some(r),
+        });
+    }
+    None
+}
+
 /// The impact scan of a global run from the stepper's start: every
 /// contact tracked; if `started` (the stepper is at t = 0), those already
 /// engaged there (s_on < s <= 0) in an impact from t = 0.
@@ -187,7 +223,12 @@ fn start_scan(
         trackers: model
             .contacts()
             .iter()
-            .map(|c| Tracker::new(&c.law, opts.impact_force_threshold))
+            .enumerate()
+            .map(|(k, c)| match model.impacts(k).is_rigid() {
+                // Never engaged: its impacts are the switches' events.
+                true => Tracker::never(),
+                false => Tracker::new(&c.law, opts.impact_force_threshold),
+            })
             .collect(),
         impacts: Vec::new(),
         previous: (0..model.contacts().len())

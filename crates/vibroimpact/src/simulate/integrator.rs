@@ -46,7 +46,7 @@ impl Integrator {
     /// record's samples and the global run is the faster).
     pub fn resolve_run(self, model: &Model, opts: &SimulationOptions) -> Integrator {
         let record = matches!(model.base(), BaseExcitation::Record(_));
-        if self != Integrator::Auto || !record {
+        if self != Integrator::Auto || !record || model.has_rigid_impacts() {
             return self.resolve(model);
         }
         let groups = crate::simulate::local::free_motion::spring_groups(model)
@@ -67,8 +67,8 @@ impl Integrator {
     /// The integrator that runs `model`: [`Integrator::Auto`] is local for
     /// a model of at least [`AUTO_LOCAL_GROUPS`] groups whose free motion
     /// has a bounded steady state under its forcing (no undamped group
-    /// under harmonic forcing) and no recorded base motion, global
-    /// otherwise; the others are themselves. (A record moves every group
+    /// under harmonic forcing), no recorded base motion and no rigid
+    /// impacts, global otherwise; the others are themselves. (A record moves every group
     /// and the global integrator steps at its samples anyway: at full
     /// scale rows of 16 and 64 yielding buildings at DOPRI5 rtol 1e-4
     /// take 1.5 and 0.8 times the global run's time locally, their
@@ -77,7 +77,12 @@ impl Integrator {
     /// local where it pays.)
     pub fn resolve(self, model: &Model) -> Integrator {
         match self {
-            Integrator::Auto if matches!(model.base(), BaseExcitation::Record(_)) => {
+            // (Rigid impacts run on the global integrator: docs/theory.md
+            // §12.)
+            Integrator::Auto
+                if matches!(model.base(), BaseExcitation::Record(_))
+                    || model.has_rigid_impacts() =>
+            {
                 Integrator::Global
             }
             Integrator::Auto => {

@@ -4,16 +4,20 @@
 //! - `mod.rs` — [`simulate`], options, the impact log;
 //! - `global.rs` — the global run, streamed sample by sample;
 //! - `events.rs`, `switches/` — impact onsets and ends; events that change
-//!   the right-hand side inside a step (storey branches, onsets);
+//!   the right-hand side or the state inside a step (storey branches,
+//!   onsets, rigid impacts);
 //! - `extrema.rs`, `gauges.rs` — exact extrema on the dense output, of
 //!   the bodies and of the gauges (drifts, closings, accelerations);
 //! - `integrator.rs`, `estimate.rs` — which integrator runs; the work of a
 //!   run, estimated before it starts;
 //! - `local/` — the local integrator, exact motion between contacts;
-//! - `tests.rs` — the checks of the global run.
+//! - `tests/` — the checks of the global run.
 //!
 //! ## Impacts
-//! An impact of contact k starts when its approach coordinate s rises
+//! A rigid contact's impact (docs/theory.md §12) is an event: where its
+//! approach reaches zero the velocities jump, and the log records the
+//! instant, U, eU and the map's estimates. A soft contact's impact of
+//! contact k starts when its approach coordinate s rises
 //! through the threshold `s_on` and ends when s falls back through it. For
 //! laws with compact support `s_on = 0` (first touch). The exponential law
 //! never vanishes, so `s_on` is where its static force `a e^{α s}` equals the
@@ -43,6 +47,7 @@
 //! and carries the error.
 
 use crate::dynamics::{Chain, ChainDynamics};
+use crate::impact::rigid::RigidImpact;
 use crate::integrate::events::EventLocator;
 use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
@@ -149,6 +154,10 @@ pub struct ImpactRecord {
     pub peak_force: f64,
     /// Time of the peak force (s).
     pub peak_time: f64,
+    /// A rigid impact (docs/theory.md §12): its e, impulse, energy lost
+    /// and the soft law's estimates; its start and end are the instant of
+    /// the jump, `peak_force` the estimate. None for a soft impact.
+    pub rigid: Option<RigidImpact>,
 }
 
 impl ImpactRecord {

@@ -2,6 +2,7 @@
 //! schema checked and translated, one function per table, each error
 //! naming the source, the line and the key.
 
+use crate::model::Impacts;
 use std::collections::HashMap;
 
 use super::*;
@@ -77,6 +78,7 @@ impl ModelDocument {
             (None, false) => body_tables(&cx, &file.body)?,
         };
         let names = Names::new(&tables.bodies);
+        let row_contacts = tables.contacts.len();
         let springs = spring_tables(&cx, &file.spring, &names)?;
         let contacts = contact_tables(&cx, &file.contact, &names)?;
         let base = self.excitation_table(&cx)?;
@@ -96,6 +98,7 @@ impl ModelDocument {
             tables.init_v,
         )
         .map_err(|e| cx.plain(e))?;
+        let model = impacts_keys(&cx, file, row_contacts, model)?;
         let simulation = simulation_table(&cx, file)?;
         let record = match (&self.record, model.base()) {
             (Some(r), BaseExcitation::Record(a)) => Some(r.metadata(a.scale())),
@@ -366,6 +369,50 @@ fn contact_table(
         clearance: spec.clearance,
         law,
     })
+}
+
+/// The `impacts` and `restitution` keys of `[row]` (its contacts, the
+/// first `row_contacts`) and of each `[[contact]]`, set on the model.
+fn impacts_keys(
+    cx: &Ctx<'_>,
+    file: &ModelFile,
+    row_contacts: usize,
+    mut model: Model,
+) -> Result<Model, ModelFileError> {
+    let row = file.row.iter().flat_map(|r| {
+        let spec = r.get_ref();
+        (0..row_contacts).map(move |k| {
+            (
+                k,
+                r.span(),
+                "[row]".to_string(),
+                &spec.impacts,
+                spec.restitution,
+            )
+        })
+    });
+    let tables = file.contact.iter().enumerate().map(|(i, c)| {
+        let spec = c.get_ref();
+        let at = format!("[[contact]] {}|{}", spec.between[0], spec.between[1]);
+        (
+            row_contacts + i,
+            c.span(),
+            at,
+            &spec.impacts,
+            spec.restitution,
+        )
+    });
+    for (k, span, at, name, restitution) in row.chain(tables) {
+        if name.is_none() && restitution.is_none() {
+            continue;
+        }
+        let impacts = Impacts::parse(name.as_deref().unwrap_or("soft"), restitution)
+            .map_err(|m| cx.err_at(span.clone(), format!("{at} {m}")))?;
+        model = model
+            .with_impacts(k, impacts)
+            .map_err(|e| cx.err_at(span, format!("{at} impacts = \"rigid\": {}", e.message)))?;
+    }
+    Ok(model)
 }
 
 /// `[[force]]` tables: harmonic forces on named bodies.

@@ -219,6 +219,10 @@ pub(crate) struct RowSpec {
     pub(crate) walls: Option<String>,
     /// Spring–damper between neighbours.
     pub(crate) coupling: Option<CouplingSpec>,
+    /// "soft" (default) or "rigid", for every contact of the row.
+    pub(crate) impacts: Option<String>,
+    /// A rigid impact's Newton coefficient in place of the law's e(U).
+    pub(crate) restitution: Option<f64>,
 }
 
 #[derive(Serialize, Deserialize, Debug, Clone)]
@@ -269,6 +273,10 @@ pub(crate) struct ContactSpec {
     pub(crate) between: [String; 2],
     pub(crate) clearance: f64,
     pub(crate) law: LawSpec,
+    /// "soft" (default) or "rigid".
+    pub(crate) impacts: Option<String>,
+    /// A rigid impact's Newton coefficient in place of the law's e(U).
+    pub(crate) restitution: Option<f64>,
 }
 
 #[derive(Serialize, Deserialize, Debug, Clone)]

@@ -268,3 +268,52 @@ fn a_contact_of_a_body_with_itself_is_named() {
         "{e}"
     );
 }
+
+/// `impacts = "rigid"` makes every contact of a row rigid, and a
+/// `[[contact]]`'s with its `restitution`; bad values name the table, the
+/// key and the line (docs/theory.md §12).
+#[test]
+fn impacts_are_soft_or_rigid() {
+    use crate::model::Impacts;
+    let m = parse(&ROW.replace("clearance = ", "impacts = \"rigid\"\nclearance = "))
+        .unwrap()
+        .model;
+    assert!((0..4).all(|k| m.impacts(k) == Impacts::Rigid { restitution: None }));
+    let text = EXPLICIT.replace(
+        "law = { law = \"hertz\", stiffness = 1e9 }",
+        "law = { law = \"hertz\", stiffness = 1e9 }\nimpacts = \"rigid\"\nrestitution = 0.8",
+    );
+    let m = parse(&text).unwrap().model;
+    assert_eq!(
+        m.impacts(0),
+        Impacts::Rigid {
+            restitution: Some(0.8)
+        }
+    );
+    assert_eq!(m.impacts(1), Impacts::Soft);
+    let e = err(&text.replace("impacts = \"rigid\"", "impacts = \"hard\""));
+    assert!(
+        e.contains("[[contact]] wall|a impacts = \"hard\": must be soft or rigid"),
+        "{e}"
+    );
+    assert!(e.starts_with("m.toml:"), "{e}");
+    let e = err(&text.replace("impacts = \"rigid\"\n", ""));
+    assert!(
+        e.contains("restitution = 0.8: a coefficient of restitution is for rigid impacts"),
+        "{e}"
+    );
+    let e = err(&text.replace("restitution = 0.8", "restitution = 1.5"));
+    assert!(
+        e.contains("wall|a") && e.contains("restitution = 1.5 is invalid"),
+        "{e}"
+    );
+    // A Kelvin–Voigt contact damped past critical never separates.
+    let e = err(&EXPLICIT.replace(
+        "damping = 10.0, form = \"non-negative\" }",
+        "damping = 1e5 }\nimpacts = \"rigid\"",
+    ));
+    assert!(
+        e.contains("[[contact]] a|b") && e.contains("never separates"),
+        "{e}"
+    );
+}

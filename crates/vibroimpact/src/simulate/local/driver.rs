@@ -517,6 +517,12 @@ fn check_request(
     tape: bool,
     tangents: Option<Tangents<'_>>,
 ) -> Result<(), OptionsError> {
+    if let Some(k) = (0..model.contacts().len()).find(|&k| model.impacts(k).is_rigid()) {
+        return Err(OptionsError(format!(
+            "contact {}: rigid impacts run on the global integrator (integrator = global, or auto)",
+            model.contact_name(k)
+        )));
+    }
     if opts.energy && (tape || tangents.is_some_and(|w| w.columns > 0)) {
         return Err(OptionsError(
             "the energy audit carries no tangent columns or tape".into(),

@@ -4,14 +4,17 @@
 //! in its drift; its switch function is yield or unloading), and the onset
 //! of a contact whose law needs its impact velocity (Lankarani–Nikravesh:
 //! the step that crosses the onset must not be taken with the previous
-//! impact's velocity). Where one happens inside a step, the step is taken
-//! again up to that time, and the event is applied there.
+//! impact's velocity), and a rigid contact's impact (docs/theory.md §12:
+//! the approach reaches zero; the velocities jump there). Where one
+//! happens inside a step, the step is taken again up to that time, and the
+//! event is applied there.
 //!
 //! Files: `mod.rs` (the switches), `tests.rs` (exact piecewise motion of
 //! bilinear storeys).
 
 use super::ChainDynamics;
 use crate::dynamics::Chain;
+use crate::impact::rigid::RigidImpact;
 use crate::integrate::{IntegrationError, Stepper};
 use crate::numeric::brent;
 
@@ -23,6 +26,9 @@ pub(super) enum Event {
     /// Contact k reaches its onset approach: its impact velocity is set
     /// there.
     Onset(usize),
+    /// Rigid contact k's approach reaches zero: an impact, the bodies'
+    /// velocities jump.
+    Impact(usize),
 }
 
 /// What a step's check found.
@@ -74,13 +80,17 @@ impl Switches {
     /// None for a model without such events; `s_on` per contact.
     pub(super) fn new(sys: &ChainDynamics, dim: usize, s_on: Vec<f64>) -> Option<Self> {
         let onsets = (0..s_on.len())
-            .filter(|&k| sys.contact_law(k).needs_impact_velocity())
+            .filter(|&k| sys.rigid_law(k).is_none() && sys.contact_law(k).needs_impact_velocity())
             .map(Event::Onset);
+        let impacts = (0..s_on.len())
+            .filter(|&k| sys.rigid_law(k).is_some())
+            .map(Event::Impact);
         let events: Vec<Event> = sys
             .storeys()
             .switching()
             .map(Event::Storey)
             .chain(onsets)
+            .chain(impacts)
             .collect();
         (!events.is_empty()).then(|| Self {
             armed: vec![true; events.len()],
@@ -137,11 +147,13 @@ impl Switches {
     }
 
     /// The event's function in the state `y`: positive before it, zero at
-    /// it (a contact's: s_on − s, positive while the contact is open).
+    /// it (a contact's: s_on − s, positive while the contact is open; a
+    /// rigid one's −s).
     fn value(&self, sys: &ChainDynamics, e: Event, y: &[f64]) -> f64 {
         match e {
             Event::Storey(k) => sys.storeys().switch_value(k, y),
             Event::Onset(k) => self.s_on[k] - sys.approach(k, y).0,
+            Event::Impact(k) => -sys.approach(k, y).0,
         }
     }
 
@@ -167,6 +179,7 @@ impl Switches {
         // ([`StoreyTerms::switch_rate_bounds`]); a contact's onset always.
         let h = t1 - t0;
         let mut any = false;
+        let mut at_start = None;
         let stamp = sys.chain().storeys().stamp();
         let carried = self.carried_stamp == Some(stamp) && self.carried_y == self.y_prev;
         self.carried_stamp = Some(stamp);
@@ -178,7 +191,18 @@ impl Switches {
             }
             let e = self.events[i];
             let Event::Storey(k) = e else {
-                let g0 = self.value(sys.chain(), e, &self.y_prev);
+                let mut g0 = self.value(sys.chain(), e, &self.y_prev);
+                if let Event::Impact(k) = e {
+                    // Touching at the step's start (s = 0 to rounding):
+                    // separating (or at rest), open from there on (after an
+                    // impact applied there); approaching, an impact there.
+                    if g0 <= 0.0 {
+                        if sys.chain().approach(k, &self.y_prev).1 > 0.0 {
+                            at_start = at_start.or(Some(e));
+                        }
+                        g0 = f64::MIN_POSITIVE;
+                    }
+                }
                 self.ends[i] = (g0, self.value(sys.chain(), e, st.y()));
                 self.look[i] = g0 > 0.0;
                 any |= self.look[i];
@@ -203,6 +227,11 @@ impl Switches {
             self.look[i] =
                 d1.min(r1) <= 0.0 || d0.min(d1) <= 2.0 * ld * h || r0.min(r1) <= 2.0 * lr * h;
             any |= self.look[i];
+        }
+        if let Some(e) = at_start {
+            self.pending = Some((t0, e));
+            st.reset(sys, t0, &self.y_prev)?;
+            return Ok(Verdict::Retake);
         }
         if !any {
             self.rearm(sys.chain(), st.y());
@@ -236,22 +265,32 @@ impl Switches {
                 // residual), so least at the drift's extremes: the dip is
                 // tested where the drift rate vanishes (Brent), and the
                 // root sought before it.
+                let before = if j == 0 {
+                    &self.y_prev
+                } else {
+                    &self.inside[j - 1]
+                };
+                let after = if j == 3 { st.y() } else { &self.inside[j] };
                 let (tb_root, gb_root) = match e {
                     Event::Storey(k)
                         if gb > 0.0 && ga + gb <= 2.0 * self.drift_rate[i] * (tb - ta) =>
                     {
-                        let before = if j == 0 {
-                            &self.y_prev
-                        } else {
-                            &self.inside[j - 1]
-                        };
-                        let after = if j == 3 { st.y() } else { &self.inside[j] };
-                        let rate = |y: &[f64]| sys.chain().storeys().drift(k, y).1;
-                        let (ra, rb) = (rate(before), rate(after));
+                        let rate = |c: &ChainDynamics, y: &[f64]| c.storeys().drift(k, y).1;
+                        let (ra, rb) = (rate(sys.chain(), before), rate(sys.chain(), after));
                         if ra * rb < 0.0 {
-                            let turn = self.turn(st, sys, k, (ta, tb), (ra, rb));
-                            st.dense_output(sys, turn, &mut self.buf);
-                            (turn, self.value(sys.chain(), e, &self.buf))
+                            self.dip(st, sys, e, rate, (ta, tb), (ra, rb))
+                        } else {
+                            (tb, gb)
+                        }
+                    }
+                    // A rigid contact open at both points can still touch
+                    // between them where its approach turns (ṡ from + to
+                    // −): tested there, grazing included.
+                    Event::Impact(k) if gb > 0.0 => {
+                        let rate = |c: &ChainDynamics, y: &[f64]| c.approach(k, y).1;
+                        let (ra, rb) = (rate(sys.chain(), before), rate(sys.chain(), after));
+                        if ra > 0.0 && rb < 0.0 {
+                            self.dip(st, sys, e, rate, (ta, tb), (ra, rb))
                         } else {
                             (tb, gb)
                         }
@@ -300,23 +339,25 @@ impl Switches {
         }
     }
 
-    /// Where storey k's drift rate vanishes inside `(ta, tb)` (its values
-    /// `ra`, `rb` at the ends of opposite signs), on the step's dense
-    /// output, by Brent.
-    fn turn<S: Chain>(
+    /// Where `rate` (the rate of what the event's function is concave in)
+    /// vanishes inside `(ta, tb)` (its values `ra`, `rb` at the ends of
+    /// opposite signs), on the step's dense output by Brent, and the
+    /// event's function there.
+    fn dip<S: Chain>(
         &mut self,
         st: &mut Stepper,
         sys: &mut S,
-        k: usize,
+        e: Event,
+        rate: impl Fn(&ChainDynamics, &[f64]) -> f64,
         (ta, tb): (f64, f64),
         (ra, rb): (f64, f64),
-    ) -> f64 {
+    ) -> (f64, f64) {
         let xtol = 4.0 * f64::EPSILON * tb.abs().max(1e-300);
         let buf = &mut self.buf;
-        brent(
+        let turn = brent(
             |t| {
                 st.dense_output(sys, t, buf);
-                sys.chain().storeys().drift(k, buf).1
+                rate(sys.chain(), buf)
             },
             ta,
             tb,
@@ -325,28 +366,79 @@ impl Switches {
             xtol,
             200,
         )
-        .unwrap_or(0.5 * (ta + tb))
+        .unwrap_or(0.5 * (ta + tb));
+        st.dense_output(sys, turn, &mut self.buf);
+        (turn, self.value(sys.chain(), e, &self.buf))
     }
 }
 
-/// Applies `event` at the stepper's point (a storey's branch switch, or a
-/// contact's impact velocity) and restarts the stepper there (the
-/// right-hand side changed).
+/// Applies `event` at the stepper's point (a storey's branch switch, a
+/// contact's impact velocity, or a rigid impact's velocity jump) and
+/// restarts the stepper there (the right-hand side or the state changed).
+/// Returns the rigid impact applied, with its contact.
 pub(super) fn apply_event<S: Chain>(
     st: &mut Stepper,
     sys: &mut S,
     event: Event,
-) -> Result<(), IntegrationError> {
-    let (t, y) = (st.t(), st.y().to_vec());
+) -> Result<Option<(usize, RigidImpact)>, IntegrationError> {
+    let (t, mut y) = (st.t(), st.y().to_vec());
+    let floor = st.options().atol;
     let chain = sys.chain_mut();
+    let mut impact = None;
     match event {
         Event::Storey(k) => chain.storeys_mut().switch(k, &y),
         Event::Onset(k) => {
             let (_, sd) = chain.approach(k, &y);
             chain.set_onset_velocity(k, sd);
         }
+        Event::Impact(k) => impact = rigid_jump(chain, k, (t, &mut y), floor)?,
     }
-    st.reset(sys, t, &y)
+    st.reset(sys, t, &y)?;
+    Ok(impact)
+}
+
+/// Rigid contact k's impact at `(t, y)` (docs/theory.md §12): the bodies'
+/// velocities jump by ∓P/m, P = μ (1 + e) U, and the energy audit's
+/// contact dissipation takes the energy lost. None where the approach
+/// reaches zero without approaching (U <= 0: a touch, no impulse). An
+/// approach velocity at or below `floor` (the absolute tolerance) stops
+/// the run: impacts that accumulate into a resting contact, which the
+/// rigid map cannot follow.
+fn rigid_jump(
+    chain: &ChainDynamics,
+    k: usize,
+    (t, y): (f64, &mut [f64]),
+    floor: f64,
+) -> Result<Option<(usize, RigidImpact)>, IntegrationError> {
+    let (_, u) = chain.approach(k, y);
+    if u <= 0.0 {
+        return Ok(None);
+    }
+    let stop = |reason: String| IntegrationError::RigidImpact {
+        t,
+        contact: k,
+        reason,
+    };
+    if u <= floor {
+        return Err(stop(format!(
+            "approach velocity {u:e} m/s, at or below the absolute tolerance {floor:e}: the impacts accumulate into a resting contact, which rigid impacts cannot follow; keep this contact soft (impacts = \"soft\")"
+        )));
+    }
+    let Some(law) = chain.rigid_law(k) else {
+        return Ok(None);
+    };
+    let r = law.impact(u).map_err(|e| stop(e.to_string()))?;
+    let [_, vl, _, vr] = chain.contact_indices(k);
+    if let Some(i) = vl {
+        y[i] -= r.impulse / chain.mass(i / 2);
+    }
+    if let Some(i) = vr {
+        y[i] += r.impulse / chain.mass(i / 2);
+    }
+    if chain.audits_energy() {
+        y[chain.audit_index() + 2] += r.energy_lost;
+    }
+    Ok(Some((k, r)))
 }
 
 #[cfg(test)]

@@ -1,4 +1,7 @@
-//! Tests of the global run (`mod.rs`).
+//! Tests of the global run.
+//!
+//! Files: `mod.rs` (soft contacts, records, outputs), `rigid.rs` (rigid
+//! impacts against closed forms, docs/theory.md §12).
 use super::*;
 use crate::contact::{ContactLaw, ForceForm};
 use crate::impact::closed_form::ExponentialImpact;
@@ -547,3 +550,5 @@ fn auto_chooses_the_integrator_by_groups() {
         assert!((x - y).abs() < 1e-8, "{x} against {y}");
     }
 }
+
+mod rigid;

@@ -1,0 +1,59 @@
+"""Rigid impacts from Python (docs/theory.md §12): the same run as the
+command line's, the impact log's rigid columns, and refusals that name
+the argument."""
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from conftest import EXAMPLES
+
+OSCILLATOR = EXAMPLES / "impact-oscillator.toml"
+
+
+def test_the_impact_oscillator_settles_on_its_closed_form_orbit():
+    r = vi.simulate(vi.Model.load(str(OSCILLATOR)), periods=40, output_step=0)
+    log = r.impacts
+    assert len(log.impact_velocity) == 40 and set(log.impacts) == {"rigid"}
+    # U of Shaw and Holmes' period-1 orbit (the Rust tests: to 1e-10).
+    assert log.impact_velocity[-1] == pytest.approx(2.503614666, rel=1e-6)
+    np.testing.assert_allclose(log.restitution, 0.8, rtol=1e-15)
+    np.testing.assert_allclose(log.impulse, 1.8 * log.impact_velocity, rtol=1e-14)
+    u = log.impact_velocity
+    np.testing.assert_allclose(log.energy_lost, 0.5 * u * u * 0.36, rtol=1e-12)
+    assert "rigid impacts with e = 0.8" in r.contact_laws[0]
+
+
+def test_soft_and_rigid_from_the_same_file():
+    m = vi.Model.load(str(OSCILLATOR))
+    soft = vi.simulate(m, periods=4, impacts="soft", output_step=0)
+    assert soft.contact_evaluations > 0 and set(soft.impacts.impacts) == {"soft"}
+    assert np.isnan(soft.impacts.impulse).all()
+    # The Hertz law's own e(U) is 1: elastic impacts.
+    law = vi.simulate(m, periods=4, impacts="rigid", output_step=0)
+    np.testing.assert_allclose(law.impacts.restitution, 1.0, rtol=1e-14)
+    half = vi.simulate(m, periods=4, restitution=0.5, output_step=0)
+    np.testing.assert_allclose(half.impacts.restitution, 0.5, rtol=1e-14)
+
+
+def test_python_equals_the_command_line(cli):
+    d = vi.simulate(vi.Model.load(str(OSCILLATOR)), periods=10, output_step=0)
+    cli = cli("simulate", str(OSCILLATOR), "--periods", "10")
+    assert cli["final_displacement"] == list(d.final_displacement)
+    assert cli["impact_count"] == d.impact_count == 10
+
+
+@pytest.mark.parametrize(
+    "kw, needle",
+    [
+        ({"impacts": "hard"}, "impacts = 'hard': give one of 'soft', 'rigid'"),
+        ({"impacts": "soft", "restitution": 0.5}, "restitution = 0.5: a coefficient of restitution is for rigid impacts"),
+        ({"restitution": 1.5}, "restitution: contact m|wall: rigid impacts: restitution = 1.5 is invalid"),
+        ({"restitution": "x"}, "restitution"),
+        ({"integrator": "local"}, "contact m|wall: rigid impacts run on the global integrator"),
+    ],
+)
+def test_bad_impacts_name_the_argument(kw, needle):
+    with pytest.raises((ValueError, TypeError)) as e:
+        vi.simulate(vi.Model.load(str(OSCILLATOR)), periods=2, output_step=0, **kw)
+    assert needle in str(e.value)

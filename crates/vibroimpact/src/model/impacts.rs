@@ -1,0 +1,144 @@
+//! How a contact's impacts are modelled (docs/theory.md §12): through its
+//! soft law, integrated, or in the rigid limit as instantaneous velocity
+//! jumps with the law's e(U) or a Newton coefficient.
+
+use super::{Model, ModelError, ModelErrorKind};
+use crate::field_error::{shown, FieldError};
+use crate::impact::rigid::RigidLaw;
+
+/// A contact's impacts.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Impacts {
+    /// The soft law, integrated through every contact (the default).
+    #[default]
+    Soft,
+    /// Velocity jumps where the approach reaches zero, with the law's
+    /// e(U), or with this Newton coefficient in (0, 1].
+    Rigid {
+        /// A constant coefficient of restitution in place of the law's.
+        restitution: Option<f64>,
+    },
+}
+
+impl Impacts {
+    /// From its name, `soft` or `rigid`, and an optional Newton
+    /// coefficient (rigid impacts only).
+    pub fn parse(name: &str, restitution: Option<f64>) -> Result<Self, String> {
+        match (name, restitution) {
+            ("soft", None) => Ok(Impacts::Soft),
+            ("soft", Some(e)) => Err(format!(
+                "restitution = {e}: a coefficient of restitution is for rigid impacts (impacts = \"rigid\"); a soft contact's comes from its law"
+            )),
+            ("rigid", restitution) => Ok(Impacts::Rigid { restitution }),
+            (other, _) => Err(format!("impacts = \"{other}\": must be soft or rigid")),
+        }
+    }
+
+    /// `soft` or `rigid`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Impacts::Soft => "soft",
+            Impacts::Rigid { .. } => "rigid",
+        }
+    }
+
+    /// Whether these are rigid impacts.
+    pub fn is_rigid(&self) -> bool {
+        matches!(self, Impacts::Rigid { .. })
+    }
+}
+
+impl Model {
+    /// Contact `k`'s impacts.
+    pub fn impacts(&self, k: usize) -> Impacts {
+        self.impacts[k]
+    }
+
+    /// Whether any contact's impacts are rigid.
+    pub fn has_rigid_impacts(&self) -> bool {
+        self.impacts.iter().any(Impacts::is_rigid)
+    }
+
+    /// Contact `k`'s rigid limit (None for soft impacts): its law's e(U)
+    /// between the pair's reduced mass, or its Newton coefficient.
+    pub fn rigid_law(&self, k: usize) -> Result<Option<RigidLaw>, ModelError> {
+        let Impacts::Rigid { restitution } = self.impacts[k] else {
+            return Ok(None);
+        };
+        let c = &self.contacts[k];
+        let masses = [c.pair.left(), c.pair.right()].map(|b| b.map(|i| self.bodies[i].mass));
+        let mu = match masses {
+            [Some(a), Some(b)] => a / (1.0 + a / b),
+            [Some(m), None] | [None, Some(m)] => m,
+            [None, None] => f64::INFINITY,
+        };
+        RigidLaw::new(&c.law, mu, restitution)
+            .map(Some)
+            .map_err(|e| {
+                ModelError::new(
+                    ModelErrorKind::InvalidValue,
+                    format!("contact.{}.impacts", self.contact_name(k)),
+                    format!("contact {}: rigid impacts: {e}", self.contact_name(k)),
+                )
+            })
+    }
+
+    /// Contact `k`'s impacts set to `impacts`; a rigid limit the law does
+    /// not have (or a coefficient outside (0, 1]) is refused, naming the
+    /// contact.
+    pub fn with_impacts(mut self, k: usize, impacts: Impacts) -> Result<Self, ModelError> {
+        self.impacts[k] = impacts;
+        self.rigid_law(k)?;
+        Ok(self)
+    }
+
+    /// Every contact's impacts set to `impacts`.
+    pub fn with_all_impacts(mut self, impacts: Impacts) -> Result<Self, ModelError> {
+        for k in 0..self.contacts.len() {
+            self = self.with_impacts(k, impacts)?;
+        }
+        Ok(self)
+    }
+
+    /// Every contact's impacts as a face's options set them, over the
+    /// model file's: `impacts` `soft` or `rigid` (None: the file's), and
+    /// `restitution` a Newton coefficient for rigid impacts (alone: on the
+    /// file's rigid contacts). A refusal names the option.
+    pub fn with_impact_options(
+        mut self,
+        impacts: Option<&str>,
+        restitution: Option<f64>,
+    ) -> Result<Self, FieldError> {
+        let field = if restitution.is_some() {
+            "restitution"
+        } else {
+            "impacts"
+        };
+        let refused = |e: ModelError| FieldError::about(field, e.message);
+        let rigid = Impacts::Rigid { restitution };
+        match impacts {
+            Some("rigid") => return self.with_all_impacts(rigid).map_err(refused),
+            Some("soft") | None => {}
+            Some(other) => {
+                return Err(FieldError::new("impacts", other, "must be soft or rigid"));
+            }
+        }
+        match (impacts, restitution) {
+            (Some(_), None) => self.with_all_impacts(Impacts::Soft).map_err(refused),
+            (None, None) => Ok(self),
+            (None, Some(_)) if self.has_rigid_impacts() => {
+                for k in 0..self.contacts.len() {
+                    if self.impacts[k].is_rigid() {
+                        self = self.with_impacts(k, rigid).map_err(refused)?;
+                    }
+                }
+                Ok(self)
+            }
+            (_, Some(e)) => Err(FieldError::new(
+                "restitution",
+                shown(e),
+                "a coefficient of restitution is for rigid impacts: set impacts to rigid",
+            )),
+        }
+    }
+}
