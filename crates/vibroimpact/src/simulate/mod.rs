@@ -444,13 +444,19 @@ fn by_start(impacts: &mut [ImpactRecord]) {
 }
 
 /// The failure `source` at the interleaved state `y`, with the contact
-/// engaged deepest past its impact threshold `s_on`.
+/// engaged deepest past its impact threshold `s_on` (a rigid impact's
+/// failure: its contact).
 fn failure(model: &Model, source: IntegrationError, y: &[f64], s_on: &[f64]) -> SimulationFailure {
     let n = model.bodies().len();
     let u: Vec<f64> = (0..n).map(|i| y[2 * i]).collect();
-    let deepest = (0..model.contacts().len())
-        .map(|k| (k, model.approach(k, &u)))
-        .max_by(|a, b| (a.1 - s_on[a.0]).total_cmp(&(b.1 - s_on[b.0])));
+    let deepest = match source {
+        IntegrationError::RigidImpact { contact, .. } => {
+            Some((contact, model.approach(contact, &u)))
+        }
+        _ => (0..model.contacts().len())
+            .map(|k| (k, model.approach(k, &u)))
+            .max_by(|a, b| (a.1 - s_on[a.0]).total_cmp(&(b.1 - s_on[b.0]))),
+    };
     SimulationFailure {
         source,
         contact: deepest.map(|(k, _)| model.contact_name(k)),

@@ -60,6 +60,10 @@ pub(super) struct Switches {
     /// step's inside is looked at (kept between steps: no allocation).
     ends: Vec<(f64, f64)>,
     look: Vec<bool>,
+    /// Per event, whether a rigid contact starts the step touching and
+    /// separating (just after its impact): its function is 0 there to
+    /// rounding, so its next root is sought after its approach turns.
+    opened: Vec<bool>,
     /// Per storey event, the bound on its drift terms' rate over the
     /// last step ([`crate::dynamics::storeys::StoreyTerms::switch_rate_bounds`]).
     drift_rate: Vec<f64>,
@@ -96,6 +100,7 @@ impl Switches {
             armed: vec![true; events.len()],
             ends: vec![(0.0, 0.0); events.len()],
             look: vec![false; events.len()],
+            opened: vec![false; events.len()],
             drift_rate: vec![0.0; events.len()],
             carried: vec![(f64::NAN, f64::NAN); events.len()],
             carried_y: vec![0.0; dim],
@@ -192,6 +197,7 @@ impl Switches {
             let e = self.events[i];
             let Event::Storey(k) = e else {
                 let mut g0 = self.value(sys.chain(), e, &self.y_prev);
+                self.opened[i] = false;
                 if let Event::Impact(k) = e {
                     // Touching at the step's start (s = 0 to rounding):
                     // separating (or at rest), open from there on (after an
@@ -200,6 +206,7 @@ impl Switches {
                         if sys.chain().approach(k, &self.y_prev).1 > 0.0 {
                             at_start = at_start.or(Some(e));
                         }
+                        self.opened[i] = true;
                         g0 = f64::MIN_POSITIVE;
                     }
                 }
@@ -271,6 +278,10 @@ impl Switches {
                     &self.inside[j - 1]
                 };
                 let after = if j == 3 { st.y() } else { &self.inside[j] };
+                let rb_impact = match e {
+                    Event::Impact(k) => sys.chain().approach(k, after).1,
+                    _ => 0.0,
+                };
                 let (tb_root, gb_root) = match e {
                     Event::Storey(k)
                         if gb > 0.0 && ga + gb <= 2.0 * self.drift_rate[i] * (tb - ta) =>
@@ -297,6 +308,34 @@ impl Switches {
                     }
                     _ => (tb, gb),
                 };
+                // Just after its impact a rigid contact is at s = 0 to
+                // rounding: its root is the return, after the approach
+                // turns back (ṡ from − to +), where the separation is
+                // largest; none while it still separates. A separation
+                // lost in rounding is a resting contact.
+                let (ta_root, ga_root) = match e {
+                    Event::Impact(k) if gb_root <= 0.0 && self.opened[i] && ta == t0 => {
+                        let rate = |c: &ChainDynamics, y: &[f64]| c.approach(k, y).1;
+                        let (ra, rb) = (rate(sys.chain(), &self.y_prev), rb_impact);
+                        if rb <= 0.0 {
+                            (ta, ga) = (tb, f64::MIN_POSITIVE);
+                            continue;
+                        }
+                        let (tm, gm) = self.dip(st, sys, e, rate, (t0, tb), (ra, rb));
+                        if gm <= 0.0 {
+                            return Err(IntegrationError::RigidImpact {
+                                t: t0,
+                                contact: k,
+                                reason: format!(
+                                    "it separates by no more than rounding (rebound {:e} m/s): a resting contact, beyond rigid impacts; keep this contact soft (impacts = \"soft\")",
+                                    -ra
+                                ),
+                            });
+                        }
+                        (tm, gm)
+                    }
+                    _ => (ta, ga),
+                };
                 if gb_root <= 0.0 {
                     let xtol = 4.0 * f64::EPSILON * tb_root.abs().max(1e-300);
                     let mut buf = std::mem::take(&mut self.buf);
@@ -305,9 +344,9 @@ impl Switches {
                             st.dense_output(sys, t, &mut buf);
                             self.value(sys.chain(), e, &buf)
                         },
-                        ta,
+                        ta_root,
                         tb_root,
-                        ga,
+                        ga_root,
                         gb_root,
                         xtol,
                         200,
@@ -421,7 +460,7 @@ fn rigid_jump(
     };
     if u <= floor {
         return Err(stop(format!(
-            "approach velocity {u:e} m/s, at or below the absolute tolerance {floor:e}: the impacts accumulate into a resting contact, which rigid impacts cannot follow; keep this contact soft (impacts = \"soft\")"
+            "approach velocity {u:e} m/s, at or below the absolute tolerance {floor:e}: impacts that accumulate into a resting contact (or a touch that slow) are beyond rigid impacts; keep this contact soft (impacts = \"soft\"), or tighten atol"
         )));
     }
     let Some(law) = chain.rigid_law(k) else {
