@@ -7,6 +7,7 @@
 //! - `jacobian.rs` — the analytic Jacobian and its record for tangent
 //!   replay;
 //! - `storeys.rs` — the hysteretic storeys' terms and states;
+//! - `saltation.rs` — the saltation matrix of a rigid impact;
 //! - `variational.rs` — the variational equations (sensitivities,
 //!   monodromy matrices, docs/theory.md §5);
 //! - `tests.rs` — the checks.
@@ -44,6 +45,7 @@ use crate::integrate::{BandMatrix, OdeSystem, Recorder};
 use crate::model::{BaseExcitation, Model};
 
 mod jacobian;
+pub mod saltation;
 mod storeys;
 pub mod variational;
 pub use storeys::{Branch, StoreyTerms};

@@ -97,6 +97,11 @@ impl<S: OdeSystem> Variational<S> {
         &self.sys
     }
 
+    /// The system at `p + dp` and `dp`, with a parameter column.
+    pub fn shifted(&self) -> Option<(&S, f64)> {
+        self.parameter.as_ref().map(|(s, dp)| (s, *dp))
+    }
+
     /// The wrapped system, mutably.
     pub fn system_mut(&mut self) -> &mut S {
         &mut self.sys

@@ -3,6 +3,7 @@
 //! replayed on the integration's tape; by the global integrator, or the
 //! dense map by the local one (§10).
 
+use super::rigid::{rigid_image, rigid_map, rigid_product};
 use super::*;
 
 /// Evaluates the shooting map (the period map, or the symmetric half map
@@ -35,16 +36,18 @@ pub(crate) struct MapDerivatives {
 #[derive(Clone, Debug)]
 pub(crate) struct MapTangent {
     pub(super) tape: Tape,
-    n: usize,
-    symmetric: bool,
+    pub(super) n: usize,
+    pub(super) symmetric: bool,
 }
 
 /// The record of the integration that computed a map: the global
-/// integrator's steps, or the local integrator's sets and exact motion.
+/// integrator's steps, or the local integrator's sets and exact motion;
+/// through rigid impacts, the dense Φ itself (interleaved, column-major).
 #[derive(Clone, Debug)]
 pub(crate) enum Tape {
     Global(Box<TangentTape<ChainDynamics>>),
     Local(Box<LocalTape>),
+    Dense(Vec<f64>),
 }
 
 impl Tape {
@@ -53,6 +56,13 @@ impl Tape {
         match self {
             Tape::Global(tape) => tape.apply(v),
             Tape::Local(tape) => tape.apply(v),
+            Tape::Dense(phi) => {
+                let mut w = vec![0.0; v.len()];
+                for (column, vc) in phi.chunks_exact(v.len()).zip(v) {
+                    w.iter_mut().zip(column).for_each(|(a, p)| *a += p * vc);
+                }
+                w
+            }
         }
     }
 
@@ -62,6 +72,7 @@ impl Tape {
         match self {
             Tape::Global(tape) => tape.entries(),
             Tape::Local(tape) => tape.entries(),
+            Tape::Dense(_) => 0,
         }
     }
 }
@@ -135,6 +146,9 @@ pub(crate) fn period_map_with(
     if local {
         return local_map(model, x, opts, (shifted, dense), t, max_steps);
     }
+    if model.has_rigid_impacts() {
+        return rigid_map(model, x, opts, (shifted, dense), t, max_steps);
+    }
     if let Some((model_p, dp)) = shifted {
         // The state's steps alone choose the steps, with or without the
         // column: the column can then be replayed on the tape.
@@ -201,15 +215,18 @@ pub(crate) fn map_image(
     let n = model.bodies().len();
     let t = map_time(model, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
     let y0 = to_interleaved(x);
-    let (y, stats) = if opts.integrator.resolve(model) == Integrator::Local {
+    let (y, steps) = if opts.integrator.resolve(model) == Integrator::Local {
         let sim_opts = local_options(opts, t, max_steps);
         let flow = local_flow(model, &sim_opts, &y0, (&[], 0), false)
             .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
-        (flow.y, flow.stats)
+        (flow.y, flow.stats.steps)
+    } else if model.has_rigid_impacts() {
+        rigid_image(model, &y0, t, &opts.integrator_options(max_steps, None))?
     } else {
         let mut sys = ChainDynamics::new(model, false);
         let int_opts = opts.integrator_options(max_steps, None);
-        integrate_to(&mut sys, 0.0, &y0, t, &int_opts)?
+        let (y, stats) = integrate_to(&mut sys, 0.0, &y0, t, &int_opts)?;
+        (y, stats.steps)
     };
     let image = from_interleaved(&y, n);
     Ok((
@@ -218,14 +235,14 @@ pub(crate) fn map_image(
         } else {
             image
         },
-        stats.steps,
+        steps,
     ))
 }
 
 /// The parameter's column `∂P/∂p = s(T) + f(T, y(T)) dT/dp` (docs/theory.md
 /// §5) in body order, mirrored for the half map, from the sensitivity
 /// column `s` and the flow `f(T, y(T))` (both interleaved).
-fn parameter_column(s: &[f64], flow: &[f64], dt_dp: f64, symmetric: bool) -> Vec<f64> {
+pub(super) fn parameter_column(s: &[f64], flow: &[f64], dt_dp: f64, symmetric: bool) -> Vec<f64> {
     let column: Vec<f64> = s.iter().zip(flow).map(|(s, f)| s + f * dt_dp).collect();
     let column = from_interleaved(&column, column.len() / 2);
     if symmetric {
@@ -408,6 +425,9 @@ pub(crate) fn map_and_product(
         let flow = local_flow(model, &sim_opts, &to_interleaved(x), (&column, 1), false)
             .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))??;
         (flow.y, flow.columns)
+    } else if model.has_rigid_impacts() {
+        let int_opts = opts.integrator_options(MAX_STEPS, Some(d));
+        rigid_product(model, &to_interleaved(x), &to_interleaved(v), t, &int_opts)?
     } else {
         let mut var = Variational::new(ChainDynamics::new(model, false), 1);
         let z0 = var.initial_state_with(&to_interleaved(x), &[&to_interleaved(v)]);

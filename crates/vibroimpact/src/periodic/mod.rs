@@ -3,6 +3,7 @@
 //!
 //! ## Files
 //! - `map.rs` — the period map and its derivatives;
+//! - `rigid.rs` — the period map through rigid impacts (saltation);
 //! - `shooting.rs` — dense and Newton–Krylov shooting;
 //! - `floquet.rs` — Floquet multipliers;
 //! - `orbit.rs` — orbits from simulation (guesses, summaries);
@@ -10,7 +11,7 @@
 //!   periodic, still settling (and for how long), or irregular (the
 //!   sweeps' verdict, and whether a simulated guess is worth a Newton
 //!   solve);
-//! - `tests.rs` — the checks.
+//! - `tests/` — the checks (`rigid.rs`: through rigid impacts).
 //!
 //! Under forcing of period `T = 2π/Ω`, a periodic solution of period `nT`
 //! (n = 1 harmonic, n > 1 subharmonic) is a fixed point of the period map
@@ -301,12 +302,6 @@ pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
     if !model.storeys().is_empty() {
         return Err("hysteretic storeys: their history is not part of the period map's state: no shooting, continuation or Lyapunov exponents with them (simulations and pounding runs are fine)".into());
     }
-    if let Some(k) = (0..model.contacts().len()).find(|&k| model.impacts(k).is_rigid()) {
-        return Err(format!(
-            "contact {}: rigid impacts: the period map's derivatives need their saltation, which is not in yet: no shooting, continuation or Lyapunov exponents with them (simulations are fine)",
-            model.contact_name(k)
-        ));
-    }
     match (0..model.contacts().len()).find(|&k| model.contacts()[k].law.needs_impact_velocity()) {
         Some(k) => Err(format!(
             "contact {}: its law needs the impact's onset velocity, whose dependence on the state the period map and its derivatives do not carry yet: no shooting, continuation or Lyapunov exponents with it (simulations, sweeps and pounding runs are fine)",
@@ -319,6 +314,7 @@ pub(crate) fn refuse_onset_laws(model: &Model) -> Result<(), String> {
 mod floquet;
 mod map;
 mod orbit;
+mod rigid;
 pub mod settling;
 mod shooting;
 

@@ -624,6 +624,7 @@ use extrema::ExtremaScan;
 pub use gauges::{Gauge, GaugeReading};
 pub use global::simulate_streaming;
 pub use integrator::{Integrator, AUTO_LOCAL_GROUPS};
+pub(crate) use switches::{flow_through_events, ImpactJump};
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -136,6 +136,12 @@ pub fn lyapunov_spectrum(
     if let Err(m) = crate::periodic::refuse_onset_laws(model) {
         return invalid(m);
     }
+    if let Some(k) = (0..model.contacts().len()).find(|&k| model.impacts(k).is_rigid()) {
+        return invalid(format!(
+            "contact {}: rigid impacts: the Lyapunov exponents' variational equations do not take the impacts' saltation yet (periodic orbits, their stability and continuation do); keep this contact soft (impacts = \"soft\")",
+            model.contact_name(k)
+        ));
+    }
     let n = model.bodies().len();
     let d = 2 * n;
     if x0.len() != d {

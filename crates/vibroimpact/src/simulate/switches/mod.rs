@@ -9,7 +9,8 @@
 //! happens inside a step, the step is taken again up to that time, and the
 //! event is applied there.
 //!
-//! Files: `mod.rs` (the switches), `tests.rs` (exact piecewise motion of
+//! Files: `mod.rs` (the switches), `flow.rs` (a bare flow through the
+//! events, for the period maps), `tests.rs` (exact piecewise motion of
 //! bilinear storeys).
 
 use super::ChainDynamics;
@@ -17,6 +18,9 @@ use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
 use crate::integrate::{IntegrationError, Stepper};
 use crate::numeric::brent;
+
+mod flow;
+pub(crate) use flow::{flow_through_events, ImpactJump};
 
 /// An event that changes the right-hand side.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -551,4 +551,4 @@ fn auto_chooses_the_integrator_by_groups() {
     }
 }
 
-mod rigid;
+pub(crate) mod rigid;

@@ -9,7 +9,12 @@ use crate::numeric::brent;
 
 /// A unit mass on a spring (ω = 1) with damping ratio ζ, a wall on its
 /// right at `gap`, a harmonic force `p sin(Ωt + φ)`, starting at `(u, v)`.
-fn oscillator(zeta: f64, gap: f64, (p, omega, phi): (f64, f64, f64), (u, v): (f64, f64)) -> Model {
+pub(crate) fn oscillator(
+    zeta: f64,
+    gap: f64,
+    (p, omega, phi): (f64, f64, f64),
+    (u, v): (f64, f64),
+) -> Model {
     let body = Body {
         name: "m".into(),
         mass: 1.0,
@@ -50,7 +55,7 @@ fn oscillator(zeta: f64, gap: f64, (p, omega, phi): (f64, f64, f64), (u, v): (f6
 /// `Φ(t)`, and one period later it is back at (g, V): row 1 of
 /// `Φ(T) (g − x_p, −eV − ẋ_p) = (g − x_p, V − ẋ_p)` gives V, row 2 is one
 /// equation in φ (Brent). Returns (φ, V).
-fn shaw_holmes(
+pub(crate) fn shaw_holmes(
     zeta: f64,
     gap: f64,
     (p, omega): (f64, f64),
@@ -273,8 +278,9 @@ fn the_soft_law_tends_to_its_rigid_limit() {
 }
 
 /// Rigid impacts run on the global integrator: `auto` picks it, the local
-/// one refuses by the contact's name, and the period maps (shooting,
-/// continuation, Lyapunov exponents) refuse until their saltation is in.
+/// one refuses by the contact's name, and the Lyapunov exponents refuse
+/// until their variational equations take the saltation (the period maps
+/// have it).
 #[test]
 fn rigid_impacts_are_refused_where_they_are_not_followed() {
     let model = oscillator(0.05, 0.6, (1.0, 1.5, 0.0), (0.0, 0.0))
@@ -296,11 +302,15 @@ fn rigid_impacts_are_refused_where_they_are_not_followed() {
         )),
         "{e}"
     );
-    let e = crate::periodic::refuse_onset_laws(&model).unwrap_err();
+    let lyapunov = crate::maps::lyapunov::LyapunovOptions::default();
+    let e = crate::maps::lyapunov::lyapunov_spectrum(&model, &[0.0, 0.0], 0.0, &lyapunov)
+        .unwrap_err()
+        .to_string();
     assert!(
-        e.contains("rigid impacts") && e.contains("saltation"),
+        e.contains(&format!("contact {name}: rigid impacts")) && e.contains("saltation"),
         "{e}"
     );
+    assert!(crate::periodic::refuse_onset_laws(&model).is_ok());
 }
 
 /// A body pressed against a wall by a steady force (a ball on a table:

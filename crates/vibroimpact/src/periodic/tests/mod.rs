@@ -1,4 +1,7 @@
 //! Tests of the periodic module: maps, shooting, Floquet multipliers, orbits.
+//!
+//! Files: `mod.rs` (soft contacts), `rigid.rs` (through rigid impacts:
+//! saltation, closed forms).
 use super::*;
 use crate::model::BaseExcitation;
 use crate::simulate::Integrator;
@@ -619,3 +622,5 @@ fn local_krylov_shooting_matches_global() {
         );
     }
 }
+
+mod rigid;

@@ -1,0 +1,149 @@
+//! The shooting map of a model with rigid impacts (docs/theory.md §12):
+//! the state and Φ's columns integrated between impacts by the global
+//! integrator, the velocities' jump applied at each impact and the
+//! columns multiplied by its saltation matrix (including de/dU of a
+//! velocity-dependent law, seed eq. (10)). Φ is always dense here: the
+//! matrix-free products are products with it.
+
+use super::map::{parameter_column, shooting_map, MapDerivatives, MapTangent, Tape};
+use super::*;
+use crate::dynamics::saltation::Saltation;
+use crate::simulate::{flow_through_events, ImpactJump};
+
+/// [`period_map_with`](super::period_map_with) for a model with rigid
+/// impacts: the map, its dense Jacobian (also behind the tangent without
+/// `dense`) and, with `shifted = (model at p + dp, dp)`, `∂P/∂p`.
+pub(super) fn rigid_map(
+    model: &Model,
+    x: &[f64],
+    opts: &ShootingOptions,
+    (shifted, dense): (Option<(&Model, f64)>, bool),
+    t: f64,
+    max_steps: u64,
+) -> Result<MapDerivatives, IntegrationError> {
+    let n = model.bodies().len();
+    let d = 2 * n;
+    if d > MAX_DENSE_DIM {
+        return Err(IntegrationError::InvalidOptions(format!(
+            "rigid impacts: the period map of {n} bodies carries its dense {d}×{d} monodromy through the impacts' saltation; at most {} bodies",
+            MAX_DENSE_DIM / 2
+        )));
+    }
+    let sys = ChainDynamics::new(model, false);
+    let (mut var, dt_dp) = match shifted {
+        Some((model_p, dp)) => {
+            let t_p = map_time(model_p, opts)
+                .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+            let shifted_sys = ChainDynamics::new(model_p, false);
+            let var =
+                if model.differs_only_in_forcing(model_p) && sys.same_contact_terms(&shifted_sys) {
+                    Variational::with_forcing_parameter(sys, d, shifted_sys, dp)
+                } else {
+                    Variational::with_parameter(sys, d, shifted_sys, dp)
+                };
+            (var, (t_p - t) / dp)
+        }
+        None => (Variational::new(sys, d), 0.0),
+    };
+    let z0 = var.initial_state(&to_interleaved(x));
+    let int_opts = opts.integrator_options(max_steps, Some(d));
+    let (z, steps, _) = flow_through_events(&mut var, &z0, t, &int_opts, saltation)?;
+    let image = from_interleaved(&z[..d], n);
+    let phi = var.sensitivity(&z).to_vec();
+    let dp_column = var.parameter_sensitivity(&z).map(|s| {
+        let mut flow = vec![0.0; d];
+        var.system_mut().rhs(t, &z[..d], &mut flow);
+        parameter_column(s, &flow, dt_dp, opts.symmetric)
+    });
+    let symmetric = opts.symmetric;
+    let map = shooting_map(image, &phi, d, n, symmetric);
+    let tangent = (!dense).then_some(MapTangent {
+        tape: Tape::Dense(phi),
+        n,
+        symmetric,
+    });
+    Ok(MapDerivatives {
+        map,
+        dp_column,
+        steps,
+        tangent,
+    })
+}
+
+/// The shooting map's image alone through rigid impacts (interleaved),
+/// and the steps taken.
+pub(super) fn rigid_image(
+    model: &Model,
+    y0: &[f64],
+    t: f64,
+    int_opts: &IntegratorOptions,
+) -> Result<(Vec<f64>, u64), IntegrationError> {
+    let mut sys = ChainDynamics::new(model, false);
+    let (y, steps, _) = flow_through_events(&mut sys, y0, t, int_opts, |_, _| Ok(()))?;
+    Ok((y, steps))
+}
+
+/// The shooting map's image and its product with the interleaved column
+/// `w0` through rigid impacts (both interleaved).
+pub(super) fn rigid_product(
+    model: &Model,
+    y0: &[f64],
+    w0: &[f64],
+    t: f64,
+    int_opts: &IntegratorOptions,
+) -> Result<(Vec<f64>, Vec<f64>), IntegrationError> {
+    let mut var = Variational::new(ChainDynamics::new(model, false), 1);
+    let z0 = var.initial_state_with(y0, &[w0]);
+    let (mut z, _, _) = flow_through_events(&mut var, &z0, t, int_opts, saltation)?;
+    let w = z.split_off(y0.len());
+    Ok((z, w))
+}
+
+/// The saltation of an impact applied to the carried columns of `var`
+/// (docs/theory.md §12): `S w` for each column of Φ, and for a parameter's
+/// column `S s + ∂g/∂p + (f⁺ − G f⁻) ∂h/∂p / U`, the jump's and the event's
+/// own dependence on p by differences against the shifted system.
+fn saltation(
+    var: &mut Variational<ChainDynamics>,
+    jump: ImpactJump,
+) -> Result<(), IntegrationError> {
+    let d = var.state_dim();
+    let k = jump.contact;
+    let states = (&jump.before[..d], &jump.after[..d]);
+    let salt = Saltation::new(var.system_mut(), k, jump.t, states, jump.impact);
+    let columns = var.columns();
+    for c in 0..columns {
+        salt.apply(&mut jump.after[d * (1 + c)..d * (2 + c)]);
+    }
+    let Some((shifted, dp)) = var.shifted() else {
+        return Ok(());
+    };
+    let chain = var.system();
+    let before = &jump.before[..d];
+    let h_p = (shifted.approach(k, before).0 - chain.approach(k, before).0) / dp;
+    let column = &mut jump.after[d * (1 + columns)..d * (2 + columns)];
+    salt.apply_shifted(column, h_p);
+    // The jump's own ∂g/∂p: the shifted law's and masses' velocity changes.
+    let u = jump.impact.impact_velocity;
+    let impulse_p = match shifted.rigid_law(k) {
+        Some(law) => {
+            law.impact(u)
+                .map_err(|e| IntegrationError::RigidImpact {
+                    t: jump.t,
+                    contact: k,
+                    reason: e.to_string(),
+                })?
+                .impulse
+        }
+        None => 0.0,
+    };
+    let [_, vl, _, vr] = chain.contact_indices(k);
+    let p = jump.impact.impulse;
+    if let Some(i) = vl {
+        column[i] += (p / chain.mass(i / 2) - impulse_p / shifted.mass(i / 2)) / dp;
+    }
+    if let Some(i) = vr {
+        column[i] += (impulse_p / shifted.mass(i / 2) - p / chain.mass(i / 2)) / dp;
+    }
+    Ok(())
+}

@@ -1,0 +1,87 @@
+//! A bare flow through a run's events: a state, with whatever rides along
+//! (the columns of a variational system), integrated over an interval by
+//! DOP853, every event located and applied where it happens, and a hook at
+//! each rigid impact that updates what rides along (docs/theory.md §12:
+//! the saltation of the period map's columns).
+
+use super::{apply_event, rigid_jump, Event, Switches, Verdict};
+use crate::dynamics::Chain;
+use crate::impact::rigid::RigidImpact;
+use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stepper};
+
+/// What a rigid impact hands the hook: the contact, the time, the
+/// extended state just before the jump, and the state just after it (the
+/// velocities jumped; the rest, to be updated by the hook, as before).
+pub(crate) struct ImpactJump<'a> {
+    /// The model's contact index.
+    pub(crate) contact: usize,
+    /// The impact's time.
+    pub(crate) t: f64,
+    /// The extended state just before.
+    pub(crate) before: &'a [f64],
+    /// The extended state just after.
+    pub(crate) after: &'a mut [f64],
+    /// The impact.
+    pub(crate) impact: &'a RigidImpact,
+}
+
+/// Integrates `sys` from `(0, z0)` to `t_end` with `opts` (at most
+/// `opts.max_steps` steps, retaken ones and events included), applying its
+/// events (rigid impacts, storeys' switches, onsets) where they happen;
+/// `at_impact` updates the rest of the state at each rigid impact. Returns
+/// the state at `t_end`, the steps taken and the rigid impacts applied.
+pub(crate) fn flow_through_events<S: Chain>(
+    sys: &mut S,
+    z0: &[f64],
+    t_end: f64,
+    opts: &IntegratorOptions,
+    mut at_impact: impl FnMut(&mut S, ImpactJump) -> Result<(), IntegrationError>,
+) -> Result<(Vec<f64>, u64, usize), IntegrationError> {
+    let dim = sys.dim();
+    let mut st = Stepper::new(Method::Dop853, dim, opts.clone())?;
+    st.reset(sys, 0.0, z0)?;
+    let contacts = sys.chain().contacts();
+    let mut switches = Switches::new(sys.chain(), dim, vec![0.0; contacts]);
+    let (mut steps, mut impacts) = (0_u64, 0_usize);
+    while st.t() < t_end {
+        steps += 1;
+        if steps > opts.max_steps {
+            return Err(IntegrationError::TooManySteps { t: st.t(), steps });
+        }
+        let Some(sw) = switches.as_mut() else {
+            st.step(sys, t_end)?;
+            continue;
+        };
+        let event = match sw.before_step(&st, t_end) {
+            Err(event) => event,
+            Ok(bound) => {
+                st.step(sys, bound)?;
+                match sw.after_step(&mut st, sys)? {
+                    Verdict::Switch(event) => event,
+                    Verdict::Retake | Verdict::Clear => continue,
+                }
+            }
+        };
+        let Event::Impact(k) = event else {
+            apply_event(&mut st, sys, event)?;
+            continue;
+        };
+        let (t, before) = (st.t(), st.y().to_vec());
+        let mut after = before.clone();
+        if let Some((contact, impact)) = rigid_jump(sys.chain(), k, (t, &mut after), opts.atol)? {
+            impacts += 1;
+            at_impact(
+                sys,
+                ImpactJump {
+                    contact,
+                    t,
+                    before: &before,
+                    after: &mut after,
+                    impact: &impact,
+                },
+            )?;
+        }
+        st.reset(sys, t, &after)?;
+    }
+    Ok((st.y().to_vec(), steps, impacts))
+}
