@@ -1099,3 +1099,40 @@ fn continue_two_parameter_bad_input() {
         assert_clean_error(&[&base[..], extra].concat(), needle);
     }
 }
+
+/// Rigid impacts and gravity from the command line (docs/theory.md §12):
+/// the shipped bouncing ball's period-1 orbit has the closed form's
+/// multipliers (−0.241599 ± 0.437756i at Γ = 1.3), and its branch in the
+/// table's acceleration doubles its period at Γ_PD g = 14.97814050 m/s²
+/// (the library's tests: to 1e-8).
+#[test]
+fn the_bouncing_ball_from_the_command_line() {
+    let model = repo_file("examples/bouncing-ball.toml");
+    let doc = json(&["periodic", &model, "--format", "json"]);
+    assert_eq!(doc["converged"], true, "{doc}");
+    assert_eq!(doc["impacts_per_period"], 1, "{doc}");
+    for m in doc["floquet_multipliers"].as_array().unwrap() {
+        let (re, im) = (m[0].as_f64().unwrap(), m[1].as_f64().unwrap());
+        assert!(
+            (re + 0.2415986).abs() < 1e-6 && (im.abs() - 0.4377558).abs() < 1e-6,
+            "{m}"
+        );
+    }
+    let doc = json(&[
+        "continue",
+        &model,
+        "--parameter",
+        "amplitude",
+        "--from",
+        "12.753",
+        "--to",
+        "16",
+        "--format",
+        "json",
+    ]);
+    let special = doc["special_points"].as_array().unwrap();
+    assert_eq!(special.len(), 1, "{special:?}");
+    assert_eq!(special[0]["kind"], "period-doubling");
+    let p = special[0]["parameter"].as_f64().unwrap();
+    assert!((p - 14.97814050).abs() < 1e-6, "{p}");
+}

@@ -57,3 +57,19 @@ def test_bad_impacts_name_the_argument(kw, needle):
     with pytest.raises((ValueError, TypeError)) as e:
         vi.simulate(vi.Model.load(str(OSCILLATOR)), periods=2, output_step=0, **kw)
     assert needle in str(e.value)
+
+
+def test_periodic_orbits_through_rigid_impacts(cli):
+    # The bouncing ball (gravity, rigid impacts with e = 0.5): the orbit's
+    # multipliers are the closed form's, equal to the command line's, and
+    # its branch doubles its period at Gamma_PD g = 14.97814050 m/s^2.
+    ball = EXAMPLES / "bouncing-ball.toml"
+    r = vi.periodic(ball)
+    doc = cli("periodic", str(ball))
+    np.testing.assert_allclose(r.floquet_multipliers, doc["floquet_multipliers"], rtol=1e-12)
+    np.testing.assert_allclose(r.initial_state, doc["initial_state"], rtol=1e-12)
+    assert np.abs(np.array(r.floquet_multipliers)[:, 1]).max() == pytest.approx(0.4377558, abs=1e-6)
+    b = vi.continue_(ball, "amplitude", 12.753, 16.0)
+    (pd,) = b.special_points
+    assert pd["kind"] == "period-doubling"
+    assert pd["parameter"] == pytest.approx(14.97814050, abs=1e-6)

@@ -319,6 +319,37 @@ impl<F: Family + Send> Continuation<F> {
         interrupt.as_ref().is_some_and(|i| i.requested())
     }
 
+    /// Why a branch through rigid impacts ends (docs/theory.md §12): at
+    /// the current point a rigid contact's slowest impact is below 1e-3 of
+    /// the orbit's largest velocity, a grazing, where the period map is
+    /// not differentiable (its saltation grows as 1/U).
+    fn rigid_grazing(&mut self) -> Option<String> {
+        let point = &self.current.point;
+        let model = self.problem.model(point.parameter).ok()?;
+        if !model.has_rigid_impacts() {
+            return None;
+        }
+        let shooting = &self.problem.opts.shooting;
+        let period =
+            crate::periodic::forcing_period(&model).ok()? * f64::from(shooting.subharmonic.max(1));
+        let orbit =
+            crate::periodic::orbit_summary(&model, &point.state, period, 0, shooting.rtol).ok()?;
+        let (k, u) = orbit
+            .impacts
+            .iter()
+            .filter(|c| model.impacts(c.contact).is_rigid())
+            .flat_map(|c| c.impact_velocities.iter().map(move |u| (c.contact, *u)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let scale = orbit.max_velocity.iter().fold(0.0_f64, |a, v| a.max(*v));
+        (u < 1e-3 * scale).then(|| {
+            format!(
+                ": the rigid impact of contact {} grazes there (impact velocity {u:.3e} m/s, largest multiplier {:.3e}); a rigid impact's period map is not differentiable where it grazes, so the branch of impacting orbits ends (GR); beyond it the orbit does not touch",
+                model.contact_name(k),
+                point.spectral_radius()
+            )
+        })
+    }
+
     /// The next point corrected, not yet finished, or the reason the
     /// branch ends.
     fn advance(&mut self) -> Result<Corrected, Ending> {
@@ -352,8 +383,9 @@ impl<F: Family + Send> Continuation<F> {
             }
             if self.ds < self.problem.opts.ds_min {
                 let p = self.current.point.parameter;
+                let grazes = self.rigid_grazing().unwrap_or_default();
                 return Err(end(StopReason::CannotContinue(format!(
-                    "the corrector does not converge beyond parameter {p} even with step {:e}",
+                    "the corrector does not converge beyond parameter {p} even with step {:e}{grazes}",
                     self.ds
                 ))));
             }

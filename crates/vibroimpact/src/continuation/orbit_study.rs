@@ -85,8 +85,12 @@ impl OrbitStudy {
     /// one frequency, a period multiple ≥ 1, the half map only on a
     /// mirror-symmetric model with an odd multiple, enough Arnoldi
     /// vectors and a given guess of the model's size.
-    pub fn check(self, document: ModelDocument) -> Result<CheckedOrbit, StudyError> {
-        let model = document.build()?.model;
+    pub fn check(mut self, document: ModelDocument) -> Result<CheckedOrbit, StudyError> {
+        let loaded = document.build()?;
+        let model = loaded.model;
+        if let Some(scale) = loaded.simulation.displacement_scale {
+            self.options.displacement_scale = scale;
+        }
         let invalid = |field, message: String| StudyError::Invalid { field, message };
         if model.forcing_frequency().is_none() {
             return Err(StudyError::Model(format!(

@@ -265,10 +265,13 @@ impl BranchStudy {
                 "the model has no periodic forcing with one frequency there: nothing to continue",
             ));
         }
-        let options = ContinuationOptions {
+        let mut options = ContinuationOptions {
             krylov: self.linear.krylov(start_model.bodies().len(), self.arnoldi),
             ..self.options.clone()
         };
+        if let Some(scale) = family.simulation().displacement_scale {
+            options.shooting.displacement_scale = scale;
+        }
         validate_size(&start_model, &options).map_err(|e| match (e, options.krylov) {
             (ContinuationError::Invalid(m), Some(_)) if m.starts_with("Arnoldi") => {
                 StudyError::Invalid {

@@ -302,10 +302,19 @@ impl ChainDynamics {
                 .collect(),
             onset_velocity: vec![0.0; contacts.len()],
             contacts,
+            // Gravity as a steady force −m g = −m g sin(0 t + π/2) per body.
             forces: model
                 .forces()
                 .iter()
                 .map(|f| (f.body, f.amplitude, f.frequency, f.phase))
+                .chain(
+                    (0..model.bodies().len())
+                        .filter(|_| model.gravity() != 0.0)
+                        .map(|i| {
+                            let weight = -model.bodies()[i].mass * model.gravity();
+                            (i, weight, 0.0, std::f64::consts::FRAC_PI_2)
+                        }),
+                )
                 .collect(),
             base: model.base().clone(),
             segment: 0,

@@ -1,5 +1,6 @@
 //! What drives a model besides its initial state: the base's motion
-//! (harmonic or a recorded accelerogram) and harmonic forces on bodies.
+//! (harmonic or a recorded accelerogram), harmonic forces on bodies, and
+//! gravity along a vertical row.
 
 use super::*;
 
@@ -229,4 +230,28 @@ pub struct HarmonicForce {
     pub frequency: f64,
     /// φ (rad).
     pub phase: f64,
+}
+
+impl Model {
+    /// Gravity along the row (m/s²): every body feels the steady force
+    /// −m g (a vertical row, u up: a ball on a vibrating table, an impact
+    /// damper); 0 for a horizontal row.
+    pub fn gravity(&self) -> f64 {
+        self.gravity
+    }
+
+    /// The model with gravity `g` (m/s², finite) along the row. It breaks
+    /// the mirror symmetry of a row; the local integrator does not take
+    /// it (auto picks the global one).
+    pub fn with_gravity(mut self, g: f64) -> Result<Self, ModelError> {
+        if !g.is_finite() {
+            return Err(ModelError::new(
+                ModelErrorKind::InvalidValue,
+                "gravity",
+                format!("gravity = {g}: must be finite (m/s², toward -u)"),
+            ));
+        }
+        self.gravity = g;
+        Ok(self)
+    }
 }

@@ -192,6 +192,8 @@ pub struct Model {
     storeys: Vec<Storey>,
     /// Per contact, its impacts (soft unless set).
     impacts: Vec<Impacts>,
+    /// Gravity along the row (m/s², toward −u; 0 for a horizontal row).
+    gravity: f64,
 }
 
 /// `v` must be finite and >= 0; `key` is its path, `what` names it (both
@@ -265,6 +267,7 @@ impl Model {
             impacts,
             forces,
             storeys: Vec::new(),
+            gravity: 0.0,
         };
         check_overlaps(&model)?;
         scales::check_rounding(&model)?;
@@ -342,7 +345,7 @@ impl Model {
         displacement: Vec<f64>,
         velocity: Vec<f64>,
     ) -> Result<Self, ModelError> {
-        let impacts = self.impacts;
+        let (impacts, gravity) = (self.impacts, self.gravity);
         Self::new(
             self.bodies,
             self.couplings,
@@ -352,7 +355,11 @@ impl Model {
             displacement,
             velocity,
         )
-        .map(|m| Self { impacts, ..m })
+        .map(|m| Self {
+            impacts,
+            gravity,
+            ..m
+        })
     }
 
     /// The model whose time 0 is this model's time `t0`: every harmonic
@@ -495,7 +502,7 @@ impl Model {
     pub fn is_mirror_symmetric(&self) -> bool {
         let n = self.bodies.len();
         let m = |i: usize| n - 1 - i;
-        if self.forcing_frequency().is_none() {
+        if self.forcing_frequency().is_none() || self.gravity != 0.0 {
             return false;
         }
         let bodies = (0..n).all(|i| {

@@ -46,7 +46,11 @@ impl Integrator {
     /// record's samples and the global run is the faster).
     pub fn resolve_run(self, model: &Model, opts: &SimulationOptions) -> Integrator {
         let record = matches!(model.base(), BaseExcitation::Record(_));
-        if self != Integrator::Auto || !record || model.has_rigid_impacts() {
+        if self != Integrator::Auto
+            || !record
+            || model.has_rigid_impacts()
+            || model.gravity() != 0.0
+        {
             return self.resolve(model);
         }
         let groups = crate::simulate::local::free_motion::spring_groups(model)
@@ -81,7 +85,8 @@ impl Integrator {
             // §12.)
             Integrator::Auto
                 if matches!(model.base(), BaseExcitation::Record(_))
-                    || model.has_rigid_impacts() =>
+                    || model.has_rigid_impacts()
+                    || model.gravity() != 0.0 =>
             {
                 Integrator::Global
             }

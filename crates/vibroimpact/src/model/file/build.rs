@@ -99,6 +99,12 @@ impl ModelDocument {
         )
         .map_err(|e| cx.plain(e))?;
         let model = impacts_keys(&cx, file, row_contacts, model)?;
+        let model = match &file.gravity {
+            Some(g) => model
+                .with_gravity(*g.get_ref())
+                .map_err(|e| cx.err_at(g.span(), e.to_string()))?,
+            None => model,
+        };
         let simulation = simulation_table(&cx, file)?;
         let record = match (&self.record, model.base()) {
             (Some(r), BaseExcitation::Record(a)) => Some(r.metadata(a.scale())),
@@ -477,6 +483,7 @@ fn simulation_table(cx: &Ctx<'_>, file: &ModelFile) -> Result<SimulationSpec, Mo
         ("rtol", simulation.rtol),
         ("atol", simulation.atol),
         ("impact_force_threshold", simulation.impact_force_threshold),
+        ("displacement_scale", simulation.displacement_scale),
     ] {
         if let Some(v) = value.filter(|v| !(*v > 0.0 && v.is_finite())) {
             return Err(cx.plain(format!("[simulation] {key} = {v}: must be finite and > 0")));

@@ -394,11 +394,20 @@ pub struct SimulationSpec {
     pub atol: Option<f64>,
     /// Impact force threshold F_on (N).
     pub impact_force_threshold: Option<f64>,
+    /// The size of the motion (m) that periodic orbits and continuation
+    /// measure the state in: the shooting's scaled norm and absolute
+    /// tolerance, the continuation's arclength (default 1e-3: millimetre
+    /// motion, the seed's rows).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub displacement_scale: Option<f64>,
 }
 
 #[derive(Serialize, Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct ModelFile {
+    /// Gravity along the row (m/s², toward −u), a top-level key.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) gravity: Option<Spanned<f64>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(crate) row: Option<Spanned<RowSpec>>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -317,3 +317,35 @@ fn impacts_are_soft_or_rigid() {
         "{e}"
     );
 }
+
+/// `gravity` (top level, m/s² toward −u) reaches the model and breaks
+/// its mirror symmetry; a value that is not finite is refused with the
+/// line and the key.
+#[test]
+fn gravity_is_a_top_level_key() {
+    let m = parse(&format!("gravity = 9.81\n{EXPLICIT}")).unwrap().model;
+    assert_eq!(m.gravity(), 9.81);
+    assert!(!m.is_mirror_symmetric());
+    assert_eq!(parse(EXPLICIT).unwrap().model.gravity(), 0.0);
+    let e = err(&format!("gravity = nan\n{EXPLICIT}"));
+    assert!(
+        e.starts_with("m.toml:1") && e.contains("gravity = NaN: must be finite"),
+        "{e}"
+    );
+    let e = err(&format!("gravity = \"down\"\n{EXPLICIT}"));
+    assert!(e.contains("gravity"), "{e}");
+}
+
+/// `[simulation] displacement_scale` is kept for the studies that shoot,
+/// and refused unless finite and positive, by key.
+#[test]
+fn displacement_scale_is_a_simulation_setting() {
+    let text = format!("{EXPLICIT}\n[simulation]\ndisplacement_scale = 0.1\n");
+    let loaded = parse(&text).unwrap();
+    assert_eq!(loaded.simulation.displacement_scale, Some(0.1));
+    let e = err(&text.replace("0.1", "-1.0"));
+    assert!(
+        e.contains("[simulation] displacement_scale = -1: must be finite and > 0"),
+        "{e}"
+    );
+}

@@ -227,3 +227,190 @@ fn multipliers_carry_the_slope_of_the_seeds_restitution() {
     assert!((product.re / det - 1.0).abs() < 1e-9, "{product} vs {det}");
     assert!(((e * e) / det - 1.0).abs() > 1e-3);
 }
+
+/// Gravity (m/s²), restitution and forcing of the bouncing ball.
+const G: f64 = 9.81;
+const E_BALL: f64 = 0.5;
+const W_TABLE: f64 = 2.0 * std::f64::consts::PI;
+
+/// A ball (1 kg, no spring) on a table moving as z = A sin ωt with
+/// Γ = A ω²/g, in the table's frame: ü = −z̈ − g, the table a wall at
+/// u = 0 below it, Newton's e.
+fn bouncing_ball(gamma: f64) -> Model {
+    use crate::model::{Body, Contact, ContactPair};
+    let ball = Body {
+        name: "ball".into(),
+        mass: 1.0,
+        stiffness: 0.0,
+        damping: 0.0,
+    };
+    let table = Contact {
+        pair: ContactPair::LeftWall { body: 0 },
+        clearance: 0.0,
+        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
+    };
+    // z̈ = −A ω² sin ωt = A ω² sin(ωt + π).
+    let base = BaseExcitation::Harmonic {
+        amplitude: gamma * G,
+        frequency: W_TABLE,
+        phase: std::f64::consts::PI,
+    };
+    Model::new(
+        vec![ball],
+        vec![],
+        vec![table],
+        base,
+        vec![],
+        vec![0.1],
+        vec![],
+    )
+    .unwrap()
+    .with_gravity(G)
+    .unwrap()
+    .with_all_impacts(Impacts::Rigid {
+        restitution: Some(E_BALL),
+    })
+    .unwrap()
+}
+
+/// The ball's period-1 orbit in closed form (Holmes 1982, without his
+/// small-bounce approximation): it leaves the table at phase φ with the
+/// absolute velocity gT/2 and lands one period later at the same phase,
+/// so the table's velocity there is A ω cos φ = gT (1 − e)/(2 (1 + e)),
+/// sin φ > 0 on the stable branch. Returns the state (u, u̇) relative to
+/// the table at t = 0 and the impact map's Jacobian's trace, whose
+/// determinant is e²: tr = 1 + e² − (1 + e)² Γ sin φ.
+fn ball_orbit(gamma: f64) -> ([f64; 2], f64) {
+    let period = 2.0 * std::f64::consts::PI / W_TABLE;
+    let amp = gamma * G / (W_TABLE * W_TABLE);
+    let cos = std::f64::consts::PI * (1.0 - E_BALL) / ((1.0 + E_BALL) * gamma);
+    let phi = cos.acos();
+    let (t_star, v_up) = (phi / W_TABLE, 0.5 * G * period);
+    // From the impact at t* to t = T (≡ 0), free flight above the table.
+    let tau = period - t_star;
+    let z = |t: f64| amp * (W_TABLE * t).sin();
+    let zd = |t: f64| amp * W_TABLE * (W_TABLE * t).cos();
+    let u = z(t_star) + v_up * tau - 0.5 * G * tau * tau - z(period);
+    let v = v_up - G * tau - zd(period);
+    let trace = 1.0 + E_BALL * E_BALL - (1.0 + E_BALL).powi(2) * gamma * phi.sin();
+    ([u, v], trace)
+}
+
+/// The bouncing ball's period-1 orbit and its multipliers by shooting
+/// equal the closed form to 1e-8, below the period doubling and at it
+/// (Γ_PD² = (π(1 − e)/(1 + e))² + (2(1 + e²)/(1 + e)²)²: a multiplier
+/// −1 to 1e-8).
+#[test]
+fn the_bouncing_ball_of_holmes() {
+    let pi = std::f64::consts::PI;
+    let ratio = (1.0 - E_BALL) / (1.0 + E_BALL);
+    let gamma_pd = (pi * ratio).hypot(2.0 * (1.0 + E_BALL * E_BALL) / (1.0 + E_BALL).powi(2));
+    for gamma in [1.3, gamma_pd] {
+        let model = bouncing_ball(gamma);
+        let (x, trace) = ball_orbit(gamma);
+        let guess = [x[0] * 1.01, x[1] * 0.99];
+        let sol = shoot(&model, &guess, &tight()).unwrap();
+        assert!(sol.converged, "{gamma}: {:?}", sol.residual_history);
+        for i in 0..2 {
+            assert!(
+                (sol.initial_state[i] - x[i]).abs() < 1e-8,
+                "{gamma}: {:?} vs {x:?}",
+                sol.initial_state
+            );
+        }
+        let disc = Complex::new(trace * trace - 4.0 * E_BALL * E_BALL, 0.0).sqrt();
+        let exact = [(trace + disc) / 2.0, (trace - disc) / 2.0];
+        for m in &sol.multipliers {
+            let err = exact
+                .iter()
+                .map(|x| (m - x).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(err < 1e-8, "{gamma}: {m} vs {exact:?}");
+        }
+        eprintln!("Γ {gamma}: multipliers {:?}", sol.multipliers);
+    }
+}
+
+/// Continued in the table's acceleration from Γ = 1.2, the ball's
+/// period-1 branch has its period doubling at the closed form's Γ_PD to
+/// 1e-8 (and no other special point before Γ = 1.7); in metres, so the
+/// shooting's displacement scale is 1 m.
+#[test]
+fn continuation_locates_the_bouncing_balls_period_doubling() {
+    use crate::continuation::{continue_branch, ContinuationOptions, SpecialKind};
+    use crate::model::family::of;
+    let pi = std::f64::consts::PI;
+    let ratio = (1.0 - E_BALL) / (1.0 + E_BALL);
+    let gamma_pd = (pi * ratio).hypot(2.0 * (1.0 + E_BALL * E_BALL) / (1.0 + E_BALL).powi(2));
+    let opts = ContinuationOptions {
+        shooting: tight(),
+        ..Default::default()
+    };
+    let family = of("amplitude", |a: f64| Ok(bouncing_ball(a / G)));
+    let (x0, _) = ball_orbit(1.2);
+    let branch = continue_branch(family, 1.2 * G, &x0, 1.7 * G, &opts, |_| true).unwrap();
+    let found: Vec<(SpecialKind, f64)> = branch
+        .special
+        .iter()
+        .map(|s| (s.kind, s.parameter / G))
+        .collect();
+    eprintln!(
+        "{} points: {found:?} vs Γ_PD {gamma_pd}",
+        branch.points.len()
+    );
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].0, SpecialKind::PeriodDoubling);
+    assert!(
+        (found[0].1 - gamma_pd).abs() < 1e-8,
+        "{found:?} vs {gamma_pd}"
+    );
+}
+
+/// The impact oscillator's branch of impacting orbits (e = 0.8) from
+/// Ω = 1.5 folds at Ω = 1.8576 and comes back to the grazing of its
+/// impact, where it ends with the reason: the grazing orbit is the linear
+/// steady state of amplitude g, (1 − Ω²)² + (2ζΩ)² = (p/g)², and the last
+/// point lies within 1e-7 of that Ω, its impact velocity below 1e-3 of
+/// the orbit's.
+#[test]
+fn the_impact_oscillators_branch_ends_at_its_grazing() {
+    use crate::continuation::{continue_branch, ContinuationOptions, StopReason};
+    use crate::model::family::of;
+    let opts = ContinuationOptions {
+        shooting: ShootingOptions {
+            displacement_scale: 0.1,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let family = of("frequency", |w: f64| {
+        Ok(oscillator(ZETA_O, GAP, (1.0, w, 0.0), (0.0, 0.0))
+            .with_all_impacts(Impacts::Rigid {
+                restitution: Some(0.8),
+            })
+            .unwrap())
+    });
+    let (sol, _) = settled_orbit(&rigid_oscillator(Some(0.8), 0.0, (0.0, 0.0)));
+    let branch = continue_branch(family, OMEGA, &sol.initial_state, 3.5, &opts, |_| true).unwrap();
+    let StopReason::CannotContinue(why) = &branch.stop else {
+        unreachable!("{:?}", branch.stop)
+    };
+    assert!(
+        why.contains("grazes there") && why.contains("(GR)"),
+        "{why}"
+    );
+    // Ω² = y: y² − (2 − 4ζ²) y + 1 − (p/g)² = 0.
+    let b = 2.0 - 4.0 * ZETA_O * ZETA_O;
+    let y = (b + (b * b + 4.0 * (1.0 / (GAP * GAP) - 1.0)).sqrt()) / 2.0;
+    let grazing = y.sqrt();
+    let last = branch.points.last().unwrap().parameter;
+    eprintln!(
+        "{} points, last at {last} vs grazing {grazing}: {why}",
+        branch.points.len()
+    );
+    assert!((last - grazing).abs() < 1e-7, "{last} vs {grazing}");
+    assert!(branch
+        .special
+        .iter()
+        .any(|s| (s.parameter - 1.85757).abs() < 1e-4));
+}

@@ -523,6 +523,11 @@ fn check_request(
             model.contact_name(k)
         )));
     }
+    if model.gravity() != 0.0 {
+        return Err(OptionsError(
+            "gravity along the row: such models run on the global integrator (integrator = global, or auto)".into(),
+        ));
+    }
     if opts.energy && (tape || tangents.is_some_and(|w| w.columns > 0)) {
         return Err(OptionsError(
             "the energy audit carries no tangent columns or tape".into(),
