@@ -103,7 +103,7 @@ pub(super) fn rigid_product(
 /// (docs/theory.md §12): `S w` for each column of Φ, and for a parameter's
 /// column `S s + ∂g/∂p + (f⁺ − G f⁻) ∂h/∂p / U`, the jump's and the event's
 /// own dependence on p by differences against the shifted system.
-fn saltation(
+pub(crate) fn saltation(
     var: &mut Variational<ChainDynamics>,
     jump: ImpactJump,
 ) -> Result<(), IntegrationError> {

@@ -364,3 +364,54 @@ fn exponents_refuse_onset_velocity_laws() {
         assert!(e.to_string().contains(&model.contact_name(0)), "{e}");
     }
 }
+
+/// Through rigid impacts the tangent vectors take each impact's saltation
+/// (docs/theory.md §12): on the impact oscillator's stable one-impact
+/// orbit with the seed's e(U), the spectrum's sum is ln |det Φ| / T of
+/// its monodromy to 1e-9 (det Φ = e (e + U de/dU) e^{−2ζT}), and each
+/// exponent is ln |μ| / T of its complex pair of multipliers to 1e-3.
+#[test]
+fn rigid_impacts_exponents_equal_the_orbits_multipliers() {
+    use crate::contact::{ContactLaw, ForceForm};
+    use crate::model::Impacts;
+    use crate::simulate::tests::rigid::oscillator;
+    let law = ContactLaw::exponential(2.5, 1.0, 1e3, ForceForm::Published).unwrap();
+    let model = oscillator(0.05, 0.6, (1.0, 1.5, 0.0), (0.0, 0.0))
+        .with_contact_law(law)
+        .with_all_impacts(Impacts::Rigid { restitution: None })
+        .unwrap();
+    let shooting = ShootingOptions {
+        rtol: 1e-12,
+        tol: 1e-10,
+        displacement_scale: 0.1,
+        ..Default::default()
+    };
+    let sol = shoot(&model, &[-0.5, 1.0], &shooting).unwrap();
+    assert!(sol.converged && sol.stable(), "{:?}", sol.multipliers);
+    let ly = lyapunov_spectrum(
+        &model,
+        &sol.initial_state,
+        0.0,
+        &LyapunovOptions {
+            transient: 0,
+            periods: 100,
+            rtol: 1e-11,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let t = sol.period;
+    let sum: f64 = ly.exponents.iter().sum();
+    let det: f64 = sol.multipliers.iter().map(|m| m.norm().ln()).sum::<f64>() / t;
+    eprintln!(
+        "exponents {:?} vs multipliers {:?}",
+        ly.exponents, sol.multipliers
+    );
+    assert!((sum / det - 1.0).abs() < 1e-9, "{sum} vs {det}");
+    for (l, m) in ly.exponents.iter().zip(&sol.multipliers) {
+        assert!(
+            (l - m.norm().ln() / t).abs() < 1e-3 * det.abs(),
+            "{l} vs {m}"
+        );
+    }
+}
