@@ -4,7 +4,9 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use vibroimpact::continuation::{Linear, Start};
+use vibroimpact::field_error::FieldError;
 use vibroimpact::integrate::Method;
+use vibroimpact::model::file::ModelDocument;
 use vibroimpact::model::Model;
 use vibroimpact::simulate::Integrator;
 
@@ -62,17 +64,34 @@ pub struct ImpactArgs {
 }
 
 impl ImpactArgs {
+    /// `--impacts` as the library spells it.
+    fn name(&self) -> Option<&'static str> {
+        self.impacts.map(|i| match i {
+            ImpactsName::Soft => "soft",
+            ImpactsName::Rigid => "rigid",
+        })
+    }
+
     /// `model` with the impacts asked for (`--restitution` alone: on the
     /// model file's rigid contacts).
     pub fn apply(&self, model: Model) -> Result<Model, CliError> {
-        let name = self.impacts.map(|i| match i {
-            ImpactsName::Soft => "soft",
-            ImpactsName::Rigid => "rigid",
-        });
         model
-            .with_impact_options(name, self.restitution)
-            .map_err(|e| CliError::new(e.spelled(&format!("--{}", e.field), " ")))
+            .with_impact_options(self.name(), self.restitution)
+            .map_err(spelled)
     }
+
+    /// The model file at `path`, read, with the impacts asked for in
+    /// every model it builds (a sweep's, a branch's).
+    pub fn read(&self, path: &std::path::Path) -> Result<ModelDocument, CliError> {
+        crate::model_io::read_document(path)?
+            .with_impact_options(self.name(), self.restitution)
+            .map_err(spelled)
+    }
+}
+
+/// A refusal of `--impacts` or `--restitution`, naming the option.
+fn spelled(e: FieldError) -> CliError {
+    CliError::new(e.spelled(&format!("--{}", e.field), " "))
 }
 
 /// `--integrator`.
@@ -169,6 +188,8 @@ pub struct ParameterRange {
     /// Last parameter value.
     #[arg(long)]
     pub to: f64,
+    #[command(flatten)]
+    pub impacts: ImpactArgs,
 }
 
 /// How `continue` finds its first periodic orbit.

@@ -1136,3 +1136,97 @@ fn the_bouncing_ball_from_the_command_line() {
     let p = special[0]["parameter"].as_f64().unwrap();
     assert!((p - 14.97814050).abs() < 1e-6, "{p}");
 }
+
+/// `--impacts` and `--restitution` reach every command that simulates
+/// (issue 40): `periodic --restitution 0.6` shoots the impact oscillator
+/// with e = 0.6, whose multipliers' product is e² e^{−2ζT} (the
+/// saltation's determinant); `sweep`, `continue`, `chart` and `basins`
+/// refuse a bad coefficient by the option's name.
+#[test]
+fn impact_options_on_every_command_that_simulates() {
+    let model = repo_file("examples/impact-oscillator.toml");
+    let doc = json(&[
+        "periodic",
+        &model,
+        "--restitution",
+        "0.6",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["converged"], true, "{doc}");
+    let product = doc["floquet_multipliers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m[0].as_f64().unwrap().hypot(m[1].as_f64().unwrap()))
+        .product::<f64>();
+    let period = 2.0 * std::f64::consts::PI / 1.5;
+    let det = 0.36 * (-0.1 * period).exp();
+    assert!((product / det - 1.0).abs() < 1e-6, "{product} vs {det}");
+    let range = [
+        "--parameter",
+        "force.1.frequency",
+        "--from",
+        "1.4",
+        "--to",
+        "1.6",
+    ];
+    let grid = [
+        "--x",
+        "force.1.frequency",
+        "--x-from",
+        "1.4",
+        "--x-to",
+        "1.6",
+        "--x-points",
+        "2",
+        "--y",
+        "force.1.amplitude",
+        "--y-from",
+        "0.9",
+        "--y-to",
+        "1",
+        "--y-points",
+        "2",
+    ];
+    let bad = ["--impacts", "rigid", "--restitution", "1.5"];
+    for command in [
+        [
+            &["sweep", &model, "--points", "2"][..],
+            &range[..],
+            &bad[..],
+        ]
+        .concat(),
+        [&["continue", &model][..], &range[..], &bad[..]].concat(),
+        [&["chart", &model][..], &grid[..], &bad[..]].concat(),
+        [
+            &[
+                "basins",
+                &model,
+                "--x",
+                "u1",
+                "--x-from",
+                "-1",
+                "--x-to",
+                "1",
+                "--x-points",
+                "2",
+                "--y",
+                "v1",
+                "--y-from",
+                "-1",
+                "--y-to",
+                "1",
+                "--y-points",
+                "2",
+            ][..],
+            &bad[..],
+        ]
+        .concat(),
+    ] {
+        assert_clean_error(
+            &command,
+            "--restitution: contact m|wall: rigid impacts: restitution = 1.5 is invalid",
+        );
+    }
+}

@@ -181,6 +181,21 @@ impl PyModel {
         Self::new(doc)
     }
 
+    /// The model with every contact's impacts set: `impacts` "soft" or
+    /// "rigid" (None: the file's), `restitution` a Newton coefficient for
+    /// rigid impacts (alone: on the file's rigid contacts), as
+    /// `--impacts` and `--restitution` set them. Raises ValueError naming
+    /// the argument.
+    #[pyo3(signature = (impacts = None, restitution = None))]
+    fn with_impacts(&self, impacts: Option<&str>, restitution: Option<f64>) -> PyResult<Self> {
+        let doc = self
+            .document
+            .clone()
+            .with_impact_options(impacts, restitution)
+            .map_err(|e| value_error(e.spelled(e.field, " = ")))?;
+        Self::new(doc)
+    }
+
     /// The value of a numeric key (`frequency`, `row.clearance`, …).
     fn get(&self, name: &str) -> PyResult<f64> {
         Ok(self.document.parameter(name).map_err(value_error)?.initial)

@@ -73,3 +73,32 @@ def test_periodic_orbits_through_rigid_impacts(cli):
     (pd,) = b.special_points
     assert pd["kind"] == "period-doubling"
     assert pd["parameter"] == pytest.approx(14.97814050, abs=1e-6)
+
+
+def test_impacts_reach_every_study(cli):
+    # As --impacts/--restitution: periodic with e = 0.6 equals the command
+    # line's, its multipliers' product is e^2 exp(-2 zeta T) (the
+    # saltation's determinant); sweep, chart, basins and continue_ take
+    # the same arguments and refuse a bad one by name.
+    m = vi.Model.load(str(OSCILLATOR))
+    r = vi.periodic(m, restitution=0.6)
+    doc = cli("periodic", str(OSCILLATOR), "--restitution", "0.6")
+    np.testing.assert_allclose(r.floquet_multipliers, doc["floquet_multipliers"], rtol=1e-12)
+    mu = np.array(r.floquet_multipliers)
+    det = 0.36 * np.exp(-0.1 * 2 * np.pi / 1.5)
+    assert np.prod(np.hypot(mu[:, 0], mu[:, 1])) == pytest.approx(det, rel=1e-6)
+    assert m.with_impacts(restitution=0.6).to_toml().count("restitution = 0.6") == 1
+    s = vi.sweep(m, "force.1.frequency", from_=1.4, to=1.6, points=2, transient=5, record=2, impacts="soft")
+    assert s.column("parameter").size == 2
+    for call in (
+        lambda: vi.sweep(m, "force.1.frequency", from_=1.4, to=1.6, points=2, restitution=1.5),
+        lambda: vi.continue_(m, "force.1.frequency", 1.4, 1.6, restitution=1.5),
+        lambda: vi.chart(m, "force.1.frequency", [1.4, 1.6], "force.1.amplitude", [0.9, 1.0], restitution=1.5),
+        lambda: vi.basins(m, "u1", [-1, 1], "v1", [-1, 1], restitution=1.5),
+    ):
+        with pytest.raises(ValueError) as e:
+            call()
+        assert "restitution = 1.5 is invalid" in str(e.value)
+    with pytest.raises(ValueError) as e:
+        vi.periodic(m, impacts="hard")
+    assert "impacts = 'hard'" in str(e.value)

@@ -7,11 +7,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use vibroimpact::maps::basins::{basins, BasinError, Basins, Component};
 
-use crate::args::{AttractorRuns, GridAxes};
+use crate::args::{AttractorRuns, GridAxes, ImpactArgs};
 use crate::error::{option_error, CliError};
 use crate::figures::{attractor_label, basins_figure};
 use crate::format::{CsvText, Format};
-use crate::model_io::read_model;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::render;
 
@@ -28,6 +27,8 @@ pub struct BasinsArgs {
     base: Option<Vec<f64>>,
     #[command(flatten)]
     runs: AttractorRuns,
+    #[command(flatten)]
+    impacts: ImpactArgs,
     /// Output folder for basins.csv, basins.json and the figure; without it
     /// only the table of attractors is printed.
     #[arg(long)]
@@ -98,7 +99,7 @@ fn write_outputs(dir: &Path, b: &Basins) -> Result<(), CliError> {
 /// Runs `vibroimpact basins`.
 pub fn run(args: &BasinsArgs) -> Result<(), CliError> {
     let (xs, ys) = args.grid.values()?;
-    let loaded = read_model(&args.model)?;
+    let loaded = args.impacts.read(&args.model)?.build()?;
     let n = loaded.model.bodies().len();
     let parse = |flag: &str, text: &str| {
         Component::parse(text, n).map_err(|e| CliError::new(format!("--{flag}: {e}")))

@@ -20,7 +20,6 @@ use crate::curves::{self, SecondParameter};
 use crate::error::{option_error, CliError};
 use crate::figures::{branch_figure, parameter_label};
 use crate::format::{CsvText, Format};
-use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::render;
 
@@ -328,7 +327,7 @@ fn print_curves(c: &Curves) {
 pub fn run_continue(args: &ContinueArgs) -> Result<(), CliError> {
     let interrupt = crate::interrupt::on_ctrl_c();
     let checked = continue_study(args, &interrupt)?
-        .check(read_document(&args.range.model)?)
+        .check(args.range.impacts.read(&args.range.model)?)
         .map_err(|e| study_error(e, args))?;
     if let Some(path) = &args.second.special_points {
         return curves_from_file(args, checked, path, &interrupt);

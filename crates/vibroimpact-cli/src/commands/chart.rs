@@ -8,11 +8,10 @@ use clap::Args;
 use vibroimpact::maps::chart::{chart, Chart, ChartError, ChartOptions};
 use vibroimpact::maps::sweep::SweepOptions;
 
-use crate::args::{AttractorRuns, GridAxes};
+use crate::args::{AttractorRuns, GridAxes, ImpactArgs};
 use crate::error::{option_error, CliError};
 use crate::figures::{chart_figure, class, curve_series, CLASSES};
 use crate::format::{CsvText, Format};
-use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Series};
 
@@ -26,6 +25,8 @@ pub struct ChartArgs {
     grid: GridAxes,
     #[command(flatten)]
     runs: AttractorRuns,
+    #[command(flatten)]
+    impacts: ImpactArgs,
     /// Initial states per cell: the model's own, then points spread over
     /// |u| ≤ 0.9 gap, |v| ≤ 0.9 gap × Ω; runs that end on different
     /// attractors mark the cell as coexisting.
@@ -185,7 +186,7 @@ fn overlay_series(path: &Path, x: &str, y: &str) -> Result<Vec<Series>, CliError
 /// Runs `vibroimpact chart`.
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let (xs, ys) = args.grid.values()?;
-    let document = read_document(&args.model)?;
+    let document = args.impacts.read(&args.model)?;
     let overlay = match &args.overlay {
         Some(path) => overlay_series(path, &args.grid.x, &args.grid.y)?,
         None => Vec::new(),

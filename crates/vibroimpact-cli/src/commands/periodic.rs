@@ -11,10 +11,9 @@ use vibroimpact::model::Model;
 use vibroimpact::periodic::{OrbitSummary, PeriodicSolution, ShootingOptions};
 use vibroimpact::results::periodic_document;
 
-use crate::args::{IntegratorName, LinearAlgebra};
+use crate::args::{ImpactArgs, IntegratorName, LinearAlgebra};
 use crate::error::CliError;
 use crate::format::{history_csv, SummaryFormat};
-use crate::model_io::read_document;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
 
@@ -43,6 +42,8 @@ pub struct PeriodicArgs {
     tol: f64,
     #[command(flatten)]
     linear: LinearAlgebra,
+    #[command(flatten)]
+    impacts: ImpactArgs,
     /// Look for a mirror-symmetric orbit (u_i(t + nT/2) = -u_{N+1-i}(t)) with
     /// the half map S P_{nT/2}: half the integration per Newton step; needs
     /// a mirror-symmetric model and an odd --subharmonic.
@@ -133,7 +134,9 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
         },
     };
     let spell = |e| study_error(e, args, &interrupt);
-    let checked = study.check(read_document(&args.model)?).map_err(spell)?;
+    let checked = study
+        .check(args.impacts.read(&args.model)?)
+        .map_err(spell)?;
     crate::progress::announce_long(checked.work());
     let (model, krylov) = (checked.model.clone(), checked.krylov.is_some());
     let out = checked.run().map_err(spell)?;

@@ -15,9 +15,9 @@ use crate::args::{IntegratorName, MethodName};
 use crate::error::{option_error, CliError};
 use crate::figures::{diagram_figure, lyapunov_figure, parameter_label, sweep_directions};
 use crate::format::{CsvText, Format};
-use crate::model_io::read_family;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render, Figure, LegendPosition, Series};
+use vibroimpact::model::parameter::ParameterizedModel;
 
 /// Options of `vibroimpact sweep`.
 #[derive(Args, Debug)]
@@ -266,7 +266,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             args.points
         )));
     }
-    let family = read_family(&args.range.model, &args.range.parameter)?;
+    let document = args.range.impacts.read(&args.range.model)?;
+    let family = ParameterizedModel::new(document, &args.range.parameter)?;
     let values = parameter_values(args.range.from, args.range.to, args.points);
     let lyapunov = match args.lyapunov {
         Some(None) => Some(

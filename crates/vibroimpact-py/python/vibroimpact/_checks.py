@@ -97,6 +97,18 @@ def _model(model: Any) -> Model:
     )
 
 
+def _with_impacts(m: Model, impacts: Optional[str], restitution: Any) -> Model:
+    """``m`` with the ``impacts`` and ``restitution`` arguments applied
+    (``--impacts``, ``--restitution``): every model a study builds has
+    them."""
+    if impacts is None and restitution is None:
+        return m
+    return m.with_impacts(
+        None if impacts is None else _method(impacts, ("soft", "rigid"), "impacts"),
+        _real(restitution, "restitution", optional=True),
+    )
+
+
 def _method(name: str, choices: Sequence[str], arg: str = "method") -> str:
     if name not in choices:
         raise ValueError(f"{arg} = {name!r}: give one of {', '.join(map(repr, choices))}")

@@ -23,6 +23,7 @@ from ._checks import (
     _method,
     _model,
     _progress,
+    _with_impacts,
     _real,
 )
 from ._map_runs import _chart_local, _sweep_local
@@ -95,6 +96,8 @@ def sweep(
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Progress = None,
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
 ) -> Result:
     """The brute-force bifurcation diagram (``vibroimpact sweep``): every
     value of ``parameter`` simulated for ``transient`` forcing periods, then
@@ -112,6 +115,11 @@ def sweep(
     for the periods the convergence needs, at most ``settle`` more (default
     9 × ``transient``): it is called periodic only once its samples repeat
     to ``cluster_tolerance`` (docs/theory.md §8).
+
+    ``impacts``: "soft" or "rigid" for every contact (rigid: velocity
+    jumps with the law's e(U), docs/theory.md §12), default the model
+    file's; ``restitution``: a constant coefficient in (0, 1] for rigid
+    impacts, as ``Model.with_impacts``.
 
     Returns ``parameter_name``, ``bodies``, ``from``, ``to``,
     ``transient_periods``, ``record_periods``, ``up_down``, ``rtol``,
@@ -133,7 +141,7 @@ def sweep(
     periods; a positive first one marks chaos) and
     ``lyapunov_uncertainty``, their standard errors (batch means).
     """
-    m = _model(model)
+    m = _with_impacts(_model(model), impacts, restitution)
     if not isinstance(parameter, str):
         raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
     v = _sweep_values(values, from_, to, points)
@@ -178,6 +186,8 @@ def chart(
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Progress = None,
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
 ) -> Result:
     """The brute-force stability chart (``vibroimpact chart``): every cell of
     the grid ``x_values`` × ``y_values`` of the parameters ``x`` and ``y``
@@ -197,6 +207,11 @@ def chart(
     on its workers in ``tasks`` chunks; the result is bit for bit the local
     one.
 
+    ``impacts``: "soft" or "rigid" for every contact (rigid: velocity
+    jumps with the law's e(U), docs/theory.md §12), default the model
+    file's; ``restitution``: a constant coefficient in (0, 1] for rigid
+    impacts, as ``Model.with_impacts``.
+
     Returns ``x_name``, ``y_name``, ``x_values``, ``y_values``,
     ``transient_periods``, ``record_periods``, ``rtol``,
     ``cluster_tolerance`` and ``cells`` (row by row: all x at the first y,
@@ -204,7 +219,7 @@ def chart(
     runs) and ``runs`` (``start``, ``period``, ``impacts_per_period``,
     ``max_displacement``, ``lyapunov``, ``error``).
     """
-    m = _model(model)
+    m = _with_impacts(_model(model), impacts, restitution)
     for name, value in (("x", x), ("y", y)):
         if not isinstance(value, str):
             raise TypeError(f"{name}: expected a parameter name, got {type(value).__name__}")
@@ -253,6 +268,8 @@ def basins(
     tasks: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Progress = None,
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
 ) -> Result:
     """Basins of attraction (``vibroimpact basins``): every initial state of
     the grid ``x_values`` × ``y_values`` of the state components ``x`` and
@@ -265,6 +282,11 @@ def basins(
     ``tasks`` chunks and the attractors are identified here over all of
     them; the result is bit for bit the local one.
 
+    ``impacts``: "soft" or "rigid" for every contact (rigid: velocity
+    jumps with the law's e(U), docs/theory.md §12), default the model
+    file's; ``restitution``: a constant coefficient in (0, 1] for rigid
+    impacts, as ``Model.with_impacts``.
+
     Returns ``x_component``, ``y_component``, ``x_values``, ``y_values``,
     ``base_state``, ``transient_periods``, ``record_periods``,
     ``attractors`` (each with ``period``, ``impacts_per_period``,
@@ -273,7 +295,7 @@ def basins(
     start, row by row; None where the start overlaps a contact or failed),
     ``inadmissible``, ``failed`` and ``errors``.
     """
-    m = _model(model)
+    m = _with_impacts(_model(model), impacts, restitution)
     for name, value in (("x", x), ("y", y)):
         if not isinstance(value, str):
             raise TypeError(f"{name}: expected a state component such as 'u1', got {type(value).__name__}")

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import Any, Optional, Sequence
 
 from . import _core
-from ._checks import ModelLike, Progress, _count, _flag, _floats, _method, _model, _progress, _real
+from ._checks import ModelLike, Progress, _count, _flag, _floats, _method, _model, _progress, _real, _with_impacts
 from ._core import VibroimpactError
 from ._results import Result, _keeping_on_ctrl_c
 
@@ -33,6 +33,8 @@ def periodic(
     symmetric: bool = False,
     progress: Progress = None,
     integrator: str = "auto",
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
 ) -> Result:
     """A periodic solution by shooting, with its Floquet multipliers
     (``vibroimpact periodic``).
@@ -51,6 +53,11 @@ def periodic(
     products replay); the simulated guess is the same for every
     integrator (simulated by the one "auto" picks).
 
+    ``impacts``: "soft" or "rigid" for every contact (rigid: velocity
+    jumps with the law's e(U), docs/theory.md §12), default the model
+    file's; ``restitution``: a constant coefficient in (0, 1] for rigid
+    impacts, as ``Model.with_impacts``.
+
     Returns ``converged``, ``method``, ``period``, ``subharmonic``,
     ``initial_state``, ``residual_history``, ``floquet_multipliers`` ([re,
     im] rows), ``spectral_radius``, ``stable``, ``symmetric_orbit``,
@@ -60,7 +67,7 @@ def periodic(
     Newton does not converge (the result is on the exception as
     ``.result``).
     """
-    m = _model(model)
+    m = _with_impacts(_model(model), impacts, restitution)
     if isinstance(guess, os.PathLike) or (
         isinstance(guess, str) and guess not in ("simulate", "homotopy")
     ):
@@ -169,6 +176,8 @@ def continue_(
     curves: Sequence[str] = ("fold", "bp", "pd", "ns", "grazing"),
     curve_step: float = 0.05,
     special_points: Any = None,
+    impacts: Optional[str] = None,
+    restitution: Optional[float] = None,
 ) -> Result:
     """A branch of periodic solutions by pseudo-arclength continuation in
     ``parameter`` from ``from_`` to ``to`` (``vibroimpact continue``), with
@@ -198,6 +207,11 @@ def continue_(
     curves' document (``parameter``, ``parameter2``, ``curves``,
     ``skipped``).
 
+    ``impacts``: "soft" or "rigid" for every contact (rigid: velocity
+    jumps with the law's e(U), docs/theory.md §12), default the model
+    file's; ``restitution``: a constant coefficient in (0, 1] for rigid
+    impacts, as ``Model.with_impacts``.
+
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
     MaxPoints, Interrupted, CannotContinue, ClosedLoop or TurnedBack: a
     fold brought it out of the range on its start's side) with ``stop_detail``,
@@ -209,7 +223,7 @@ def continue_(
     continue, and KeyboardInterrupt on Ctrl-C: the points so far are on
     the exception as ``.result`` (on Ctrl-C with ``stop`` "Interrupted").
     """
-    m = _model(model)
+    m = _with_impacts(_model(model), impacts, restitution)
     if not isinstance(parameter, str):
         raise TypeError(f"parameter: expected a name, got {type(parameter).__name__}")
     if switch_at is not None and not isinstance(switch_at, str):

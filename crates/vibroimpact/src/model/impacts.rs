@@ -142,3 +142,47 @@ impl Model {
         }
     }
 }
+
+impl crate::model::file::ModelDocument {
+    /// The document with every contact's impacts as a face's options set
+    /// them ([`Model::with_impact_options`], whose refusals, naming the
+    /// option, it gives): the `impacts` and `restitution` keys of `[row]`
+    /// and of every `[[contact]]` rewritten, so that every model the
+    /// document builds (a sweep's, a branch's) has them.
+    pub fn with_impact_options(
+        mut self,
+        impacts: Option<&str>,
+        restitution: Option<f64>,
+    ) -> Result<Self, FieldError> {
+        if impacts.is_none() && restitution.is_none() {
+            return Ok(self);
+        }
+        let model = self
+            .build()
+            .map_err(|e| FieldError::about("impacts", e.to_string()))?
+            .model
+            .with_impact_options(impacts, restitution)?;
+        let file = &mut self.file;
+        let row = file.row.iter_mut().map(|r| {
+            let spec = r.get_mut();
+            (&mut spec.impacts, &mut spec.restitution)
+        });
+        let tables = file.contact.iter_mut().map(|c| {
+            let spec = c.get_mut();
+            (&mut spec.impacts, &mut spec.restitution)
+        });
+        let rigid = model.has_rigid_impacts();
+        for (name, e) in row.chain(tables) {
+            match impacts {
+                Some(chosen) => {
+                    *name = Some(chosen.to_string());
+                    *e = restitution;
+                }
+                // A coefficient alone: on the file's rigid contacts.
+                None if rigid && name.as_deref() == Some("rigid") => *e = restitution,
+                None => {}
+            }
+        }
+        Ok(self)
+    }
+}

@@ -349,3 +349,51 @@ fn displacement_scale_is_a_simulation_setting() {
         "{e}"
     );
 }
+
+/// A face's `--impacts` and `--restitution` rewrite the document's keys,
+/// so that every model it builds has them (a sweep's, a branch's);
+/// refusals name the option.
+#[test]
+fn impact_options_rewrite_the_document() {
+    use crate::model::Impacts;
+    let doc = ModelDocument::from_toml(ROW, "m.toml").unwrap();
+    let rigid = doc
+        .clone()
+        .with_impact_options(Some("rigid"), Some(0.7))
+        .unwrap();
+    let m = rigid.build().unwrap().model;
+    let want = Impacts::Rigid {
+        restitution: Some(0.7),
+    };
+    assert!((0..4).all(|k| m.impacts(k) == want));
+    let p = rigid.parameter("frequency").unwrap();
+    let shifted = rigid.with_parameter(&p, 7.5).unwrap().model;
+    assert!((0..4).all(|k| shifted.impacts(k) == want));
+    // A coefficient alone changes the file's rigid contacts.
+    let e = rigid
+        .clone()
+        .with_impact_options(None, Some(0.4))
+        .unwrap()
+        .build()
+        .unwrap()
+        .model;
+    assert_eq!(
+        e.impacts(0),
+        Impacts::Rigid {
+            restitution: Some(0.4)
+        }
+    );
+    let soft = rigid.with_impact_options(Some("soft"), None).unwrap();
+    assert!(!soft.build().unwrap().model.has_rigid_impacts());
+    let e = doc
+        .clone()
+        .with_impact_options(Some("hard"), None)
+        .unwrap_err();
+    assert!(e.to_string().contains("impacts"), "{e}");
+    let e = doc.with_impact_options(None, Some(0.5)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("restitution = 0.5: a coefficient of restitution is for rigid impacts"),
+        "{e}"
+    );
+}
