@@ -585,6 +585,10 @@ pub struct SimulationSummary {
     pub contact_laws: Vec<String>,
     /// `global` or `local` (docs/theory.md §10).
     pub integrator: &'static str,
+    /// Rigid contacts' soft episodes (docs/theory.md §12): where the rigid
+    /// idealisation broke and the contact's law was integrated.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub soft_episodes: Vec<EpisodeSummary>,
     /// The local integrator's work: bound checks of contacts between
     /// exactly moving bodies, changes of the integrated set, its largest
     /// size and the number of bodies ever integrated.
@@ -686,6 +690,19 @@ pub struct EnergySummary {
     pub residual: f64,
 }
 
+/// One soft episode of a rigid contact, for the summaries.
+#[derive(Clone, Debug, Serialize)]
+pub struct EpisodeSummary {
+    /// The contact's name.
+    pub contact: String,
+    /// Start (s).
+    pub start_time: f64,
+    /// End (s): the bodies separated; None if still in contact at the end.
+    pub end_time: Option<f64>,
+    /// Why its law took over.
+    pub reason: String,
+}
+
 /// Builds the summary of a simulation.
 pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary {
     let mut counts = vec![0usize; model.contacts().len()];
@@ -730,6 +747,16 @@ pub fn simulation_summary(model: &Model, sim: &Simulation) -> SimulationSummary 
         rejected_steps: sim.stats.rejected_steps,
         contact_evaluations: sim.contact_evaluations,
         contact_laws: laws,
+        soft_episodes: sim
+            .soft_episodes
+            .iter()
+            .map(|e| EpisodeSummary {
+                contact: model.contact_name(e.contact),
+                start_time: e.start_time,
+                end_time: (!e.end_time.is_nan()).then_some(e.end_time),
+                reason: e.reason.describe(model),
+            })
+            .collect(),
         integrator: if sim.local.is_some() {
             "local"
         } else {

@@ -8,6 +8,7 @@
 //!   replay;
 //! - `storeys.rs` — the hysteretic storeys' terms and states;
 //! - `saltation.rs` — the saltation matrix of a rigid impact;
+//! - `episodes.rs` — a rigid contact's soft episodes;
 //! - `variational.rs` — the variational equations (sensitivities,
 //!   monodromy matrices, docs/theory.md §5);
 //! - `tests.rs` — the checks.
@@ -44,6 +45,7 @@ use crate::impact::rigid::RigidLaw;
 use crate::integrate::{BandMatrix, OdeSystem, Recorder};
 use crate::model::{BaseExcitation, Model};
 
+mod episodes;
 mod jacobian;
 pub mod saltation;
 mod storeys;
@@ -138,6 +140,9 @@ struct ContactTerm {
     /// Rigid impacts (docs/theory.md §12): never evaluated; the run
     /// applies each impact as a velocity jump by this map.
     rigid: Option<RigidLaw>,
+    /// The law's own screen and absurd approach: a rigid contact's soft
+    /// episode evaluates its law (`episodes.rs`).
+    soft: (Screen, f64),
 }
 
 /// Equations of motion of a model, ready for an integrator.
@@ -222,10 +227,11 @@ impl ChainDynamics {
                 // (A rigid contact's law was checked when it was set:
                 // Model::with_impacts.)
                 let rigid = model.rigid_law(k).ok().flatten();
+                let soft = (screen, absurd);
                 let (screen, absurd) = if rigid.is_some() {
                     (Screen::Never, f64::INFINITY)
                 } else {
-                    (screen, absurd)
+                    soft
                 };
                 ContactTerm {
                     left: c.pair.left(),
@@ -235,6 +241,7 @@ impl ChainDynamics {
                     screen,
                     absurd,
                     rigid,
+                    soft,
                 }
             })
             .collect::<Vec<_>>();
@@ -262,15 +269,7 @@ impl ChainDynamics {
             screen.ml.push(if c.left.is_some() { 1.0 } else { 0.0 });
             screen.mr.push(if c.right.is_some() { 1.0 } else { 0.0 });
             screen.g.push(c.clearance);
-            let (alpha, boa, limit) = match c.screen {
-                Screen::Exponential {
-                    alpha,
-                    b_over_a,
-                    limit,
-                } => (alpha, b_over_a, limit),
-                Screen::CompactSupport => (1.0, 0.0, 0.0),
-                Screen::Never => (0.0, 0.0, f64::INFINITY),
-            };
+            let (alpha, boa, limit) = c.screen.parts();
             screen.alpha.push(alpha);
             screen.boa.push(boa);
             screen.limit.push(limit);
@@ -536,7 +535,7 @@ impl ChainDynamics {
             .contacts
             .iter()
             .enumerate()
-            .filter(|(_, c)| c.rigid.is_none())
+            .filter(|(_, c)| !matches!(c.screen, Screen::Never))
         {
             let (s, _) = self.approach(k, y);
             e += c.law.potential(s);

@@ -4,7 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
-use super::switches::{apply_event, Event, Switches, Verdict};
+use super::switches::{apply_event, Event, Jump, Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -76,6 +76,7 @@ pub fn simulate_streaming(
     };
     let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
     let mut switches = Switches::new(&sys, y0.len(), s_on);
+    let mut episodes = Vec::new();
     let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
@@ -89,7 +90,8 @@ pub fn simulate_streaming(
                 // (counted as a step: events alone cannot run forever).
                 Err(event) => {
                     steps += 1;
-                    error = applied(event, (&mut st, &mut sys), &mut scan, extrema.as_mut())
+                    let runs = (&mut scan, extrema.as_mut(), &mut episodes);
+                    error = applied(event, (&mut st, &mut sys), sw, runs, opts)
                         .or_else(|| early_end(&st, method, opts, steps));
                     if error.is_some() {
                         break;
@@ -127,6 +129,12 @@ pub fn simulate_streaming(
         if let Some(x) = extrema.as_mut() {
             x.step(&mut st, &mut sys);
         }
+        if let Some(sw) = switches.as_mut() {
+            if let Err(e) = separated(&mut episodes, (&mut st, &mut sys), sw, &mut scan) {
+                error = Some(e);
+                break;
+            }
+        }
         if let Some(h) = scan.entry_limit(st.h_next()) {
             st.limit_next_step(h);
         }
@@ -155,8 +163,9 @@ pub fn simulate_streaming(
         // A bilinear storey's branch switches, or a contact's impact
         // velocity is set, where the step ended; the right-hand side
         // changes there, so the stepper restarts.
-        if let Some(event) = switch_here {
-            error = applied(event, (&mut st, &mut sys), &mut scan, extrema.as_mut());
+        if let (Some(event), Some(sw)) = (switch_here, switches.as_mut()) {
+            let runs = (&mut scan, extrema.as_mut(), &mut episodes);
+            error = applied(event, (&mut st, &mut sys), sw, runs, opts);
             if error.is_some() {
                 break;
             }
@@ -166,37 +175,54 @@ pub fn simulate_streaming(
         error = Some(IntegrationError::Interrupted { t });
     }
     let extrema = extrema.map(ExtremaScan::finish);
-    Ok(global_result(
-        model,
-        opts,
-        (st, sys),
-        scan,
-        e0,
-        error,
-        extrema,
-    ))
+    let mut sim = global_result(model, opts, (st, sys), scan, e0, error, extrema);
+    sim.soft_episodes = episodes;
+    Ok(sim)
 }
 
-/// Applies `event` where the stepper stands ([`apply_event`]): the extrema
-/// scan restarts there (and takes a rigid impact's velocity jump); a rigid
-/// impact enters the impact log.
+/// Applies `event` where the stepper stands ([`apply_event`]; a rigid
+/// contact's impact by [`Switches::rigid_or_soft`]): the extrema scan
+/// restarts there (and takes a rigid impact's velocity jump); a rigid
+/// impact enters the impact log; a soft episode starts its contact's law
+/// and tracker there.
 fn applied(
     event: Event,
     (st, sys): (&mut Stepper, &mut ChainDynamics),
-    scan: &mut StepScan,
-    extrema: Option<&mut ExtremaScan>,
+    sw: &mut Switches,
+    (scan, extrema, episodes): (
+        &mut StepScan,
+        Option<&mut ExtremaScan>,
+        &mut Vec<SoftEpisode>,
+    ),
+    opts: &SimulationOptions,
 ) -> Option<IntegrationError> {
-    let impact = match apply_event(st, sys, event) {
-        Ok(impact) => impact,
+    let Event::Impact(k) = event else {
+        if let Err(e) = apply_event(st, sys, event) {
+            return Some(e);
+        }
+        if let Some(x) = extrema {
+            x.restarted(st, false);
+        }
+        return None;
+    };
+    let (t, mut y, dydt) = (st.t(), st.y().to_vec(), st.dydt().to_vec());
+    let floor = st.options().atol;
+    let jump = match sw.rigid_or_soft(sys, k, (t, &mut y, &dydt), floor) {
+        Ok(jump) => jump,
         Err(e) => return Some(e),
     };
-    if let Some(x) = extrema {
-        x.restarted(st, impact.is_some());
+    if let Jump::Soft(_) = jump {
+        sys.set_soft_episode(k, true);
+        sw.suspend(k, true);
     }
-    if let Some((contact, r)) = impact {
-        let t = st.t();
-        scan.impacts.push(ImpactRecord {
-            contact,
+    if let Err(e) = st.reset(sys, t, &y) {
+        return Some(e);
+    }
+    let jumped = matches!(jump, Jump::Rigid(_));
+    match jump {
+        Jump::Touch => {}
+        Jump::Rigid(r) => scan.impacts.push(ImpactRecord {
+            contact: k,
             start_time: t,
             end_time: t,
             impact_velocity: r.impact_velocity,
@@ -204,9 +230,52 @@ fn applied(
             peak_force: r.peak_force,
             peak_time: t,
             rigid: Some(r),
-        });
+        }),
+        Jump::Soft(reason) => {
+            scan.trackers[k] = Tracker::new(sys.contact_law(k), opts.impact_force_threshold);
+            scan.previous[k] = contact_end(sys, k, st.y(), st.dydt());
+            scan.start(st, sys, k, t);
+            episodes.push(SoftEpisode {
+                contact: k,
+                start_time: t,
+                end_time: f64::NAN,
+                reason,
+            });
+        }
+    }
+    if let Some(x) = extrema {
+        x.restarted(st, jumped);
     }
     None
+}
+
+/// Ends every soft episode whose bodies have separated by the stepper's
+/// point (the approach below its impact threshold and opening, no impact
+/// under way): the contact's impacts are jumps again from there.
+fn separated(
+    episodes: &mut [SoftEpisode],
+    (st, sys): (&mut Stepper, &mut ChainDynamics),
+    sw: &mut Switches,
+    scan: &mut StepScan,
+) -> Result<(), IntegrationError> {
+    let mut ended = false;
+    for ep in episodes.iter_mut().filter(|e| e.end_time.is_nan()) {
+        let k = ep.contact;
+        let tracker = scan.trackers[k];
+        let (s, sd) = sys.approach(k, st.y());
+        if tracker.active.is_none() && s < tracker.s_on.min(0.0) && sd < 0.0 {
+            sys.set_soft_episode(k, false);
+            sw.suspend(k, false);
+            scan.trackers[k] = Tracker::never();
+            ep.end_time = st.t();
+            ended = true;
+        }
+    }
+    if ended {
+        let (t, y) = (st.t(), st.y().to_vec());
+        st.reset(sys, t, &y)?;
+    }
+    Ok(())
 }
 
 /// The impact scan of a global run from the stepper's start: every
@@ -474,5 +543,6 @@ fn global_result(
         error,
         extrema,
         local: None,
+        soft_episodes: Vec::new(),
     }
 }

@@ -236,6 +236,8 @@ pub struct Simulation {
     pub extrema: Option<Extrema>,
     /// The local integrator's work (None for the global one).
     pub local: Option<local::LocalStats>,
+    /// Rigid contacts' soft episodes, in order (docs/theory.md §12).
+    pub soft_episodes: Vec<SoftEpisode>,
 }
 
 impl Simulation {
@@ -605,6 +607,7 @@ fn simulate_local(
         error,
         extrema: run.extrema,
         local: Some(run.local),
+        soft_episodes: Vec::new(),
     })
 }
 
@@ -625,6 +628,7 @@ pub use gauges::{Gauge, GaugeReading};
 pub use global::simulate_streaming;
 pub use integrator::{Integrator, AUTO_LOCAL_GROUPS};
 pub(crate) use switches::{flow_through_events, ImpactJump};
+pub use switches::{EpisodeReason, SoftEpisode};
 
 #[cfg(test)]
 pub(crate) mod tests;

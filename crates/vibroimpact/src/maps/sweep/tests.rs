@@ -94,6 +94,7 @@ fn handover_skips_overlapping_states() {
         error: None,
         extrema: None,
         local: None,
+        soft_episodes: Vec::new(),
     };
     let s = handover(&model, &sim, 5, 16, 5 + 32).unwrap();
     assert_eq!(s.u, vec![-5e-4, 1e-4]);

@@ -4,7 +4,7 @@
 //! each rigid impact that updates what rides along (docs/theory.md §12:
 //! the saltation of the period map's columns).
 
-use super::{apply_event, rigid_jump, Event, Switches, Verdict};
+use super::{apply_event, Event, Jump, Switches, Verdict};
 use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
 use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stepper};
@@ -66,20 +66,32 @@ pub(crate) fn flow_through_events<S: Chain>(
             apply_event(&mut st, sys, event)?;
             continue;
         };
-        let (t, before) = (st.t(), st.y().to_vec());
+        let (t, before, dydt) = (st.t(), st.y().to_vec(), st.dydt().to_vec());
         let mut after = before.clone();
-        if let Some((contact, impact)) = rigid_jump(sys.chain(), k, (t, &mut after), opts.atol)? {
-            impacts += 1;
-            at_impact(
-                sys,
-                ImpactJump {
-                    contact,
+        match sw.rigid_or_soft(sys.chain(), k, (t, &mut after, &dydt), opts.atol)? {
+            Jump::Touch => {}
+            Jump::Rigid(impact) => {
+                impacts += 1;
+                at_impact(
+                    sys,
+                    ImpactJump {
+                        contact: k,
+                        t,
+                        before: &before,
+                        after: &mut after,
+                        impact: &impact,
+                    },
+                )?;
+            }
+            // A soft episode has no saltation: the map is the rigid one
+            // throughout, or none.
+            Jump::Soft(reason) => {
+                return Err(IntegrationError::RigidImpact {
                     t,
-                    before: &before,
-                    after: &mut after,
-                    impact: &impact,
-                },
-            )?;
+                    contact: k,
+                    reason: format!("{reason:?}: the rigid idealisation breaks there (a simulation takes it by the contact's law); the period map needs rigid impacts throughout: keep this contact soft (impacts = \"soft\")"),
+                });
+            }
         }
         st.reset(sys, t, &after)?;
     }

@@ -9,9 +9,9 @@
 //! happens inside a step, the step is taken again up to that time, and the
 //! event is applied there.
 //!
-//! Files: `mod.rs` (the switches), `flow.rs` (a bare flow through the
-//! events, for the period maps), `tests.rs` (exact piecewise motion of
-//! bilinear storeys).
+//! Files: `mod.rs` (the switches), `episodes.rs` (a rigid contact's soft
+//! episodes), `flow.rs` (a bare flow through the events, for the period
+//! maps), `tests.rs` (exact piecewise motion of bilinear storeys).
 
 use super::ChainDynamics;
 use crate::dynamics::Chain;
@@ -19,7 +19,10 @@ use crate::impact::rigid::RigidImpact;
 use crate::integrate::{IntegrationError, Stepper};
 use crate::numeric::brent;
 
+mod episodes;
 mod flow;
+pub(super) use episodes::Jump;
+pub use episodes::{EpisodeReason, SoftEpisode};
 pub(crate) use flow::{flow_through_events, ImpactJump};
 
 /// An event that changes the right-hand side.
@@ -82,6 +85,9 @@ pub(super) struct Switches {
     inside: [Vec<f64>; 3],
     /// The next event's time, once located.
     pending: Option<(f64, Event)>,
+    /// Per contact, its last rigid impact's time and estimated duration
+    /// (soft episodes, `episodes.rs`).
+    last_impact: Vec<(f64, f64)>,
 }
 
 impl Switches {
@@ -117,6 +123,7 @@ impl Switches {
             buf: vec![0.0; dim],
             inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
             pending: None,
+            last_impact: vec![(f64::NEG_INFINITY, 0.0); sys.contacts()],
         })
     }
 
@@ -142,6 +149,10 @@ impl Switches {
     /// that is kept (not one about to be taken again).
     fn rearm(&mut self, sys: &ChainDynamics, y: &[f64]) {
         for i in 0..self.events.len() {
+            // (A rigid contact's impact is suspended in a soft episode.)
+            if matches!(self.events[i], Event::Impact(_)) {
+                continue;
+            }
             if !self.armed[i] && self.value(sys, self.events[i], y) > 0.0 {
                 self.armed[i] = true;
             }

@@ -303,63 +303,74 @@ fn rigid_impacts_are_refused_where_they_are_not_followed() {
     assert!(crate::periodic::refuse_onset_laws(&model).is_ok());
 }
 
-/// A body pressed against a wall by a steady force (a ball on a table:
-/// p = 1 N, 0.1 m to fall, e = 0.5) bounces with U halving each time, so
-/// its impacts accumulate in finite time (at 3 √0.2 = 1.342 s): the run
-/// stops there with the reason, the resting contact, once the rebound's
-/// height (eU)²/2p is lost in the rounding of the gap (27 impacts, U of
-/// 7e-9 m/s), never crawling on. (It ran on for minutes before: each
-/// return was sought from the touch itself, found there in rounding, and
-/// applied as no impact.)
+/// A ball dropped 0.1 m on a table under gravity g = 1 m/s² (a
+/// Hunt–Crossley contact, k = 1e6 N/m^1.5, χ = 10 s/m): its rigid
+/// impacts lose less and less (e(U) → 1 − (2/3)χU), so they never
+/// accumulate in finite time, they only slow; once a rebound would return
+/// within the impact's estimated duration, the contact's law takes over
+/// in soft episodes (reason: resting; the first ones still separate) and
+/// the ball settles on the table at the static deflection (m g / k)^{2/3}
+/// = 1e-4 m, to 1e-7 m. (A constant e < 1 had stopped the run at the
+/// accumulation point.)
 #[test]
-fn accumulating_impacts_stop_the_run_with_the_reason() {
-    let steady = (1.0, 1e-9, std::f64::consts::FRAC_PI_2);
-    let mut model = oscillator(0.0, 0.1, steady, (0.0, 0.0))
-        .with_all_impacts(Impacts::Rigid {
-            restitution: Some(0.5),
-        })
-        .unwrap();
-    model = Model::new(
-        vec![Body {
-            stiffness: 0.0,
-            ..model.bodies()[0].clone()
-        }],
+fn a_ball_on_a_table_comes_to_rest_in_a_soft_episode() {
+    let ball = Body {
+        name: "ball".into(),
+        mass: 1.0,
+        stiffness: 0.0,
+        damping: 0.0,
+    };
+    let table = Contact {
+        pair: ContactPair::LeftWall { body: 0 },
+        clearance: 0.1,
+        law: ContactLaw::hunt_crossley(1e6, 1.5, 10.0, ForceForm::Published).unwrap(),
+    };
+    let model = Model::new(
+        vec![ball],
         vec![],
-        model.contacts().to_vec(),
+        vec![table],
         BaseExcitation::None,
-        model.forces().to_vec(),
-        vec![0.0],
-        vec![0.0],
+        vec![],
+        vec![],
+        vec![],
     )
     .unwrap()
-    .with_all_impacts(Impacts::Rigid {
-        restitution: Some(0.5),
-    })
+    .with_gravity(1.0)
+    .unwrap()
+    .with_all_impacts(Impacts::Rigid { restitution: None })
     .unwrap();
-    let sim = rigid_run(&model, 3.0, 1e-10, false);
-    let e = sim
-        .error
-        .as_ref()
-        .map(ToString::to_string)
-        .unwrap_or_default();
+    let sim = rigid_run(&model, 4.0, 1e-10, false);
+    assert!(sim.error.is_none(), "{:?}", sim.error);
+    let rigid = sim.impacts.iter().filter(|i| i.rigid.is_some()).count();
+    eprintln!("{rigid} rigid impacts, episodes {:?}", sim.soft_episodes);
+    assert!((5..=30).contains(&rigid), "{rigid}");
+    // (Measured: 9 rigid impacts, two soft episodes that still separate,
+    // the third for good from t = 1.218 s.)
+    let episodes = &sim.soft_episodes;
+    assert!((1..=5).contains(&episodes.len()), "{episodes:?}");
+    assert!(episodes
+        .iter()
+        .all(|e| matches!(e.reason, EpisodeReason::Resting { .. })));
+    let (last, before) = episodes.split_last().unwrap();
     assert!(
-        e.contains("rigid impact of contact 0") && e.contains("resting contact"),
-        "{e}"
+        before.iter().all(|e| e.end_time > e.start_time),
+        "{episodes:?}"
     );
+    let ep = last;
+    assert!(ep.end_time.is_nan() && ep.start_time < 3.0, "{ep:?}");
+    let rest = -0.1 - 1e-4;
     assert!(
-        e.contains("contact wall|m") || e.contains("contact m|wall"),
-        "{e}"
-    );
-    assert!(
-        (20..=45).contains(&sim.impacts.len()),
+        (sim.final_displacement[0] - rest).abs() < 1e-7,
         "{}",
-        sim.impacts.len()
+        sim.final_displacement[0]
     );
-    let t_inf = 3.0 * 0.2f64.sqrt();
-    let Some(IntegrationError::RigidImpact { t, .. }) = sim.error.map(|f| f.source) else {
-        unreachable!("checked above")
-    };
-    assert!((t - t_inf).abs() < 1e-7, "{t} {t_inf}");
+    assert!(
+        sim.final_velocity[0].abs() < 1e-5,
+        "{}",
+        sim.final_velocity[0]
+    );
+    let described = ep.reason.describe(&model);
+    assert!(described.contains("a resting contact"), "{described}");
 }
 
 /// The seed's row R2 N = 3 at 0.95 ω0 from rest, soft (the exponential
