@@ -18,7 +18,7 @@ use super::frame::Gravity;
 use super::ShearFrame;
 use crate::contact::ContactLaw;
 use crate::model::hysteresis::{BoucWen, Degradation, LawError, StoreyLaw, StoreySpec};
-use crate::model::{Body, Contact, ContactPair, Coupling, Storey};
+use crate::model::{Body, Contact, ContactPair, Coupling, Impacts, Storey};
 
 /// Standard gravity (m/s²): a friction pendulum's weight, P-Δ loads,
 /// accelerations in g.
@@ -213,6 +213,9 @@ pub struct Moat {
     pub law: ContactLaw,
     /// A flexible wall (each side), or None for a rigid one.
     pub wall: Option<Wall>,
+    /// How slab and wall impact: through the law (soft, the default) or
+    /// as velocity jumps (rigid, docs/theory.md §12).
+    pub impacts: Impacts,
 }
 
 /// A flexible moat wall: the mass that moves with it and its spring and

@@ -8,6 +8,7 @@ use crate::field_error::FieldError;
 use crate::model::file::LawSpec;
 use crate::model::hysteresis::StoreySpec;
 use crate::model::record::Record;
+use crate::model::Impacts;
 
 /// Why a pounding study cannot run or did not finish.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -106,6 +107,8 @@ struct MoatSpec {
     gap: f64,
     law: LawSpec,
     wall: Option<Wall>,
+    impacts: Option<String>,
+    restitution: Option<f64>,
 }
 
 #[derive(serde::Deserialize)]
@@ -178,10 +181,18 @@ fn building(name: String, f: BuildingSpec, what: &str) -> Result<Building, Pound
             let moat = i
                 .moat
                 .map(|m| {
+                    let impacts = match (&m.impacts, m.restitution) {
+                        (None, None) => Ok(Impacts::Soft),
+                        (name, e) => Impacts::parse(name.as_deref().unwrap_or("soft"), e),
+                    }
+                    .map_err(|e| {
+                        PoundingError::pair("impacts", format!("{what}: isolation: moat.{e}"))
+                    })?;
                     Ok::<_, PoundingError>(Moat {
                         gap: m.gap,
                         law: law(&m.law, "law", &format!("{what}: isolation: moat."))?,
                         wall: m.wall,
+                        impacts,
                     })
                 })
                 .transpose()?;

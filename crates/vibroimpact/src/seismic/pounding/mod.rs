@@ -352,6 +352,16 @@ impl Row {
             Vec::new(),
         )
         .and_then(|m| m.with_storeys(parts.storeys))
+        .and_then(|mut m| {
+            // Rigid moat walls (docs/theory.md §12).
+            for (b, p) in self.buildings.iter().zip(&placements) {
+                let moat = b.isolation.as_ref().and_then(|i| i.moat.as_ref());
+                for (&k, moat) in p.moat.iter().zip(std::iter::repeat(moat).flatten()) {
+                    m = m.with_impacts(k, moat.impacts)?;
+                }
+            }
+            Ok(m)
+        })
         .map_err(|e| PoundingError::Pair {
             file: None,
             line: None,

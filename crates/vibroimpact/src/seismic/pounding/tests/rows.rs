@@ -459,3 +459,60 @@ fn a_storey_past_its_height_stops_the_run() {
         assert!((a - b).abs() <= 1e-9 * a.abs(), "{a} {b}");
     }
 }
+
+/// A rigid moat wall (`impacts = "rigid"`, docs/theory.md §12). Against
+/// a stiff wall (Hertz k = 5e12) the slab reaches the wall and rebounds
+/// at once, entering it only in soft episodes: its peak displacement lies
+/// between the gap and the soft wall's. Against the example's
+/// wall (k = 5e9) an impact lasts 80 ms: where the ground presses the
+/// slab back within that time, the wall's law takes over in a soft
+/// episode (reason: resting), as the summary says. Bad keys are refused
+/// by name.
+#[test]
+fn a_rigid_moat_wall() {
+    let run = RunSettings::new(0.005, 1e-8);
+    let gap = 0.117;
+    let file = |extra: &str, k: &str| {
+        isolated(&gap.to_string(), extra).replace("stiffness = 5e9", &format!("stiffness = {k}"))
+    };
+    let at = |extra: &str, k: &str| {
+        let row = parse_row(&file(extra, k), "iso.toml").unwrap();
+        let rm = row.model(&record(), 0.4, true).unwrap();
+        let res = row.respond(&record(), 0.4, true, &run).unwrap();
+        (res.isolators[0].unwrap(), rm)
+    };
+    let rigid = ", impacts = \"rigid\", restitution = 0.7";
+    let (stiff, _) = at(rigid, "5e12");
+    let (soft, _) = at("", "5e12");
+    eprintln!("rigid {stiff:?}\nsoft {soft:?}");
+    // (Measured: rigid 0.117198 m, 19 impacts, the slab in the wall only
+    // in its soft episodes; soft 0.117743 m.)
+    assert!(stiff.moat_impacts > 0, "{stiff:?}");
+    assert!(
+        stiff.peak_displacement >= gap && stiff.peak_displacement < soft.peak_displacement,
+        "{stiff:?} vs {soft:?}"
+    );
+    // The example's wall: soft episodes where the slab is pressed back.
+    let row = parse_row(&file(rigid, "5e9"), "iso.toml").unwrap();
+    let rm = row.model(&record(), 0.4, true).unwrap();
+    let opts = row.options(&record(), &run).unwrap();
+    let sim = crate::simulate::simulate(&rm.model, &opts).unwrap();
+    assert!(!sim.soft_episodes.is_empty());
+    for ep in &sim.soft_episodes {
+        let why = ep.reason.describe(&rm.model);
+        assert!(why.contains("a resting contact"), "{why}");
+    }
+    for (extra, needle) in [
+        (
+            ", impacts = \"hard\"",
+            "impacts = \"hard\": must be soft or rigid",
+        ),
+        (
+            ", restitution = 0.7",
+            "restitution = 0.7: a coefficient of restitution is for rigid impacts",
+        ),
+    ] {
+        let e = parse_row(&isolated(&gap.to_string(), extra), "iso.toml").unwrap_err();
+        assert!(e.to_string().contains(needle), "{e}");
+    }
+}
