@@ -157,23 +157,15 @@ pub(crate) fn period_map_with(
             return forced_map(model, x, opts, (model_p, dp, t_p), t, max_steps);
         }
     }
-    let sys = Recorder::new(ChainDynamics::new(model, false), !dense);
     let columns = if dense { d } else { 0 };
-    let (mut var, dt_dp) = match shifted {
-        Some((model_p, dp)) => {
-            let t_p = map_time(model_p, opts).map_err(invalid)?;
-            let shifted_sys = Recorder::new(ChainDynamics::new(model_p, false), false);
-            let reforced = model.differs_only_in_forcing(model_p)
-                && sys.system().same_contact_terms(shifted_sys.system());
-            let var = if reforced {
-                Variational::with_forcing_parameter(sys, columns, shifted_sys, dp)
-            } else {
-                Variational::with_parameter(sys, columns, shifted_sys, dp)
-            };
-            (var, (t_p - t) / dp)
-        }
-        None => (Variational::new(sys, columns), 0.0),
-    };
+    let recorded = |m: &Model, on: bool| Recorder::new(ChainDynamics::new(m, false), on);
+    let (mut var, dt_dp) = variational_map(
+        (model, recorded(model, !dense)),
+        columns,
+        shifted.map(|(m, dp)| (m, recorded(m, false), dp)),
+        (opts, t),
+        Recorder::system,
+    )?;
     let z0 = var.initial_state(&to_interleaved(x));
     // The state controls the steps: Φ rides along on the same steps, so a
     // period map costs O(N) steps × O(N² · bandwidth) per step.
@@ -202,6 +194,33 @@ pub(crate) fn period_map_with(
         steps: stats.steps,
         tangent,
     })
+}
+
+/// The variational system of a period map: `sys` (of `model`) with
+/// `columns` columns of Φ and, with `shifted = (model at p + dp, its
+/// system, dp)`, the parameter's column (the shifted system reusing the
+/// rest of the right-hand side where only the forcing differs); and dT/dp
+/// of the map's time `t`. `chain` reads a system's dynamics.
+pub(super) fn variational_map<S: OdeSystem>(
+    (model, sys): (&Model, S),
+    columns: usize,
+    shifted: Option<(&Model, S, f64)>,
+    (opts, t): (&ShootingOptions, f64),
+    chain: impl Fn(&S) -> &ChainDynamics,
+) -> Result<(Variational<S>, f64), IntegrationError> {
+    let Some((model_p, shifted_sys, dp)) = shifted else {
+        return Ok((Variational::new(sys, columns), 0.0));
+    };
+    let t_p =
+        map_time(model_p, opts).map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+    let reforced = model.differs_only_in_forcing(model_p)
+        && chain(&sys).same_contact_terms(chain(&shifted_sys));
+    let var = if reforced {
+        Variational::with_forcing_parameter(sys, columns, shifted_sys, dp)
+    } else {
+        Variational::with_parameter(sys, columns, shifted_sys, dp)
+    };
+    Ok((var, (t_p - t) / dp))
 }
 
 /// The shooting map's image alone (body order) in at most `max_steps`

@@ -5,7 +5,9 @@
 //! velocity-dependent law, seed eq. (10)). Φ is always dense here: the
 //! matrix-free products are products with it.
 
-use super::map::{parameter_column, shooting_map, MapDerivatives, MapTangent, Tape};
+use super::map::{
+    parameter_column, shooting_map, variational_map, MapDerivatives, MapTangent, Tape,
+};
 use super::*;
 use crate::dynamics::saltation::Saltation;
 use crate::simulate::{flow_through_events, ImpactJump};
@@ -29,22 +31,14 @@ pub(super) fn rigid_map(
             MAX_DENSE_DIM / 2
         )));
     }
-    let sys = ChainDynamics::new(model, false);
-    let (mut var, dt_dp) = match shifted {
-        Some((model_p, dp)) => {
-            let t_p = map_time(model_p, opts)
-                .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
-            let shifted_sys = ChainDynamics::new(model_p, false);
-            let var =
-                if model.differs_only_in_forcing(model_p) && sys.same_contact_terms(&shifted_sys) {
-                    Variational::with_forcing_parameter(sys, d, shifted_sys, dp)
-                } else {
-                    Variational::with_parameter(sys, d, shifted_sys, dp)
-                };
-            (var, (t_p - t) / dp)
-        }
-        None => (Variational::new(sys, d), 0.0),
-    };
+    let dynamics = |m: &Model| ChainDynamics::new(m, false);
+    let (mut var, dt_dp) = variational_map(
+        (model, dynamics(model)),
+        d,
+        shifted.map(|(m, dp)| (m, dynamics(m), dp)),
+        (opts, t),
+        |c| c,
+    )?;
     let z0 = var.initial_state(&to_interleaved(x));
     let int_opts = opts.integrator_options(max_steps, Some(d));
     let (z, steps, _) = flow_through_events(&mut var, &z0, t, &int_opts, saltation)?;
