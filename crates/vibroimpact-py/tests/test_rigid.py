@@ -102,3 +102,14 @@ def test_impacts_reach_every_study(cli):
     with pytest.raises(ValueError) as e:
         vi.periodic(m, impacts="hard")
     assert "impacts = 'hard'" in str(e.value)
+
+
+def test_soft_episodes_are_listed_as_on_the_command_line(cli):
+    # The seed's row with rigid impacts: chains overlap, and those
+    # impacts are taken by the law in soft episodes, each with its
+    # contact, times and reason, the same from Python as from the CLI.
+    row = EXAMPLES / "fujita-row.toml"
+    r = vi.simulate(row, periods=5, impacts="rigid", output_step=0)
+    doc = cli("simulate", str(row), "--periods", "5", "--impacts", "rigid")
+    assert r.soft_episodes == doc["soft_episodes"] and len(r.soft_episodes) >= 1
+    assert all("shared body" in e["reason"] for e in r.soft_episodes)
