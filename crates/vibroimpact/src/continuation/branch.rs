@@ -350,6 +350,26 @@ impl<F: Family + Send> Continuation<F> {
         })
     }
 
+    /// Why a branch through rigid impacts cannot step on where it is not
+    /// at a grazing: the rigid period map just beyond the current point
+    /// (a step of 10 ds_min) fails, typically because an impact there
+    /// would overlap another's estimated duration, where the rigid
+    /// idealisation breaks (docs/theory.md §12).
+    fn rigid_breaks(&mut self) -> Option<String> {
+        let z = self.current.predict(10.0 * self.problem.opts.ds_min);
+        let (x, p) = self.problem.unscale(&z);
+        let model = self.problem.model(p).ok()?;
+        if !model.has_rigid_impacts() {
+            return None;
+        }
+        let shooting = &self.problem.opts.shooting;
+        let e =
+            crate::periodic::map_image(&model, &x, shooting, crate::periodic::MAX_STEPS).err()?;
+        Some(format!(
+            ": just beyond it (parameter {p}) the rigid period map fails: {e}"
+        ))
+    }
+
     /// The next point corrected, not yet finished, or the reason the
     /// branch ends.
     fn advance(&mut self) -> Result<Corrected, Ending> {
@@ -383,7 +403,10 @@ impl<F: Family + Send> Continuation<F> {
             }
             if self.ds < self.problem.opts.ds_min {
                 let p = self.current.point.parameter;
-                let grazes = self.rigid_grazing().unwrap_or_default();
+                let grazes = self
+                    .rigid_grazing()
+                    .or_else(|| self.rigid_breaks())
+                    .unwrap_or_default();
                 return Err(end(StopReason::CannotContinue(format!(
                     "the corrector does not converge beyond parameter {p} even with step {:e}{grazes}",
                     self.ds

@@ -366,7 +366,22 @@ impl ParameterizedModel {
 
     /// `document` as a family in its forcing amplitude, with its own
     /// amplitude (the homotopy start's family and the value to reach).
+    ///
+    /// Rigid impacts are taken soft (docs/theory.md §12): the rigid period
+    /// map is not smooth where the growing orbit first grazes, the soft
+    /// one is, and the soft orbit at the target starts Newton on the
+    /// rigid one.
     pub fn in_amplitude(document: ModelDocument) -> Result<(Self, f64), ModelFileError> {
+        let rigid = document
+            .build()
+            .is_ok_and(|loaded| loaded.model.has_rigid_impacts());
+        let document = if rigid {
+            document
+                .with_impact_options(Some("soft"), None)
+                .map_err(|e| ModelFileError(e.to_string()))?
+        } else {
+            document
+        };
         let family = Self::new(document, "amplitude")?;
         let target = family.initial();
         Ok((family, target))

@@ -537,3 +537,56 @@ fn the_map_jumps_as_the_square_root_past_grazing() {
     eprintln!("jumps {d:?}: exponent {slope}");
     assert!((slope - 0.5).abs() < 0.02, "{slope}: {d:?}");
 }
+
+/// The rigid R2 N = 2 branch from the homotopy, which runs with soft
+/// impacts (the rigid map's corner at the first grazing stopped it at an
+/// amplitude of 0.0055 of 0.05 m/s²): Newton on the rigid model converges
+/// from the soft orbit at 0.95 ω0 to the rigid orbit that the soft orbits
+/// tend to (its state within 7.5e-5 m of the soft one at the seed's α,
+/// as `soft_orbits_tend_to_the_rigid_orbit` measures). Continued down in
+/// frequency, the branch ends where an impact would start within another's
+/// estimated duration (the rigid idealisation breaks), near 0.56 ω0, and
+/// says so.
+#[test]
+fn a_rigid_branch_starts_from_the_soft_homotopy() {
+    use crate::continuation::{
+        amplitude_homotopy, continue_branch, ContinuationOptions, StopReason,
+    };
+    use crate::model::file::ModelDocument;
+    use crate::model::parameter::ParameterizedModel;
+    let text = include_str!("../../../../../examples/fujita-row-n2.toml");
+    let soft_doc = ModelDocument::from_toml(text, "fujita-row-n2.toml").unwrap();
+    let doc = soft_doc
+        .clone()
+        .with_impact_options(Some("rigid"), None)
+        .unwrap();
+    let opts = ContinuationOptions::default();
+    let (family, target) = ParameterizedModel::in_amplitude(doc.clone()).unwrap();
+    let guess = amplitude_homotopy(&family, target, &opts).unwrap();
+    let rigid = doc.build().unwrap().model;
+    let r = shoot(&rigid, &guess, &opts.shooting).unwrap();
+    assert!(r.converged, "{:?}", r.residual_history);
+    let soft = shoot(&soft_doc.build().unwrap().model, &guess, &opts.shooting).unwrap();
+    let dx = r
+        .initial_state
+        .iter()
+        .zip(&soft.initial_state)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "rigid orbit {:?}, {dx:e} m from the soft one",
+        r.multipliers
+    );
+    assert!((6.0e-5..7.5e-5).contains(&dx), "{dx}");
+    let frequency = ParameterizedModel::new(doc, "frequency").unwrap();
+    let w = rigid.forcing_frequency().unwrap();
+    let branch =
+        continue_branch(&frequency, w, &r.initial_state, 0.5 * w, &opts, |_| true).unwrap();
+    let StopReason::CannotContinue(why) = &branch.stop else {
+        unreachable!("{:?}", branch.stop)
+    };
+    let last = branch.points.last().unwrap().parameter;
+    eprintln!("{} points, last at {last}: {why}", branch.points.len());
+    assert!(why.contains("the rigid idealisation breaks"), "{why}");
+    assert!((0.55..0.6).contains(&(last / 7.41)), "{last}");
+}

@@ -51,17 +51,22 @@ pub enum EpisodeReason {
 impl EpisodeReason {
     /// The reason in words, contacts by name.
     pub fn describe(&self, model: &Model) -> String {
+        self.describe_by(|k| model.contact_name(k))
+    }
+
+    /// The reason in words, contacts named by `name` (of an index).
+    pub fn describe_by<S: std::fmt::Display>(&self, name: impl Fn(usize) -> S) -> String {
         match self {
             Self::Resting { rebound, back, duration } => format!(
                 "its rebound ({rebound:.3e} m/s) returns after {back:.3e} s, within the impact's estimated duration {duration:.3e} s: a resting contact"
             ),
             Self::Overlap { other, after, duration } => format!(
                 "{after:.3e} s after an impact of contact {} on a shared body, within that impact's estimated duration {duration:.3e} s",
-                model.contact_name(*other)
+                name(*other)
             ),
             Self::Cluster { other } => format!(
                 "contact {}, on a shared body, is in a soft episode",
-                model.contact_name(*other)
+                name(*other)
             ),
             Self::Slow { velocity } => format!(
                 "approach velocity {velocity:.3e} m/s, at or below the absolute tolerance"

@@ -89,7 +89,7 @@ pub(crate) fn flow_through_events<S: Chain>(
                 return Err(IntegrationError::RigidImpact {
                     t,
                     contact: k,
-                    reason: format!("{reason:?}: the rigid idealisation breaks there (a simulation takes it by the contact's law); the period map needs rigid impacts throughout: keep this contact soft (impacts = \"soft\")"),
+                    reason: format!("{}: the rigid idealisation breaks there (a simulation takes it by the contact's law); the period map needs rigid impacts throughout: keep this contact soft (impacts = \"soft\")", reason.describe_by(|j| j)),
                 });
             }
         }
