@@ -8,7 +8,8 @@
 //! - `shooting.rs` — one period map with the full monodromy, Newton–Krylov;
 //! - `local.rs` — the local integrator against SUNDIALS and the global one,
 //!   and on many clusters;
-//! - `storeys.rs` — the local integrator with yielding storeys.
+//! - `storeys.rs` — the local integrator with yielding storeys;
+//! - `rigid.rs` — rigid impacts against the soft law they are the limit of.
 
 use serde_json::Value;
 
@@ -17,6 +18,7 @@ use crate::common::Peers;
 pub mod local;
 pub mod n1000;
 pub mod n3;
+pub mod rigid;
 pub mod scaling;
 pub mod shooting;
 pub mod storeys;
@@ -29,7 +31,7 @@ pub type Entries = Vec<(&'static str, Value)>;
 pub type Section = fn(Option<&Peers>, bool) -> Entries;
 
 /// Every section in the order it runs, with the name `--only` takes.
-pub const ALL: [(&str, Section); 7] = [
+pub const ALL: [(&str, Section); 8] = [
     ("n3", n3::run),
     ("n1000", n1000::run),
     ("scaling", scaling::run),
@@ -37,4 +39,5 @@ pub const ALL: [(&str, Section); 7] = [
     ("local", local::run),
     ("clusters", local::clusters_section),
     ("storeys", storeys::run),
+    ("rigid", rigid::run),
 ];

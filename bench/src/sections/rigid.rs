@@ -1,0 +1,189 @@
+//! Section 8: rigid impacts (docs/theory.md §12) against the soft law they
+//! are the limit of, on the same problems (issue 40's speed checks).
+//!
+//! 1. R2, N = 3 over 1,000 periods at 0.95 ω0, rtol 1e-8 (atol 1e-12):
+//!    the soft run and the rigid run with the seed's e(V), global
+//!    integrator (the local one does not take rigid impacts yet), timed,
+//!    with their impact counts and the rigid run's soft episodes.
+//! 2. The R2 N = 2 frequency-response branch from 0.95 ω0 up to 1.5 ω0,
+//!    default continuation settings, each model from its own orbit at
+//!    0.95 ω0 (the homotopy, timed apart): the branch alone, timed, with
+//!    its points and special points. (Below 0.56 ω0 the rigid branch ends
+//!    where impacts of 3e-4 m/s would overlap: the rigid idealisation
+//!    breaks there, so the whole 0.5–1.5 ω0 branch has no rigid twin.)
+//! 3. A struck row of N = 1,000 pendulums (R2's, 1 mm gaps, no forcing,
+//!    the first at 0.1 m/s) over 0.5 s: impacts one at a time. Soft on
+//!    the local integrator against rigid on the global one.
+
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use vibroimpact::continuation::{amplitude_homotopy, continue_branch, ContinuationOptions};
+use vibroimpact::model::file::ModelDocument;
+use vibroimpact::model::parameter::ParameterizedModel;
+use vibroimpact::model::{reference, Impacts, Model};
+use vibroimpact::simulate::{simulate, Integrator, SimulationOptions};
+
+use super::Entries;
+use crate::common::{r2, t_end, Peers};
+
+/// The example row of two (`examples/fujita-row-n2.toml`).
+const ROW_N2: &str = include_str!("../../../examples/fujita-row-n2.toml");
+
+pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
+    let repeats = if quick { 2 } else { 5 };
+    let mut out = serde_json::Map::new();
+    out.insert("r2_n3_1000_periods".into(), r2_n3(repeats));
+    out.insert("r2_n2_branch".into(), r2_n2_branch(repeats));
+    out.insert("struck_row".into(), struck_row(repeats));
+    vec![("rigid", Value::Object(out))]
+}
+
+/// One timed simulation (best of `repeats`): seconds, impacts, soft
+/// episodes, right-hand sides.
+fn timed(model: &Model, opts: &SimulationOptions, repeats: usize) -> (f64, usize, usize, u64) {
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        let sim = simulate(model, opts).expect("valid options");
+        best = best.min(start.elapsed().as_secs_f64());
+        assert!(sim.error.is_none(), "run failed: {:?}", sim.error);
+        last = Some(sim);
+    }
+    let sim = last.expect("one run");
+    (
+        best,
+        sim.impacts.len(),
+        sim.soft_episodes.len(),
+        sim.stats.rhs_evaluations,
+    )
+}
+
+/// Section 1: R2 N = 3 over 1,000 periods, soft and rigid.
+pub fn r2_n3(repeats: usize) -> Value {
+    println!("\n== rigid impacts: R2, N = 3, 1000 periods at 0.95 omega0, rtol 1e-8, global integrator ==");
+    let soft = r2(3);
+    let rigid = soft
+        .clone()
+        .with_all_impacts(Impacts::Rigid { restitution: None })
+        .expect("rigid R2");
+    let opts = SimulationOptions {
+        t_end: t_end(1000.0),
+        rtol: 1e-8,
+        atol: 1e-12,
+        integrator: Integrator::Global,
+        ..SimulationOptions::default()
+    };
+    let (ts, is, _, rs) = timed(&soft, &opts, repeats);
+    let (tr, ir, er, rr) = timed(&rigid, &opts, repeats);
+    println!("soft  {:>9.1} ms  impacts {is:>6}  rhs {rs}", ts * 1e3);
+    println!(
+        "rigid {:>9.1} ms  impacts {ir:>6}  rhs {rr}  soft episodes {er}",
+        tr * 1e3
+    );
+    println!("soft / rigid = {:.2} (issue 40 asks >= 30)", ts / tr);
+    json!({
+        "soft": {"seconds": ts, "impacts": is, "rhs_evaluations": rs},
+        "rigid": {"seconds": tr, "impacts": ir, "rhs_evaluations": rr, "soft_episodes": er},
+        "soft_over_rigid": ts / tr,
+    })
+}
+
+/// Section 2: the R2 N = 2 branch from 0.95 ω0 to 1.5 ω0, soft and rigid.
+pub fn r2_n2_branch(repeats: usize) -> Value {
+    println!("\n== rigid impacts: R2, N = 2 branch from 0.95 to 1.5 omega0 (the branch alone) ==");
+    let from = 0.95 * reference::NATURAL_FREQUENCY;
+    let to = 1.5 * reference::NATURAL_FREQUENCY;
+    let text = ROW_N2.replace("frequency = 7.0395 ", &format!("frequency = {from} "));
+    let opts = ContinuationOptions::default();
+    let mut rows = serde_json::Map::new();
+    let mut seconds = [0.0; 2];
+    for (i, impacts) in ["soft", "rigid"].into_iter().enumerate() {
+        let doc = ModelDocument::from_toml(&text, "fujita-row-n2.toml")
+            .and_then(|d| {
+                d.with_impact_options(Some(impacts), None)
+                    .map_err(|e| vibroimpact::model::file::ModelFileError(e.to_string()))
+            })
+            .expect("the example row");
+        let (amplitude, target) = ParameterizedModel::in_amplitude(doc.clone()).expect("family");
+        let start = amplitude_homotopy(&amplitude, target, &opts).expect("homotopy");
+        let family = ParameterizedModel::new(doc, "frequency").expect("family");
+        let mut best = f64::INFINITY;
+        let mut last = None;
+        for _ in 0..repeats.max(1) {
+            let t0 = Instant::now();
+            let branch =
+                continue_branch(&family, from, &start, to, &opts, |_| true).expect("branch");
+            best = best.min(t0.elapsed().as_secs_f64());
+            last = Some(branch);
+        }
+        let branch = last.expect("one branch");
+        let special: Vec<(String, f64)> = branch
+            .special
+            .iter()
+            .map(|s| (s.label.clone(), s.parameter))
+            .collect();
+        println!(
+            "{impacts:<5} {:>8.2} ms  {} points  {}  special {special:?}",
+            best * 1e3,
+            branch.points.len(),
+            branch.stop
+        );
+        seconds[i] = best;
+        rows.insert(
+            impacts.into(),
+            json!({"seconds": best, "points": branch.points.len(), "special": special, "stop": branch.stop.to_string()}),
+        );
+    }
+    println!(
+        "soft / rigid = {:.2} (issue 40 asks >= 10)",
+        seconds[0] / seconds[1]
+    );
+    rows.insert("soft_over_rigid".into(), json!(seconds[0] / seconds[1]));
+    Value::Object(rows)
+}
+
+/// Section 3: a struck row of 1,000 pendulums with gaps, soft (local)
+/// and rigid (global).
+pub fn struck_row(repeats: usize) -> Value {
+    println!(
+        "\n== rigid impacts: struck row of 1000 pendulums, 1 mm gaps, first at 0.1 m/s, 0.5 s =="
+    );
+    let n = 1000;
+    let mut velocity = vec![0.0; n];
+    velocity[0] = 0.1;
+    let soft = reference::r2_forced(n, reference::CLEARANCE, reference::NATURAL_FREQUENCY, 0.0)
+        .and_then(|m| m.with_initial_state(vec![0.0; n], velocity))
+        .expect("struck row");
+    let rigid = soft
+        .clone()
+        .with_all_impacts(Impacts::Rigid { restitution: None })
+        .expect("rigid row");
+    let opts = |integrator| SimulationOptions {
+        t_end: 0.5,
+        rtol: 1e-8,
+        atol: 1e-12,
+        integrator,
+        ..SimulationOptions::default()
+    };
+    let (ts, is, _, rs) = timed(&soft, &opts(Integrator::Local), repeats);
+    let (tr, ir, er, rr) = timed(&rigid, &opts(Integrator::Global), repeats);
+    println!(
+        "soft, local   {:>9.2} ms  impacts {is:>5}  rhs {rs}",
+        ts * 1e3
+    );
+    println!(
+        "rigid, global {:>9.2} ms  impacts {ir:>5}  rhs {rr}  soft episodes {er}",
+        tr * 1e3
+    );
+    println!(
+        "soft local / rigid global = {:.2} (issue 40 asks >= 10 of a rigid local run)",
+        ts / tr
+    );
+    json!({
+        "soft_local": {"seconds": ts, "impacts": is, "rhs_evaluations": rs},
+        "rigid_global": {"seconds": tr, "impacts": ir, "rhs_evaluations": rr, "soft_episodes": er},
+        "soft_local_over_rigid_global": ts / tr,
+    })
+}
