@@ -4,7 +4,7 @@
 //! early ends (stiff, crawling) and the output sampler; the local
 //! integrator's run where it is chosen (§10).
 
-use super::switches::{apply_event, Event, Jump, Switches, Verdict};
+use super::switches::{apply_event, judging_gaps, Event, Jump, Switches, Verdict};
 use super::*;
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
@@ -75,7 +75,8 @@ pub fn simulate_streaming(
         _ => None,
     };
     let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
-    let mut switches = Switches::new(&sys, y0.len(), s_on);
+    let pre = judging_gaps(&sys, opts.impact_force_threshold);
+    let mut switches = Switches::new(&sys, y0.len(), s_on, pre);
     let mut episodes = Vec::new();
     let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
@@ -196,20 +197,34 @@ fn applied(
     ),
     opts: &SimulationOptions,
 ) -> Option<IntegrationError> {
-    let Event::Impact(k) = event else {
-        if let Err(e) = apply_event(st, sys, event) {
-            return Some(e);
+    let (k, approach) = match event {
+        Event::Impact(k) => (k, false),
+        Event::Approach(k) => (k, true),
+        _ => {
+            if let Err(e) = apply_event(st, sys, event) {
+                return Some(e);
+            }
+            if let Some(x) = extrema {
+                x.restarted(st, false);
+            }
+            return None;
         }
-        if let Some(x) = extrema {
-            x.restarted(st, false);
-        }
-        return None;
     };
     let (t, mut y, dydt) = (st.t(), st.y().to_vec(), st.dydt().to_vec());
     let floor = st.options().atol;
-    let jump = match sw.rigid_or_soft(sys, k, (t, &mut y, &dydt), floor) {
-        Ok(jump) => jump,
-        Err(e) => return Some(e),
+    // Judged where the law's force starts (an approach): a soft episode
+    // from there, or on to the touch; at the touch, the jump or an
+    // episode from there.
+    let jump = match approach {
+        true => match sw.judge(sys, k, (t, &y, &dydt), floor) {
+            Ok(Some(reason)) => Jump::Soft(reason),
+            Ok(None) => return None,
+            Err(e) => return Some(e),
+        },
+        false => match sw.rigid_or_soft(sys, k, (t, &mut y, &dydt), floor) {
+            Ok(jump) => jump,
+            Err(e) => return Some(e),
+        },
     };
     if let Jump::Soft(_) = jump {
         sys.set_soft_episode(k, true);

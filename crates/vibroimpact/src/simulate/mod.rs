@@ -607,7 +607,7 @@ fn simulate_local(
         error,
         extrema: run.extrema,
         local: Some(run.local),
-        soft_episodes: Vec::new(),
+        soft_episodes: run.episodes,
     })
 }
 

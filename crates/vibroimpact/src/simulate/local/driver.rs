@@ -2,6 +2,7 @@
 //! steps with roll-back, the history sampled from exact and integrated
 //! motion, and the run from start to end.
 
+use super::pace::{checks_crawl, counted};
 use super::*;
 
 /// How a step of the active set ended.
@@ -45,6 +46,8 @@ pub(in crate::simulate) struct LocalRun {
     /// The bodies of the set whose step failed or passed a limit (model
     /// indices), if one did.
     pub failed_set: Vec<usize>,
+    /// The rigid contacts' soft episodes.
+    pub episodes: Vec<SoftEpisode>,
 }
 
 /// Tangent columns carried by a run: `columns` vectors of the interleaved
@@ -265,58 +268,6 @@ impl Run<'_> {
     }
 }
 
-/// The set's pace after its `steps`-th kept step, as the global
-/// integrator judges its own: an explicit method whose step stability
-/// limits so far that the rest of the run would pass the step limit stops
-/// with [`IntegrationError::Stiff`]; any method that crawls (projected
-/// steps above `CRAWL_FACTOR` times the limit) with
-/// [`IntegrationError::NoProgress`].
-fn pace(
-    set: &ActiveSet,
-    method: Method,
-    opts: &SimulationOptions,
-    steps: u64,
-) -> Option<IntegrationError> {
-    let (t, limit) = (set.st.t(), opts.max_steps);
-    if matches!(method, Method::Dop853 | Method::Dopri5) && set.st.stiffness_detected() {
-        let h = t - set.st.t_prev();
-        let projected = (opts.t_end - t) / h;
-        if projected > limit.saturating_sub(steps) as f64 {
-            return Some(IntegrationError::Stiff {
-                t,
-                h,
-                projected,
-                limit,
-            });
-        }
-    }
-    if steps % PROGRESS_CHECK == 0 {
-        let projected = steps as f64 * opts.t_end / t;
-        if projected > CRAWL_FACTOR * limit as f64 {
-            return Some(IntegrationError::NoProgress {
-                t,
-                steps,
-                projected,
-                limit,
-            });
-        }
-    }
-    None
-}
-
-/// Why the run ends after the set's `steps`-th step (kept or taken
-/// again) at `t`, if it does: past the step limit, or its pace.
-fn counted(
-    set: &ActiveSet,
-    (method, opts): (Method, &SimulationOptions),
-    (t, steps): (f64, u64),
-) -> Option<IntegrationError> {
-    if steps > opts.max_steps {
-        return Some(IntegrationError::TooManySteps { t, steps });
-    }
-    pace(set, method, opts, steps)
-}
-
 /// Simulates `model` over `[0, opts.t_end]` by the local integrator,
 /// handing samples to `record` as [`simulate_streaming`] does.
 pub(in crate::simulate) fn run(
@@ -347,6 +298,7 @@ pub(in crate::simulate) fn run(
         storeys: StoreyTerms::default(),
         sink_stopped: None,
         failed_set: Vec::new(),
+        episodes: Vec::new(),
     };
     // The whole state, and the storeys' Bouc–Wen states after it.
     let mut sample = vec![0.0; 2 * n + run.hysteretic.len()];
@@ -517,11 +469,14 @@ fn check_request(
     tape: bool,
     tangents: Option<Tangents<'_>>,
 ) -> Result<(), OptionsError> {
+    let columns = tape || tangents.is_some_and(|w| w.columns > 0);
     if let Some(k) = (0..model.contacts().len()).find(|&k| model.impacts(k).is_rigid()) {
-        return Err(OptionsError(format!(
-            "contact {}: rigid impacts run on the global integrator (integrator = global, or auto)",
-            model.contact_name(k)
-        )));
+        if columns {
+            return Err(OptionsError(format!(
+                "contact {}: the local integrator carries no tangent columns through rigid impacts (their period maps run on the global flow)",
+                model.contact_name(k)
+            )));
+        }
     }
     if model.gravity() != 0.0 {
         return Err(OptionsError(
@@ -556,30 +511,6 @@ fn check_request(
         )));
     }
     Ok(())
-}
-
-/// Why the checks crawl, if they do at `t` after `checks`: the error and
-/// the contact checked most since the last look (`before`).
-fn checks_crawl(
-    run: &Run,
-    opts: &SimulationOptions,
-    (t, checks): (f64, u64),
-    before: &[u64],
-) -> Option<(IntegrationError, Option<usize>)> {
-    let nc = run.checks_per_contact.len();
-    let projected = checks as f64 * opts.t_end / t;
-    if projected <= CRAWL_FACTOR * (opts.max_steps as f64).max(nc as f64) {
-        return None;
-    }
-    let e = IntegrationError::ChecksCrawl {
-        t,
-        checks,
-        projected,
-        limit: opts.max_steps,
-    };
-    // (A storey's checks crawl: no contact to name.)
-    let k = (0..nc).max_by_key(|&k| (run.checks_per_contact[k] - before[k], Reverse(k)));
-    Some((e, k.filter(|&k| k < run.model.contacts().len())))
 }
 
 impl<'a> Run<'a> {
@@ -648,6 +579,7 @@ impl<'a> Run<'a> {
                 Activation::new(model, k, opts, s_on)
             })
             .collect();
+        let (rigid, pre) = rigid_parts(model, opts)?;
         let mut run = Self {
             model,
             opts,
@@ -688,6 +620,11 @@ impl<'a> Run<'a> {
             tape: tape.then(TapeRecord::default),
             alike: Vec::new(),
             energy: None,
+            rigid,
+            last_impact: vec![(f64::NEG_INFINITY, 0.0); nc],
+            pre,
+            armed: vec![false; nc],
+            episodes: Vec::new(),
         };
         // Every group with storeys on linear branches moves about its rest
         // state (one with a Bouc–Wen storey joins the set at once).
@@ -792,6 +729,7 @@ impl<'a> Run<'a> {
         out.energy = run.energy.map(|e| e.sums);
         out.tape = run.tape.map(|r| r.finish(run.free, n, t_final));
         out.storeys = run.storeys;
+        out.episodes = run.episodes;
         out
     }
 }

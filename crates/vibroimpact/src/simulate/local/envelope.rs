@@ -107,7 +107,7 @@ impl Run<'_> {
             .iter()
             .map(|(g, terms)| self.side(*g, state(*g), terms))
             .collect::<Option<Vec<Side>>>()?;
-        let activation = self.activation[k];
+        let (activation, rigid) = (self.activation[k], self.is_rigid(k));
         let clearance = c.clearance;
         Some(Box::new(move |h, zdd| {
             let (mut s, mut speed) = (-clearance, 0.0);
@@ -115,7 +115,7 @@ impl Run<'_> {
                 s += side.rest + side.shift.reach(h, zdd);
                 speed += side.rate.reach(h, zdd);
             }
-            s < activation.gap(speed)
+            s < if rigid { 0.0 } else { activation.gap(speed) }
         }))
     }
 }

@@ -120,13 +120,22 @@ impl Run<'_> {
         let mut first: Crossing = None;
         for bi in 0..set.boundary.len() {
             let k = set.boundary[bi];
-            let act = self.activation[k];
+            // A rigid contact joins where it is judged ([`Run::check_gap`];
+            // just after its jump it stands at s = 0 to rounding, opening:
+            // not an approach).
+            let (act, rigid) = (self.activation[k], self.is_rigid(k));
+            let judged_at = self.check_gap(k, 0.0);
+            let gap = move |s: f64, sd: f64| match rigid {
+                true if sd <= 0.0 => (s - judged_at).min(-f64::MIN_POSITIVE),
+                true => s - judged_at,
+                false => act.margin(s, sd),
+            };
             let (sa, sda) = self.boundary_state(set, ends, k, ta);
             let (sb, sdb) = self.boundary_state(set, ends, k, tb);
-            let (ga, gb) = (act.margin(sa, sda), act.margin(sb, sdb));
+            let (ga, gb) = (gap(sa, sda), gap(sb, sdb));
             let margin = |run: &mut Self, set: &mut ActiveSet, t: f64| {
                 let (s, sd) = run.boundary_state(set, ends, k, t);
-                act.margin(s, sd)
+                gap(s, sd)
             };
             let at = if ga > 0.0 {
                 Some(ta)
@@ -227,6 +236,10 @@ impl Run<'_> {
     /// `t` (the set, if any, is at `t`); the checks of the contacts and
     /// storeys that now touch the set lapse.
     pub(super) fn join(&mut self, k: usize, t: f64) -> Result<(), IntegrationError> {
+        // A rigid contact's touch: a jump, or its soft episode joins.
+        if self.rigid_touch(k, t)? {
+            return Ok(());
+        }
         if self.clustered {
             return self.join_clusters(k, t);
         }
@@ -286,14 +299,17 @@ impl Run<'_> {
         } else {
             steps
         };
-        // A group that joined within the lookahead stays (no chatter).
+        // A group that joined within the lookahead stays (no chatter); one
+        // whose contacts are all rigid (a soft episode) leaves once they
+        // have separated, as the global run's episode ends.
         let mut engaged: Vec<bool> = set
             .groups
             .iter()
-            .map(|&g| t - self.joined[g] < lookahead)
+            .map(|&g| t - self.joined[g] < self.rigid_lookahead(g, lookahead))
             .collect();
         for (kl, &k) in set.scan.ids.iter().enumerate() {
-            if Self::engaged(set, self.activation[k], kl, lookahead) {
+            let ahead = if self.is_rigid(k) { 0.0 } else { lookahead };
+            if Self::engaged(set, self.activation[k], kl, ahead) {
                 for g in self.groups_of(k) {
                     if let Ok(p) = set.groups.binary_search(&g) {
                         engaged[p] = true;
@@ -355,10 +371,13 @@ impl Run<'_> {
                     };
                     // Exact sides are at their own reference time: only
                     // contacts among set groups and walls are judged here.
+                    // (A rigid contact's next touch is a jump: only one
+                    // that touches now keeps its group.)
+                    let ahead = if self.is_rigid(k) { 0.0 } else { lookahead };
                     if sides.iter().all(|g| groups.binary_search(g).is_ok())
                         && self
                             .bound(k, t, lookahead, state)
-                            .is_none_or(|until| until - t < lookahead)
+                            .is_none_or(|until| until - t < ahead)
                     {
                         engaged[p] = true;
                         changed = true;

@@ -3,12 +3,15 @@
 //!
 //! ## Files
 //! - `mod.rs` — the active set and the local run's state;
-//! - `driver.rs` — the event loop;
+//! - `driver.rs` — the event loop; `pace.rs` — when its steps or checks
+//!   crawl;
 //! - `activation.rs`, `membership.rs`, `rebuild.rs` — when a contact
 //!   matters, the set's edge, rebuilding the set;
 //! - `clusters.rs` — a set and a stepper per cluster, earliest first;
 //! - `free_motion/` — exact motion between contacts;
 //! - `storeys.rs` — hysteretic storeys under the local integrator;
+//! - `rigid.rs` — rigid impacts: jumps between exact motions, soft
+//!   episodes;
 //! - `envelope.rs` — the modal bound of a check;
 //! - `extrema.rs`, `energy.rs`, `tape.rs` — exact extrema, the energy
 //!   audit, the tangent tape;
@@ -65,7 +68,9 @@ mod envelope;
 mod extrema;
 pub mod free_motion;
 mod membership;
+mod pace;
 mod rebuild;
+mod rigid;
 mod storeys;
 mod tape;
 
@@ -75,6 +80,7 @@ pub(super) use driver::{run, Tangents};
 use energy::LocalEnergy;
 use extrema::LocalExtrema;
 use membership::Crossing;
+use rigid::rigid_parts;
 pub use tape::LocalTape;
 use tape::TapeRecord;
 
@@ -94,6 +100,8 @@ pub struct LocalStats {
     /// Right-hand-side evaluations of each body (0: the body moved exactly
     /// for the whole run and was never evaluated).
     pub body_evaluations: Vec<u64>,
+    /// Rigid impacts taken as jumps between exact motions.
+    pub rigid_impacts: u64,
 }
 
 impl LocalStats {
@@ -242,6 +250,17 @@ struct Run<'a> {
     alike: Vec<Option<f64>>,
     /// The energy audit's sums, when asked for.
     energy: Option<LocalEnergy>,
+    /// Per contact: its rigid limit, for rigid impacts (`rigid.rs`).
+    rigid: Vec<Option<crate::impact::rigid::RigidLaw>>,
+    /// Per contact: its last rigid impact's time and estimated duration.
+    last_impact: Vec<(f64, f64)>,
+    /// Per contact: where a rigid contact's impact is judged (its law's
+    /// onset approach, negative for the exponential law), and whether it
+    /// was judged rigid and is checked against its touch now.
+    pre: Vec<f64>,
+    armed: Vec<bool>,
+    /// The rigid contacts' soft episodes.
+    episodes: Vec<super::SoftEpisode>,
 }
 
 /// ω² of the two bodies of contact `c` if they move alike: each a group
@@ -347,6 +366,24 @@ impl Run<'_> {
             let mut x = x.clone();
             self.free.propagate(g, *t0, t, &mut x);
             at.push((g, x));
+        }
+        // A rigid contact judged rigid that opens below its judging gap
+        // again without touching is judged afresh on its next approach.
+        if self.armed.get(k) == Some(&true) {
+            let c = &self.model.contacts()[k];
+            let (mut s, mut sd) = (-c.clearance, 0.0);
+            for (side, sign) in [(c.pair.left(), 1.0), (c.pair.right(), -1.0)] {
+                if let Some(i) = side {
+                    let (g, j) = self.free.place(i);
+                    if let Some((_, x)) = at.iter().find(|(h, _)| *h == g) {
+                        s += sign * x[2 * j];
+                        sd += sign * x[2 * j + 1];
+                    }
+                }
+            }
+            if s < self.pre[k] && sd < 0.0 {
+                self.armed[k] = false;
+            }
         }
         let until = {
             let at = &at;
@@ -468,7 +505,7 @@ impl Run<'_> {
             let energy = dv * dv + w2 * d * d;
             let reach = (energy / w2).sqrt();
             let size = c.clearance + xl[0].abs() + xr[0].abs();
-            let gap = self.activation[k].gap(energy.sqrt());
+            let gap = self.check_gap(k, energy.sqrt());
             // Safe to the end while both move exactly: no check is queued,
             // so every path that changes either body's motion must lapse
             // or reschedule this contact (`join` does, and `release`
@@ -517,7 +554,13 @@ impl Run<'_> {
             return None;
         }
         let speed = sd0.abs() + acc * horizon;
-        let d = self.activation[k].gap(speed) - s0;
+        // A rigid contact opening past its gap (just after its jump, at
+        // s = 0 to rounding) is judged again only once it closes.
+        let gap = self.check_gap(k, speed);
+        if self.is_rigid(k) && sd0 <= 0.0 {
+            s0 = s0.min(gap);
+        }
+        let d = gap - s0;
         Some(reach_time(d, sd0, 0.5 * acc, size)?.min(horizon))
     }
 

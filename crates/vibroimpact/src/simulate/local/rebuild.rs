@@ -58,6 +58,7 @@ impl Run<'_> {
             if let Some(tape) = self.tape.as_mut() {
                 tape.form(t, &[], &[], None, &[]);
             }
+            self.end_episodes(t);
             return Ok(());
         }
         // With clusters, each cluster is a set of its own.
@@ -89,6 +90,7 @@ impl Run<'_> {
         }
         *self.impact_log() = log;
         self.local.most_sets = self.local.most_sets.max(1 + self.sets.len());
+        self.end_episodes(t);
         formed
     }
 
@@ -163,7 +165,8 @@ impl Run<'_> {
                     .onset_approach(self.opts.impact_force_threshold)
             })
             .collect();
-        let switches = Switches::new(sys.chain(), y.len(), s_on);
+        // (A set's own model is soft throughout: no rigid contact.)
+        let switches = Switches::new(sys.chain(), y.len(), s_on, vec![0.0; ids.len()]);
         if let Some(tape) = self.tape.as_mut() {
             let rec = sys.system();
             if rec.time(0) != Some(t) {

@@ -9,7 +9,8 @@
 
 use super::{rigid_jump, Event, Switches};
 use crate::dynamics::ChainDynamics;
-use crate::impact::rigid::RigidImpact;
+use crate::impact::rigid::{RigidImpact, RigidLaw};
+use crate::impact::ImpactError;
 use crate::integrate::IntegrationError;
 use crate::model::Model;
 
@@ -34,6 +35,17 @@ pub enum EpisodeReason {
         /// Time since its impact (s).
         after: f64,
         /// Its impact's estimated duration (s).
+        duration: f64,
+    },
+    /// Contact `other`, sharing a body, would reach its law `within` s
+    /// (from its approach, rate and acceleration), inside this impact's
+    /// estimated duration: a chain about to form.
+    Ahead {
+        /// The neighbour's contact index.
+        other: usize,
+        /// When it would reach its law (s from now).
+        within: f64,
+        /// This impact's estimated duration (s).
         duration: f64,
     },
     /// Contact `other`, sharing a body, is in a soft episode.
@@ -62,6 +74,10 @@ impl EpisodeReason {
             ),
             Self::Overlap { other, after, duration } => format!(
                 "{after:.3e} s after an impact of contact {} on a shared body, within that impact's estimated duration {duration:.3e} s",
+                name(*other)
+            ),
+            Self::Ahead { other, within, duration } => format!(
+                "contact {}, on a shared body, would reach its law within {within:.3e} s, inside this impact's estimated duration {duration:.3e} s",
                 name(*other)
             ),
             Self::Cluster { other } => format!(
@@ -98,10 +114,142 @@ pub(in crate::simulate) enum Jump {
     Soft(EpisodeReason),
 }
 
+/// Per contact, where a rigid contact's impact is judged: where its law's
+/// force reaches `threshold` (the exponential law acts before the touch,
+/// so a soft episode must start there to take the whole impact: begun at
+/// the touch it would miss the approach's part and start with the force
+/// a, the energy a/α out of nothing), 0 for laws with compact support (at
+/// the touch) and for soft contacts.
+pub(in crate::simulate) fn judging_gaps(chain: &ChainDynamics, threshold: f64) -> Vec<f64> {
+    (0..chain.contacts())
+        .map(|k| match chain.rigid_law(k) {
+            Some(_) => chain.contact_law(k).onset_approach(threshold).min(0.0),
+            None => 0.0,
+        })
+        .collect()
+}
+
+/// Why an impact at approach velocity `u`, under the pressing
+/// acceleration `pressing` (s̈, positive toward each other), is taken by
+/// its law: an approach at or below `floor`; the neighbours' reason
+/// (`neighbour`, of the impact's estimated duration); a rebound that would
+/// return within that duration. None: a rigid impact.
+pub(in crate::simulate) fn soft_reason(
+    law: &RigidLaw,
+    (u, pressing): (f64, f64),
+    floor: f64,
+    neighbour: impl FnOnce(f64) -> Option<EpisodeReason>,
+) -> Result<Option<EpisodeReason>, ImpactError> {
+    if u <= floor {
+        return Ok(Some(EpisodeReason::Slow { velocity: u }));
+    }
+    let r = law.impact(u)?;
+    if let Some(reason) = neighbour(r.duration) {
+        return Ok(Some(reason));
+    }
+    if pressing > 0.0 {
+        let back = 2.0 * r.rebound_velocity / pressing;
+        if back < r.duration {
+            return Ok(Some(EpisodeReason::Resting {
+                rebound: r.rebound_velocity,
+                back,
+                duration: r.duration,
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// When a neighbour at approach `s` (m), rate `sd` and acceleration
+/// `sdd` reaches its judging gap `pre`, if within `duration`: the first
+/// root of s + ṡ τ + ½ s̈ τ² = pre (0 if there already and closing). One
+/// past it and opening is the overlap's to judge (its last impact).
+pub(in crate::simulate) fn reaches_within(
+    (s, sd, sdd): (f64, f64, f64),
+    pre: f64,
+    duration: f64,
+) -> Option<f64> {
+    let d = pre - s;
+    if d <= 0.0 {
+        return (sd > 0.0).then_some(0.0);
+    }
+    let disc = sd * sd + 2.0 * sdd * d;
+    if disc < 0.0 {
+        return None;
+    }
+    let den = sd + disc.sqrt();
+    let tau = 2.0 * d / den;
+    (den > 0.0 && tau <= duration).then_some(tau)
+}
+
 impl Switches {
+    /// Whether rigid contact k's impact, judged at `(t, y)` (`dydt` the
+    /// derivative there), is taken by its law, and why ([`soft_reason`];
+    /// the neighbours' reasons: a contact sharing a body in a soft episode,
+    /// or whose impact began within its estimated duration). None: rigid,
+    /// or not approaching.
+    pub(in crate::simulate) fn judge(
+        &self,
+        chain: &ChainDynamics,
+        k: usize,
+        (t, y, dydt): (f64, &[f64], &[f64]),
+        floor: f64,
+    ) -> Result<Option<EpisodeReason>, IntegrationError> {
+        let (_, u) = chain.approach(k, y);
+        let Some(law) = chain.rigid_law(k) else {
+            return Ok(None);
+        };
+        if u <= 0.0 {
+            return Ok(None);
+        }
+        let bodies = |j: usize| {
+            let [_, vl, _, vr] = chain.contact_indices(j);
+            [vl.map(|i| i / 2), vr.map(|i| i / 2)]
+        };
+        let mine = bodies(k);
+        let sdd = |j: usize| {
+            let [_, vl, _, vr] = chain.contact_indices(j);
+            vl.map_or(0.0, |i| dydt[i]) - vr.map_or(0.0, |i| dydt[i])
+        };
+        let neighbour = |duration: f64| {
+            (0..chain.contacts())
+                .filter(|&j| j != k && bodies(j).iter().flatten().any(|b| mine.contains(&Some(*b))))
+                .find_map(|j| {
+                    if chain.in_soft_episode(j) {
+                        return Some(EpisodeReason::Cluster { other: j });
+                    }
+                    let (tj, dj) = self.last_impact[j];
+                    if t - tj < dj {
+                        return Some(EpisodeReason::Overlap {
+                            other: j,
+                            after: t - tj,
+                            duration: dj,
+                        });
+                    }
+                    chain.rigid_law(j)?;
+                    let (s, sd) = chain.approach(j, y);
+                    let within = reaches_within((s, sd, sdd(j)), self.pre[j], duration)?;
+                    Some(EpisodeReason::Ahead {
+                        other: j,
+                        within,
+                        duration,
+                    })
+                })
+        };
+        let pressing = sdd(k);
+        soft_reason(law, (u, pressing), floor, neighbour).map_err(|e| {
+            IntegrationError::RigidImpact {
+                t,
+                contact: k,
+                reason: e.to_string(),
+            }
+        })
+    }
+
     /// Rigid contact k's impact at `(t, y)` (`dydt` the derivative just
     /// before it): the velocities' jump applied to `y`, or a soft episode
-    /// where the rigid idealisation breaks (the module's reasons).
+    /// where the rigid idealisation breaks ([`Switches::judge`], again at
+    /// the touch: a neighbour may have struck since the approach).
     pub(in crate::simulate) fn rigid_or_soft(
         &mut self,
         chain: &ChainDynamics,
@@ -109,64 +257,30 @@ impl Switches {
         (t, y, dydt): (f64, &mut [f64], &[f64]),
         floor: f64,
     ) -> Result<Jump, IntegrationError> {
-        let (_, u) = chain.approach(k, y);
-        let Some(law) = chain.rigid_law(k) else {
-            return Ok(Jump::Touch);
-        };
-        if u <= 0.0 {
+        if chain.approach(k, y).1 <= 0.0 || chain.rigid_law(k).is_none() {
             return Ok(Jump::Touch);
         }
-        let bodies = |j: usize| {
-            let [_, vl, _, vr] = chain.contact_indices(j);
-            [vl.map(|i| i / 2), vr.map(|i| i / 2)]
+        if let Some(reason) = self.judge(chain, k, (t, y, dydt), floor)? {
+            return Ok(Jump::Soft(reason));
+        }
+        let Some((_, r)) = rigid_jump(chain, k, (t, y), floor)? else {
+            return Ok(Jump::Touch);
         };
-        let mine = bodies(k);
-        for j in (0..chain.contacts()).filter(|&j| j != k) {
-            if !bodies(j).iter().flatten().any(|b| mine.contains(&Some(*b))) {
-                continue;
-            }
-            if chain.in_soft_episode(j) {
-                return Ok(Jump::Soft(EpisodeReason::Cluster { other: j }));
-            }
-            let (tj, duration) = self.last_impact[j];
-            if t - tj < duration {
-                return Ok(Jump::Soft(EpisodeReason::Overlap {
-                    other: j,
-                    after: t - tj,
-                    duration,
-                }));
-            }
-        }
-        if u <= floor {
-            return Ok(Jump::Soft(EpisodeReason::Slow { velocity: u }));
-        }
-        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
-            t,
-            contact: k,
-            reason: e.to_string(),
-        })?;
-        let [_, vl, _, vr] = chain.contact_indices(k);
-        let pressing = vl.map_or(0.0, |i| dydt[i]) - vr.map_or(0.0, |i| dydt[i]);
-        if pressing > 0.0 {
-            let back = 2.0 * r.rebound_velocity / pressing;
-            if back < r.duration {
-                return Ok(Jump::Soft(EpisodeReason::Resting {
-                    rebound: r.rebound_velocity,
-                    back,
-                    duration: r.duration,
-                }));
-            }
-        }
-        rigid_jump(chain, k, (t, y), floor)?;
         self.last_impact[k] = (t, r.duration);
         Ok(Jump::Rigid(r))
     }
 
-    /// Suspends (`on`) or resumes contact k's impact event: in a soft
-    /// episode its law is integrated, no jump.
+    /// Suspends (`on`) or resumes contact k's impact and approach events:
+    /// in a soft episode its law is integrated, no jump. (A resumed
+    /// approach is armed again once the contact is open.)
     pub(in crate::simulate) fn suspend(&mut self, k: usize, on: bool) {
-        if let Some(i) = self.events.iter().position(|e| *e == Event::Impact(k)) {
-            self.armed[i] = !on;
+        self.episode[k] = on;
+        for (i, e) in self.events.iter().enumerate() {
+            match *e {
+                Event::Impact(j) if j == k => self.armed[i] = !on,
+                Event::Approach(j) if j == k && on => self.armed[i] = false,
+                _ => {}
+            }
         }
     }
 }

@@ -4,7 +4,7 @@
 //! each rigid impact that updates what rides along (docs/theory.md §12:
 //! the saltation of the period map's columns).
 
-use super::{apply_event, Event, Jump, Switches, Verdict};
+use super::{apply_event, EpisodeReason, Event, Jump, Switches, Verdict};
 use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
 use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stepper};
@@ -41,7 +41,11 @@ pub(crate) fn flow_through_events<S: Chain>(
     let mut st = Stepper::new(Method::Dop853, dim, opts.clone())?;
     st.reset(sys, 0.0, z0)?;
     let contacts = sys.chain().contacts();
-    let mut switches = Switches::new(sys.chain(), dim, vec![0.0; contacts]);
+    // (Rigid impacts judged where a simulation judges them, at the default
+    // impact force threshold.)
+    let threshold = crate::simulate::SimulationOptions::default().impact_force_threshold;
+    let pre = super::episodes::judging_gaps(sys.chain(), threshold);
+    let mut switches = Switches::new(sys.chain(), dim, vec![0.0; contacts], pre);
     let (mut steps, mut impacts) = (0_u64, 0_usize);
     while st.t() < t_end {
         steps += 1;
@@ -62,6 +66,13 @@ pub(crate) fn flow_through_events<S: Chain>(
                 }
             }
         };
+        if let Event::Approach(k) = event {
+            let (t, y, dydt) = (st.t(), st.y(), st.dydt());
+            if let Some(reason) = sw.judge(sys.chain(), k, (t, y, dydt), opts.atol)? {
+                return Err(episode_refused(t, k, &reason));
+            }
+            continue;
+        }
         let Event::Impact(k) = event else {
             apply_event(&mut st, sys, event)?;
             continue;
@@ -85,15 +96,19 @@ pub(crate) fn flow_through_events<S: Chain>(
             }
             // A soft episode has no saltation: the map is the rigid one
             // throughout, or none.
-            Jump::Soft(reason) => {
-                return Err(IntegrationError::RigidImpact {
-                    t,
-                    contact: k,
-                    reason: format!("{}: the rigid idealisation breaks there (a simulation takes it by the contact's law); the period map needs rigid impacts throughout: keep this contact soft (impacts = \"soft\")", reason.describe_by(|j| j)),
-                });
-            }
+            Jump::Soft(reason) => return Err(episode_refused(t, k, &reason)),
         }
         st.reset(sys, t, &after)?;
     }
     Ok((st.y().to_vec(), steps, impacts))
+}
+
+/// A period map meets a soft episode of contact k at `t`: it has no
+/// saltation, so the map is the rigid one throughout, or none.
+fn episode_refused(t: f64, k: usize, reason: &EpisodeReason) -> IntegrationError {
+    IntegrationError::RigidImpact {
+        t,
+        contact: k,
+        reason: format!("{}: the rigid idealisation breaks there (a simulation takes it by the contact's law); the period map needs rigid impacts throughout: keep this contact soft (impacts = \"soft\")", reason.describe_by(|j| j)),
+    }
 }

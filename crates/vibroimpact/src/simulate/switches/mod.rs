@@ -21,7 +21,8 @@ use crate::numeric::brent;
 
 mod episodes;
 mod flow;
-pub(super) use episodes::Jump;
+pub(super) use episodes::{judging_gaps, reaches_within, soft_reason, Jump};
+
 pub use episodes::{EpisodeReason, SoftEpisode};
 pub(crate) use flow::{flow_through_events, ImpactJump};
 
@@ -36,6 +37,11 @@ pub(super) enum Event {
     /// Rigid contact k's approach reaches zero: an impact, the bodies'
     /// velocities jump.
     Impact(usize),
+    /// Rigid contact k's approach reaches where its law's force stops
+    /// being negligible, before the touch (the exponential law): its
+    /// impact is judged there, rigid or a soft episode from there
+    /// (`episodes.rs`).
+    Approach(usize),
 }
 
 /// What a step's check found.
@@ -59,6 +65,9 @@ pub(super) struct Switches {
     armed: Vec<bool>,
     /// Per contact, its onset approach s_on.
     s_on: Vec<f64>,
+    /// Per contact, where a rigid contact's impact is judged
+    /// ([`episodes::judging_gaps`]).
+    pre: Vec<f64>,
     t_prev: f64,
     y_prev: Vec<f64>,
     /// The derivative at the step's start.
@@ -88,23 +97,36 @@ pub(super) struct Switches {
     /// Per contact, its last rigid impact's time and estimated duration
     /// (soft episodes, `episodes.rs`).
     last_impact: Vec<(f64, f64)>,
+    /// Per contact, whether it is in a soft episode.
+    episode: Vec<bool>,
 }
 
 impl Switches {
-    /// None for a model without such events; `s_on` per contact.
-    pub(super) fn new(sys: &ChainDynamics, dim: usize, s_on: Vec<f64>) -> Option<Self> {
+    /// None for a model without such events; `s_on` per contact, and
+    /// `pre`, where a rigid contact's impact is judged
+    /// ([`episodes::judging_gaps`]).
+    pub(super) fn new(
+        sys: &ChainDynamics,
+        dim: usize,
+        s_on: Vec<f64>,
+        pre: Vec<f64>,
+    ) -> Option<Self> {
         let onsets = (0..s_on.len())
             .filter(|&k| sys.rigid_law(k).is_none() && sys.contact_law(k).needs_impact_velocity())
             .map(Event::Onset);
         let impacts = (0..s_on.len())
             .filter(|&k| sys.rigid_law(k).is_some())
             .map(Event::Impact);
+        let approaches = (0..s_on.len())
+            .filter(|&k| sys.rigid_law(k).is_some() && pre[k] < 0.0)
+            .map(Event::Approach);
         let events: Vec<Event> = sys
             .storeys()
             .switching()
             .map(Event::Storey)
             .chain(onsets)
             .chain(impacts)
+            .chain(approaches)
             .collect();
         (!events.is_empty()).then(|| Self {
             armed: vec![true; events.len()],
@@ -117,6 +139,7 @@ impl Switches {
             carried_stamp: None,
             events,
             s_on,
+            pre,
             t_prev: 0.0,
             y_prev: vec![0.0; dim],
             f_prev: vec![0.0; dim],
@@ -124,6 +147,7 @@ impl Switches {
             inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
             pending: None,
             last_impact: vec![(f64::NEG_INFINITY, 0.0); sys.contacts()],
+            episode: vec![false; sys.contacts()],
         })
     }
 
@@ -149,9 +173,12 @@ impl Switches {
     /// that is kept (not one about to be taken again).
     fn rearm(&mut self, sys: &ChainDynamics, y: &[f64]) {
         for i in 0..self.events.len() {
-            // (A rigid contact's impact is suspended in a soft episode.)
-            if matches!(self.events[i], Event::Impact(_)) {
-                continue;
+            // (A rigid contact's impact is suspended in a soft episode,
+            // and so is its approach.)
+            match self.events[i] {
+                Event::Impact(_) => continue,
+                Event::Approach(k) if self.episode[k] => continue,
+                _ => {}
             }
             if !self.armed[i] && self.value(sys, self.events[i], y) > 0.0 {
                 self.armed[i] = true;
@@ -159,9 +186,11 @@ impl Switches {
         }
     }
 
-    /// Marks `e` applied: an onset waits for its contact to open again.
+    /// Marks `e` applied: an onset or an approach waits for its contact
+    /// to open again.
     fn disarm(&mut self, e: Event) {
-        if let (Event::Onset(_), Some(i)) = (e, self.events.iter().position(|x| *x == e)) {
+        let once = matches!(e, Event::Onset(_) | Event::Approach(_));
+        if let (true, Some(i)) = (once, self.events.iter().position(|x| *x == e)) {
             self.armed[i] = false;
         }
     }
@@ -174,6 +203,7 @@ impl Switches {
             Event::Storey(k) => sys.storeys().switch_value(k, y),
             Event::Onset(k) => self.s_on[k] - sys.approach(k, y).0,
             Event::Impact(k) => -sys.approach(k, y).0,
+            Event::Approach(k) => self.pre[k] - sys.approach(k, y).0,
         }
     }
 
@@ -446,6 +476,8 @@ pub(super) fn apply_event<S: Chain>(
             chain.set_onset_velocity(k, sd);
         }
         Event::Impact(k) => impact = rigid_jump(chain, k, (t, &mut y), floor)?,
+        // (Judged by the caller: nothing changes.)
+        Event::Approach(_) => {}
     }
     st.reset(sys, t, &y)?;
     Ok(impact)
