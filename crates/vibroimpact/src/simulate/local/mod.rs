@@ -353,56 +353,80 @@ impl Run<'_> {
     fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
         self.local.contact_checks += 1;
         self.checks_per_contact[k] += 1;
-        // The sides' groups at t. Inside a step of the set they only go into
-        // `deferred`: samples and a step taken back still ask for earlier
-        // times of these groups, and exact motion never runs backward.
-        let mut at: Vec<(usize, Vec<f64>)> = Vec::with_capacity(2);
+        // The sides' groups at t: their reference states move there (in
+        // place, no allocation). Inside a step of the set the moves only go
+        // into `deferred`: samples and a step taken back still ask for
+        // earlier times of these groups, and exact motion never runs
+        // backward.
+        let mut groups = [usize::MAX; 2];
+        let mut count = 0;
         for i in self.sides(k).into_iter().flatten() {
             let g = self.free.place(i).0;
-            if at.iter().any(|(h, _)| *h == g) {
-                continue;
+            if !groups[..count].contains(&g) {
+                groups[count] = g;
+                count += 1;
             }
-            let (t0, x) = &self.exact[g];
-            let mut x = x.clone();
-            self.free.propagate(g, *t0, t, &mut x);
-            at.push((g, x));
         }
-        // A rigid contact judged rigid that opens below its judging gap
-        // again without touching is judged afresh on its next approach.
-        if self.armed.get(k) == Some(&true) {
-            let c = &self.model.contacts()[k];
-            let (mut s, mut sd) = (-c.clearance, 0.0);
-            for (side, sign) in [(c.pair.left(), 1.0), (c.pair.right(), -1.0)] {
-                if let Some(i) = side {
-                    let (g, j) = self.free.place(i);
-                    if let Some((_, x)) = at.iter().find(|(h, _)| *h == g) {
-                        s += sign * x[2 * j];
-                        sd += sign * x[2 * j + 1];
-                    }
+        let groups = &groups[..count];
+        if self.defer {
+            let at: Vec<(usize, Vec<f64>)> = groups
+                .iter()
+                .map(|&g| {
+                    let (t0, x) = &self.exact[g];
+                    let mut x = x.clone();
+                    self.free.propagate(g, *t0, t, &mut x);
+                    (g, x)
+                })
+                .collect();
+            self.disarm_if_open(k, |g| {
+                at.iter().find(|(h, _)| *h == g).map(|(_, x)| x.as_slice())
+            });
+            let until = {
+                let exact = &self.exact;
+                self.bound(k, t, f64::INFINITY, |g| {
+                    at.iter()
+                        .find(|(h, _)| *h == g)
+                        .map_or(exact[g].1.as_slice(), |(_, x)| x.as_slice())
+                })
+            };
+            self.deferred.extend(at.into_iter().map(|(g, x)| (g, t, x)));
+            return until;
+        }
+        for &g in groups {
+            self.before_move(g, t);
+            let Run { free, exact, .. } = &mut *self;
+            let (t0, x) = &mut exact[g];
+            free.propagate(g, *t0, t, x);
+            *t0 = t;
+        }
+        let exact = std::mem::take(&mut self.exact);
+        self.disarm_if_open(k, |g| Some(exact[g].1.as_slice()));
+        let until = self.bound(k, t, f64::INFINITY, |g| exact[g].1.as_slice());
+        self.exact = exact;
+        until
+    }
+
+    /// A rigid contact judged rigid that opens below its judging gap again
+    /// without touching is judged afresh on its next approach (`state(g)`:
+    /// its sides' groups' states now).
+    fn disarm_if_open<'s>(&mut self, k: usize, state: impl Fn(usize) -> Option<&'s [f64]>) {
+        if self.armed.get(k) != Some(&true) {
+            return;
+        }
+        let c = &self.model.contacts()[k];
+        let (mut s, mut sd) = (-c.clearance, 0.0);
+        for (side, sign) in [(c.pair.left(), 1.0), (c.pair.right(), -1.0)] {
+            if let Some(i) = side {
+                let (g, j) = self.free.place(i);
+                if let Some(x) = state(g) {
+                    s += sign * x[2 * j];
+                    sd += sign * x[2 * j + 1];
                 }
             }
-            if s < self.pre[k] && sd < 0.0 {
-                self.armed[k] = false;
-            }
         }
-        let until = {
-            let at = &at;
-            let exact = &self.exact;
-            self.bound(k, t, f64::INFINITY, move |g| {
-                at.iter()
-                    .find(|(h, _)| *h == g)
-                    .map_or(exact[g].1.as_slice(), |(_, x)| x.as_slice())
-            })
-        };
-        for (g, x) in at {
-            if self.defer {
-                self.deferred.push((g, t, x));
-            } else {
-                self.before_move(g, t);
-                self.exact[g] = (t, x);
-            }
+        if s < self.pre[k] && sd < 0.0 {
+            self.armed[k] = false;
         }
-        until
     }
 
     /// Moves the exact groups' reference states deferred during a step of
