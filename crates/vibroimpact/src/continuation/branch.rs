@@ -321,31 +321,50 @@ impl<F: Family + Send> Continuation<F> {
 
     /// Why a branch through rigid impacts ends (docs/theory.md §12): at
     /// the current point a rigid contact's slowest impact is below 1e-3 of
-    /// the orbit's largest velocity, a grazing, where the period map is
-    /// not differentiable (its saltation grows as 1/U).
+    /// the orbit's largest velocity, or its orbit's closest approach to a
+    /// contact within 1e-6 of its reach: a grazing, where the period map
+    /// is not differentiable (its saltation grows as 1/U).
     fn rigid_grazing(&mut self) -> Option<String> {
-        let point = &self.current.point;
-        let model = self.problem.model(point.parameter).ok()?;
+        let p = self.current.point.parameter;
+        let model = self.problem.model(p).ok()?;
         if !model.has_rigid_impacts() {
             return None;
         }
+        let orbit = self.problem.add_orbit(self.current.clone())?;
         let shooting = &self.problem.opts.shooting;
         let period =
             crate::periodic::forcing_period(&model).ok()? * f64::from(shooting.subharmonic.max(1));
-        let orbit =
-            crate::periodic::orbit_summary(&model, &point.state, period, 0, shooting.rtol).ok()?;
-        let (k, u) = orbit
-            .impacts
-            .iter()
-            .filter(|c| model.impacts(c.contact).is_rigid())
-            .flat_map(|c| c.impact_velocities.iter().map(move |u| (c.contact, *u)))
-            .min_by(|a, b| a.1.total_cmp(&b.1))?;
-        let scale = orbit.max_velocity.iter().fold(0.0_f64, |a, v| a.max(*v));
-        (u < 1e-3 * scale).then(|| {
-            format!(
-                ": the rigid impact of contact {} grazes there (impact velocity {u:.3e} m/s, largest multiplier {:.3e}); a rigid impact's period map is not differentiable where it grazes, so the branch of impacting orbits ends (GR); beyond it the orbit does not touch",
+        let y0 = crate::dynamics::to_interleaved(&orbit.point.state);
+        let int_opts = shooting.integrator_options(crate::periodic::MAX_STEPS, None);
+        let largest = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        let (speed, reach) = (
+            largest(&orbit.point.max_velocity),
+            largest(&orbit.point.max_displacement),
+        );
+        let spectral = orbit.point.spectral_radius();
+        let slowest = match crate::periodic::rigid_impacts_over(&model, &y0, period, &int_opts) {
+            Ok(found) => found
+                .into_iter()
+                .filter(|(k, _)| model.impacts(*k).is_rigid())
+                .min_by(|a, b| a.1.total_cmp(&b.1)),
+            // An impact at or below the absolute tolerance: grazing.
+            Err(crate::integrate::IntegrationError::RigidImpact { contact, .. }) => {
+                Some((contact, int_opts.atol))
+            }
+            Err(_) => return None,
+        };
+        if let Some((k, u)) = slowest.filter(|(_, u)| *u < 1e-3 * speed) {
+            return Some(format!(
+                ": the rigid impact of contact {} grazes there (impact velocity {u:.3e} m/s, largest multiplier {spectral:.3e}); a rigid impact's period map is not differentiable where it grazes, so the branch of impacting orbits ends (GR); beyond it the orbit does not touch",
                 model.contact_name(k),
-                point.spectral_radius()
+            ));
+        }
+        // The orbit's closest approach at the contact (from the side that
+        // does not touch, or an impact lost in rounding).
+        let margin = orbit.tests.grazing_margin;
+        (margin.abs() < 1e-6 * reach).then(|| {
+            format!(
+                ": the orbit grazes a rigid contact there (closest approach {margin:.3e} m, largest multiplier {spectral:.3e}); the rigid period map is not differentiable where an orbit grazes, so the branch ends there (GR)"
             )
         })
     }
@@ -403,10 +422,10 @@ impl<F: Family + Send> Continuation<F> {
             }
             if self.ds < self.problem.opts.ds_min {
                 let p = self.current.point.parameter;
-                let grazes = self
-                    .rigid_grazing()
-                    .or_else(|| self.rigid_breaks())
-                    .unwrap_or_default();
+                if let Some(why) = self.rigid_grazing() {
+                    return Err(end(StopReason::Grazing(format!("at parameter {p}{why}"))));
+                }
+                let grazes = self.rigid_breaks().unwrap_or_default();
                 return Err(end(StopReason::CannotContinue(format!(
                     "the corrector does not converge beyond parameter {p} even with step {:e}{grazes}",
                     self.ds

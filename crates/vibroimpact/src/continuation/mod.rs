@@ -371,6 +371,10 @@ pub enum StopReason {
     Interrupted,
     /// The corrector failed down to the smallest step: where and why.
     CannotContinue(String),
+    /// A branch through rigid impacts reached a grazing impact, where the
+    /// rigid period map is not differentiable (docs/theory.md §12): the
+    /// branch of impacting orbits ends there, labelled GR; where and why.
+    Grazing(String),
     /// The branch returned to its first point (a closed loop, e.g. the
     /// asymmetric branch between two symmetry-breaking points and its
     /// mirror image); it is not traversed again.
@@ -383,24 +387,25 @@ pub enum StopReason {
 
 impl StopReason {
     /// A stable name: `ReachedEnd`, `MaxPoints`, `Interrupted`,
-    /// `CannotContinue`, `ClosedLoop` or `TurnedBack` (the documents'
-    /// `stop`).
+    /// `CannotContinue`, `Grazing`, `ClosedLoop` or `TurnedBack` (the
+    /// documents' `stop`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::ReachedEnd => "ReachedEnd",
             Self::MaxPoints => "MaxPoints",
             Self::Interrupted => "Interrupted",
             Self::CannotContinue(_) => "CannotContinue",
+            Self::Grazing(_) => "Grazing",
             Self::ClosedLoop => "ClosedLoop",
             Self::TurnedBack => "TurnedBack",
         }
     }
 
-    /// Where and why a branch could not continue (the documents'
-    /// `stop_detail`); None for the other stops.
+    /// Where and why a branch could not continue or ended at a grazing
+    /// (the documents' `stop_detail`); None for the other stops.
     pub fn detail(&self) -> Option<&str> {
         match self {
-            Self::CannotContinue(why) => Some(why),
+            Self::CannotContinue(why) | Self::Grazing(why) => Some(why),
             _ => None,
         }
     }
@@ -413,6 +418,7 @@ impl std::fmt::Display for StopReason {
             Self::MaxPoints => write!(f, "used the point budget"),
             Self::Interrupted => write!(f, "interrupted"),
             Self::CannotContinue(why) => write!(f, "cannot continue: {why}"),
+            Self::Grazing(why) => write!(f, "ends at a grazing (GR): {why}"),
             Self::ClosedLoop => write!(
                 f,
                 "closed loop (back at its first point or its mirror image)"
@@ -502,6 +508,26 @@ where
             None => break StopReason::Interrupted,
         }
     };
+    // A rigid branch's grazing end is its last point, labelled GR.
+    if let (StopReason::Grazing(_), Some(last)) = (&stop, points.last_mut()) {
+        let n = 1 + special
+            .iter()
+            .filter(|s: &&SpecialPoint| s.kind == SpecialKind::Grazing)
+            .count();
+        let label = format!("{}{n}", SpecialKind::Grazing.prefix());
+        last.label = Some(label.clone());
+        special.push(SpecialPoint {
+            kind: SpecialKind::Grazing,
+            label,
+            parameter: last.parameter,
+            state: last.state.clone(),
+            max_displacement: last.max_displacement.clone(),
+            multipliers: last.multipliers.clone(),
+            tangent: Vec::new(),
+            after_point: points.len() - 1,
+            symmetry_breaking: false,
+        });
+    }
     Ok(Branch {
         points,
         special,

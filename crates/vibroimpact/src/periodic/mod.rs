@@ -327,7 +327,7 @@ pub use orbit::{
     guess_by_simulation, guess_by_simulation_with, orbit_summary, orbit_summary_by, ContactImpacts,
     OrbitSummary,
 };
-pub(crate) use rigid::saltation;
+pub(crate) use rigid::{rigid_impacts_over, saltation};
 
 pub use shooting::{shoot, shoot_krylov};
 

@@ -77,6 +77,23 @@ pub(super) fn rigid_image(
     Ok((y, steps))
 }
 
+/// The rigid impacts over `t` from the interleaved state `y0`: each one's
+/// contact and approach velocity, in order (a branch's grazing test).
+pub(crate) fn rigid_impacts_over(
+    model: &Model,
+    y0: &[f64],
+    t: f64,
+    int_opts: &IntegratorOptions,
+) -> Result<Vec<(usize, f64)>, IntegrationError> {
+    let mut sys = ChainDynamics::new(model, false);
+    let mut found = Vec::new();
+    flow_through_events(&mut sys, y0, t, int_opts, |_, jump| {
+        found.push((jump.contact, jump.impact.impact_velocity));
+        Ok(())
+    })?;
+    Ok(found)
+}
+
 /// The shooting map's image and its product with the interleaved column
 /// `w0` through rigid impacts (both interleaved).
 pub(super) fn rigid_product(

@@ -368,10 +368,12 @@ fn continuation_locates_the_bouncing_balls_period_doubling() {
 
 /// The impact oscillator's branch of impacting orbits (e = 0.8) from
 /// Ω = 1.5 folds at Ω = 1.8576 and comes back to the grazing of its
-/// impact, where it ends with the reason: the grazing orbit is the linear
-/// steady state of amplitude g, (1 − Ω²)² + (2ζΩ)² = (p/g)², and the last
-/// point lies within 1e-7 of that Ω, its impact velocity below 1e-3 of
-/// the orbit's.
+/// impact, where it ends with the reason, labelled GR1: the grazing orbit
+/// is the linear steady state of amplitude g, (1 − Ω²)² + (2ζΩ)² =
+/// (p/g)², and the last point lies within 1e-7 of that Ω, its impact
+/// velocity below 1e-3 of the orbit's (or its closest approach within
+/// 1e-6 of the reach, where the impact is lost in rounding). The linear branch from Ω = 2.5,
+/// which does not touch, ends there too, at its closest approach.
 #[test]
 fn the_impact_oscillators_branch_ends_at_its_grazing() {
     use crate::continuation::{continue_branch, ContinuationOptions, StopReason};
@@ -392,27 +394,55 @@ fn the_impact_oscillators_branch_ends_at_its_grazing() {
     });
     let (sol, _) = settled_orbit(&rigid_oscillator(Some(0.8), 0.0, (0.0, 0.0)));
     let branch = continue_branch(family, OMEGA, &sol.initial_state, 3.5, &opts, |_| true).unwrap();
-    let StopReason::CannotContinue(why) = &branch.stop else {
+    let StopReason::Grazing(why) = &branch.stop else {
         unreachable!("{:?}", branch.stop)
     };
-    assert!(
-        why.contains("grazes there") && why.contains("(GR)"),
-        "{why}"
-    );
+    assert!(why.contains("(GR)"), "{why}");
     // Ω² = y: y² − (2 − 4ζ²) y + 1 − (p/g)² = 0.
     let b = 2.0 - 4.0 * ZETA_O * ZETA_O;
     let y = (b + (b * b + 4.0 * (1.0 / (GAP * GAP) - 1.0)).sqrt()) / 2.0;
     let grazing = y.sqrt();
-    let last = branch.points.last().unwrap().parameter;
-    eprintln!(
-        "{} points, last at {last} vs grazing {grazing}: {why}",
-        branch.points.len()
-    );
-    assert!((last - grazing).abs() < 1e-7, "{last} vs {grazing}");
+    let ends_at_gr = |branch: &crate::continuation::Branch| {
+        let last = branch.points.last().unwrap();
+        let gr = branch.special.last().unwrap();
+        assert_eq!((gr.label.as_str(), gr.parameter), ("GR1", last.parameter));
+        assert_eq!(last.label.as_deref(), Some("GR1"));
+        assert!(
+            (last.parameter - grazing).abs() < 1e-7,
+            "{} vs {grazing}",
+            last.parameter
+        );
+        eprintln!(
+            "{} points, GR1 at {} vs grazing {grazing}: {}",
+            branch.points.len(),
+            last.parameter,
+            branch.stop
+        );
+    };
+    ends_at_gr(&branch);
     assert!(branch
         .special
         .iter()
         .any(|s| (s.parameter - 1.85757).abs() < 1e-4));
+    // From the side that does not touch: the linear steady state at
+    // Ω = 2.5, continued down, grazes the wall at the same Ω_g.
+    let linear = oscillator(ZETA_O, GAP, (1.0, 2.5, 0.0), (0.0, 0.0))
+        .with_all_impacts(Impacts::Rigid {
+            restitution: Some(0.8),
+        })
+        .unwrap();
+    let start = shoot(&linear, &[0.0, 0.0], &tight()).unwrap();
+    assert!(start.converged);
+    let family = of("frequency", |w: f64| {
+        Ok(oscillator(ZETA_O, GAP, (1.0, w, 0.0), (0.0, 0.0))
+            .with_all_impacts(Impacts::Rigid {
+                restitution: Some(0.8),
+            })
+            .unwrap())
+    });
+    let branch = continue_branch(family, 2.5, &start.initial_state, 1.2, &opts, |_| true).unwrap();
+    assert!(matches!(&branch.stop, StopReason::Grazing(why) if why.contains("closest approach")));
+    ends_at_gr(&branch);
 }
 
 /// The rigid limit of the seed's law on a periodic orbit: R2 N = 2 at
@@ -544,9 +574,9 @@ fn the_map_jumps_as_the_square_root_past_grazing() {
 /// from the soft orbit at 0.95 ω0 to the rigid orbit that the soft orbits
 /// tend to (its state within 7.5e-5 m of the soft one at the seed's α,
 /// as `soft_orbits_tend_to_the_rigid_orbit` measures). Continued down in
-/// frequency, the branch ends where an impact would start within another's
-/// estimated duration (the rigid idealisation breaks), near 0.56 ω0, and
-/// says so.
+/// frequency, the branch ends at a grazing (GR1, near 0.56 ω0), just past
+/// which an impact would start within another's estimated duration (the
+/// rigid idealisation breaks).
 #[test]
 fn a_rigid_branch_starts_from_the_soft_homotopy() {
     use crate::continuation::{
@@ -582,11 +612,25 @@ fn a_rigid_branch_starts_from_the_soft_homotopy() {
     let w = rigid.forcing_frequency().unwrap();
     let branch =
         continue_branch(&frequency, w, &r.initial_state, 0.5 * w, &opts, |_| true).unwrap();
-    let StopReason::CannotContinue(why) = &branch.stop else {
+    let StopReason::Grazing(why) = &branch.stop else {
         unreachable!("{:?}", branch.stop)
     };
     let last = branch.points.last().unwrap().parameter;
     eprintln!("{} points, last at {last}: {why}", branch.points.len());
-    assert!(why.contains("the rigid idealisation breaks"), "{why}");
+    assert_eq!(branch.special.last().unwrap().label, "GR1");
     assert!((0.55..0.6).contains(&(last / 7.41)), "{last}");
+    // Just past it the rigid idealisation breaks: an impact would start
+    // within another's estimated duration.
+    let beyond = frequency.model_at(last - 0.02).unwrap();
+    let e = crate::periodic::map_image(
+        &beyond,
+        &branch.points.last().unwrap().state,
+        &opts.shooting,
+        crate::periodic::MAX_STEPS,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("the rigid idealisation breaks"),
+        "{e}"
+    );
 }
