@@ -236,16 +236,7 @@ fn applied(
     let jumped = matches!(jump, Jump::Rigid(_));
     match jump {
         Jump::Touch => {}
-        Jump::Rigid(r) => scan.impacts.push(ImpactRecord {
-            contact: k,
-            start_time: t,
-            end_time: t,
-            impact_velocity: r.impact_velocity,
-            rebound_velocity: r.rebound_velocity,
-            peak_force: r.peak_force,
-            peak_time: t,
-            rigid: Some(r),
-        }),
+        Jump::Rigid(r) => scan.impacts.push(ImpactRecord::jump(k, t, r)),
         Jump::Soft(reason) => {
             scan.trackers[k] = Tracker::new(sys.contact_law(k), opts.impact_force_threshold);
             scan.previous[k] = contact_end(sys, k, st.y(), st.dydt());

@@ -161,6 +161,20 @@ pub struct ImpactRecord {
 }
 
 impl ImpactRecord {
+    /// Rigid contact k's impact `r` at `t`: an instant.
+    pub(crate) fn jump(k: usize, t: f64, r: RigidImpact) -> Self {
+        Self {
+            contact: k,
+            start_time: t,
+            end_time: t,
+            impact_velocity: r.impact_velocity,
+            rebound_velocity: r.rebound_velocity,
+            peak_force: r.peak_force,
+            peak_time: t,
+            rigid: Some(r),
+        }
+    }
+
     /// Coefficient of restitution, rebound / impact velocity.
     pub fn restitution(&self) -> f64 {
         self.rebound_velocity / self.impact_velocity

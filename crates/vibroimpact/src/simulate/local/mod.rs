@@ -369,15 +369,7 @@ impl Run<'_> {
         }
         let groups = &groups[..count];
         if self.defer {
-            let at: Vec<(usize, Vec<f64>)> = groups
-                .iter()
-                .map(|&g| {
-                    let (t0, x) = &self.exact[g];
-                    let mut x = x.clone();
-                    self.free.propagate(g, *t0, t, &mut x);
-                    (g, x)
-                })
-                .collect();
+            let at = self.states_at(groups, t);
             self.disarm_if_open(k, |g| {
                 at.iter().find(|(h, _)| *h == g).map(|(_, x)| x.as_slice())
             });
@@ -404,6 +396,19 @@ impl Run<'_> {
         let until = self.bound(k, t, f64::INFINITY, |g| exact[g].1.as_slice());
         self.exact = exact;
         until
+    }
+
+    /// The states of `groups` at `t` by their exact motion (copies).
+    fn states_at(&self, groups: &[usize], t: f64) -> Vec<(usize, Vec<f64>)> {
+        groups
+            .iter()
+            .map(|&g| {
+                let (t0, x) = &self.exact[g];
+                let mut x = x.clone();
+                self.free.propagate(g, *t0, t, &mut x);
+                (g, x)
+            })
+            .collect()
     }
 
     /// A rigid contact judged rigid that opens below its judging gap again

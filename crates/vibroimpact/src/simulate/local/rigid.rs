@@ -76,15 +76,7 @@ impl Run<'_> {
             return Ok(false);
         }
         let groups = self.groups_of(k);
-        let mut states: Vec<(usize, Vec<f64>)> = groups
-            .iter()
-            .map(|&g| {
-                let (t0, x) = &self.exact[g];
-                let mut x = x.clone();
-                self.free.propagate(g, *t0, t, &mut x);
-                (g, x)
-            })
-            .collect();
+        let mut states = self.states_at(&groups, t);
         let c = &self.model.contacts()[k];
         let sides = [(c.pair.left(), 1.0), (c.pair.right(), -1.0)];
         let (mut u, mut pressing) = (0.0, 0.0);
@@ -138,16 +130,7 @@ impl Run<'_> {
         if let Some(energy) = self.energy.as_mut() {
             energy.sums[2] += r.energy_lost;
         }
-        self.impact_log().push(ImpactRecord {
-            contact: k,
-            start_time: t,
-            end_time: t,
-            impact_velocity: r.impact_velocity,
-            rebound_velocity: r.rebound_velocity,
-            peak_force: r.peak_force,
-            peak_time: t,
-            rigid: Some(r),
-        });
+        self.impact_log().push(ImpactRecord::jump(k, t, r));
         self.last_impact[k] = (t, r.duration);
         self.armed[k] = false;
         self.local.rigid_impacts += 1;
@@ -177,13 +160,8 @@ impl Run<'_> {
         near.sort_unstable();
         near.dedup();
         near.into_iter().find_map(|j| {
-            let (tj, dj) = self.last_impact[j];
-            if t - tj < dj {
-                return Some(EpisodeReason::Overlap {
-                    other: j,
-                    after: t - tj,
-                    duration: dj,
-                });
+            if let Some(overlap) = EpisodeReason::overlap(j, t, self.last_impact[j]) {
+                return Some(overlap);
             }
             if !self.is_rigid(j) {
                 return None;

@@ -61,6 +61,17 @@ pub enum EpisodeReason {
 }
 
 impl EpisodeReason {
+    /// An impact at `t` overlapping contact j's last impact, begun at
+    /// `last.0` with the estimated duration `last.1`, if it does.
+    pub(in crate::simulate) fn overlap(j: usize, t: f64, last: (f64, f64)) -> Option<Self> {
+        let (tj, duration) = last;
+        (t - tj < duration).then_some(Self::Overlap {
+            other: j,
+            after: t - tj,
+            duration,
+        })
+    }
+
     /// The reason in words, contacts by name.
     pub fn describe(&self, model: &Model) -> String {
         self.describe_by(|k| model.contact_name(k))
@@ -218,13 +229,8 @@ impl Switches {
                     if chain.in_soft_episode(j) {
                         return Some(EpisodeReason::Cluster { other: j });
                     }
-                    let (tj, dj) = self.last_impact[j];
-                    if t - tj < dj {
-                        return Some(EpisodeReason::Overlap {
-                            other: j,
-                            after: t - tj,
-                            duration: dj,
-                        });
+                    if let Some(overlap) = EpisodeReason::overlap(j, t, self.last_impact[j]) {
+                        return Some(overlap);
                     }
                     chain.rigid_law(j)?;
                     let (s, sd) = chain.approach(j, y);
