@@ -213,8 +213,10 @@ def continue_(
     impacts, as ``Model.with_impacts``.
 
     Returns ``parameter_name``, ``subharmonic``, ``symmetric``, ``stop`` (ReachedEnd,
-    MaxPoints, Interrupted, CannotContinue, ClosedLoop or TurnedBack: a
-    fold brought it out of the range on its start's side) with ``stop_detail``,
+    MaxPoints, Interrupted, CannotContinue, Grazing: a branch through rigid
+    impacts reached a grazing, its last point the special point GR,
+    ClosedLoop or TurnedBack: a fold brought it out of the range on its
+    start's side) with ``stop_detail``,
     ``contacts``, ``points`` (each with ``parameter``, ``max_displacement``,
     ``max_velocity``, ``impacts_per_period``, ``stable``,
     ``spectral_radius``, ``floquet_multipliers``, ``initial_state``,
