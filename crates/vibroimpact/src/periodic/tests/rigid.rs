@@ -7,7 +7,7 @@ use super::*;
 use crate::contact::{ContactLaw, ForceForm};
 use crate::impact::closed_form::{restitution, restitution_derivative};
 use crate::model::Impacts;
-use crate::simulate::tests::rigid::{oscillator, shaw_holmes};
+use crate::simulate::tests::rigid::{ball_on_table, oscillator, shaw_holmes};
 use crate::simulate::{simulate, SimulationOptions};
 
 const ZETA_O: f64 = 0.05;
@@ -237,18 +237,7 @@ const W_TABLE: f64 = 2.0 * std::f64::consts::PI;
 /// Γ = A ω²/g, in the table's frame: ü = −z̈ − g, the table a wall at
 /// u = 0 below it, Newton's e.
 fn bouncing_ball(gamma: f64) -> Model {
-    use crate::model::{Body, Contact, ContactPair};
-    let ball = Body {
-        name: "ball".into(),
-        mass: 1.0,
-        stiffness: 0.0,
-        damping: 0.0,
-    };
-    let table = Contact {
-        pair: ContactPair::LeftWall { body: 0 },
-        clearance: 0.0,
-        law: ContactLaw::hertz(1e9, 1.5).unwrap(),
-    };
+    let (ball, table) = ball_on_table(0.0, ContactLaw::hertz(1e9, 1.5).unwrap());
     // z̈ = −A ω² sin ωt = A ω² sin(ωt + π).
     let base = BaseExcitation::Harmonic {
         amplitude: gamma * G,

@@ -254,6 +254,22 @@ impl Run<'_> {
         self.rebuild(groups, t)
     }
 
+    /// The checks (contacts, then storeys `nc + s`) of `groups`, ascending,
+    /// each once.
+    pub(super) fn checks_of(&self, groups: &[usize]) -> Vec<usize> {
+        let nc = self.model.contacts().len();
+        let mut checks: Vec<usize> = groups
+            .iter()
+            .flat_map(|&g| {
+                let storeys = self.group_storeys[g].iter().map(move |s| nc + s);
+                self.group_contacts[g].iter().copied().chain(storeys)
+            })
+            .collect();
+        checks.sort_unstable();
+        checks.dedup();
+        checks
+    }
+
     /// The checks of the contacts and storeys of check k's groups lapse
     /// (the groups join a set).
     pub(super) fn lapse_checks_of(&mut self, k: usize) {
@@ -419,17 +435,7 @@ impl Run<'_> {
         }
         self.rebuild(keep, t)?;
         let mut first: Crossing = None;
-        let nc = self.model.contacts().len();
-        let mut freed: Vec<usize> = leaving
-            .iter()
-            .flat_map(|&g| {
-                let storeys = self.group_storeys[g].iter().map(move |s| nc + s);
-                self.group_contacts[g].iter().copied().chain(storeys)
-            })
-            .collect();
-        freed.sort_unstable();
-        freed.dedup();
-        for k in freed {
+        for k in self.checks_of(&leaving) {
             if !self.touches_set(k) && self.schedule(k, t) {
                 match first {
                     None => first = Some((t, k)),

@@ -204,18 +204,8 @@ impl Run<'_> {
     /// changed there); those active at once (a chain's next touch) are
     /// taken in turn.
     fn reschedule(&mut self, groups: &[usize], t: f64) -> Result<(), IntegrationError> {
-        let nc = self.model.contacts().len();
-        let mut checks: Vec<usize> = groups
-            .iter()
-            .flat_map(|&g| {
-                let storeys = self.group_storeys[g].iter().map(move |s| nc + s);
-                self.group_contacts[g].iter().copied().chain(storeys)
-            })
-            .collect();
-        checks.sort_unstable();
-        checks.dedup();
         let mut active = Vec::new();
-        for kk in checks {
+        for kk in self.checks_of(groups) {
             if !self.touches_set(kk) && self.schedule(kk, t) {
                 active.push(kk);
             }

@@ -92,6 +92,23 @@ pub(crate) fn shaw_holmes(
     (f, v_of(f).0)
 }
 
+/// A ball (1 kg, no spring) and a table below it: a wall `clearance`
+/// under the ball's rest position, with contact law `law`.
+pub(crate) fn ball_on_table(clearance: f64, law: ContactLaw) -> (Body, Contact) {
+    let ball = Body {
+        name: "ball".into(),
+        mass: 1.0,
+        stiffness: 0.0,
+        damping: 0.0,
+    };
+    let table = Contact {
+        pair: ContactPair::LeftWall { body: 0 },
+        clearance,
+        law,
+    };
+    (ball, table)
+}
+
 fn rigid_run(
     model: &Model,
     t_end: f64,
@@ -376,17 +393,10 @@ fn the_local_run_carries_no_tangents_through_rigid_impacts() {
 /// accumulation point.)
 #[test]
 fn a_ball_on_a_table_comes_to_rest_in_a_soft_episode() {
-    let ball = Body {
-        name: "ball".into(),
-        mass: 1.0,
-        stiffness: 0.0,
-        damping: 0.0,
-    };
-    let table = Contact {
-        pair: ContactPair::LeftWall { body: 0 },
-        clearance: 0.1,
-        law: ContactLaw::hunt_crossley(1e6, 1.5, 10.0, ForceForm::Published).unwrap(),
-    };
+    let (ball, table) = ball_on_table(
+        0.1,
+        ContactLaw::hunt_crossley(1e6, 1.5, 10.0, ForceForm::Published).unwrap(),
+    );
     let model = Model::new(
         vec![ball],
         vec![],
