@@ -202,6 +202,16 @@ impl ChainDynamics {
     pub fn new(model: &Model, energy: bool) -> Self {
         let bodies = model.bodies();
         let n = bodies.len();
+        // (A rigid contact's law was checked when it was set:
+        // Model::with_impacts.)
+        let mut rigid_laws = model
+            .rigid_laws()
+            .unwrap_or_else(|_| {
+                (0..model.contacts().len())
+                    .map(|k| model.rigid_law(k).ok().flatten())
+                    .collect()
+            })
+            .into_iter();
         let contacts = model
             .contacts()
             .iter()
@@ -224,9 +234,7 @@ impl ChainDynamics {
                     }
                     _ => (Screen::CompactSupport, f64::INFINITY),
                 };
-                // (A rigid contact's law was checked when it was set:
-                // Model::with_impacts.)
-                let rigid = model.rigid_law(k).ok().flatten();
+                let rigid = rigid_laws.next().flatten();
                 let soft = (screen, absurd);
                 let (screen, absurd) = if rigid.is_some() {
                     (Screen::Never, f64::INFINITY)

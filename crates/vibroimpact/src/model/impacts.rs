@@ -65,13 +65,53 @@ impl Model {
         let Impacts::Rigid { restitution } = self.impacts[k] else {
             return Ok(None);
         };
+        self.built_rigid_law(k, self.reduced_mass(k), restitution)
+    }
+
+    /// Every contact's [`Model::rigid_law`], in contact order. A contact
+    /// with the law, reduced mass and coefficient of the one before takes
+    /// a copy of its limit: a row of a thousand like pairs builds one.
+    pub fn rigid_laws(&self) -> Result<Vec<Option<RigidLaw>>, ModelError> {
+        let mut laws: Vec<Option<RigidLaw>> = Vec::with_capacity(self.contacts.len());
+        let mut last: Option<(usize, f64, Option<f64>)> = None;
+        for k in 0..self.contacts.len() {
+            let Impacts::Rigid { restitution } = self.impacts[k] else {
+                laws.push(None);
+                continue;
+            };
+            let mu = self.reduced_mass(k);
+            let same = last.filter(|&(j, m, e)| {
+                self.contacts[j].law == self.contacts[k].law && m == mu && e == restitution
+            });
+            let law = match same {
+                Some((j, ..)) => laws[j].clone(),
+                None => self.built_rigid_law(k, mu, restitution)?,
+            };
+            last = Some((k, mu, restitution));
+            laws.push(law);
+        }
+        Ok(laws)
+    }
+
+    /// Contact `k`'s reduced mass (a wall's side infinite).
+    fn reduced_mass(&self, k: usize) -> f64 {
         let c = &self.contacts[k];
         let masses = [c.pair.left(), c.pair.right()].map(|b| b.map(|i| self.bodies[i].mass));
-        let mu = match masses {
+        match masses {
             [Some(a), Some(b)] => a / (1.0 + a / b),
             [Some(m), None] | [None, Some(m)] => m,
             [None, None] => f64::INFINITY,
-        };
+        }
+    }
+
+    /// Contact `k`'s rigid limit between the reduced mass `mu`.
+    fn built_rigid_law(
+        &self,
+        k: usize,
+        mu: f64,
+        restitution: Option<f64>,
+    ) -> Result<Option<RigidLaw>, ModelError> {
+        let c = &self.contacts[k];
         RigidLaw::new(&c.law, mu, restitution)
             .map(Some)
             .map_err(|e| {

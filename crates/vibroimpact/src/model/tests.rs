@@ -220,3 +220,42 @@ fn a_hinted_record_value_is_the_value() {
         );
     }
 }
+
+/// The rigid limits of a row built at once (a copy where a contact is
+/// like the one before) are those built one by one: the walls' reduced
+/// mass is the body's, the pairs' half of it, and a soft contact has none.
+#[test]
+fn rigid_laws_at_once_equal_those_built_one_by_one() {
+    let m = Model::row(
+        4,
+        0.227,
+        12.0,
+        0.04,
+        1e-3,
+        law(),
+        (true, true),
+        BaseExcitation::None,
+    )
+    .unwrap()
+    .with_all_impacts(Impacts::Rigid { restitution: None })
+    .unwrap()
+    .with_impacts(2, Impacts::Soft)
+    .unwrap();
+    let laws = m.rigid_laws().unwrap();
+    assert_eq!(laws.len(), 5);
+    for (k, law) in laws.iter().enumerate() {
+        let alone = m.rigid_law(k).unwrap();
+        assert_eq!(law.is_some(), k != 2, "contact {k}");
+        let (Some(law), Some(alone)) = (law, alone) else {
+            continue;
+        };
+        let mu = if k == 0 || k == 4 { 0.227 } else { 0.1135 };
+        assert!((law.reduced_mass() - mu).abs() < 1e-15, "contact {k}");
+        assert_eq!(law.reduced_mass(), alone.reduced_mass(), "contact {k}");
+        for u in [1e-3, 0.1, 2.0] {
+            let (a, b) = (law.impact(u).unwrap(), alone.impact(u).unwrap());
+            assert_eq!(a.restitution, b.restitution, "contact {k}, U {u}");
+            assert_eq!(a.impulse, b.impulse, "contact {k}, U {u}");
+        }
+    }
+}

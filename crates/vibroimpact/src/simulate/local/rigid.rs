@@ -27,9 +27,8 @@ pub(super) fn rigid_parts(
     opts: &SimulationOptions,
 ) -> Result<(Vec<Option<RigidLaw>>, Vec<f64>), OptionsError> {
     let nc = model.contacts().len();
-    let laws = (0..nc)
-        .map(|k| model.rigid_law(k))
-        .collect::<Result<_, _>>()
+    let laws = model
+        .rigid_laws()
         .map_err(|e| OptionsError(e.to_string()))?;
     let pre = (0..nc)
         .map(|k| match model.impacts(k).is_rigid() {

@@ -105,22 +105,40 @@ pub(super) fn steady_states(
     Ok((harmonic, rate))
 }
 
-/// The propagator of bodies with `mass`, `stiffness` and `damping` and
-/// the system matrix `a`: a single body's closed form, or the group's.
-pub(super) fn propagator(
+/// The free motion of bodies with `mass`, ground `stiffness` and
+/// `damping`, and `couplings`, under the harmonic `terms`: its propagator
+/// (a single body's closed form, or the group's system matrix), the
+/// terms' steady states and the fastest rate ([`steady_states`]). A
+/// single body without terms builds no matrix: a row of a thousand
+/// pendulums sets up a thousand of these.
+#[allow(clippy::type_complexity)]
+pub(super) fn motion(
     mass: &[f64],
     stiffness: &[f64],
     damping: &[f64],
-    a: DMatrix<f64>,
-) -> Propagator {
-    if mass.len() == 1 {
+    couplings: &[(usize, usize, f64, f64)],
+    terms: &[(f64, f64, Vec<f64>)],
+    names: &str,
+) -> Result<(Propagator, Vec<(f64, f64, Vec<f64>, Vec<f64>)>, f64), FreeMotionError> {
+    if mass.len() == 1 && couplings.is_empty() && terms.is_empty() {
+        let (w2, c2) = (stiffness[0] / mass[0], damping[0] / mass[0]);
+        return Ok((
+            Propagator::Single { w2, c2 },
+            Vec::new(),
+            w2.max(0.0).sqrt(),
+        ));
+    }
+    let a = system_matrix(mass, stiffness, damping, couplings);
+    let (harmonic, rate) = steady_states(&a, terms, names)?;
+    let propagator = if mass.len() == 1 {
         Propagator::Single {
-            w2: stiffness[0] / mass[0],
-            c2: damping[0] / mass[0],
+            w2: -a[(1, 0)],
+            c2: -a[(1, 1)],
         }
     } else {
         Propagator::Group(a)
-    }
+    };
+    Ok((propagator, harmonic, rate))
 }
 
 impl Group {
@@ -186,16 +204,17 @@ impl FreeMotion {
                 Slot::Coupling(c) => group.couplings[c].2 = new,
             }
         }
-        let a = system_matrix(
+        let (propagator, harmonic, rate) = motion(
             &group.mass,
             &group.stiffness,
             &group.damping,
             &group.couplings,
-        );
-        let (harmonic, rate) = steady_states(&a, &group.terms, &group.names)?;
+            &group.terms,
+            &group.names,
+        )?;
         group.harmonic = harmonic;
         group.rate = rate;
-        group.propagator = propagator(&group.mass, &group.stiffness, &group.damping, a);
+        group.propagator = propagator;
         Self::dress(group, record_step);
         Ok(())
     }

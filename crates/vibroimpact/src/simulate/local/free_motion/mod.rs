@@ -343,8 +343,8 @@ impl FreeMotion {
             storeys.push((i, slot));
             storey_stiffness.push(k);
         }
-        let a = branches::system_matrix(&mass, &stiffness, &damping, &couplings);
-        // Harmonic terms b sin(Ω t + φ) (per unit mass, velocity rows).
+        // Harmonic terms b sin(Ω t + φ) (per unit mass, velocity rows); a
+        // term of zero amplitude has the steady state zero, and is left out.
         let mut terms: Vec<(f64, f64, Vec<f64>)> = Vec::new();
         if let BaseExcitation::Harmonic {
             amplitude,
@@ -352,11 +352,13 @@ impl FreeMotion {
             phase,
         } = *model.base()
         {
-            let mut b = vec![0.0; 2 * m];
-            for j in 0..m {
-                b[2 * j + 1] = -amplitude;
+            if amplitude != 0.0 {
+                let mut b = vec![0.0; 2 * m];
+                for j in 0..m {
+                    b[2 * j + 1] = -amplitude;
+                }
+                terms.push((frequency, phase, b));
             }
-            terms.push((frequency, phase, b));
         }
         let mut force_amplitude = vec![0.0; m];
         let mut forces = Vec::new();
@@ -369,15 +371,22 @@ impl FreeMotion {
             b[2 * j + 1] = f.amplitude / mass[j];
             force_amplitude[j] += f.amplitude.abs();
             forces.push((j, f.amplitude, f.frequency, f.phase));
-            terms.push((f.frequency, f.phase, b));
+            if f.amplitude != 0.0 {
+                terms.push((f.frequency, f.phase, b));
+            }
         }
-        let names = bodies
-            .iter()
-            .map(|&i| all[i].name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ");
-        let (harmonic, rate) = branches::steady_states(&a, &terms, &names)?;
-        let propagator = branches::propagator(&mass, &stiffness, &damping, a);
+        // The names serve a resonance's error alone (none without terms).
+        let names = if terms.is_empty() {
+            String::new()
+        } else {
+            bodies
+                .iter()
+                .map(|&i| all[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let (propagator, harmonic, rate) =
+            branches::motion(&mass, &stiffness, &damping, &couplings, &terms, &names)?;
         Ok(Group {
             bodies,
             propagator,

@@ -621,3 +621,40 @@ fn the_extrema_grid_parts_whole_steps() {
     }
     assert_close(&x, &integrated(&m, b), 1e-9);
 }
+
+/// A harmonic base or force of zero amplitude is left out of the free
+/// motion (no steady state to solve for, no system matrix for a single
+/// body): a single body and a coupled pair under both move as unforced,
+/// to the last bit, and as integrated.
+#[test]
+fn zero_amplitude_terms_are_left_out() {
+    let silent = |body| HarmonicForce {
+        body,
+        amplitude: 0.0,
+        frequency: 5.3,
+        phase: 0.4,
+    };
+    let single = |base, forces| free_model(vec![body("a", 1.0, 12.0, 0.02)], vec![], base, forces);
+    let pair = |base, forces| {
+        joined(
+            [body("a", 1.0, 12.0, 0.02), body("b", 1.2, 9.0, 0.02)],
+            (40.0, 0.3),
+            base,
+            forces,
+        )
+    };
+    for (unforced, silenced) in [
+        (
+            single(BaseExcitation::None, vec![]),
+            single(harmonic(0.0, 6.0, 0.2), vec![silent(0)]),
+        ),
+        (
+            pair(BaseExcitation::None, vec![]),
+            pair(harmonic(0.0, 6.0, 0.2), vec![silent(1)]),
+        ),
+    ] {
+        let (a, b) = (exact(&unforced, 2.0, 7), exact(&silenced, 2.0, 7));
+        assert_eq!(a, b);
+        assert_close(&b, &integrated(&silenced, 2.0), 1e-9);
+    }
+}
