@@ -7,6 +7,7 @@
 //! - `jacobian.rs` — the analytic Jacobian and its record for tangent
 //!   replay;
 //! - `storeys.rs` — the hysteretic storeys' terms and states;
+//! - `linear.rs` — the linear form of a chain whose contacts are rigid;
 //! - `saltation.rs` — the saltation matrix of a rigid impact;
 //! - `episodes.rs` — a rigid contact's soft episodes;
 //! - `variational.rs` — the variational equations (sensitivities,
@@ -42,11 +43,12 @@
 use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::dynamics::variational::Variational;
 use crate::impact::rigid::RigidLaw;
-use crate::integrate::{BandMatrix, OdeSystem, Recorder};
+use crate::integrate::{BandMatrix, LinearForm, OdeSystem, Recorder};
 use crate::model::{BaseExcitation, Model};
 
 mod episodes;
 mod jacobian;
+mod linear;
 pub mod saltation;
 mod storeys;
 pub mod variational;
@@ -616,6 +618,10 @@ impl OdeSystem for ChainDynamics {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
         self.rhs_with(t, y, dydt, None);
+    }
+
+    fn linear_form(&self) -> Option<LinearForm> {
+        self.linear_form_of()
     }
 
     fn rhs_reforced(&mut self, source: &Self, t: f64, y: &[f64], dydt: &mut [f64]) {

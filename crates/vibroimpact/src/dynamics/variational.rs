@@ -21,7 +21,7 @@
 //! ([`Variational::error_components`]); including the columns controls the
 //! accuracy of Φ itself.
 
-use crate::integrate::{BandMatrix, OdeSystem};
+use crate::integrate::{BandMatrix, Harmonic, LinearForm, OdeSystem};
 
 /// A system extended by its variational equations.
 #[derive(Clone, Debug)]
@@ -235,6 +235,40 @@ impl<S: OdeSystem> OdeSystem for Variational<S> {
 
     fn jacobian(&mut self, t: f64, z: &[f64], jac: &mut BandMatrix) -> bool {
         self.carried() == 0 && self.sys.jacobian(t, z, jac)
+    }
+
+    /// The system's form for the state and the same `A` for every
+    /// column: Φ's columns unforced, the parameter's forced by the
+    /// difference of the shifted system's harmonics and the system's over
+    /// δp (where the shift leaves `A` as it is; else None).
+    fn linear_form(&self) -> Option<LinearForm> {
+        let form = self.sys.linear_form()?;
+        let [own] = form.blocks.as_slice() else {
+            return None;
+        };
+        let scaled = |h: &Harmonic, by: f64| Harmonic {
+            omega: h.omega,
+            cos: h.cos.iter().map(|x| x * by).collect(),
+            sin: h.sin.iter().map(|x| x * by).collect(),
+        };
+        let mut blocks = vec![own.clone()];
+        blocks.resize(1 + self.columns, Vec::new());
+        if let Some((shifted, dp)) = &self.parameter {
+            let theirs = shifted.linear_form()?;
+            let [their] = theirs.blocks.as_slice() else {
+                return None;
+            };
+            if theirs.a != form.a {
+                return None;
+            }
+            let column = their
+                .iter()
+                .map(|h| scaled(h, 1.0 / dp))
+                .chain(own.iter().map(|h| scaled(h, -1.0 / dp)))
+                .collect();
+            blocks.push(column);
+        }
+        Some(LinearForm { a: form.a, blocks })
     }
 }
 

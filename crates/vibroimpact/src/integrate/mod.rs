@@ -5,6 +5,8 @@
 //! - `explicit.rs` — what the explicit Runge–Kutta methods share;
 //! - `dop853/`, `dopri5/`, `rosenbrock/` — the three methods (DOP853 with
 //!   its tableau, DOPRI5, RODAS), each with its tests;
+//! - `exact/` — the exact flow of a linear system under harmonic forcing
+//!   (a chain whose every contact is rigid, between impacts);
 //! - `stepper.rs` — any method behind one interface, automatic switching;
 //! - `events.rs` — event location on the dense output;
 //! - `tangent.rs` — the tangent tape: products replayed on recorded steps;
@@ -49,6 +51,7 @@ mod dop853;
 mod dopri5;
 mod driver;
 pub mod events;
+mod exact;
 mod explicit;
 pub mod rosenbrock;
 mod stepper;
@@ -61,6 +64,7 @@ pub use crate::linalg::{BandMatrix, Singular};
 pub use dop853::{Dop853, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Method};
 pub use driver::{Attempt, Driver, Point, StepMethod, Trial};
+pub use exact::{Exact, ExactMethod, Harmonic, Linear, LinearForm};
 pub use rosenbrock::{Rodas, RodasMethod};
 pub use stepper::{Method, Stepper};
 pub use tangent::{integrate_recorded, RecordedJacobian, Recorder, TangentTape};
@@ -198,6 +202,13 @@ pub trait OdeSystem {
         Self: Sized,
     {
         self.rhs(t, y, dydt)
+    }
+
+    /// The system as `A y + b(t)` with harmonic `b`, where it is one
+    /// ([`LinearForm`]; None by default): [`Method::Exact`] then moves it
+    /// exactly.
+    fn linear_form(&self) -> Option<LinearForm> {
+        None
     }
 }
 

@@ -1,7 +1,7 @@
 //! [`Stepper`]: DOP853, DOPRI5 or RODAS behind one interface, with the
 //! automatic switch from DOP853 to RODAS when DOP853's stiffness test fires.
 
-use super::{Dop853, Dopri5, IntegrationError, IntegratorOptions, OdeSystem, Rodas, Stats};
+use super::{Dop853, Dopri5, Exact, IntegrationError, IntegratorOptions, OdeSystem, Rodas, Stats};
 
 /// Integration method of a [`Stepper`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -11,6 +11,10 @@ pub enum Method {
     /// The explicit [`Dopri5`] (non-stiff problems at loose tolerances,
     /// steps limited by breakpoints such as a record's samples).
     Dopri5,
+    /// The exact flow [`Exact`] of a system with a
+    /// [`linear_form`](super::OdeSystem::linear_form) (the period map of a
+    /// chain whose every contact is rigid, between impacts).
+    Exact,
     /// The linearly implicit [`Rodas`] (stiff problems).
     Rodas,
     /// Start every integration (every [`Stepper::reset`]) with DOP853 and
@@ -27,6 +31,7 @@ impl Method {
         match self {
             Method::Dop853 => "dop853",
             Method::Dopri5 => "dopri5",
+            Method::Exact => "exact",
             Method::Rodas => "rodas",
             Method::Auto => "auto",
         }
@@ -40,6 +45,7 @@ impl Method {
 enum Engines {
     Dop853(Dop853),
     Dopri5(Dopri5),
+    Exact(Exact),
     Rodas(Rodas),
     /// DOP853 from every reset, RODAS (`on_rodas`) from the moment DOP853's
     /// stiffness test fired until the next reset.
@@ -64,6 +70,7 @@ macro_rules! active {
             Engines::Dop853($d) | Engines::Auto { dop853: $d, on_rodas: false, .. } => $e,
             Engines::Rodas($d) | Engines::Auto { rodas: $d, on_rodas: true, .. } => $e,
             Engines::Dopri5($d) => $e,
+            Engines::Exact($d) => $e,
         }
     };
 }
@@ -102,6 +109,7 @@ impl Stepper {
         let engines = match method {
             Method::Dop853 => Engines::Dop853(Dop853::new(dim, opts.clone())?),
             Method::Dopri5 => Engines::Dopri5(Dopri5::new(dim, opts.clone())?),
+            Method::Exact => Engines::Exact(Exact::new(dim, opts.clone())?),
             Method::Rodas => Engines::Rodas(Rodas::new(dim, opts.clone())?),
             Method::Auto => Engines::Auto {
                 dop853: Dop853::new(dim, opts.clone())?,
@@ -126,6 +134,7 @@ impl Stepper {
     pub fn active(&self) -> Method {
         match self.engines {
             Engines::Dopri5(_) => Method::Dopri5,
+            Engines::Exact(_) => Method::Exact,
             Engines::Dop853(_)
             | Engines::Auto {
                 on_rodas: false, ..
@@ -226,6 +235,7 @@ impl Stepper {
         match &self.engines {
             Engines::Dop853(d) => d.stats(),
             Engines::Dopri5(d) => d.stats(),
+            Engines::Exact(d) => d.stats(),
             Engines::Rodas(r) => r.stats(),
             Engines::Auto { dop853, rodas, .. } => dop853.stats() + rodas.stats(),
         }
@@ -236,6 +246,7 @@ impl Stepper {
         match &mut self.engines {
             Engines::Dop853(d) => d.reset_stats(),
             Engines::Dopri5(d) => d.reset_stats(),
+            Engines::Exact(d) => d.reset_stats(),
             Engines::Rodas(r) => r.reset_stats(),
             Engines::Auto { dop853, rodas, .. } => {
                 dop853.reset_stats();

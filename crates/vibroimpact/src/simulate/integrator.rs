@@ -76,7 +76,7 @@ impl Integrator {
         let pays = match opts.method {
             Method::Dop853 => true,
             Method::Dopri5 => opts.rtol <= 1e-7,
-            Method::Rodas | Method::Auto => false,
+            Method::Exact | Method::Rodas | Method::Auto => false,
         };
         if groups >= AUTO_LOCAL_GROUPS && pays && opts.extrema_window.is_none() {
             Integrator::Local

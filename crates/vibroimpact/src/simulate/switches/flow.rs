@@ -1,13 +1,14 @@
 //! A bare flow through a run's events: a state, with whatever rides along
 //! (the columns of a variational system), integrated over an interval by
-//! DOP853, every event located and applied where it happens, and a hook at
+//! DOP853 (or moved exactly, where every contact is rigid: [`Method::Exact`]),
+//! every event located and applied where it happens, and a hook at
 //! each rigid impact that updates what rides along (docs/theory.md §12:
 //! the saltation of the period map's columns).
 
 use super::{apply_event, EpisodeReason, Event, Jump, Switches, Verdict};
 use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
-use crate::integrate::{IntegrationError, IntegratorOptions, Method, Stepper};
+use crate::integrate::{IntegrationError, IntegratorOptions, LinearForm, Method, Stepper};
 
 /// What a rigid impact hands the hook: the contact, the time, the
 /// extended state just before the jump, and the state just after it (the
@@ -38,7 +39,23 @@ pub(crate) fn flow_through_events<S: Chain>(
     mut at_impact: impl FnMut(&mut S, ImpactJump) -> Result<(), IntegrationError>,
 ) -> Result<(Vec<f64>, u64, usize), IntegrationError> {
     let dim = sys.dim();
-    let mut st = Stepper::new(Method::Dop853, dim, opts.clone())?;
+    // A chain whose every contact is rigid moves exactly between impacts
+    // (its linear form), in steps the exact series takes to rounding;
+    // another by DOP853.
+    let (method, opts) = match sys.linear_form().and_then(LinearForm::solve) {
+        Some(form) => {
+            let h = opts.h_max.min(form.step_limit());
+            let exact = IntegratorOptions {
+                h_max: h,
+                h_init: Some(h),
+                ..opts.clone()
+            };
+            (Method::Exact, exact)
+        }
+        None => (Method::Dop853, opts.clone()),
+    };
+    let opts = &opts;
+    let mut st = Stepper::new(method, dim, opts.clone())?;
     st.reset(sys, 0.0, z0)?;
     let contacts = sys.chain().contacts();
     // (Rigid impacts judged where a simulation judges them, at the default

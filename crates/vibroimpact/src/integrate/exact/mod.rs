@@ -1,0 +1,537 @@
+//! The exact flow of a linear system under harmonic forcing, as a step
+//! method: "EXACT" (docs/theory.md §12: the rigid period map between
+//! impacts).
+//!
+//! Files: `mod.rs` (the form and the method), `tests.rs` (against closed
+//! forms and DOP853).
+//!
+//! A system whose right-hand side is `f(t, y) = A y + b(t)`, the state made
+//! of blocks of one dimension d that share the d × d matrix `A`, each with
+//! its own forcing `b(t) = Σ_j (c_j cos Ω_j t + s_j sin Ω_j t)`
+//! ([`LinearForm`]; a chain whose every contact is rigid, and its
+//! variational columns), moves as
+//!
+//! ```text
+//! y(t) = y_p(t) + e^{A (t − t₀)} (y(t₀) − y_p(t₀)),
+//! ```
+//!
+//! `y_p` the steady state of the harmonics, `Re[X e^{iΩt}]` with
+//! `(iΩ − A) X = c − i s` (a constant force is Ω = 0). Where some
+//! `iΩ − A` is singular (a resonance, a free body under a constant force)
+//! the system has no exact form here, and [`LinearForm::solve`] says so.
+//!
+//! * **A step** of size h multiplies each block's deviation from the
+//!   steady state by `e^{Ah}`, kept with `e^{Ah/4}`, `e^{Ah/2}` and
+//!   `e^{3Ah/4}` for the last few step sizes met (one matrix exponential
+//!   and three products a new size; the steps are mostly `h_max`). Its
+//!   error is rounding, so the driver sees zero and the step grows to
+//!   `h_max`, kept below [`Linear::step_limit`] (`‖A‖∞ h ≤ 2`).
+//! * **Dense output**: at a quarter of the step those matrices; elsewhere
+//!   (an event being located) the exponential's series on the deviation,
+//!   `Σ_k τ^k A^k v / k!` to the first term below 1e-17 of the sum, built
+//!   once a step and summed by Horner (at `‖A‖∞ τ ≤ 2` its terms never
+//!   exceed the sum by more than a factor 3): exact to rounding, so events
+//!   are located on the motion itself.
+//! * `f(t + h, y_new)` is `A y_new + b(t + h)`: no evaluation of the
+//!   system's own right-hand side inside a step.
+//!
+//! The form is read at the first reset: a system handed to this method
+//! keeps its form for the whole integration (rigid impacts jump the state,
+//! not `A`). Every buffer is allocated in `ExactMethod::new` and that
+//! reset.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use super::driver::{all_finite, Attempt, Driver, Point, StepMethod, Trial, NON_FINITE};
+use super::{OdeSystem, RejectReason, Stats};
+
+/// Most terms of a step's series (at `‖A‖∞ h ≤ 2` it meets 1e-17 of the
+/// sum by the 30th).
+const MAX_TERMS: usize = 40;
+/// Largest `‖A‖∞ h` of a step.
+const NORM_STEP: f64 = 2.0;
+
+/// One harmonic of a block's forcing, `cos·cos(Ω t) + sin·sin(Ω t)` (Ω ≥
+/// 0; Ω = 0 a constant `cos`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Harmonic {
+    /// Ω (rad/s).
+    pub omega: f64,
+    /// The cosine's coefficients, one per row of the block.
+    pub cos: Vec<f64>,
+    /// The sine's coefficients, one per row of the block.
+    pub sin: Vec<f64>,
+}
+
+/// A linear system under harmonic forcing: blocks of the state that share
+/// the matrix `a`, each under its own harmonics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearForm {
+    /// The d × d matrix every block moves by.
+    pub a: DMatrix<f64>,
+    /// Per block (the state is `blocks.len()` blocks of d rows, in order),
+    /// its forcing.
+    pub blocks: Vec<Vec<Harmonic>>,
+}
+
+impl LinearForm {
+    /// The form with its steady states solved, or None where some
+    /// `iΩ − A` is singular or the coefficients are not finite.
+    pub fn solve(self) -> Option<Linear> {
+        let d = self.a.nrows();
+        if self.a.ncols() != d || !self.a.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let norm = (0..d)
+            .map(|i| (0..d).map(|j| self.a[(i, j)].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        let mut steady = Vec::with_capacity(self.blocks.len());
+        for block in &self.blocks {
+            let mut terms = Vec::with_capacity(block.len());
+            for h in block {
+                if h.cos.len() != d || h.sin.len() != d {
+                    return None;
+                }
+                terms.push(steady_state(&self.a, norm, h)?);
+            }
+            steady.push(terms);
+        }
+        let rows = (0..d)
+            .flat_map(|i| (0..d).map(move |j| (i, j)))
+            .map(|(i, j)| self.a[(i, j)])
+            .collect();
+        Some(Linear {
+            rows,
+            d,
+            norm,
+            steady,
+            forcing: self.blocks,
+        })
+    }
+}
+
+/// The complex amplitude X of `(iΩ − A) X = c − i s`: `(Ω, Re X, Im X)`,
+/// None where the matrix is singular to working accuracy.
+fn steady_state(a: &DMatrix<f64>, norm: f64, h: &Harmonic) -> Option<Steady> {
+    let d = a.nrows();
+    let w = h.omega;
+    if h.cos.iter().chain(&h.sin).all(|&x| x == 0.0) {
+        return Some((w, vec![0.0; d], vec![0.0; d]));
+    }
+    let m = DMatrix::<Complex<f64>>::from_fn(d, d, |i, j| {
+        Complex::new(-a[(i, j)], if i == j { w } else { 0.0 })
+    });
+    let b = DVector::<Complex<f64>>::from_fn(d, |i, _| Complex::new(h.cos[i], -h.sin[i]));
+    let x = m.clone().lu().solve(&b)?;
+    // A singular pivot may still solve, to a response far beyond any
+    // physical one: the residual and the size tell.
+    let bmax = b.iter().fold(0.0f64, |s, z| s.max(z.norm()));
+    let xmax = x.iter().fold(0.0f64, |s, z| s.max(z.norm()));
+    let residual = (&m * &x - &b).iter().fold(0.0f64, |s, z| s.max(z.norm()));
+    let ok = x.iter().all(|z| z.re.is_finite() && z.im.is_finite())
+        && xmax * (norm + w) * 1e-12 <= bmax
+        && residual <= 1e-10 * bmax;
+    ok.then(|| {
+        (
+            w,
+            x.iter().map(|z| z.re).collect(),
+            x.iter().map(|z| z.im).collect(),
+        )
+    })
+}
+
+/// A harmonic's steady state `(Ω, Re X, Im X)`: `Re X cos Ωt − Im X sin Ωt`.
+type Steady = (f64, Vec<f64>, Vec<f64>);
+
+/// A [`LinearForm`] with its steady states: what [`ExactMethod`] steps.
+#[derive(Clone, Debug)]
+pub struct Linear {
+    /// `A` by rows, d × d.
+    rows: Vec<f64>,
+    d: usize,
+    /// `‖A‖∞`.
+    norm: f64,
+    /// Per block, per harmonic: (Ω, Re X, Im X).
+    steady: Vec<Vec<Steady>>,
+    /// Per block, its harmonics as given.
+    forcing: Vec<Vec<Harmonic>>,
+}
+
+impl Linear {
+    /// The longest step the method takes (`‖A‖∞ h ≤ 2`; unbounded for
+    /// `A = 0`).
+    pub fn step_limit(&self) -> f64 {
+        if self.norm > 0.0 {
+            NORM_STEP / self.norm
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The steady state's row `r` of block `b` at `t`.
+    fn steady_at(&self, b: usize, r: usize, t: f64) -> f64 {
+        self.steady[b]
+            .iter()
+            .map(|(w, xr, xi)| {
+                let (s, c) = (w * t).sin_cos();
+                xr[r] * c - xi[r] * s
+            })
+            .sum()
+    }
+
+    /// The steady state of every block at `t` into `out`.
+    fn steady_into(&self, t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for (block, terms) in out.chunks_exact_mut(self.d).zip(&self.steady) {
+            for (w, xr, xi) in terms {
+                let (s, c) = (w * t).sin_cos();
+                for ((o, r), i) in block.iter_mut().zip(xr).zip(xi) {
+                    *o += r * c - i * s;
+                }
+            }
+        }
+    }
+
+    /// `A y + b(t)`, the right-hand side, into `out`.
+    fn rate(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        let d = self.d;
+        for ((yb, ob), forcing) in y
+            .chunks_exact(d)
+            .zip(out.chunks_exact_mut(d))
+            .zip(&self.forcing)
+        {
+            times(&self.rows, yb, ob);
+            for h in forcing {
+                let (s, c) = (h.omega * t).sin_cos();
+                for ((o, hc), hs) in ob.iter_mut().zip(&h.cos).zip(&h.sin) {
+                    *o += hc * c + hs * s;
+                }
+            }
+        }
+    }
+
+    /// `e^{Aτ}` by rows, for `‖A‖∞ τ ≤ 0.55` (a quarter step): its
+    /// series to the first term below 1e-17 (at most 20 terms).
+    fn exponential(&self, tau: f64) -> Vec<f64> {
+        let d = self.d;
+        let mut e = vec![0.0; d * d];
+        let mut term = vec![0.0; d * d];
+        let mut next = vec![0.0; d * d];
+        for i in 0..d {
+            e[i * d + i] = 1.0;
+            term[i * d + i] = 1.0;
+        }
+        for k in 1..=MAX_TERMS {
+            let c = tau / k as f64;
+            for i in 0..d {
+                for j in 0..d {
+                    next[i * d + j] = c
+                        * (0..d)
+                            .map(|l| term[i * d + l] * self.rows[l * d + j])
+                            .sum::<f64>();
+                }
+            }
+            std::mem::swap(&mut term, &mut next);
+            let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            e.iter_mut().zip(&term).for_each(|(e, t)| *e += t);
+            if largest <= 1e-17 {
+                break;
+            }
+        }
+        e
+    }
+}
+
+/// `out = M x`, M by rows (square, of x's length).
+fn times(m: &[f64], x: &[f64], out: &mut [f64]) {
+    for (o, row) in out.iter_mut().zip(m.chunks_exact(x.len())) {
+        *o = row.iter().zip(x).map(|(a, b)| a * b).sum();
+    }
+}
+
+/// `e^{A j h/4}` for j = 1 … 4, by rows, of one step size h.
+#[derive(Clone, Debug)]
+struct Quarters {
+    h: f64,
+    e: [Vec<f64>; 4],
+}
+
+impl Quarters {
+    /// The four from one exponential and three products.
+    fn new(form: &Linear, h: f64) -> Self {
+        let d = form.d;
+        let product = |p: &[f64], q: &[f64]| -> Vec<f64> {
+            (0..d * d)
+                .map(|ij| (0..d).map(|k| p[ij / d * d + k] * q[k * d + ij % d]).sum())
+                .collect()
+        };
+        let e1 = form.exponential(0.25 * h);
+        let e2 = product(&e1, &e1);
+        let e3 = product(&e2, &e1);
+        let e4 = product(&e2, &e2);
+        Self {
+            h,
+            e: [e1, e2, e3, e4],
+        }
+    }
+}
+
+/// The quarter `j/4` of a step that `s` is (to rounding), as the index
+/// j − 1 of [`Quarters::e`].
+fn quarter(s: f64) -> Option<usize> {
+    let j = (4.0 * s).round();
+    ((4.0 * s - j).abs() <= 1e-12 && (1.0..=4.0).contains(&j)).then(|| j as usize - 1)
+}
+
+/// How many step sizes keep their quarters.
+const KEPT_SIZES: usize = 4;
+
+/// The exact flow of a [`LinearForm`]: the shared [`Driver`] around the
+/// [`ExactMethod`].
+pub type Exact = Driver<ExactMethod>;
+
+/// The exact step and dense output (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct ExactMethod {
+    form: Option<Linear>,
+    /// The quarters of the last step sizes met, and which to replace next.
+    sizes: Vec<Quarters>,
+    next: usize,
+    /// The attempt's deviation from the steady state at its start, and
+    /// its quarters.
+    deviation: Vec<f64>,
+    quarters: usize,
+    /// The accepted step's.
+    deviation_acc: Vec<f64>,
+    quarters_acc: usize,
+    /// The accepted step's series terms `A^k v / k!`, term k at
+    /// `[k·n..(k+1)·n]`, and how many (0: not built yet).
+    terms: Vec<f64>,
+    count: usize,
+    /// Scratch: a steady state.
+    steady: Vec<f64>,
+    /// `f(t + h, y_new)`.
+    end: Vec<f64>,
+}
+
+impl ExactMethod {
+    /// The form this method steps, once reset on a system that has one.
+    pub fn form(&self) -> Option<&Linear> {
+        self.form.as_ref()
+    }
+
+    /// The accepted step's series, built on first use (see the module
+    /// documentation); false where it does not converge.
+    fn series(&mut self, h: f64) -> bool {
+        if self.count > 0 {
+            return true;
+        }
+        let Some(form) = self.form.as_ref() else {
+            return false;
+        };
+        let (n, d) = (self.deviation_acc.len(), form.d);
+        let (first, rest) = self.terms.split_at_mut(n);
+        first.copy_from_slice(&self.deviation_acc);
+        let size = first.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let mut count = 1;
+        let mut previous: &[f64] = first;
+        let mut scale = 1.0;
+        for (k, term) in rest.chunks_exact_mut(n).enumerate() {
+            let inv = 1.0 / (k + 1) as f64;
+            for (p, t) in previous.chunks_exact(d).zip(term.chunks_exact_mut(d)) {
+                times(&form.rows, p, t);
+                t.iter_mut().for_each(|x| *x *= inv);
+            }
+            count += 1;
+            scale *= h;
+            let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs())) * scale;
+            if largest <= 1e-17 * size {
+                self.count = count;
+                return true;
+            }
+            previous = term;
+        }
+        false
+    }
+}
+
+impl StepMethod for ExactMethod {
+    // The error is rounding: the controller grows every step to `h_max`.
+    const ERROR_EXPONENT: f64 = 1.0 / 8.0;
+    const SHRINK_LIMIT: f64 = 4.0;
+
+    fn new(dim: usize) -> Self {
+        Self {
+            form: None,
+            sizes: Vec::with_capacity(KEPT_SIZES),
+            next: 0,
+            deviation: vec![0.0; dim],
+            quarters: 0,
+            deviation_acc: vec![0.0; dim],
+            quarters_acc: 0,
+            terms: vec![0.0; (MAX_TERMS + 1) * dim],
+            count: 0,
+            steady: vec![0.0; dim],
+            end: vec![0.0; dim],
+        }
+    }
+
+    fn reset<S: OdeSystem>(&mut self, sys: &S, dim: usize) {
+        if self.form.is_none() {
+            self.form = sys
+                .linear_form()
+                .and_then(LinearForm::solve)
+                .filter(|f| f.d * f.steady.len() == dim);
+        }
+    }
+
+    fn begin_step<S: OdeSystem>(&mut self, _sys: &mut S, _at: &Point, _stats: &mut Stats) {}
+
+    /// `y_p(t + h) + e^{Ah} (y − y_p(t))`.
+    fn attempt<S: OdeSystem>(&mut self, _sys: &mut S, at: &Point, trial: &mut Trial) -> Attempt {
+        let Some(form) = self.form.as_ref() else {
+            return Err(NON_FINITE);
+        };
+        let (h, d) = (trial.h, form.d);
+        // (The driver stretches a step by up to 1 % onto its bound.)
+        if form.norm * h > NORM_STEP * 1.05 {
+            let factor = (NORM_STEP / (form.norm * h)).min(0.9);
+            return Err((RejectReason::ErrorEstimate, factor));
+        }
+        let q = match self.sizes.iter().position(|q| q.h == h) {
+            Some(q) => q,
+            None if self.sizes.len() < KEPT_SIZES => {
+                self.sizes.push(Quarters::new(form, h));
+                self.sizes.len() - 1
+            }
+            None => {
+                let q = self.next;
+                self.next = (q + 1) % KEPT_SIZES;
+                // (Never the accepted step's own: its dense output reads them.)
+                let q = if q == self.quarters_acc { self.next } else { q };
+                self.sizes[q] = Quarters::new(form, h);
+                q
+            }
+        };
+        self.quarters = q;
+        form.steady_into(at.t, &mut self.steady);
+        for ((v, y), p) in self.deviation.iter_mut().zip(&at.y).zip(&self.steady) {
+            *v = y - p;
+        }
+        form.steady_into(trial.t_new, &mut self.steady);
+        let y_new = &mut *trial.y_new;
+        let e = &self.sizes[q].e[3];
+        for ((yb, vb), pb) in y_new
+            .chunks_exact_mut(d)
+            .zip(self.deviation.chunks_exact(d))
+            .zip(self.steady.chunks_exact(d))
+        {
+            times(e, vb, yb);
+            for (y, p) in yb.iter_mut().zip(pb) {
+                *y += p;
+            }
+        }
+        if !all_finite(y_new) {
+            return Err(NON_FINITE);
+        }
+        Ok(0.0)
+    }
+
+    /// `A y_new + b(t + h)`.
+    fn evaluate_end<S: OdeSystem>(&mut self, _sys: &mut S, trial: &mut Trial) -> bool {
+        let Some(form) = self.form.as_ref() else {
+            return false;
+        };
+        form.rate(trial.t_new, trial.y_new, &mut self.end);
+        all_finite(&self.end)
+    }
+
+    fn accept(&mut self, _at: &Point, _y_new: &[f64], _h: f64) {
+        std::mem::swap(&mut self.deviation, &mut self.deviation_acc);
+        self.quarters_acc = self.quarters;
+        self.count = 0;
+    }
+
+    fn end_derivative(&self) -> &[f64] {
+        &self.end
+    }
+
+    /// Component i as [`ExactMethod::dense_all`] has it.
+    fn dense<S: OdeSystem>(
+        &mut self,
+        _sys: &mut S,
+        at: &Point,
+        i: usize,
+        s: f64,
+        _stats: &mut Stats,
+    ) -> f64 {
+        let Some(form) = self.form.as_ref() else {
+            return f64::NAN;
+        };
+        let (n, d, h) = (at.dim(), form.d, at.h_last);
+        let tau = s * h;
+        let (b, r) = (i / d, i % d);
+        let steady = form.steady_at(b, r, at.t_prev + tau);
+        if let Some(j) = quarter(s) {
+            let row = &self.sizes[self.quarters_acc].e[j][r * d..(r + 1) * d];
+            let v = &self.deviation_acc[b * d..(b + 1) * d];
+            return steady + row.iter().zip(v).map(|(a, x)| a * x).sum::<f64>();
+        }
+        if !self.series(h) {
+            return f64::NAN;
+        }
+        let series = (0..self.count)
+            .rev()
+            .fold(0.0, |acc, k| acc * tau + self.terms[k * n + i]);
+        steady + series
+    }
+
+    /// At a quarter of the step its matrix on the deviation; elsewhere the
+    /// series; plus the steady state there.
+    fn dense_all<S: OdeSystem>(
+        &mut self,
+        _sys: &mut S,
+        at: &Point,
+        s: f64,
+        out: &mut [f64],
+        _stats: &mut Stats,
+    ) {
+        let Some(form) = self.form.as_ref() else {
+            out.fill(f64::NAN);
+            return;
+        };
+        let (n, d, h) = (at.dim(), form.d, at.h_last);
+        let tau = s * h;
+        form.steady_into(at.t_prev + tau, out);
+        if let Some(j) = quarter(s) {
+            let e = &self.sizes[self.quarters_acc].e[j];
+            for (ob, vb) in out
+                .chunks_exact_mut(d)
+                .zip(self.deviation_acc.chunks_exact(d))
+            {
+                for (o, row) in ob.iter_mut().zip(e.chunks_exact(d)) {
+                    *o += row.iter().zip(vb).map(|(a, b)| a * b).sum::<f64>();
+                }
+            }
+            return;
+        }
+        if !self.series(h) {
+            out.fill(f64::NAN);
+            return;
+        }
+        let count = self.count;
+        let series = &mut self.steady;
+        series.copy_from_slice(&self.terms[(count - 1) * n..count * n]);
+        for k in (0..count - 1).rev() {
+            for (x, t) in series.iter_mut().zip(&self.terms[k * n..(k + 1) * n]) {
+                *x = *x * tau + t;
+            }
+        }
+        for (o, x) in out.iter_mut().zip(series.iter()) {
+            *o += x;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
