@@ -315,11 +315,6 @@ pub struct ExactMethod {
 }
 
 impl ExactMethod {
-    /// The form this method steps, once reset on a system that has one.
-    pub fn form(&self) -> Option<&Linear> {
-        self.form.as_ref()
-    }
-
     /// The accepted step's series, built on first use (see the module
     /// documentation); false where it does not converge.
     fn series(&mut self, h: f64) -> bool {
