@@ -399,10 +399,23 @@ impl ChainDynamics {
         2 * self.n + self.storeys.states()
     }
 
-    /// The initial ODE state of a model (interleaved, energy quadratures 0).
-    pub fn initial_state(&self, model: &Model) -> Vec<f64> {
-        let mut y = vec![0.0; self.dim()];
-        for i in 0..self.n {
+    /// The length of a model's ODE state: u, v interleaved, the Bouc–Wen
+    /// storeys' two states each, and with `energy` the audit's three
+    /// quadratures (the `dim` of its system, without building it).
+    pub fn state_len(model: &Model, energy: bool) -> usize {
+        let bouc_wen = model
+            .storeys()
+            .iter()
+            .filter(|s| matches!(s.law, crate::model::hysteresis::StoreyLaw::BoucWen(_)))
+            .count();
+        2 * model.bodies().len() + 2 * bouc_wen + if energy { 3 } else { 0 }
+    }
+
+    /// The initial ODE state of a model (interleaved, energy quadratures 0;
+    /// [`ChainDynamics::state_len`] long).
+    pub fn initial_state(model: &Model, energy: bool) -> Vec<f64> {
+        let mut y = vec![0.0; Self::state_len(model, energy)];
+        for i in 0..model.bodies().len() {
             y[2 * i] = model.initial_displacement()[i];
             y[2 * i + 1] = model.initial_velocity()[i];
         }

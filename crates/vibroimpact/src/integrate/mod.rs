@@ -278,7 +278,7 @@ impl Default for IntegratorOptions {
 impl IntegratorOptions {
     /// Checks the options for a system of dimension `dim`; returns the number
     /// of error-controlled components.
-    fn validate(&self, dim: usize) -> Result<usize, IntegrationError> {
+    pub(crate) fn validate(&self, dim: usize) -> Result<usize, IntegrationError> {
         let invalid = |msg: String| Err(IntegrationError::InvalidOptions(msg));
         if dim == 0 {
             return invalid("the system dimension must be positive".into());

@@ -19,25 +19,33 @@ pub fn simulate_streaming(
     mut sink: impl FnMut(f64, &[f64]) -> bool,
 ) -> Result<Simulation, OptionsError> {
     check_run(model, opts)?;
-    let mut sys = ChainDynamics::new(model, opts.energy);
-    let y0 = start_state(model, opts, &sys)?;
-    let n2 = sys.state_dim();
+    let y0 = start_state(model, opts)?;
     let int_opts = IntegratorOptions {
         rtol: opts.rtol,
         atol: opts.atol,
         max_steps: opts.max_steps,
         // Not the audit's quadratures (the storeys' states come before).
-        error_components: opts.energy.then_some(sys.audit_index()),
+        error_components: opts
+            .energy
+            .then_some(ChainDynamics::state_len(model, false)),
         interrupt: opts.interrupt.clone(),
         ..IntegratorOptions::default()
     };
     let method = effective_method(model, opts)?;
-    let mut st =
-        Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
     let breakpoints = breakpoints(model, opts.t_end);
     if opts.integrator.resolve_run(model, opts) == Integrator::Local {
+        // (Its options checked as the global stepper's would be; the local
+        // run builds its own systems and steppers.)
+        int_opts
+            .validate(y0.len())
+            .map_err(|e| OptionsError(e.to_string()))?;
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
+    let mut sys = ChainDynamics::new(model, opts.energy);
+    debug_assert_eq!(crate::integrate::OdeSystem::dim(&sys), y0.len());
+    let n2 = sys.state_dim();
+    let mut st =
+        Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
     let mut next_break = 0;
     let mut output = Output::new(opts, (y0.len(), n2, model.storeys().len()), &mut sink);
     let mut sink_stopped = None;
@@ -351,12 +359,8 @@ pub(super) fn check_run(model: &Model, opts: &SimulationOptions) -> Result<(), O
 
 /// The interleaved start state: the model's, or the options' `start`
 /// (body order, checked).
-fn start_state(
-    model: &Model,
-    opts: &SimulationOptions,
-    sys: &ChainDynamics,
-) -> Result<Vec<f64>, OptionsError> {
-    let mut y0 = sys.initial_state(model);
+fn start_state(model: &Model, opts: &SimulationOptions) -> Result<Vec<f64>, OptionsError> {
+    let mut y0 = ChainDynamics::initial_state(model, opts.energy);
     if let Some(start) = &opts.start {
         let n = model.bodies().len();
         if start.len() != 2 * n || start.iter().any(|x| !x.is_finite()) {

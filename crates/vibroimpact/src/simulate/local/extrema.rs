@@ -152,10 +152,10 @@ struct Carried {
     /// The side's place in its group.
     j: usize,
     t: f64,
-    x: Vec<f64>,
+    x: Rows,
     /// The furthest state read ahead of `t` since it moved, and its time
     /// (NaN: none): a piece's end is read first, then carried to.
-    ahead: (f64, Vec<f64>),
+    ahead: (f64, Rows),
 }
 
 impl Carried {
@@ -178,7 +178,7 @@ impl Carried {
         if t == self.ahead.0 {
             return (self.ahead.1[2 * self.j], self.ahead.1[2 * self.j + 1]);
         }
-        let mut inside = Vec::new();
+        let mut inside = Rows::new();
         let y = if self.ahead.0.is_nan() || t > self.ahead.0 {
             self.ahead.0 = t;
             &mut self.ahead.1
@@ -293,7 +293,7 @@ impl Run<'_> {
             gs[1]
         };
         // The gauge's value and rate in the groups' states x.
-        let read = |gauge: &Gauge, x: &[Vec<f64>; 2]| -> (f64, f64) {
+        let read = |gauge: &Gauge, x: &[Rows; 2]| -> (f64, f64) {
             let side = |i: Option<usize>| {
                 i.map_or((0.0, 0.0), |i| {
                     let (h, j) = free.place(i);

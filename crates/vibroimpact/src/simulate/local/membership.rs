@@ -13,7 +13,7 @@ pub(super) type Crossing = Option<(f64, usize)>;
 pub(super) struct BoundaryEnds {
     ta: f64,
     tb: f64,
-    groups: Vec<(usize, Vec<f64>, Vec<f64>)>,
+    groups: Vec<(usize, Rows, Rows)>,
 }
 
 impl BoundaryEnds {

@@ -58,7 +58,7 @@ use crate::dynamics::variational::Variational;
 use crate::dynamics::{Chain, SetSystem, StoreyTerms};
 use crate::integrate::Recorder;
 use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce, Storey};
-use crate::simulate::local::free_motion::FreeMotion;
+use crate::simulate::local::free_motion::{FreeMotion, Rows};
 
 mod activation;
 mod clusters;
@@ -159,7 +159,7 @@ struct ActiveSet {
     event: Option<Event>,
     /// The exactly moving groups of its boundary contacts at the end of
     /// its last step: (group, time, state), the next step's start.
-    carried: Vec<(usize, f64, Vec<f64>)>,
+    carried: Vec<(usize, f64, Rows)>,
     /// The activation its steps are to stop at (after a step taken back).
     pending: Crossing,
     /// Its last kept step while it is open (its impacts not yet logged,
@@ -178,7 +178,7 @@ struct Run<'a> {
     method: Method,
     free: FreeMotion,
     /// Per group: time and interleaved state of its exact motion.
-    exact: Vec<(f64, Vec<f64>)>,
+    exact: Vec<(f64, Rows)>,
     /// Per group: in the active set.
     in_set: Vec<bool>,
     /// Per group: when it last joined the set.
@@ -187,7 +187,7 @@ struct Run<'a> {
     /// states (samples and a step taken back still need earlier times);
     /// the moves wait in `deferred` (group, time, state).
     defer: bool,
-    deferred: Vec<(usize, f64, Vec<f64>)>,
+    deferred: Vec<(usize, f64, Rows)>,
     /// Per body: index in the active set.
     slot: Vec<Option<usize>>,
     activation: Vec<Activation>,
@@ -312,7 +312,7 @@ fn reach_time(d: f64, b: f64, cq: f64, size: f64) -> Option<f64> {
 
 /// The rows `[u, v]` of `bodies` in an interleaved state `v` of the whole
 /// model.
-fn rows_of(bodies: &[usize], v: &[f64]) -> Vec<f64> {
+fn rows_of(bodies: &[usize], v: &[f64]) -> Rows {
     bodies
         .iter()
         .flat_map(|&i| [v[2 * i], v[2 * i + 1]])
@@ -399,7 +399,7 @@ impl Run<'_> {
     }
 
     /// The states of `groups` at `t` by their exact motion (copies).
-    fn states_at(&self, groups: &[usize], t: f64) -> Vec<(usize, Vec<f64>)> {
+    fn states_at(&self, groups: &[usize], t: f64) -> Vec<(usize, Rows)> {
         groups
             .iter()
             .map(|&g| {

@@ -188,7 +188,7 @@ impl LocalTape {
     fn replay(&self, v: &[f64], mut source: Option<Source>) -> Vec<f64> {
         let groups = self.free.groups();
         // Per group: the time and rows of its exact motion.
-        let mut exact: Vec<(f64, Vec<f64>)> = groups
+        let mut exact: Vec<(f64, Rows)> = groups
             .iter()
             .map(|g| (0.0, rows_of(g.bodies(), v)))
             .collect();

@@ -21,7 +21,7 @@ pub(super) enum Slot {
 /// What changes with the storeys' stiffness.
 #[derive(Clone, Debug)]
 pub(super) struct Variant {
-    stiffness: Vec<f64>,
+    stiffness: super::PerBody,
     couplings: Vec<(usize, usize, f64, f64)>,
     propagator: Propagator,
     harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,

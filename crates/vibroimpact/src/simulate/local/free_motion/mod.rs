@@ -38,6 +38,7 @@
 //! (`bounds.rs`).
 
 use nalgebra::{DMatrix, DVector};
+use smallvec::SmallVec;
 
 use crate::model::{Accelerogram, BaseExcitation, Model};
 
@@ -75,20 +76,28 @@ enum Propagator {
     Group(DMatrix<f64>),
 }
 
+/// A group's bodies (most groups of a row are one or two bodies: kept
+/// inline, no allocation per group).
+pub(crate) type Bodies = SmallVec<[usize; 2]>;
+/// A value per body of a group.
+type PerBody = SmallVec<[f64; 2]>;
+/// A group's state rows (u, v per body), or a value per row.
+pub(crate) type Rows = SmallVec<[f64; 4]>;
+
 /// One spring-coupled group of bodies and its exact propagator.
 #[derive(Clone, Debug)]
 pub struct Group {
-    bodies: Vec<usize>,
+    bodies: Bodies,
     propagator: Propagator,
     /// Steady states of the harmonic terms: (Ω, φ, Re X, Im X).
     harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
-    mass: Vec<f64>,
-    stiffness: Vec<f64>,
-    damping: Vec<f64>,
+    mass: PerBody,
+    stiffness: PerBody,
+    damping: PerBody,
     /// Couplings inside the group: (local a, local b, k, c).
     couplings: Vec<(usize, usize, f64, f64)>,
     /// Sum of the harmonic forces' amplitudes on each body (N).
-    force_amplitude: Vec<f64>,
+    force_amplitude: PerBody,
     /// Harmonic forces: (body in the group, P, Ω, φ).
     forces: Vec<(usize, f64, f64, f64)>,
     /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
@@ -101,8 +110,8 @@ pub struct Group {
     hold_step: Option<HoldStep>,
     /// The static rest state of its storeys' constant forces
     /// (interleaved; zero without storeys), and those forces.
-    rest: Vec<f64>,
-    rest_forces: Vec<f64>,
+    rest: Rows,
+    rest_forces: PerBody,
     /// Its storeys (model index), where each one's stiffness sits, and
     /// that stiffness now (its branch's, less its P-Δ stiffness).
     storeys: Vec<(usize, branches::Slot)>,
@@ -111,7 +120,7 @@ pub struct Group {
     terms: Vec<(f64, f64, Vec<f64>)>,
     /// The bodies' own springs to the ground (without storeys), and the
     /// bodies' names (for errors).
-    own_stiffness: Vec<f64>,
+    own_stiffness: PerBody,
     names: String,
     /// The propagators of other branches met so far, by their storeys'
     /// stiffness ([`FreeMotion::set_storey_stiffness`]).
@@ -218,7 +227,7 @@ fn single_exp(w2: f64, c2: f64, tau: f64) -> [f64; 4] {
 /// The groups of `model`: the connected components of its couplings and
 /// storeys (union–find), as each body's (group, index in the group) and each
 /// group's bodies (ascending), groups in the order of their first body.
-pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usize>>) {
+pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Bodies>) {
     let n = model.bodies().len();
     let mut root: Vec<usize> = (0..n).collect();
     fn find(root: &mut [usize], mut i: usize) -> usize {
@@ -237,12 +246,12 @@ pub(crate) fn spring_groups(model: &Model) -> (Vec<(usize, usize)>, Vec<Vec<usiz
         root[a.max(b)] = a.min(b);
     }
     let mut place = vec![(usize::MAX, 0); n];
-    let mut members: Vec<Vec<usize>> = Vec::new();
+    let mut members: Vec<Bodies> = Vec::new();
     for i in 0..n {
         let r = find(&mut root, i);
         if place[r].0 == usize::MAX {
             place[r] = (members.len(), 0);
-            members.push(Vec::new());
+            members.push(Bodies::new());
         }
         let g = place[r].0;
         place[i] = (g, members[g].len());
@@ -304,14 +313,14 @@ impl FreeMotion {
     fn group(
         model: &Model,
         place: &[(usize, usize)],
-        bodies: Vec<usize>,
+        bodies: Bodies,
     ) -> Result<Group, FreeMotionError> {
         let m = bodies.len();
         let all = model.bodies();
-        let mass: Vec<f64> = bodies.iter().map(|&i| all[i].mass).collect();
-        let own_stiffness: Vec<f64> = bodies.iter().map(|&i| all[i].stiffness).collect();
+        let mass: PerBody = bodies.iter().map(|&i| all[i].mass).collect();
+        let own_stiffness: PerBody = bodies.iter().map(|&i| all[i].stiffness).collect();
         let mut stiffness = own_stiffness.clone();
-        let damping: Vec<f64> = bodies.iter().map(|&i| all[i].damping).collect();
+        let damping: PerBody = bodies.iter().map(|&i| all[i].damping).collect();
         let here = place[bodies[0]].0;
         let mut couplings: Vec<(usize, usize, f64, f64)> = model
             .couplings()
@@ -360,7 +369,7 @@ impl FreeMotion {
                 terms.push((frequency, phase, b));
             }
         }
-        let mut force_amplitude = vec![0.0; m];
+        let mut force_amplitude = PerBody::from_elem(0.0, m);
         let mut forces = Vec::new();
         for f in model.forces() {
             if place[f.body].0 != place[bodies[0]].0 {
@@ -400,8 +409,8 @@ impl FreeMotion {
             rate,
             modal: None,
             hold_step: None,
-            rest: vec![0.0; 2 * m],
-            rest_forces: vec![0.0; m],
+            rest: Rows::from_elem(0.0, 2 * m),
+            rest_forces: PerBody::from_elem(0.0, m),
             storeys,
             storey_stiffness,
             terms,
