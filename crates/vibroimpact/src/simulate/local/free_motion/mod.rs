@@ -646,7 +646,7 @@ impl FreeMotion {
     /// exactly (in place).
     pub fn propagate(&self, g: usize, t0: f64, t1: f64, x: &mut [f64]) {
         let group = &self.groups[g];
-        if t1 == t0 {
+        if t1 == t0 || group.stays_at_rest(&self.base, x) {
             return;
         }
         self.add_particular(group, t0, -1.0, x);
@@ -782,6 +782,16 @@ impl FreeMotion {
 }
 
 impl Group {
+    /// Whether the group at state `x` stays there exactly: at rest at zero
+    /// without forcing (no harmonic term, no record, no constant force), as
+    /// a row's bodies are before a pulse reaches them.
+    fn stays_at_rest(&self, base: &BaseExcitation, x: &[f64]) -> bool {
+        self.harmonic.is_empty()
+            && !matches!(base, BaseExcitation::Record(_))
+            && self.rest.iter().all(|&r| r == 0.0)
+            && x.iter().all(|&v| v == 0.0)
+    }
+
     /// The bodies, in order along the line.
     pub fn bodies(&self) -> &[usize] {
         &self.bodies
