@@ -1,7 +1,11 @@
 //! [`Stepper`]: DOP853, DOPRI5 or RODAS behind one interface, with the
-//! automatic switch from DOP853 to RODAS when DOP853's stiffness test fires.
+//! automatic switch from DOP853 to RODAS when DOP853's stiffness test
+//! fires, and, where asked, the exact flow from every reset at which the
+//! system has a linear form ([`Stepper::exact_where_linear`]).
 
-use super::{Dop853, Dopri5, Exact, IntegrationError, IntegratorOptions, OdeSystem, Rodas, Stats};
+use super::{
+    Dop853, Dopri5, Exact, IntegrationError, IntegratorOptions, LinearForm, OdeSystem, Rodas, Stats,
+};
 
 /// Integration method of a [`Stepper`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,6 +60,45 @@ enum Engines {
     },
 }
 
+impl Engines {
+    fn new(method: Method, dim: usize, opts: &IntegratorOptions) -> Result<Self, IntegrationError> {
+        Ok(match method {
+            Method::Dop853 => Engines::Dop853(Dop853::new(dim, opts.clone())?),
+            Method::Dopri5 => Engines::Dopri5(Dopri5::new(dim, opts.clone())?),
+            Method::Exact => Engines::Exact(Exact::new(dim, opts.clone())?),
+            Method::Rodas => Engines::Rodas(Rodas::new(dim, opts.clone())?),
+            Method::Auto => Engines::Auto {
+                dop853: Dop853::new(dim, opts.clone())?,
+                rodas: Rodas::new(dim, opts.clone())?,
+                on_rodas: false,
+            },
+        })
+    }
+
+    fn stats(&self) -> Stats {
+        match self {
+            Engines::Dop853(d) => d.stats(),
+            Engines::Dopri5(d) => d.stats(),
+            Engines::Exact(d) => d.stats(),
+            Engines::Rodas(r) => r.stats(),
+            Engines::Auto { dop853, rodas, .. } => dop853.stats() + rodas.stats(),
+        }
+    }
+
+    fn reset_stats(&mut self) {
+        match self {
+            Engines::Dop853(d) => d.reset_stats(),
+            Engines::Dopri5(d) => d.reset_stats(),
+            Engines::Exact(d) => d.reset_stats(),
+            Engines::Rodas(r) => r.reset_stats(),
+            Engines::Auto { dop853, rodas, .. } => {
+                dop853.reset_stats();
+                rodas.reset_stats();
+            }
+        }
+    }
+}
+
 /// Runs `$e` with `$d` bound to the active driver: `active!(self, d => …)`
 /// borrows it shared, `active!(mut self, d => …)` mutably.
 macro_rules! active {
@@ -95,6 +138,21 @@ pub struct Stepper {
     method: Method,
     opts: IntegratorOptions,
     engines: Engines,
+    /// With [`Stepper::exact_where_linear`]: the form the exact flow moves,
+    /// and the engine not in use.
+    exact: Option<ExactSwitch>,
+}
+
+/// The exact flow beside the method of construction: `form` the linear
+/// form the exact engine was made for (None: none made, or its form is
+/// gone), `spare` the engine not in use (the exact one while the method of
+/// construction runs, and the other way round), `retired` the work of
+/// exact engines dropped with their form.
+#[derive(Clone, Debug, Default)]
+struct ExactSwitch {
+    form: Option<LinearForm>,
+    spare: Option<Engines>,
+    retired: Stats,
 }
 
 impl Stepper {
@@ -106,22 +164,80 @@ impl Stepper {
         dim: usize,
         opts: IntegratorOptions,
     ) -> Result<Self, IntegrationError> {
-        let engines = match method {
-            Method::Dop853 => Engines::Dop853(Dop853::new(dim, opts.clone())?),
-            Method::Dopri5 => Engines::Dopri5(Dopri5::new(dim, opts.clone())?),
-            Method::Exact => Engines::Exact(Exact::new(dim, opts.clone())?),
-            Method::Rodas => Engines::Rodas(Rodas::new(dim, opts.clone())?),
-            Method::Auto => Engines::Auto {
-                dop853: Dop853::new(dim, opts.clone())?,
-                rodas: Rodas::new(dim, opts.clone())?,
-                on_rodas: false,
-            },
-        };
+        let engines = Engines::new(method, dim, &opts)?;
         Ok(Self {
             method,
             opts,
             engines,
+            exact: None,
         })
+    }
+
+    /// From every [`reset`](Self::reset) at which the system has a
+    /// [`linear_form`](OdeSystem::linear_form) that solves, moves it
+    /// exactly ([`Method::Exact`], steps up to its
+    /// [`step_limit`](super::Linear::step_limit)); elsewhere by the method
+    /// of construction. The form is read at each reset (a system that
+    /// changes there, e.g. a contact's soft episode starting or ending,
+    /// changes method there); an exact engine is kept while its form
+    /// holds, so its exponentials are reused.
+    pub fn exact_where_linear(mut self) -> Self {
+        self.exact = Some(ExactSwitch::default());
+        self
+    }
+
+    /// Puts the engine for `sys`'s form in place (see
+    /// [`Stepper::exact_where_linear`]).
+    fn choose_engine<S: OdeSystem>(&mut self, sys: &S) -> Result<(), IntegrationError> {
+        let Some(sw) = self.exact.as_mut() else {
+            return Ok(());
+        };
+        let form = sys.linear_form();
+        let on_exact = matches!(self.engines, Engines::Exact(_));
+        if form.is_some() && form == sw.form {
+            if on_exact {
+                return Ok(());
+            }
+            if let Some(exact) = sw.spare.take() {
+                sw.spare = Some(std::mem::replace(&mut self.engines, exact));
+                return Ok(());
+            }
+        }
+        let dim = sys.dim();
+        let exact = match form.clone().and_then(LinearForm::solve) {
+            Some(linear) if linear.dim() == dim => {
+                let h = self.opts.h_max.min(linear.step_limit());
+                let opts = IntegratorOptions {
+                    h_max: h,
+                    h_init: Some(h),
+                    ..self.opts.clone()
+                };
+                Some(Engines::Exact(Exact::new(dim, opts)?))
+            }
+            _ => None,
+        };
+        sw.form = exact.as_ref().and(form);
+        // (An exact engine dropped with its form keeps its work counted.)
+        let old = match (on_exact, exact) {
+            (true, Some(e)) => Some(std::mem::replace(&mut self.engines, e)),
+            (true, None) => {
+                let back = match sw.spare.take() {
+                    Some(back) => back,
+                    None => Engines::new(self.method, dim, &self.opts)?,
+                };
+                Some(std::mem::replace(&mut self.engines, back))
+            }
+            (false, Some(e)) => {
+                let old = sw.spare.take();
+                sw.spare = Some(std::mem::replace(&mut self.engines, e));
+                old
+            }
+            (false, None) => sw.spare.take(),
+        };
+        if let Some(Engines::Exact(d)) = old {
+            sw.retired = sw.retired + d.stats();
+        }
+        Ok(())
     }
 
     /// The method the stepper was created with.
@@ -144,13 +260,15 @@ impl Stepper {
     }
 
     /// Start (or restart) at `(t0, y0)` with the method of construction
-    /// (DOP853 for [`Method::Auto`], also after an earlier switch).
+    /// (DOP853 for [`Method::Auto`], also after an earlier switch), or the
+    /// exact flow ([`Stepper::exact_where_linear`]).
     pub fn reset<S: OdeSystem>(
         &mut self,
         sys: &mut S,
         t0: f64,
         y0: &[f64],
     ) -> Result<(), IntegrationError> {
+        self.choose_engine(sys)?;
         if let Engines::Auto { on_rodas, .. } = &mut self.engines {
             *on_rodas = false;
         }
@@ -230,27 +348,25 @@ impl Stepper {
         active!(mut self, d => d.dense_component(sys, i, t))
     }
 
-    /// Work counters of both integrators together.
+    /// Work counters of every integrator together.
     pub fn stats(&self) -> Stats {
-        match &self.engines {
-            Engines::Dop853(d) => d.stats(),
-            Engines::Dopri5(d) => d.stats(),
-            Engines::Exact(d) => d.stats(),
-            Engines::Rodas(r) => r.stats(),
-            Engines::Auto { dop853, rodas, .. } => dop853.stats() + rodas.stats(),
+        let mut stats = self.engines.stats();
+        if let Some(sw) = &self.exact {
+            stats = stats + sw.retired;
+            if let Some(spare) = &sw.spare {
+                stats = stats + spare.stats();
+            }
         }
+        stats
     }
 
-    /// Sets the work counters of both integrators to zero.
+    /// Sets the work counters of every integrator to zero.
     pub fn reset_stats(&mut self) {
-        match &mut self.engines {
-            Engines::Dop853(d) => d.reset_stats(),
-            Engines::Dopri5(d) => d.reset_stats(),
-            Engines::Exact(d) => d.reset_stats(),
-            Engines::Rodas(r) => r.reset_stats(),
-            Engines::Auto { dop853, rodas, .. } => {
-                dop853.reset_stats();
-                rodas.reset_stats();
+        self.engines.reset_stats();
+        if let Some(sw) = &mut self.exact {
+            sw.retired = Stats::default();
+            if let Some(spare) = &mut sw.spare {
+                spare.reset_stats();
             }
         }
     }

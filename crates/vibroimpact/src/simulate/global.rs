@@ -46,6 +46,12 @@ pub fn simulate_streaming(
     let n2 = sys.state_dim();
     let mut st =
         Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
+    // Between rigid impacts a small chain moves exactly (its linear form,
+    // while no soft episode runs; docs/theory.md §12).
+    let rigid = (0..model.contacts().len()).any(|k| model.impacts(k).is_rigid());
+    if rigid && y0.len() <= EXACT_MAX_DIM {
+        st = st.exact_where_linear();
+    }
     let mut next_break = 0;
     let mut output = Output::new(opts, (y0.len(), n2, model.storeys().len()), &mut sink);
     let mut sink_stopped = None;
@@ -85,7 +91,9 @@ pub fn simulate_streaming(
     let s_on: Vec<f64> = scan.trackers.iter().map(|tr| tr.s_on).collect();
     let pre = judging_gaps(&sys, opts.impact_force_threshold);
     let mut switches = Switches::new(&sys, y0.len(), s_on, pre);
-    let mut episodes = Vec::new();
+    let mut episodes: Vec<SoftEpisode> = Vec::new();
+    // (Every episode before `closed` has ended: the checks start there.)
+    let mut closed = 0;
     let mut steps: u64 = 0;
     while error.is_none() && sink_stopped.is_none() && st.t() < opts.t_end {
         while next_break < breakpoints.len() && breakpoints[next_break] <= st.t() {
@@ -139,9 +147,13 @@ pub fn simulate_streaming(
             x.step(&mut st, &mut sys);
         }
         if let Some(sw) = switches.as_mut() {
-            if let Err(e) = separated(&mut episodes, (&mut st, &mut sys), sw, &mut scan) {
+            let open = &mut episodes[closed..];
+            if let Err(e) = separated(open, (&mut st, &mut sys), sw, &mut scan) {
                 error = Some(e);
                 break;
+            }
+            while episodes.get(closed).is_some_and(|e| !e.end_time.is_nan()) {
+                closed += 1;
             }
         }
         if let Some(h) = scan.entry_limit(st.h_next()) {

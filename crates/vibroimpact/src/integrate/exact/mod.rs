@@ -22,10 +22,14 @@
 //!
 //! * **A step** of size h multiplies each block's deviation from the
 //!   steady state by `e^{Ah}`, kept with `e^{Ah/4}`, `e^{Ah/2}` and
-//!   `e^{3Ah/4}` for the last few step sizes met (one matrix exponential
-//!   and three products a new size; the steps are mostly `h_max`). Its
-//!   error is rounding, so the driver sees zero and the step grows to
-//!   `h_max`, kept below [`Linear::step_limit`] (`‖A‖∞ h ≤ 2`).
+//!   `e^{3Ah/4}` for the last few step sizes met more than once (one
+//!   matrix exponential and three products a size; the steps are mostly
+//!   `h_max`). A size met once (a step cut short at an event or a sample)
+//!   is taken by the exponential's series on the deviation instead, which
+//!   its dense output then reads: a few products of `A` with a vector, not
+//!   an exponential of `A`. Its error is rounding, so the driver sees zero
+//!   and the step grows to `h_max`, kept below [`Linear::step_limit`]
+//!   (`‖A‖∞ h ≤ 2`).
 //! * **Dense output**: at a quarter of the step those matrices; elsewhere
 //!   (an event being located) the exponential's series on the deviation,
 //!   `Σ_k τ^k A^k v / k!` to the first term below 1e-17 of the sum, built
@@ -168,6 +172,11 @@ impl Linear {
         }
     }
 
+    /// The state's dimension: the blocks' rows together.
+    pub fn dim(&self) -> usize {
+        self.d * self.steady.len()
+    }
+
     /// The steady state's row `r` of block `b` at `t`.
     fn steady_at(&self, b: usize, r: usize, t: f64) -> f64 {
         self.steady[b]
@@ -294,20 +303,29 @@ pub type Exact = Driver<ExactMethod>;
 #[derive(Clone, Debug)]
 pub struct ExactMethod {
     form: Option<Linear>,
-    /// The quarters of the last step sizes met, and which to replace next.
+    /// The quarters of the step sizes met more than once, and which to
+    /// replace next.
     sizes: Vec<Quarters>,
     next: usize,
+    /// The last step sizes met once (a size met again gets its quarters;
+    /// one met once, such as a step cut short at an event, is taken by
+    /// the series), and which to replace next.
+    seen: [f64; KEPT_SIZES],
+    seen_next: usize,
     /// The attempt's deviation from the steady state at its start, and
-    /// its quarters.
+    /// its quarters (None: taken by the series).
     deviation: Vec<f64>,
-    quarters: usize,
+    quarters: Option<usize>,
     /// The accepted step's.
     deviation_acc: Vec<f64>,
-    quarters_acc: usize,
+    quarters_acc: Option<usize>,
     /// The accepted step's series terms `A^k v / k!`, term k at
-    /// `[k·n..(k+1)·n]`, and how many (0: not built yet).
+    /// `[k·n..(k+1)·n]`, and how many (0: not built yet); the attempt's,
+    /// where it was taken by the series.
     terms: Vec<f64>,
     count: usize,
+    terms_try: Vec<f64>,
+    count_try: usize,
     /// Scratch: a steady state.
     steady: Vec<f64>,
     /// `f(t + h, y_new)`.
@@ -324,29 +342,52 @@ impl ExactMethod {
         let Some(form) = self.form.as_ref() else {
             return false;
         };
-        let (n, d) = (self.deviation_acc.len(), form.d);
-        let (first, rest) = self.terms.split_at_mut(n);
-        first.copy_from_slice(&self.deviation_acc);
-        let size = first.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let mut count = 1;
-        let mut previous: &[f64] = first;
-        let mut scale = 1.0;
-        for (k, term) in rest.chunks_exact_mut(n).enumerate() {
-            let inv = 1.0 / (k + 1) as f64;
-            for (p, t) in previous.chunks_exact(d).zip(term.chunks_exact_mut(d)) {
-                times(&form.rows, p, t);
-                t.iter_mut().for_each(|x| *x *= inv);
-            }
-            count += 1;
-            scale *= h;
-            let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs())) * scale;
-            if largest <= 1e-17 * size {
+        match series_terms(form, &self.deviation_acc, h, &mut self.terms) {
+            Some(count) => {
                 self.count = count;
-                return true;
+                true
             }
-            previous = term;
+            None => false,
         }
-        false
+    }
+}
+
+/// The series terms `A^k v / k!` of the deviation `v` into `terms` (term k
+/// at `[k·n..(k+1)·n]`), as many as reach 1e-17 of the largest entry of
+/// `v` over a step `h`: how many, or None where `MAX_TERMS` do not.
+fn series_terms(form: &Linear, v: &[f64], h: f64, terms: &mut [f64]) -> Option<usize> {
+    let (n, d) = (v.len(), form.d);
+    let (first, rest) = terms.split_at_mut(n);
+    first.copy_from_slice(v);
+    let size = first.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut count = 1;
+    let mut previous: &[f64] = first;
+    let mut scale = 1.0;
+    for (k, term) in rest.chunks_exact_mut(n).enumerate() {
+        let inv = 1.0 / (k + 1) as f64;
+        for (p, t) in previous.chunks_exact(d).zip(term.chunks_exact_mut(d)) {
+            times(&form.rows, p, t);
+            t.iter_mut().for_each(|x| *x *= inv);
+        }
+        count += 1;
+        scale *= h;
+        let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs())) * scale;
+        if largest <= 1e-17 * size {
+            return Some(count);
+        }
+        previous = term;
+    }
+    None
+}
+
+/// `out = Σ_k τ^k terms_k` over the first `count` terms (Horner).
+fn sum_series(terms: &[f64], count: usize, tau: f64, out: &mut [f64]) {
+    let n = out.len();
+    out.copy_from_slice(&terms[(count - 1) * n..count * n]);
+    for k in (0..count - 1).rev() {
+        for (x, t) in out.iter_mut().zip(&terms[k * n..(k + 1) * n]) {
+            *x = *x * tau + t;
+        }
     }
 }
 
@@ -360,12 +401,16 @@ impl StepMethod for ExactMethod {
             form: None,
             sizes: Vec::with_capacity(KEPT_SIZES),
             next: 0,
+            seen: [f64::NAN; KEPT_SIZES],
+            seen_next: 0,
             deviation: vec![0.0; dim],
-            quarters: 0,
+            quarters: None,
             deviation_acc: vec![0.0; dim],
-            quarters_acc: 0,
+            quarters_acc: None,
             terms: vec![0.0; (MAX_TERMS + 1) * dim],
             count: 0,
+            terms_try: vec![0.0; (MAX_TERMS + 1) * dim],
+            count_try: 0,
             steady: vec![0.0; dim],
             end: vec![0.0; dim],
         }
@@ -394,18 +439,27 @@ impl StepMethod for ExactMethod {
             return Err((RejectReason::ErrorEstimate, factor));
         }
         let q = match self.sizes.iter().position(|q| q.h == h) {
-            Some(q) => q,
+            Some(q) => Some(q),
+            None if !self.seen.contains(&h) => {
+                self.seen[self.seen_next] = h;
+                self.seen_next = (self.seen_next + 1) % KEPT_SIZES;
+                None
+            }
             None if self.sizes.len() < KEPT_SIZES => {
                 self.sizes.push(Quarters::new(form, h));
-                self.sizes.len() - 1
+                Some(self.sizes.len() - 1)
             }
             None => {
                 let q = self.next;
                 self.next = (q + 1) % KEPT_SIZES;
                 // (Never the accepted step's own: its dense output reads them.)
-                let q = if q == self.quarters_acc { self.next } else { q };
+                let q = if Some(q) == self.quarters_acc {
+                    self.next
+                } else {
+                    q
+                };
                 self.sizes[q] = Quarters::new(form, h);
-                q
+                Some(q)
             }
         };
         self.quarters = q;
@@ -413,17 +467,35 @@ impl StepMethod for ExactMethod {
         for ((v, y), p) in self.deviation.iter_mut().zip(&at.y).zip(&self.steady) {
             *v = y - p;
         }
-        form.steady_into(trial.t_new, &mut self.steady);
         let y_new = &mut *trial.y_new;
-        let e = &self.sizes[q].e[3];
-        for ((yb, vb), pb) in y_new
-            .chunks_exact_mut(d)
-            .zip(self.deviation.chunks_exact(d))
-            .zip(self.steady.chunks_exact(d))
-        {
-            times(e, vb, yb);
-            for (y, p) in yb.iter_mut().zip(pb) {
-                *y += p;
+        match q {
+            Some(q) => {
+                form.steady_into(trial.t_new, &mut self.steady);
+                let e = &self.sizes[q].e[3];
+                for ((yb, vb), pb) in y_new
+                    .chunks_exact_mut(d)
+                    .zip(self.deviation.chunks_exact(d))
+                    .zip(self.steady.chunks_exact(d))
+                {
+                    times(e, vb, yb);
+                    for (y, p) in yb.iter_mut().zip(pb) {
+                        *y += p;
+                    }
+                }
+            }
+            // A size met once: the series on the deviation, kept for the
+            // step's dense output.
+            None => {
+                let Some(count) = series_terms(form, &self.deviation, h, &mut self.terms_try)
+                else {
+                    return Err(NON_FINITE);
+                };
+                self.count_try = count;
+                sum_series(&self.terms_try, count, h, y_new);
+                form.steady_into(trial.t_new, &mut self.steady);
+                for (y, p) in y_new.iter_mut().zip(&self.steady) {
+                    *y += p;
+                }
             }
         }
         if !all_finite(y_new) {
@@ -445,6 +517,10 @@ impl StepMethod for ExactMethod {
         std::mem::swap(&mut self.deviation, &mut self.deviation_acc);
         self.quarters_acc = self.quarters;
         self.count = 0;
+        if self.quarters.is_none() {
+            std::mem::swap(&mut self.terms, &mut self.terms_try);
+            self.count = self.count_try;
+        }
     }
 
     fn end_derivative(&self) -> &[f64] {
@@ -467,8 +543,8 @@ impl StepMethod for ExactMethod {
         let tau = s * h;
         let (b, r) = (i / d, i % d);
         let steady = form.steady_at(b, r, at.t_prev + tau);
-        if let Some(j) = quarter(s) {
-            let row = &self.sizes[self.quarters_acc].e[j][r * d..(r + 1) * d];
+        if let (Some(j), Some(q)) = (quarter(s), self.quarters_acc) {
+            let row = &self.sizes[q].e[j][r * d..(r + 1) * d];
             let v = &self.deviation_acc[b * d..(b + 1) * d];
             return steady + row.iter().zip(v).map(|(a, x)| a * x).sum::<f64>();
         }
@@ -495,11 +571,11 @@ impl StepMethod for ExactMethod {
             out.fill(f64::NAN);
             return;
         };
-        let (n, d, h) = (at.dim(), form.d, at.h_last);
+        let (d, h) = (form.d, at.h_last);
         let tau = s * h;
         form.steady_into(at.t_prev + tau, out);
-        if let Some(j) = quarter(s) {
-            let e = &self.sizes[self.quarters_acc].e[j];
+        if let (Some(j), Some(q)) = (quarter(s), self.quarters_acc) {
+            let e = &self.sizes[q].e[j];
             for (ob, vb) in out
                 .chunks_exact_mut(d)
                 .zip(self.deviation_acc.chunks_exact(d))
@@ -514,14 +590,8 @@ impl StepMethod for ExactMethod {
             out.fill(f64::NAN);
             return;
         }
-        let count = self.count;
         let series = &mut self.steady;
-        series.copy_from_slice(&self.terms[(count - 1) * n..count * n]);
-        for k in (0..count - 1).rev() {
-            for (x, t) in series.iter_mut().zip(&self.terms[k * n..(k + 1) * n]) {
-                *x = *x * tau + t;
-            }
-        }
+        sum_series(&self.terms, self.count, tau, series);
         for (o, x) in out.iter_mut().zip(series.iter()) {
             *o += x;
         }

@@ -1,6 +1,7 @@
 //! Tests of the exact flow: a forced oscillator against its closed form,
-//! a forced pair against DOP853, the dense output between quarters, and a
-//! resonance refused.
+//! a forced pair against DOP853, the dense output between quarters, a
+//! resonance refused, and a stepper that takes the exact flow where the
+//! form holds.
 
 use super::*;
 use crate::integrate::{IntegratorOptions, Method, Stepper};
@@ -228,4 +229,70 @@ fn a_resonance_has_no_exact_form() {
         ..resonant
     };
     assert!(off.linear_form().unwrap().solve().is_some());
+}
+
+/// [`Forced`] whose form can be withheld (as a chain's goes while a soft
+/// episode runs).
+struct Withheld {
+    sys: Forced,
+    linear: bool,
+}
+
+impl OdeSystem for Withheld {
+    fn dim(&self) -> usize {
+        self.sys.dim()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        self.sys.rhs(t, y, dydt);
+    }
+
+    fn linear_form(&self) -> Option<LinearForm> {
+        self.linear.then(|| self.sys.linear_form()).flatten()
+    }
+}
+
+/// A stepper asked to move exactly where it can: exact while the form
+/// holds, DOP853 from the reset where it goes, exact again from the reset
+/// where it is back; the end state is the closed form's to 1e-9 of the
+/// amplitude, and the work counters hold every engine's steps.
+#[test]
+fn a_stepper_moves_exactly_from_each_reset_where_the_form_holds() {
+    let (w, zeta, f, omega) = (7.4, 0.02, 3.0, 6.1);
+    let mut sys = Withheld {
+        sys: Forced {
+            w2: vec![w * w],
+            c: vec![2.0 * zeta * w],
+            k12: 0.0,
+            omega,
+            f,
+            g: 0.0,
+            p: 0.0,
+        },
+        linear: true,
+    };
+    let y0 = [0.01, -0.2];
+    let mut st = Stepper::new(Method::Dop853, 2, options(1e-12, f64::INFINITY))
+        .unwrap()
+        .exact_where_linear();
+    let (mut t, mut y, mut steps) = (0.0, y0.to_vec(), 0);
+    for (t_end, linear, active) in [
+        (3.0, true, Method::Exact),
+        (6.5, false, Method::Dop853),
+        (10.0, true, Method::Exact),
+    ] {
+        sys.linear = linear;
+        st.reset(&mut sys, t, &y).unwrap();
+        assert_eq!(st.active(), active, "from t = {t}");
+        while st.t() < t_end {
+            st.step(&mut sys, t_end).unwrap();
+            steps += 1;
+        }
+        (t, y) = (st.t(), st.y().to_vec());
+    }
+    let (x, v) = oscillator(t, (w, zeta, f, omega), (y0[0], y0[1]));
+    let scale = 0.1;
+    assert!((y[0] - x).abs() < 1e-9 * scale, "{} vs {x}", y[0]);
+    assert!((y[1] - v).abs() < 1e-9 * scale * w, "{} vs {v}", y[1]);
+    assert_eq!(st.stats().steps, steps);
 }
