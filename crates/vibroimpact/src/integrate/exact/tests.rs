@@ -20,7 +20,24 @@ struct Forced {
     p: f64,
 }
 
+/// The lightly damped oscillator of the closed-form tests: (ω, ζ, F, Ω).
+const OSCILLATOR: (f64, f64, f64, f64) = (7.4, 0.02, 3.0, 6.1);
+
 impl Forced {
+    /// One body: [`OSCILLATOR`] under F cos Ω t.
+    fn oscillator() -> Self {
+        let (w, zeta, f, omega) = OSCILLATOR;
+        Self {
+            w2: vec![w * w],
+            c: vec![2.0 * zeta * w],
+            k12: 0.0,
+            omega,
+            f,
+            g: 0.0,
+            p: 0.0,
+        }
+    }
+
     fn matrix(&self) -> DMatrix<f64> {
         let n = self.w2.len();
         let mut a = DMatrix::zeros(2 * n, 2 * n);
@@ -124,16 +141,8 @@ fn oscillator(
 /// between quarters) equal the closed form to 1e-12 of the amplitude.
 #[test]
 fn a_forced_oscillator_moves_as_its_closed_form() {
-    let (w, zeta, f, omega) = (7.4, 0.02, 3.0, 6.1);
-    let mut sys = Forced {
-        w2: vec![w * w],
-        c: vec![2.0 * zeta * w],
-        k12: 0.0,
-        omega,
-        f,
-        g: 0.0,
-        p: 0.0,
-    };
+    let (w, zeta, f, omega) = OSCILLATOR;
+    let mut sys = Forced::oscillator();
     let y0 = [0.01, -0.2];
     let t_end = 40.0 * 2.0 * std::f64::consts::PI / omega;
     let mut st = run(&mut sys, &y0, t_end, Method::Exact, 1e-6);
@@ -258,17 +267,9 @@ impl OdeSystem for Withheld {
 /// amplitude, and the work counters hold every engine's steps.
 #[test]
 fn a_stepper_moves_exactly_from_each_reset_where_the_form_holds() {
-    let (w, zeta, f, omega) = (7.4, 0.02, 3.0, 6.1);
+    let (w, zeta, f, omega) = OSCILLATOR;
     let mut sys = Withheld {
-        sys: Forced {
-            w2: vec![w * w],
-            c: vec![2.0 * zeta * w],
-            k12: 0.0,
-            omega,
-            f,
-            g: 0.0,
-            p: 0.0,
-        },
+        sys: Forced::oscillator(),
         linear: true,
     };
     let y0 = [0.01, -0.2];
