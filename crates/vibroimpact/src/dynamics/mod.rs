@@ -7,6 +7,8 @@
 //! - `jacobian.rs` — the analytic Jacobian and its record for tangent
 //!   replay;
 //! - `storeys.rs` — the hysteretic storeys' terms and states;
+//! - `state.rs` — the state layout: interleaving, a model's state length
+//!   and initial state;
 //! - `linear.rs` — the linear form of a chain whose contacts are rigid;
 //! - `saltation.rs` — the saltation matrix of a rigid impact;
 //! - `episodes.rs` — a rigid contact's soft episodes;
@@ -50,35 +52,11 @@ mod episodes;
 mod jacobian;
 mod linear;
 pub mod saltation;
+mod state;
 mod storeys;
 pub mod variational;
+pub use state::{from_interleaved, interleaved_index, to_interleaved};
 pub use storeys::{Branch, StoreyTerms};
-
-/// Index in the interleaved state `[u_1, v_1, …]` of component k of a
-/// body-order state `[u_1..u_N, v_1..v_N]` of N bodies.
-#[inline]
-pub fn interleaved_index(k: usize, n: usize) -> usize {
-    if k < n {
-        2 * k
-    } else {
-        2 * (k - n) + 1
-    }
-}
-
-/// Body-order `[u.., v..]` to interleaved `[u_1, v_1, …]`.
-pub fn to_interleaved(x: &[f64]) -> Vec<f64> {
-    let n = x.len() / 2;
-    let mut y = vec![0.0; x.len()];
-    for (k, &v) in x.iter().enumerate() {
-        y[interleaved_index(k, n)] = v;
-    }
-    y
-}
-
-/// Interleaved `[u_1, v_1, …]` (first 2N entries of `y`) to body order.
-pub fn from_interleaved(y: &[f64], n: usize) -> Vec<f64> {
-    (0..2 * n).map(|k| y[interleaved_index(k, n)]).collect()
-}
 
 /// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
 /// (`-ml F` on the left, `+mr F` on the right; masks 0 for a wall side).
@@ -397,29 +375,6 @@ impl ChainDynamics {
     /// (u, v) and the storeys' states).
     pub fn audit_index(&self) -> usize {
         2 * self.n + self.storeys.states()
-    }
-
-    /// The length of a model's ODE state: u, v interleaved, the Bouc–Wen
-    /// storeys' two states each, and with `energy` the audit's three
-    /// quadratures (the `dim` of its system, without building it).
-    pub fn state_len(model: &Model, energy: bool) -> usize {
-        let bouc_wen = model
-            .storeys()
-            .iter()
-            .filter(|s| matches!(s.law, crate::model::hysteresis::StoreyLaw::BoucWen(_)))
-            .count();
-        2 * model.bodies().len() + 2 * bouc_wen + if energy { 3 } else { 0 }
-    }
-
-    /// The initial ODE state of a model (interleaved, energy quadratures 0;
-    /// [`ChainDynamics::state_len`] long).
-    pub fn initial_state(model: &Model, energy: bool) -> Vec<f64> {
-        let mut y = vec![0.0; Self::state_len(model, energy)];
-        for i in 0..model.bodies().len() {
-            y[2 * i] = model.initial_displacement()[i];
-            y[2 * i + 1] = model.initial_velocity()[i];
-        }
-        y
     }
 
     /// Approach coordinate and its rate of contact k in state y.

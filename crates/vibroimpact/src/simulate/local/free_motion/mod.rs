@@ -1,8 +1,9 @@
 //! Exact motion between contacts (docs/theory.md §10).
 //!
 //! Files: `mod.rs` (groups and their exact motion), `modal.rs` (complex
-//! modes), `branches.rs` (a group's propagators per storey branch),
-//! `bounds.rs` (bounds on the motion ahead), `tests.rs`.
+//! modes), `hold.rs` (a record's sample steps under first-order hold),
+//! `branches.rs` (a group's propagators per storey branch), `bounds.rs`
+//! (bounds on the motion ahead), `tests.rs`.
 //!
 //! With every contact open, a model's equations are linear with
 //! time-dependent forcing:
@@ -40,9 +41,10 @@
 use nalgebra::{DMatrix, DVector};
 use smallvec::SmallVec;
 
-use crate::model::{Accelerogram, BaseExcitation, Model};
+use crate::model::{BaseExcitation, Model};
 
 pub use bounds::Envelope;
+use hold::HoldStep;
 use modal::Modal;
 
 /// Largest group state (rows) that keeps a whole sample step's matrix
@@ -127,16 +129,6 @@ pub struct Group {
     cache: Vec<(Vec<f64>, branches::Variant)>,
 }
 
-/// The first-order-hold step of one record sample interval `τ`: `x(b) =
-/// Φ x(a) + γ₀ f(a) + γ₁ f'` (the columns of the augmented exponential).
-#[derive(Clone, Debug)]
-struct HoldStep {
-    tau: f64,
-    phi: DMatrix<f64>,
-    g0: Vec<f64>,
-    g1: Vec<f64>,
-}
-
 /// The exact free motion of every group of a model.
 #[derive(Clone, Debug)]
 pub struct FreeMotion {
@@ -148,52 +140,6 @@ pub struct FreeMotion {
     peaks: bounds::Peaks,
     /// A record's typical sample step (s).
     record_step: Option<f64>,
-}
-
-/// Calls `step(τ, f(a), f')` for every interval `[a, a + τ]` between
-/// `t0`, the record's samples and `t1`: the forcing `f = −z̈` (zero
-/// outside the record) is linear over each. A sample within 1e-12 of a
-/// record step of `t0` or `t1` (rounding of the same time) is not a
-/// breakpoint: the sliver would cost a step of its own for a change of
-/// the state far below any tolerance.
-fn record_intervals(rec: &Accelerogram, t0: f64, t1: f64, mut step: impl FnMut(f64, f64, f64)) {
-    let times = rec.times();
-    let (first, last) = (times[0], times[times.len() - 1]);
-    let sliver = 1e-12 * (last - first) / (times.len().max(2) - 1) as f64;
-    let mut ta = t0;
-    let mut k = times.partition_point(|&s| s <= t0 + sliver);
-    while ta < t1 {
-        let tb = match times.get(k) {
-            Some(&s) if s < t1 - sliver => s,
-            _ => t1,
-        };
-        let mid = 0.5 * (ta + tb);
-        let (fa, fb) = if mid > first && mid < last {
-            (-rec.at(ta), -rec.at(tb))
-        } else {
-            (0.0, 0.0)
-        };
-        let tau = tb - ta;
-        step(tau, fa, (fb - fa) / tau);
-        ta = tb;
-        k += 1;
-    }
-}
-
-/// The typical sample step of `times`: the median of its steps. Whole
-/// steps of that length are computed once; a record need not be uniform
-/// for that to pay (a pounding row appends a free-vibration tail, two
-/// steps of other lengths, to its record: with a uniform step required,
-/// every step of such a record had its coefficients computed anew, 30 %
-/// of a 16-building row's run).
-fn typical_step(times: &[f64]) -> Option<f64> {
-    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return None;
-    }
-    let mid = steps.len() / 2;
-    let (_, median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
-    Some(*median)
 }
 
 /// `e^{Aτ}` of `ü = −w2 u − c2 u̇` as `[[p00, p01], [p10, p11]]`:
@@ -270,7 +216,7 @@ impl FreeMotion {
             groups.push(Self::group(model, &place, bodies)?);
         }
         let record_step = match model.base() {
-            BaseExcitation::Record(rec) => Some(typical_step(rec.times())),
+            BaseExcitation::Record(rec) => Some(hold::typical_step(rec.times())),
             _ => None,
         };
         for g in &mut groups {
@@ -305,7 +251,7 @@ impl FreeMotion {
         // few (samples, checks a step apart) take the matrix form.
         let small = 2 * g.bodies.len() <= HOLD_ROWS;
         if let (true, Some(Some(tau))) = (g.modal.is_none() || small, record_step) {
-            let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(g), tau);
+            let (phi, g0, g1) = hold::matrices(&Self::matrix(g), tau);
             g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
         }
     }
@@ -601,47 +547,6 @@ impl FreeMotion {
         }
     }
 
-    /// `Φ = e^{Aτ}`, `γ₀` and `γ₁` of the first-order hold over `τ`: the
-    /// exponential of the augmented matrix (Van Loan).
-    fn hold_matrices(a: &DMatrix<f64>, tau: f64) -> (DMatrix<f64>, Vec<f64>, Vec<f64>) {
-        let d = a.nrows();
-        let mut big = DMatrix::<f64>::zeros(d + 2, d + 2);
-        big.view_mut((0, 0), (d, d)).copy_from(&(a * tau));
-        for j in 0..d / 2 {
-            big[(2 * j + 1, d)] = tau;
-        }
-        big[(d, d + 1)] = tau;
-        let e = big.exp();
-        (
-            e.view((0, 0), (d, d)).into_owned(),
-            (0..d).map(|i| e[(i, d)]).collect(),
-            (0..d).map(|i| e[(i, d + 1)]).collect(),
-        )
-    }
-
-    /// `x ← Φ x + γ₀ fa + γ₁ slope`: `x(b)` from `x = x(a)` under the
-    /// forcing `f(t) = fa + slope (t − a)` in every velocity row (the
-    /// harmonic part already removed); `y` is scratch of `x`'s length.
-    fn hold(
-        step: (&DMatrix<f64>, &[f64], &[f64]),
-        fa: f64,
-        slope: f64,
-        x: &mut [f64],
-        y: &mut [f64],
-    ) {
-        let (phi, g0, g1) = step;
-        for ((yi, a), b) in y.iter_mut().zip(g0).zip(g1) {
-            *yi = a * fa + b * slope;
-        }
-        // Column by column (Φ is stored by columns).
-        for (column, xj) in phi.as_slice().chunks_exact(x.len()).zip(x.iter()) {
-            for (yi, p) in y.iter_mut().zip(column) {
-                *yi += p * xj;
-            }
-        }
-        x.copy_from_slice(y);
-    }
-
     /// Propagates group `g`'s interleaved state `x` from `t0` to `t1 >= t0`
     /// exactly (in place).
     pub fn propagate(&self, g: usize, t0: f64, t1: f64, x: &mut [f64]) {
@@ -660,9 +565,9 @@ impl FreeMotion {
         match (&self.base, &group.modal, short) {
             (BaseExcitation::Record(rec), Some(modal), Some(h)) => {
                 let (mut y, mut z) = (vec![0.0; x.len()], Vec::with_capacity(x.len()));
-                record_intervals(rec, t0, t1, |tau, fa, slope| {
+                hold::intervals(rec, t0, t1, |tau, fa, slope| {
                     if (tau - h.tau).abs() <= 1e-12 * h.tau {
-                        Self::hold((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
+                        hold::step((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
                     } else {
                         modal.to_modes(x, &mut z);
                         modal.hold(tau, fa, slope, &mut z);
@@ -673,23 +578,23 @@ impl FreeMotion {
             (BaseExcitation::Record(rec), Some(modal), None) => {
                 let mut z = Vec::with_capacity(x.len());
                 modal.to_modes(x, &mut z);
-                record_intervals(rec, t0, t1, |tau, fa, slope| {
+                hold::intervals(rec, t0, t1, |tau, fa, slope| {
                     modal.hold(tau, fa, slope, &mut z)
                 });
                 modal.to_state(&z, x);
             }
             (BaseExcitation::Record(rec), None, _) => {
                 let mut y = vec![0.0; x.len()];
-                record_intervals(rec, t0, t1, |tau, fa, slope| match &group.hold_step {
+                hold::intervals(rec, t0, t1, |tau, fa, slope| match &group.hold_step {
                     // A whole sample step (to rounding of the sample times:
                     // 1e-12 of a step moves the state by far less than any
                     // tolerance).
                     Some(h) if (tau - h.tau).abs() <= 1e-12 * h.tau => {
-                        Self::hold((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
+                        hold::step((&h.phi, &h.g0, &h.g1), fa, slope, x, &mut y)
                     }
                     _ => {
-                        let (phi, g0, g1) = Self::hold_matrices(&Self::matrix(group), tau);
-                        Self::hold((&phi, &g0, &g1), fa, slope, x, &mut y)
+                        let (phi, g0, g1) = hold::matrices(&Self::matrix(group), tau);
+                        hold::step((&phi, &g0, &g1), fa, slope, x, &mut y)
                     }
                 });
             }
@@ -806,6 +711,7 @@ impl Group {
 
 mod bounds;
 mod branches;
+mod hold;
 mod modal;
 
 #[cfg(test)]

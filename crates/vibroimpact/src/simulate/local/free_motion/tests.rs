@@ -244,7 +244,7 @@ fn record_with_a_tail() -> (Vec<f64>, Vec<f64>) {
 fn a_record_with_a_tail_keeps_its_whole_steps() {
     let (times, values) = record_with_a_tail();
     let near = |h: Option<f64>| h.is_some_and(|h| (h - 0.01).abs() < 1e-15);
-    assert!(near(typical_step(&times)));
+    assert!(near(hold::typical_step(&times)));
     let rec = BaseExcitation::Record(Accelerogram::new(times, values, 0.4).unwrap());
     let m = coupled_pair(rec);
     let free = FreeMotion::new(&m).unwrap();
@@ -323,9 +323,9 @@ fn modes_agree_with_the_matrix_exponential() {
     let x0 = [0.003, -0.02, -0.001, 0.05];
     for tau in [0.01, 0.0037, 1e-9, 0.5] {
         let (fa, slope) = (0.7, -30.0);
-        let (phi, g0, g1) = FreeMotion::hold_matrices(&a, tau);
+        let (phi, g0, g1) = hold::matrices(&a, tau);
         let (mut by_matrix, mut y) = (x0.to_vec(), vec![0.0; 4]);
-        FreeMotion::hold((&phi, &g0, &g1), fa, slope, &mut by_matrix, &mut y);
+        hold::step((&phi, &g0, &g1), fa, slope, &mut by_matrix, &mut y);
         let mut z = Vec::new();
         modal.to_modes(&x0, &mut z);
         modal.hold(tau, fa, slope, &mut z);
