@@ -4,7 +4,8 @@
 //! system has a linear form ([`Stepper::exact_where_linear`]).
 
 use super::{
-    Dop853, Dopri5, Exact, IntegrationError, IntegratorOptions, LinearForm, OdeSystem, Rodas, Stats,
+    Dop853, Dopri5, Exact, ExactMethod, IntegrationError, IntegratorOptions, LinearForm, OdeSystem,
+    Rodas, Stats,
 };
 
 /// Integration method of a [`Stepper`].
@@ -144,15 +145,22 @@ pub struct Stepper {
 }
 
 /// The exact flow beside the method of construction: `form` the linear
-/// form the exact engine was made for (None: none made, or its form is
-/// gone), `spare` the engine not in use (the exact one while the method of
-/// construction runs, and the other way round), `retired` the work of
-/// exact engines dropped with their form.
+/// form the exact engine was made for (None: none made yet), `spare` the
+/// engine not in use (the exact one while the method of construction
+/// runs, and the other way round), `retired` the work of exact engines
+/// dropped for another form.
 #[derive(Clone, Debug, Default)]
 struct ExactSwitch {
     form: Option<LinearForm>,
     spare: Option<Engines>,
     retired: Stats,
+}
+
+impl ExactSwitch {
+    /// Drops an engine, its work kept in the counters.
+    fn retire(&mut self, engines: Engines) {
+        self.retired = self.retired + engines.stats();
+    }
 }
 
 impl Stepper {
@@ -179,10 +187,13 @@ impl Stepper {
     /// [`step_limit`](super::Linear::step_limit)); elsewhere by the method
     /// of construction. The form is read at each reset (a system that
     /// changes there, e.g. a contact's soft episode starting or ending,
-    /// changes method there); an exact engine is kept while its form
-    /// holds, so its exponentials are reused.
+    /// changes method there); the exact engine waits while its form is
+    /// gone and takes over again when it is back, its exponentials kept.
+    /// (No effect on a stepper built for [`Method::Exact`] itself.)
     pub fn exact_where_linear(mut self) -> Self {
-        self.exact = Some(ExactSwitch::default());
+        if self.method != Method::Exact {
+            self.exact = Some(ExactSwitch::default());
+        }
         self
     }
 
@@ -194,6 +205,8 @@ impl Stepper {
         };
         let form = sys.linear_form();
         let on_exact = matches!(self.engines, Engines::Exact(_));
+        // The form the exact engine was made for: it goes on, or takes
+        // over again from the spare.
         if form.is_some() && form == sw.form {
             if on_exact {
                 return Ok(());
@@ -204,6 +217,8 @@ impl Stepper {
             }
         }
         let dim = sys.dim();
+        // (Options the exact flow cannot take, e.g. an h_min above its
+        // step limit, leave the method of construction in place.)
         let exact = match form.clone().and_then(LinearForm::solve) {
             Some(linear) if linear.dim() == dim => {
                 let h = self.opts.h_max.min(linear.step_limit());
@@ -212,30 +227,38 @@ impl Stepper {
                     h_init: Some(h),
                     ..self.opts.clone()
                 };
-                Some(Engines::Exact(Exact::new(dim, opts)?))
+                Exact::with_method(dim, opts, ExactMethod::with_form(linear, dim))
+                    .ok()
+                    .map(Engines::Exact)
             }
             _ => None,
         };
-        sw.form = exact.as_ref().and(form);
-        // (An exact engine dropped with its form keeps its work counted.)
-        let old = match (on_exact, exact) {
-            (true, Some(e)) => Some(std::mem::replace(&mut self.engines, e)),
+        match (on_exact, exact) {
+            // Another form: a new exact engine; the old one's work stays
+            // counted.
+            (true, Some(e)) => {
+                sw.retire(std::mem::replace(&mut self.engines, e));
+                sw.form = form;
+            }
+            // The form is gone: the exact engine waits as the spare.
             (true, None) => {
                 let back = match sw.spare.take() {
                     Some(back) => back,
                     None => Engines::new(self.method, dim, &self.opts)?,
                 };
-                Some(std::mem::replace(&mut self.engines, back))
+                sw.spare = Some(std::mem::replace(&mut self.engines, back));
             }
+            // A new form: the method of construction waits as the spare
+            // (an exact engine of another form there retires).
             (false, Some(e)) => {
-                let old = sw.spare.take();
+                if let Some(old) = sw.spare.take() {
+                    sw.retire(old);
+                }
                 sw.spare = Some(std::mem::replace(&mut self.engines, e));
-                old
+                sw.form = form;
             }
-            (false, None) => sw.spare.take(),
-        };
-        if let Some(Engines::Exact(d)) = old {
-            sw.retired = sw.retired + d.stats();
+            // Still no form: nothing changes.
+            (false, None) => {}
         }
         Ok(())
     }
@@ -245,8 +268,8 @@ impl Stepper {
         self.method
     }
 
-    /// The integrator in use: [`Method::Dop853`], [`Method::Dopri5`] or
-    /// [`Method::Rodas`].
+    /// The integrator in use: [`Method::Dop853`], [`Method::Dopri5`],
+    /// [`Method::Exact`] or [`Method::Rodas`].
     pub fn active(&self) -> Method {
         match self.engines {
             Engines::Dopri5(_) => Method::Dopri5,

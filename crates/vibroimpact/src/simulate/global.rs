@@ -6,6 +6,7 @@
 
 use super::switches::{apply_event, judging_gaps, Event, Jump, Switches, Verdict};
 use super::*;
+use crate::integrate::{LinearForm, OdeSystem};
 
 /// Simulates `model` as [`simulate`] does, handing every output sample to
 /// `sink(t, [u.., v..])` instead of keeping it (the returned history is
@@ -42,14 +43,16 @@ pub fn simulate_streaming(
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
     let mut sys = ChainDynamics::new(model, opts.energy);
-    debug_assert_eq!(crate::integrate::OdeSystem::dim(&sys), y0.len());
+    debug_assert_eq!(sys.dim(), y0.len());
     let n2 = sys.state_dim();
     let mut st =
         Stepper::new(method, y0.len(), int_opts).map_err(|e| OptionsError(e.to_string()))?;
     // Between rigid impacts a small chain moves exactly (its linear form,
-    // while no soft episode runs; docs/theory.md §12).
+    // while no soft episode runs; docs/theory.md §12): asked for where the
+    // chain has a form at the start, before any episode.
     let rigid = (0..model.contacts().len()).any(|k| model.impacts(k).is_rigid());
-    if rigid && y0.len() <= EXACT_MAX_DIM {
+    if rigid && y0.len() <= EXACT_MAX_DIM && sys.linear_form().and_then(LinearForm::solve).is_some()
+    {
         st = st.exact_where_linear();
     }
     let mut next_break = 0;

@@ -333,6 +333,16 @@ pub struct ExactMethod {
 }
 
 impl ExactMethod {
+    /// The method for a system of dimension `dim` whose form is already
+    /// solved (a [`crate::integrate::Stepper`] that read it to choose the
+    /// method).
+    pub(crate) fn with_form(form: Linear, dim: usize) -> Self {
+        Self {
+            form: Some(form),
+            ..<Self as StepMethod>::new(dim)
+        }
+    }
+
     /// The accepted step's series, built on first use (see the module
     /// documentation); false where it does not converge.
     fn series(&mut self, h: f64) -> bool {
@@ -450,14 +460,12 @@ impl StepMethod for ExactMethod {
                 Some(self.sizes.len() - 1)
             }
             None => {
-                let q = self.next;
-                self.next = (q + 1) % KEPT_SIZES;
                 // (Never the accepted step's own: its dense output reads them.)
-                let q = if Some(q) == self.quarters_acc {
-                    self.next
-                } else {
-                    q
-                };
+                let mut q = self.next;
+                if Some(q) == self.quarters_acc {
+                    q = (q + 1) % KEPT_SIZES;
+                }
+                self.next = (q + 1) % KEPT_SIZES;
                 self.sizes[q] = Quarters::new(form, h);
                 Some(q)
             }
