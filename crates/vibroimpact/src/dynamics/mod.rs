@@ -42,6 +42,8 @@
 //! its gap exceeds about 0.36 mm, so the cost of a right-hand side grows with
 //! the number of contacts actually closing, and linearly with N.
 
+use std::sync::Arc;
+
 use crate::contact::{ContactForce, ContactLaw, LawKind};
 use crate::dynamics::variational::Variational;
 use crate::impact::rigid::RigidLaw;
@@ -119,7 +121,7 @@ struct ContactTerm {
     absurd: f64,
     /// Rigid impacts (docs/theory.md §12): never evaluated; the run
     /// applies each impact as a velocity jump by this map.
-    rigid: Option<RigidLaw>,
+    rigid: Option<Arc<RigidLaw>>,
     /// The law's own screen and absurd approach: a rigid contact's soft
     /// episode evaluates its law (`episodes.rs`).
     soft: (Screen, f64),
@@ -188,7 +190,7 @@ impl ChainDynamics {
             .rigid_laws()
             .unwrap_or_else(|_| {
                 (0..model.contacts().len())
-                    .map(|k| model.rigid_law(k).ok().flatten())
+                    .map(|k| model.rigid_law(k).ok().flatten().map(Arc::new))
                     .collect()
             })
             .into_iter();
@@ -409,7 +411,7 @@ impl ChainDynamics {
 
     /// Contact k's rigid impact map (None: its soft law is integrated).
     pub fn rigid_law(&self, k: usize) -> Option<&RigidLaw> {
-        self.contacts[k].rigid.as_ref()
+        self.contacts[k].rigid.as_deref()
     }
 
     /// Force of contact k at approach s and rate ṡ (N), as used in the

@@ -4,6 +4,8 @@
 
 use super::{Model, ModelError, ModelErrorKind};
 use crate::field_error::{shown, FieldError};
+use std::sync::Arc;
+
 use crate::impact::rigid::RigidLaw;
 
 /// A contact's impacts.
@@ -70,9 +72,9 @@ impl Model {
 
     /// Every contact's [`Model::rigid_law`], in contact order. A contact
     /// with the law, reduced mass and coefficient of the one before takes
-    /// a copy of its limit: a row of a thousand like pairs builds one.
-    pub fn rigid_laws(&self) -> Result<Vec<Option<RigidLaw>>, ModelError> {
-        let mut laws: Vec<Option<RigidLaw>> = Vec::with_capacity(self.contacts.len());
+    /// its limit, shared: a row of a thousand like pairs builds one.
+    pub fn rigid_laws(&self) -> Result<Vec<Option<Arc<RigidLaw>>>, ModelError> {
+        let mut laws: Vec<Option<Arc<RigidLaw>>> = Vec::with_capacity(self.contacts.len());
         let mut last: Option<(usize, f64, Option<f64>)> = None;
         for k in 0..self.contacts.len() {
             let Impacts::Rigid { restitution } = self.impacts[k] else {
@@ -85,7 +87,7 @@ impl Model {
             });
             let law = match same {
                 Some((j, ..)) => laws[j].clone(),
-                None => self.built_rigid_law(k, mu, restitution)?,
+                None => self.built_rigid_law(k, mu, restitution)?.map(Arc::new),
             };
             last = Some((k, mu, restitution));
             laws.push(law);

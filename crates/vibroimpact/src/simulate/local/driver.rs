@@ -528,29 +528,29 @@ impl<'a> Run<'a> {
         let n = model.bodies().len();
         let ng = free.groups().len();
         let nc = model.contacts().len();
-        let mut group_contacts = vec![Vec::new(); ng];
-        for (k, c) in model.contacts().iter().enumerate() {
-            let sides = side_groups(&free, c);
-            for g in sides.iter().flatten() {
-                if group_contacts[*g].last() != Some(&k) {
-                    group_contacts[*g].push(k);
-                }
-            }
-        }
-        let mut group_couplings = vec![Vec::new(); ng];
-        for (i, c) in model.couplings().iter().enumerate() {
-            group_couplings[free.place(c.a).0].push(i);
-        }
-        let mut group_forces = vec![Vec::new(); ng];
-        for (i, f) in model.forces().iter().enumerate() {
-            group_forces[free.place(f.body).0].push(i);
-        }
-        let mut group_storeys = vec![Vec::new(); ng];
-        for (s, st) in model.storeys().iter().enumerate() {
-            if Self::checked_storey(model, s) {
-                group_storeys[free.place(st.above).0].push(s);
-            }
-        }
+        let group_contacts = Lists::new(
+            ng,
+            model.contacts().iter().enumerate().flat_map(|(k, c)| {
+                side_groups(&free, c)
+                    .into_iter()
+                    .flatten()
+                    .map(move |g| (g, k))
+            }),
+        );
+        let group_couplings = Lists::new(
+            ng,
+            (model.couplings().iter().enumerate()).map(|(i, c)| (free.place(c.a).0, i)),
+        );
+        let group_forces = Lists::new(
+            ng,
+            (model.forces().iter().enumerate()).map(|(i, f)| (free.place(f.body).0, i)),
+        );
+        let group_storeys = Lists::new(
+            ng,
+            (model.storeys().iter().enumerate())
+                .filter(|&(s, _)| Self::checked_storey(model, s))
+                .map(|(s, st)| (free.place(st.above).0, s)),
+        );
         let ns = model.storeys().len();
         let storeys = StoreyTerms::new(model.storeys(), 2 * n, model.initial_displacement());
         let exact = free

@@ -5,9 +5,14 @@
 //! envelope stays clear of its limit is safe over the whole horizon; the
 //! energy bound is kept beside it, and the later of the two wins.
 
+use smallvec::{smallvec, SmallVec};
+
 use super::storeys::YIELD_APPROACH;
 use super::*;
 use crate::simulate::local::free_motion::Envelope;
+
+/// A check's quantity per group: (body, coefficient).
+type Terms = SmallVec<[(usize, f64); 2]>;
 
 /// Halvings tried below the first horizon before the modal bound gives up.
 const HALVINGS: usize = 4;
@@ -24,7 +29,10 @@ impl Run<'_> {
     /// The envelope of `Σ c u_i` over `terms` (body, coefficient), all in
     /// group `g`, from the group's state `x`.
     fn side(&self, g: usize, x: &[f64], terms: &[(usize, f64)]) -> Option<Side> {
-        let at = |r: usize| -> Vec<(usize, f64)> {
+        if !self.free.has_envelopes(g) {
+            return None;
+        }
+        let at = |r: usize| -> Terms {
             terms
                 .iter()
                 .map(|&(i, c)| (2 * self.free.place(i).1 + r, c))
@@ -84,7 +92,7 @@ impl Run<'_> {
             let (lo, hi) = self.storeys.linear_window(s, YIELD_APPROACH)?;
             let (below, above) = self.storeys.ends(s);
             let g = self.free.place(above).0;
-            let mut terms = vec![(above, 1.0)];
+            let mut terms: Terms = smallvec![(above, 1.0)];
             terms.extend(below.map(|b| (b, -1.0)));
             let side = self.side(g, state(g), &terms)?;
             return Some(Box::new(move |h, zdd| {
@@ -94,19 +102,19 @@ impl Run<'_> {
         }
         let c = &self.model.contacts()[k];
         // The gap s = u_l − u_r − clearance, per group of its sides.
-        let mut by_group: Vec<(usize, Vec<(usize, f64)>)> = Vec::with_capacity(2);
+        let mut by_group: SmallVec<[(usize, Terms); 2]> = SmallVec::new();
         for (side, sign) in [c.pair.left(), c.pair.right()].into_iter().zip([1.0, -1.0]) {
             let Some(i) = side else { continue };
             let g = self.free.place(i).0;
             match by_group.iter_mut().find(|(h, _)| *h == g) {
                 Some((_, terms)) => terms.push((i, sign)),
-                None => by_group.push((g, vec![(i, sign)])),
+                None => by_group.push((g, smallvec![(i, sign)])),
             }
         }
         let sides = by_group
             .iter()
             .map(|(g, terms)| self.side(*g, state(*g), terms))
-            .collect::<Option<Vec<Side>>>()?;
+            .collect::<Option<SmallVec<[Side; 2]>>>()?;
         let (activation, rigid) = (self.activation[k], self.is_rigid(k));
         let clearance = c.clearance;
         Some(Box::new(move |h, zdd| {

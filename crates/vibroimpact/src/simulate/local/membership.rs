@@ -2,6 +2,8 @@
 //! with exactly moving bodies followed over the set's steps, due checks,
 //! groups joining and leaving.
 
+use smallvec::SmallVec;
+
 use super::*;
 
 /// Where the active set's last step meets an activation: the earliest
@@ -221,8 +223,8 @@ impl Run<'_> {
     }
 
     /// The groups of check k's bodies (a contact's, or a storey's group).
-    pub(super) fn groups_of(&self, k: usize) -> Vec<usize> {
-        let mut groups: Vec<usize> = self
+    pub(super) fn groups_of(&self, k: usize) -> SmallVec<[usize; 2]> {
+        let mut groups: SmallVec<[usize; 2]> = self
             .sides(k)
             .into_iter()
             .flatten()

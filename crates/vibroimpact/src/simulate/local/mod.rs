@@ -8,6 +8,7 @@
 //! - `activation.rs`, `membership.rs`, `rebuild.rs` — when a contact
 //!   matters, the set's edge, rebuilding the set;
 //! - `clusters.rs` — a set and a stepper per cluster, earliest first;
+//! - `lists.rs` — lists per group in one flat array;
 //! - `free_motion/` — exact motion between contacts;
 //! - `storeys.rs` — hysteretic storeys under the local integrator;
 //! - `rigid.rs` — rigid impacts: jumps between exact motions, soft
@@ -67,6 +68,7 @@ mod energy;
 mod envelope;
 mod extrema;
 pub mod free_motion;
+mod lists;
 mod membership;
 mod pace;
 mod rebuild;
@@ -79,6 +81,7 @@ use clusters::clustered;
 pub(super) use driver::{run, Tangents};
 use energy::LocalEnergy;
 use extrema::LocalExtrema;
+use lists::Lists;
 use membership::Crossing;
 use rigid::rigid_parts;
 pub use tape::LocalTape;
@@ -193,10 +196,10 @@ struct Run<'a> {
     activation: Vec<Activation>,
     /// Per group: its contacts, couplings, harmonic forces and checked
     /// (bilinear and Bouc–Wen) storeys (model indices, ascending).
-    group_contacts: Vec<Vec<usize>>,
-    group_storeys: Vec<Vec<usize>>,
-    group_couplings: Vec<Vec<usize>>,
-    group_forces: Vec<Vec<usize>>,
+    group_contacts: Lists,
+    group_storeys: Lists,
+    group_couplings: Lists,
+    group_forces: Lists,
     /// Per check (contacts, then storeys: check `nc + s` is storey s's):
     /// the generation of its scheduled check (older queue entries are
     /// stale).
@@ -251,7 +254,7 @@ struct Run<'a> {
     /// The energy audit's sums, when asked for.
     energy: Option<LocalEnergy>,
     /// Per contact: its rigid limit, for rigid impacts (`rigid.rs`).
-    rigid: Vec<Option<crate::impact::rigid::RigidLaw>>,
+    rigid: Vec<Option<rigid::SharedLaw>>,
     /// Per contact: its last rigid impact's time and estimated duration.
     last_impact: Vec<(f64, f64)>,
     /// Per contact: where a rigid contact's impact is judged (its law's
@@ -368,6 +371,15 @@ impl Run<'_> {
             }
         }
         let groups = &groups[..count];
+        // Sides at rest that stay at rest (a row's bodies before a pulse
+        // reaches them) keep their gap: open now, open for good (a change
+        // of either side's motion schedules the check again).
+        if let Some(c) = self.model.contacts().get(k) {
+            let still = |g: &usize| self.free.stays_at_rest(*g, &self.exact[*g].1);
+            if !self.armed[k] && groups.iter().all(still) && -c.clearance < self.check_gap(k, 0.0) {
+                return Some(f64::INFINITY);
+            }
+        }
         if self.defer {
             let at = self.states_at(groups, t);
             self.disarm_if_open(k, |g| {

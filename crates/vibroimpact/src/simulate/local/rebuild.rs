@@ -418,7 +418,7 @@ impl Run<'_> {
             });
         }
         let sub_bodies: Vec<Body> = bodies.iter().map(|&i| model.bodies()[i].clone()).collect();
-        let pick = |lists: &[Vec<usize>]| {
+        let pick = |lists: &Lists| {
             let mut v: Vec<usize> = groups
                 .iter()
                 .flat_map(|&g| lists[g].iter().copied())

@@ -16,7 +16,12 @@
 //! episode.
 
 use super::*;
+use std::sync::Arc;
+
 use crate::impact::rigid::RigidLaw;
+
+/// A rigid limit, shared by like contacts ([`Model::rigid_laws`]).
+pub(super) type SharedLaw = Arc<RigidLaw>;
 use crate::simulate::switches::{reaches_within, soft_reason, EpisodeReason, SoftEpisode};
 
 /// Per contact: its rigid limit (rigid impacts only) and where it is
@@ -25,7 +30,7 @@ use crate::simulate::switches::{reaches_within, soft_reason, EpisodeReason, Soft
 pub(super) fn rigid_parts(
     model: &Model,
     opts: &SimulationOptions,
-) -> Result<(Vec<Option<RigidLaw>>, Vec<f64>), OptionsError> {
+) -> Result<(Vec<Option<SharedLaw>>, Vec<f64>), OptionsError> {
     let nc = model.contacts().len();
     let laws = model
         .rigid_laws()

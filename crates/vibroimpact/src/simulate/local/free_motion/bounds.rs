@@ -24,7 +24,7 @@
 //! its limit is safe over the whole horizon, where the energy bound, which
 //! lets every spring take the group's whole energy, crawls.
 
-use super::{FreeMotion, Group};
+use super::{FreeMotion, Group, Rows};
 use crate::model::BaseExcitation;
 
 /// Samples per block of a record's peak table.
@@ -156,6 +156,13 @@ impl Envelope {
 }
 
 impl FreeMotion {
+    /// Whether group `g` has envelopes ([`FreeMotion::envelopes`]): modes,
+    /// and no harmonic terms.
+    pub fn has_envelopes(&self, g: usize) -> bool {
+        let group = &self.groups[g];
+        group.modal.is_some() && group.harmonic.is_empty()
+    }
+
     /// The envelopes of `q = Σ c x_r` over each of `quantities` (rows r
     /// of group `g`'s interleaved state, coefficient c) from the state
     /// `x` (one change to modes for all); None where the group has no
@@ -172,7 +179,7 @@ impl FreeMotion {
         if !group.harmonic.is_empty() {
             return None;
         }
-        let about: Vec<f64> = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
+        let about: Rows = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
         let mut z = Vec::with_capacity(x.len());
         modal.to_modes(&about, &mut z);
         Some(quantities.map(|rows| {

@@ -26,8 +26,8 @@ pub(super) struct Variant {
     propagator: Propagator,
     harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
     rate: f64,
-    modal: Option<Modal>,
-    hold_step: Option<HoldStep>,
+    modal: Option<Box<Modal>>,
+    hold_step: Option<Box<HoldStep>>,
 }
 
 /// The system matrix `A` (interleaved `[u, v]` rows) of bodies with

@@ -106,10 +106,10 @@ pub struct Group {
     rate: f64,
     /// The complex modes, where they can be trusted (not for a single
     /// body under harmonic forcing: closed form).
-    modal: Option<Modal>,
+    modal: Option<Box<Modal>>,
     /// Without modes, under a record: the matrix form of a whole typical
     /// sample step, computed once.
-    hold_step: Option<HoldStep>,
+    hold_step: Option<Box<HoldStep>>,
     /// The static rest state of its storeys' constant forces
     /// (interleaved; zero without storeys), and those forces.
     rest: Rows,
@@ -237,7 +237,7 @@ impl FreeMotion {
         g.modal = None;
         g.hold_step = None;
         if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
-            g.modal = Modal::new(&Self::matrix(g), record_step.flatten());
+            g.modal = Modal::new(&Self::matrix(g), record_step.flatten()).map(Box::new);
         }
         // The exact extrema's grid parts a whole step into pieces of at
         // most a sixteenth of the fastest period ([`FreeMotion::grid`]).
@@ -252,7 +252,7 @@ impl FreeMotion {
         let small = 2 * g.bodies.len() <= HOLD_ROWS;
         if let (true, Some(Some(tau))) = (g.modal.is_none() || small, record_step) {
             let (phi, g0, g1) = hold::matrices(&Self::matrix(g), tau);
-            g.hold_step = Some(HoldStep { tau, phi, g0, g1 });
+            g.hold_step = Some(Box::new(HoldStep { tau, phi, g0, g1 }));
         }
     }
 
@@ -547,11 +547,17 @@ impl FreeMotion {
         }
     }
 
+    /// Whether group `g` at state `x` stays there for good: at rest at
+    /// zero without forcing.
+    pub fn stays_at_rest(&self, g: usize, x: &[f64]) -> bool {
+        self.groups[g].at_rest(&self.base, x)
+    }
+
     /// Propagates group `g`'s interleaved state `x` from `t0` to `t1 >= t0`
     /// exactly (in place).
     pub fn propagate(&self, g: usize, t0: f64, t1: f64, x: &mut [f64]) {
         let group = &self.groups[g];
-        if t1 == t0 || group.stays_at_rest(&self.base, x) {
+        if t1 == t0 || group.at_rest(&self.base, x) {
             return;
         }
         self.add_particular(group, t0, -1.0, x);
@@ -690,7 +696,7 @@ impl Group {
     /// Whether the group at state `x` stays there exactly: at rest at zero
     /// without forcing (no harmonic term, no record, no constant force), as
     /// a row's bodies are before a pulse reaches them.
-    fn stays_at_rest(&self, base: &BaseExcitation, x: &[f64]) -> bool {
+    fn at_rest(&self, base: &BaseExcitation, x: &[f64]) -> bool {
         self.harmonic.is_empty()
             && !matches!(base, BaseExcitation::Record(_))
             && self.rest.iter().all(|&r| r == 0.0)
