@@ -444,15 +444,24 @@ impl Model {
             body: 0,
             damping: false,
         };
+        // (A square root only where a body is faster: √(k/m) > r where
+        // k/m > r², both sides non-negative.)
         for (i, b) in self.bodies.iter().enumerate() {
-            for (rate, damping) in [((k[i] / b.mass).sqrt(), false), (c[i] / b.mass, true)] {
-                if rate > fastest.rate {
-                    fastest = FreeFlightRate {
-                        rate,
-                        body: i,
-                        damping,
-                    };
-                }
+            let w2 = k[i] / b.mass;
+            if w2 > fastest.rate * fastest.rate && w2.sqrt() > fastest.rate {
+                fastest = FreeFlightRate {
+                    rate: w2.sqrt(),
+                    body: i,
+                    damping: false,
+                };
+            }
+            let rate = c[i] / b.mass;
+            if rate > fastest.rate {
+                fastest = FreeFlightRate {
+                    rate,
+                    body: i,
+                    damping: true,
+                };
             }
         }
         fastest

@@ -26,6 +26,25 @@ pub(super) enum Activation {
 }
 
 impl Activation {
+    /// Every contact's activation, in contact order; a contact like the
+    /// one before it (`like`, [`like_previous`]) takes its activation (a
+    /// row of a thousand like pairs computes one).
+    pub(super) fn all(model: &Model, opts: &SimulationOptions, like: &[bool]) -> Vec<Self> {
+        let contacts = model.contacts();
+        let mut out: Vec<Self> = Vec::with_capacity(contacts.len());
+        for (k, c) in contacts.iter().enumerate() {
+            let a = match out.last() {
+                Some(&a) if like[k] => a,
+                _ => {
+                    let s_on = c.law.onset_approach(opts.impact_force_threshold);
+                    Self::new(model, k, opts, s_on)
+                }
+            };
+            out.push(a);
+        }
+        out
+    }
+
     pub(super) fn new(model: &Model, k_index: usize, opts: &SimulationOptions, s_on: f64) -> Self {
         let rtol = opts.rtol;
         let c = &model.contacts()[k_index];
@@ -98,6 +117,22 @@ impl Activation {
             Activation::Exponential { alpha, boa, limit } => s + (boa * sdot.abs() - limit) / alpha,
         }
     }
+}
+
+/// Whether contact `k` (k > 0) is like the one before it: the same law and
+/// clearance, walls on the same sides, and bodies of the same mass and
+/// stiffness, so that whatever the run derives from a contact alone (its
+/// activation, its force scale, its judging gap) is the same.
+pub(super) fn like_previous(model: &Model, k: usize) -> bool {
+    let Some(j) = k.checked_sub(1) else {
+        return false;
+    };
+    let (a, b) = (&model.contacts()[j], &model.contacts()[k]);
+    let body = |i: Option<usize>| i.map(|i| &model.bodies()[i]).map(|b| (b.mass, b.stiffness));
+    a.law == b.law
+        && a.clearance == b.clearance
+        && body(a.pair.left()) == body(b.pair.left())
+        && body(a.pair.right()) == body(b.pair.right())
 }
 
 /// The largest `h <= h_max` (to a factor 2) with `impulse(h) <= limit`,

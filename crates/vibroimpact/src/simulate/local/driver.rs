@@ -133,7 +133,9 @@ impl Run<'_> {
             }
             debug_assert!(t >= *t0, "exact motion never runs backward");
             let moved;
-            let x: &[f64] = if rebase {
+            let x: &[f64] = if free.stays_at_rest(g, x) {
+                x
+            } else if rebase {
                 free.propagate(g, *t0, t, x);
                 *t0 = t;
                 x
@@ -528,23 +530,13 @@ impl<'a> Run<'a> {
         let n = model.bodies().len();
         let ng = free.groups().len();
         let nc = model.contacts().len();
-        let group_contacts = Lists::new(
-            ng,
-            model.contacts().iter().enumerate().flat_map(|(k, c)| {
-                side_groups(&free, c)
-                    .into_iter()
-                    .flatten()
-                    .map(move |g| (g, k))
-            }),
-        );
-        let group_couplings = Lists::new(
-            ng,
-            (model.couplings().iter().enumerate()).map(|(i, c)| (free.place(c.a).0, i)),
-        );
-        let group_forces = Lists::new(
-            ng,
-            (model.forces().iter().enumerate()).map(|(i, f)| (free.place(f.body).0, i)),
-        );
+        let mut sides = Vec::with_capacity(2 * nc);
+        for (k, c) in model.contacts().iter().enumerate() {
+            for g in side_groups(&free, c).into_iter().flatten() {
+                sides.push((g, k));
+            }
+        }
+        let group_contacts = Lists::new(ng, sides.iter().copied());
         let group_storeys = Lists::new(
             ng,
             (model.storeys().iter().enumerate())
@@ -559,27 +551,18 @@ impl<'a> Run<'a> {
             .map(|g| (0.0, rows_of(g.bodies(), y0)))
             .collect();
         let columns = tangents.map_or(0, |w| w.columns);
-        let tangent_refs = free
-            .groups()
-            .iter()
-            .map(|g| {
-                let w = tangents.map_or(Vec::new(), |tw| {
-                    (0..columns)
-                        .flat_map(|c| rows_of(g.bodies(), &tw.values[c * 2 * n..(c + 1) * 2 * n]))
-                        .collect()
-                });
-                (0.0, w)
-            })
-            .collect();
-        let activation = (0..nc)
-            .map(|k| {
-                let s_on = model.contacts()[k]
-                    .law
-                    .onset_approach(opts.impact_force_threshold);
-                Activation::new(model, k, opts, s_on)
-            })
-            .collect();
-        let (rigid, pre) = rigid_parts(model, opts)?;
+        // (None carried: none per group.)
+        let tangent_refs = tangents.map_or(Vec::new(), |tw| {
+            let rows = |g: &free_motion::Group| -> Vec<f64> {
+                (0..columns)
+                    .flat_map(|c| rows_of(g.bodies(), &tw.values[c * 2 * n..(c + 1) * 2 * n]))
+                    .collect()
+            };
+            free.groups().iter().map(|g| (0.0, rows(g))).collect()
+        });
+        let like: Vec<bool> = (0..nc).map(|k| like_previous(model, k)).collect();
+        let activation = Activation::all(model, opts, &like);
+        let (rigid, pre) = rigid_parts(model, opts, &like)?;
         let mut run = Self {
             model,
             opts,
@@ -593,8 +576,6 @@ impl<'a> Run<'a> {
             slot: vec![None; n],
             activation,
             group_contacts,
-            group_couplings,
-            group_forces,
             group_storeys,
             generation: vec![0; nc + ns],
             queue: BinaryHeap::new(),
@@ -663,14 +644,21 @@ impl<'a> Run<'a> {
     }
 
     /// The first set at t = 0: the contacts active there, and the storeys
-    /// near yield or integrated throughout; every other check scheduled.
+    /// near yield or integrated throughout; every other check scheduled
+    /// (none for a contact open at rest for good).
     fn first_set(&mut self) -> Result<(), IntegrationError> {
         let model = self.model;
         let nc = model.contacts().len();
         let checked = (0..model.storeys().len())
             .filter(|&s| Run::checked_storey(model, s))
             .map(|s| nc + s);
+        let still: Vec<bool> = (self.exact.iter().enumerate())
+            .map(|(g, (_, x))| self.free.stays_at_rest(g, x))
+            .collect();
         for k in (0..nc).chain(checked) {
+            if self.open_at_rest(k, |g| still[g]) {
+                continue;
+            }
             if !self.touches_set(k) && self.schedule(k, 0.0) {
                 self.join(k, 0.0)?;
             }

@@ -85,12 +85,12 @@ impl Run<'_> {
             input -= b.mass * zdd * v;
             damper += b.damping * v * v;
         }
-        for &f in &self.group_forces[g] {
+        for &f in self.free.forces_in(g) {
             let f = &model.forces()[f];
             let j = bodies.iter().position(|&i| i == f.body).unwrap_or(0);
             input += f.amplitude * (f.frequency * t + f.phase).sin() * x[2 * j + 1];
         }
-        for &c in &self.group_couplings[g] {
+        for &c in self.free.couplings_in(g) {
             let c = &model.couplings()[c];
             let a = bodies.iter().position(|&i| i == c.a).unwrap_or(0);
             let b = bodies.iter().position(|&i| i == c.b).unwrap_or(0);

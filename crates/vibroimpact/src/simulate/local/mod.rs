@@ -76,7 +76,7 @@ mod rigid;
 mod storeys;
 mod tape;
 
-use activation::{first_step, Activation};
+use activation::{first_step, like_previous, Activation};
 use clusters::clustered;
 pub(super) use driver::{run, Tangents};
 use energy::LocalEnergy;
@@ -194,12 +194,11 @@ struct Run<'a> {
     /// Per body: index in the active set.
     slot: Vec<Option<usize>>,
     activation: Vec<Activation>,
-    /// Per group: its contacts, couplings, harmonic forces and checked
-    /// (bilinear and Bouc–Wen) storeys (model indices, ascending).
+    /// Per group: its contacts and checked (bilinear and Bouc–Wen) storeys
+    /// (model indices, ascending; its couplings and forces are the free
+    /// motion's).
     group_contacts: Lists,
     group_storeys: Lists,
-    group_couplings: Lists,
-    group_forces: Lists,
     /// Per check (contacts, then storeys: check `nc + s` is storey s's):
     /// the generation of its scheduled check (older queue entries are
     /// stale).
@@ -243,7 +242,7 @@ struct Run<'a> {
     columns: usize,
     /// Per group: time and tangent columns (each of the group's
     /// interleaved rows, one after the other) of its exact motion; the
-    /// set's are in its state.
+    /// set's are in its state. Empty when no columns are carried.
     tangents: Vec<(f64, Vec<f64>)>,
     breakpoints: Vec<f64>,
     /// The record of the run's linearisation, when a tape is asked for.
@@ -316,10 +315,11 @@ fn reach_time(d: f64, b: f64, cq: f64, size: f64) -> Option<f64> {
 /// The rows `[u, v]` of `bodies` in an interleaved state `v` of the whole
 /// model.
 fn rows_of(bodies: &[usize], v: &[f64]) -> Rows {
-    bodies
-        .iter()
-        .flat_map(|&i| [v[2 * i], v[2 * i + 1]])
-        .collect()
+    let mut rows = Rows::new();
+    for &i in bodies {
+        rows.extend_from_slice(&v[2 * i..2 * i + 2]);
+    }
+    rows
 }
 
 /// Writes the rows `x` of `bodies` into an interleaved state `out` of the
@@ -371,14 +371,8 @@ impl Run<'_> {
             }
         }
         let groups = &groups[..count];
-        // Sides at rest that stay at rest (a row's bodies before a pulse
-        // reaches them) keep their gap: open now, open for good (a change
-        // of either side's motion schedules the check again).
-        if let Some(c) = self.model.contacts().get(k) {
-            let still = |g: &usize| self.free.stays_at_rest(*g, &self.exact[*g].1);
-            if !self.armed[k] && groups.iter().all(still) && -c.clearance < self.check_gap(k, 0.0) {
-                return Some(f64::INFINITY);
-            }
+        if self.open_at_rest(k, |g| self.free.stays_at_rest(g, &self.exact[g].1)) {
+            return Some(f64::INFINITY);
         }
         if self.defer {
             let at = self.states_at(groups, t);
@@ -408,6 +402,20 @@ impl Run<'_> {
         let until = self.bound(k, t, f64::INFINITY, |g| exact[g].1.as_slice());
         self.exact = exact;
         until
+    }
+
+    /// Whether check k is a contact whose sides' groups are at rest and
+    /// stay there (`still`: a row's bodies before a pulse reaches them)
+    /// with its gap open: open for good (a change of either side's motion
+    /// schedules its check again).
+    fn open_at_rest(&self, k: usize, still: impl Fn(usize) -> bool) -> bool {
+        let Some(c) = self.model.contacts().get(k) else {
+            return false;
+        };
+        let mut sides = self.sides(k).into_iter().flatten();
+        !self.armed[k]
+            && sides.all(|i| still(self.free.place(i).0))
+            && -c.clearance < self.check_gap(k, 0.0)
     }
 
     /// The states of `groups` at `t` by their exact motion (copies).

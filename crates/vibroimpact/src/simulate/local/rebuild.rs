@@ -306,7 +306,9 @@ impl Run<'_> {
                             });
                         }
                     }
-                    self.tangents[g] = (t, w);
+                    if self.columns > 0 {
+                        self.tangents[g] = (t, w);
+                    }
                 }
             }
             if several {
@@ -418,15 +420,16 @@ impl Run<'_> {
             });
         }
         let sub_bodies: Vec<Body> = bodies.iter().map(|&i| model.bodies()[i].clone()).collect();
-        let pick = |lists: &Lists| {
+        let free = &self.free;
+        let pick = |list: fn(&FreeMotion, usize) -> &[usize]| {
             let mut v: Vec<usize> = groups
                 .iter()
-                .flat_map(|&g| lists[g].iter().copied())
+                .flat_map(|&g| list(free, g).iter().copied())
                 .collect();
             v.sort_unstable();
             v
         };
-        let couplings: Vec<Coupling> = pick(&self.group_couplings)
+        let couplings: Vec<Coupling> = pick(FreeMotion::couplings_in)
             .into_iter()
             .map(|i| &model.couplings()[i])
             .filter_map(|c| {
@@ -437,7 +440,7 @@ impl Run<'_> {
                 })
             })
             .collect();
-        let forces: Vec<HarmonicForce> = pick(&self.group_forces)
+        let forces: Vec<HarmonicForce> = pick(FreeMotion::forces_in)
             .into_iter()
             .map(|i| &model.forces()[i])
             .filter_map(|f| {

@@ -15,14 +15,14 @@
 //! takes the contact by its law, until the set lets them go: a soft
 //! episode.
 
-use super::*;
 use std::sync::Arc;
 
+use super::*;
 use crate::impact::rigid::RigidLaw;
+use crate::simulate::switches::{judged, reaches_within, EpisodeReason, SoftEpisode};
 
 /// A rigid limit, shared by like contacts ([`Model::rigid_laws`]).
 pub(super) type SharedLaw = Arc<RigidLaw>;
-use crate::simulate::switches::{reaches_within, soft_reason, EpisodeReason, SoftEpisode};
 
 /// Per contact: its rigid limit (rigid impacts only) and where it is
 /// judged: its law's onset approach at the impact threshold (negative for
@@ -30,20 +30,24 @@ use crate::simulate::switches::{reaches_within, soft_reason, EpisodeReason, Soft
 pub(super) fn rigid_parts(
     model: &Model,
     opts: &SimulationOptions,
+    like: &[bool],
 ) -> Result<(Vec<Option<SharedLaw>>, Vec<f64>), OptionsError> {
     let nc = model.contacts().len();
     let laws = model
         .rigid_laws()
         .map_err(|e| OptionsError(e.to_string()))?;
-    let pre = (0..nc)
-        .map(|k| match model.impacts(k).is_rigid() {
-            true => model.contacts()[k]
-                .law
-                .onset_approach(opts.impact_force_threshold)
-                .min(0.0),
-            false => 0.0,
-        })
-        .collect();
+    let mut pre: Vec<f64> = Vec::with_capacity(nc);
+    let mut judged = 0.0;
+    for (k, c) in model.contacts().iter().enumerate() {
+        if !like[k] {
+            judged = c.law.onset_approach(opts.impact_force_threshold).min(0.0);
+        }
+        pre.push(if model.impacts(k).is_rigid() {
+            judged
+        } else {
+            0.0
+        });
+    }
     Ok((laws, pre))
 }
 
@@ -92,15 +96,17 @@ impl Run<'_> {
             u += sign * x[2 * j + 1];
             pressing += sign * self.free.acceleration(g, t, x, j);
         }
-        let judged = soft_reason(&law, (u, pressing), self.opts.atol, |d| {
-            self.neighbours(k, t, d)
-        })
-        .map_err(|e| IntegrationError::RigidImpact {
+        if u <= self.opts.atol {
+            self.open_episode(k, t, EpisodeReason::Slow { velocity: u });
+            return Ok(false);
+        }
+        // (The impact at u serves the judging and, at the touch, the jump.)
+        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
             t,
             contact: k,
             reason: e.to_string(),
         })?;
-        if let Some(reason) = judged {
+        if let Some(reason) = judged(&r, pressing, |d| self.neighbours(k, t, d)) {
             self.open_episode(k, t, reason);
             return Ok(false);
         }
@@ -113,11 +119,6 @@ impl Run<'_> {
             }
             return Ok(true);
         }
-        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
-            t,
-            contact: k,
-            reason: e.to_string(),
-        })?;
         // The jump: left side −P/m, right side +P/m.
         for (i, sign) in sides.iter().filter_map(|&(i, s)| Some((i?, s))) {
             let (g, j) = self.free.place(i);

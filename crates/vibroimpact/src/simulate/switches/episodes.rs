@@ -154,21 +154,30 @@ pub(in crate::simulate) fn soft_reason(
     if u <= floor {
         return Ok(Some(EpisodeReason::Slow { velocity: u }));
     }
-    let r = law.impact(u)?;
+    Ok(judged(&law.impact(u)?, pressing, neighbour))
+}
+
+/// [`soft_reason`] of an impact `r` above the floor, found while its
+/// bodies press together at `pressing` (m/s²).
+pub(in crate::simulate) fn judged(
+    r: &RigidImpact,
+    pressing: f64,
+    neighbour: impl FnOnce(f64) -> Option<EpisodeReason>,
+) -> Option<EpisodeReason> {
     if let Some(reason) = neighbour(r.duration) {
-        return Ok(Some(reason));
+        return Some(reason);
     }
     if pressing > 0.0 {
         let back = 2.0 * r.rebound_velocity / pressing;
         if back < r.duration {
-            return Ok(Some(EpisodeReason::Resting {
+            return Some(EpisodeReason::Resting {
                 rebound: r.rebound_velocity,
                 back,
                 duration: r.duration,
-            }));
+            });
         }
     }
-    Ok(None)
+    None
 }
 
 /// When a neighbour at approach `s` (m), rate `sd` and acceleration

@@ -21,7 +21,7 @@ use crate::numeric::brent;
 
 mod episodes;
 mod flow;
-pub(super) use episodes::{judging_gaps, reaches_within, soft_reason, Jump};
+pub(super) use episodes::{judged, judging_gaps, reaches_within, Jump};
 
 pub use episodes::{EpisodeReason, SoftEpisode};
 pub(crate) use flow::{flow_through_events, ImpactJump};

@@ -39,8 +39,9 @@
 //! (`bounds.rs`).
 
 use nalgebra::{DMatrix, DVector};
-use smallvec::SmallVec;
+use smallvec::{smallvec, SmallVec};
 
+use super::lists::Lists;
 use crate::model::{BaseExcitation, Model};
 
 pub use bounds::Envelope;
@@ -129,10 +130,27 @@ pub struct Group {
     cache: Vec<(Vec<f64>, branches::Variant)>,
 }
 
+/// Per group, the model's couplings (by their first body), storeys (by
+/// the body above) and harmonic forces in it.
+#[derive(Clone, Debug)]
+struct Parts {
+    couplings: Lists,
+    storeys: Lists,
+    forces: Lists,
+}
+
+impl Parts {
+    /// Whether group `g` has no couplings, storeys or forces.
+    fn is_empty(&self, g: usize) -> bool {
+        self.couplings[g].is_empty() && self.storeys[g].is_empty() && self.forces[g].is_empty()
+    }
+}
+
 /// The exact free motion of every group of a model.
 #[derive(Clone, Debug)]
 pub struct FreeMotion {
     groups: Vec<Group>,
+    parts: Parts,
     /// (group, index in the group) of every body.
     place: Vec<(usize, usize)>,
     base: BaseExcitation,
@@ -211,9 +229,24 @@ impl FreeMotion {
     /// group in resonance with a harmonic forcing term.
     pub fn new(model: &Model) -> Result<Self, FreeMotionError> {
         let (place, members) = spring_groups(model);
-        let mut groups = Vec::with_capacity(members.len());
-        for bodies in members {
-            groups.push(Self::group(model, &place, bodies)?);
+        let ng = members.len();
+        let parts = Parts {
+            couplings: Lists::new(
+                ng,
+                (model.couplings().iter().enumerate()).map(|(i, c)| (place[c.a].0, i)),
+            ),
+            storeys: Lists::new(
+                ng,
+                (model.storeys().iter().enumerate()).map(|(i, s)| (place[s.above].0, i)),
+            ),
+            forces: Lists::new(
+                ng,
+                (model.forces().iter().enumerate()).map(|(i, f)| (place[f.body].0, i)),
+            ),
+        };
+        let mut groups = Vec::with_capacity(ng);
+        for (g, bodies) in members.into_iter().enumerate() {
+            groups.push(Self::group(model, &place, bodies, &parts, g)?);
         }
         let record_step = match model.base() {
             BaseExcitation::Record(rec) => Some(hold::typical_step(rec.times())),
@@ -224,6 +257,7 @@ impl FreeMotion {
         }
         Ok(Self {
             groups,
+            parts,
             place,
             base: model.base().clone(),
             peaks: bounds::Peaks::new(model.base()),
@@ -260,18 +294,26 @@ impl FreeMotion {
         model: &Model,
         place: &[(usize, usize)],
         bodies: Bodies,
+        parts: &Parts,
+        here: usize,
     ) -> Result<Group, FreeMotionError> {
         let m = bodies.len();
         let all = model.bodies();
+        let unforced = match model.base() {
+            BaseExcitation::Harmonic { amplitude, .. } => *amplitude == 0.0,
+            _ => true,
+        };
+        if m == 1 && unforced && parts.is_empty(here) {
+            let body = &all[bodies[0]];
+            return Ok(Group::single(bodies, body));
+        }
         let mass: PerBody = bodies.iter().map(|&i| all[i].mass).collect();
         let own_stiffness: PerBody = bodies.iter().map(|&i| all[i].stiffness).collect();
         let mut stiffness = own_stiffness.clone();
         let damping: PerBody = bodies.iter().map(|&i| all[i].damping).collect();
-        let here = place[bodies[0]].0;
-        let mut couplings: Vec<(usize, usize, f64, f64)> = model
-            .couplings()
+        let mut couplings: Vec<(usize, usize, f64, f64)> = parts.couplings[here]
             .iter()
-            .filter(|c| place[c.a].0 == here)
+            .map(|&i| &model.couplings()[i])
             .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
             .collect();
         // A storey is a spring of its initial stiffness less its P-Δ
@@ -280,10 +322,8 @@ impl FreeMotion {
         // (`set_storey_stiffness`).
         let mut storeys = Vec::new();
         let mut storey_stiffness = Vec::new();
-        for (i, s) in model.storeys().iter().enumerate() {
-            if place[s.above].0 != here {
-                continue;
-            }
+        for &i in &parts.storeys[here] {
+            let s = &model.storeys()[i];
             let k = s.law.initial_stiffness() - s.p_delta;
             let slot = match s.below {
                 None => {
@@ -317,10 +357,8 @@ impl FreeMotion {
         }
         let mut force_amplitude = PerBody::from_elem(0.0, m);
         let mut forces = Vec::new();
-        for f in model.forces() {
-            if place[f.body].0 != place[bodies[0]].0 {
-                continue;
-            }
+        for &i in &parts.forces[here] {
+            let f = &model.forces()[i];
             let j = place[f.body].1;
             let mut b = vec![0.0; 2 * m];
             b[2 * j + 1] = f.amplitude / mass[j];
@@ -463,6 +501,17 @@ impl FreeMotion {
     /// The groups.
     pub fn groups(&self) -> &[Group] {
         &self.groups
+    }
+
+    /// The model's couplings in group `g` (model indices, ascending).
+    pub(crate) fn couplings_in(&self, g: usize) -> &[usize] {
+        &self.parts.couplings[g]
+    }
+
+    /// The model's harmonic forces on group `g` (model indices,
+    /// ascending).
+    pub(crate) fn forces_in(&self, g: usize) -> &[usize] {
+        &self.parts.forces[g]
     }
 
     /// (group, index within the group) of body `i`.
@@ -693,6 +742,34 @@ impl FreeMotion {
 }
 
 impl Group {
+    /// A body alone (no couplings, storeys or forces, no harmonic base):
+    /// its closed form, built without the general path's lists.
+    fn single(bodies: Bodies, b: &crate::model::Body) -> Self {
+        let (w2, c2) = (b.stiffness / b.mass, b.damping / b.mass);
+        Group {
+            bodies,
+            propagator: Propagator::Single { w2, c2 },
+            harmonic: Vec::new(),
+            mass: smallvec![b.mass],
+            stiffness: smallvec![b.stiffness],
+            damping: smallvec![b.damping],
+            couplings: Vec::new(),
+            force_amplitude: smallvec![0.0],
+            forces: Vec::new(),
+            rate: w2.max(0.0).sqrt(),
+            modal: None,
+            hold_step: None,
+            rest: smallvec![0.0, 0.0],
+            rest_forces: smallvec![0.0],
+            storeys: Vec::new(),
+            storey_stiffness: Vec::new(),
+            terms: Vec::new(),
+            own_stiffness: smallvec![b.stiffness],
+            names: String::new(),
+            cache: Vec::new(),
+        }
+    }
+
     /// Whether the group at state `x` stays there exactly: at rest at zero
     /// without forcing (no harmonic term, no record, no constant force), as
     /// a row's bodies are before a pulse reaches them.
