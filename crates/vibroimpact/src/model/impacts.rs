@@ -2,11 +2,28 @@
 //! soft law, integrated, or in the rigid limit as instantaneous velocity
 //! jumps with the law's e(U) or a Newton coefficient.
 
-use super::{Model, ModelError, ModelErrorKind};
-use crate::field_error::{shown, FieldError};
 use std::sync::Arc;
 
+use super::{Model, ModelError, ModelErrorKind};
+use crate::field_error::{shown, FieldError};
 use crate::impact::rigid::RigidLaw;
+
+/// The rigid limits of a model's contacts, like contacts sharing one
+/// ([`Model::rigid_limits`]).
+#[derive(Clone, Debug, Default)]
+pub struct RigidLimits {
+    /// The distinct limits.
+    laws: Vec<RigidLaw>,
+    /// Each contact's limit in `laws` (None: soft impacts).
+    of: Vec<Option<usize>>,
+}
+
+impl RigidLimits {
+    /// Contact `k`'s rigid limit (None: soft impacts, or no such contact).
+    pub fn get(&self, k: usize) -> Option<&RigidLaw> {
+        self.of.get(k).copied().flatten().map(|i| &self.laws[i])
+    }
+}
 
 /// A contact's impacts.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -71,28 +88,45 @@ impl Model {
     }
 
     /// Every contact's [`Model::rigid_law`], in contact order. A contact
-    /// with the law, reduced mass and coefficient of the one before takes
-    /// its limit, shared: a row of a thousand like pairs builds one.
-    pub fn rigid_laws(&self) -> Result<Vec<Option<Arc<RigidLaw>>>, ModelError> {
-        let mut laws: Vec<Option<Arc<RigidLaw>>> = Vec::with_capacity(self.contacts.len());
+    /// with the law, reduced mass and coefficient of the rigid one before
+    /// shares its limit: a row of a thousand like pairs builds one.
+    pub fn rigid_limits(&self) -> Result<RigidLimits, ModelError> {
+        let mut limits = RigidLimits {
+            laws: Vec::new(),
+            of: Vec::with_capacity(self.contacts.len()),
+        };
         let mut last: Option<(usize, f64, Option<f64>)> = None;
         for k in 0..self.contacts.len() {
             let Impacts::Rigid { restitution } = self.impacts[k] else {
-                laws.push(None);
+                limits.of.push(None);
                 continue;
             };
             let mu = self.reduced_mass(k);
             let same = last.filter(|&(j, m, e)| {
                 self.contacts[j].law == self.contacts[k].law && m == mu && e == restitution
             });
-            let law = match same {
-                Some((j, ..)) => laws[j].clone(),
-                None => self.built_rigid_law(k, mu, restitution)?.map(Arc::new),
+            let index = match same {
+                Some((j, ..)) => limits.of[j],
+                None => self.built_rigid_law(k, mu, restitution)?.map(|law| {
+                    limits.laws.push(law);
+                    limits.laws.len() - 1
+                }),
             };
             last = Some((k, mu, restitution));
-            laws.push(law);
+            limits.of.push(index);
         }
-        Ok(laws)
+        Ok(limits)
+    }
+
+    /// [`Model::rigid_limits`] as one shared limit per contact.
+    pub fn rigid_laws(&self) -> Result<Vec<Option<Arc<RigidLaw>>>, ModelError> {
+        let limits = self.rigid_limits()?;
+        let laws: Vec<Arc<RigidLaw>> = limits.laws.into_iter().map(Arc::new).collect();
+        Ok(limits
+            .of
+            .iter()
+            .map(|i| i.map(|i| laws[i].clone()))
+            .collect())
     }
 
     /// Contact `k`'s reduced mass (a wall's side infinite).

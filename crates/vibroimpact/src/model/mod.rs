@@ -596,7 +596,7 @@ mod scales;
 mod storey;
 
 pub use excitation::{Accelerogram, BaseExcitation, HarmonicForce};
-pub use impacts::Impacts;
+pub use impacts::{Impacts, RigidLimits};
 pub use storey::Storey;
 
 /// Every body's mass finite and positive, its support's stiffness and

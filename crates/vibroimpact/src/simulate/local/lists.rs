@@ -17,6 +17,10 @@ impl Lists {
     /// (a pair equal to the one before it is dropped: an item whose two
     /// sides lie in one group is listed once).
     pub(super) fn new(groups: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> Self {
+        // (No items, as a row without couplings has: every list empty.)
+        if pairs.clone().next().is_none() {
+            return Self::default();
+        }
         let mut start = vec![0; groups + 1];
         let mut last = None;
         for p in pairs.clone() {
@@ -46,6 +50,9 @@ impl Index<usize> for Lists {
     type Output = [usize];
 
     fn index(&self, g: usize) -> &[usize] {
+        if self.start.is_empty() {
+            return &[];
+        }
         &self.items[self.start[g]..self.start[g + 1]]
     }
 }
@@ -62,5 +69,7 @@ mod tests {
         assert_eq!(&l[1], &[0, 1]);
         assert_eq!(&l[2], &[3]);
         assert!(l[3].is_empty());
+        let none = Lists::new(4, std::iter::empty());
+        assert!((0..4).all(|g| none[g].is_empty()));
     }
 }

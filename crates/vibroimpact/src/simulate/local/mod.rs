@@ -253,7 +253,7 @@ struct Run<'a> {
     /// The energy audit's sums, when asked for.
     energy: Option<LocalEnergy>,
     /// Per contact: its rigid limit, for rigid impacts (`rigid.rs`).
-    rigid: Vec<Option<rigid::SharedLaw>>,
+    rigid: crate::model::RigidLimits,
     /// Per contact: its last rigid impact's time and estimated duration.
     last_impact: Vec<(f64, f64)>,
     /// Per contact: where a rigid contact's impact is judged (its law's

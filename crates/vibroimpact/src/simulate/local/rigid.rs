@@ -15,14 +15,9 @@
 //! takes the contact by its law, until the set lets them go: a soft
 //! episode.
 
-use std::sync::Arc;
-
 use super::*;
-use crate::impact::rigid::RigidLaw;
+use crate::model::RigidLimits;
 use crate::simulate::switches::{judged, reaches_within, EpisodeReason, SoftEpisode};
-
-/// A rigid limit, shared by like contacts ([`Model::rigid_laws`]).
-pub(super) type SharedLaw = Arc<RigidLaw>;
 
 /// Per contact: its rigid limit (rigid impacts only) and where it is
 /// judged: its law's onset approach at the impact threshold (negative for
@@ -31,10 +26,10 @@ pub(super) fn rigid_parts(
     model: &Model,
     opts: &SimulationOptions,
     like: &[bool],
-) -> Result<(Vec<Option<SharedLaw>>, Vec<f64>), OptionsError> {
+) -> Result<(RigidLimits, Vec<f64>), OptionsError> {
     let nc = model.contacts().len();
     let laws = model
-        .rigid_laws()
+        .rigid_limits()
         .map_err(|e| OptionsError(e.to_string()))?;
     let mut pre: Vec<f64> = Vec::with_capacity(nc);
     let mut judged = 0.0;
@@ -57,15 +52,15 @@ impl Run<'_> {
     /// gap, or its touch once judged rigid; else the activation gap.
     pub(super) fn check_gap(&self, k: usize, speed: f64) -> f64 {
         match self.rigid.get(k) {
-            Some(Some(_)) if self.armed[k] => 0.0,
-            Some(Some(_)) => self.pre[k],
-            _ => self.activation[k].gap(speed),
+            Some(_) if self.armed[k] => 0.0,
+            Some(_) => self.pre[k],
+            None => self.activation[k].gap(speed),
         }
     }
 
     /// Whether check `k` is a rigid contact.
     pub(super) fn is_rigid(&self, k: usize) -> bool {
-        matches!(self.rigid.get(k), Some(Some(_)))
+        self.rigid.get(k).is_some()
     }
 
     /// Rigid contact k found at its gap at `t` (both sides moving
@@ -75,9 +70,9 @@ impl Run<'_> {
     /// again (a neighbour may have struck since), its jump taken (true) or
     /// an episode from there (false). Any other check: false.
     pub(super) fn rigid_touch(&mut self, k: usize, t: f64) -> Result<bool, IntegrationError> {
-        let Some(Some(law)) = self.rigid.get(k).cloned() else {
+        if !self.is_rigid(k) {
             return Ok(false);
-        };
+        }
         // A neighbour integrated: the contact joins it.
         if let Some(other) = self.integrated_neighbour(k) {
             self.open_episode(k, t, EpisodeReason::Cluster { other });
@@ -101,7 +96,10 @@ impl Run<'_> {
             return Ok(false);
         }
         // (The impact at u serves the judging and, at the touch, the jump.)
-        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
+        let Some(impact) = self.rigid.get(k).map(|law| law.impact(u)) else {
+            return Ok(false);
+        };
+        let r = impact.map_err(|e| IntegrationError::RigidImpact {
             t,
             contact: k,
             reason: e.to_string(),

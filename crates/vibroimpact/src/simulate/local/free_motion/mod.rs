@@ -244,9 +244,18 @@ impl FreeMotion {
                 (model.forces().iter().enumerate()).map(|(i, f)| (place[f.body].0, i)),
             ),
         };
+        let unforced = match model.base() {
+            BaseExcitation::Harmonic { amplitude, .. } => *amplitude == 0.0,
+            _ => true,
+        };
         let mut groups = Vec::with_capacity(ng);
         for (g, bodies) in members.into_iter().enumerate() {
-            groups.push(Self::group(model, &place, bodies, &parts, g)?);
+            if bodies.len() == 1 && unforced && parts.is_empty(g) {
+                let body = &model.bodies()[bodies[0]];
+                groups.push(Group::single(bodies, body));
+            } else {
+                groups.push(Self::group(model, &place, bodies, &parts, g)?);
+            }
         }
         let record_step = match model.base() {
             BaseExcitation::Record(rec) => Some(hold::typical_step(rec.times())),
@@ -299,14 +308,6 @@ impl FreeMotion {
     ) -> Result<Group, FreeMotionError> {
         let m = bodies.len();
         let all = model.bodies();
-        let unforced = match model.base() {
-            BaseExcitation::Harmonic { amplitude, .. } => *amplitude == 0.0,
-            _ => true,
-        };
-        if m == 1 && unforced && parts.is_empty(here) {
-            let body = &all[bodies[0]];
-            return Ok(Group::single(bodies, body));
-        }
         let mass: PerBody = bodies.iter().map(|&i| all[i].mass).collect();
         let own_stiffness: PerBody = bodies.iter().map(|&i| all[i].stiffness).collect();
         let mut stiffness = own_stiffness.clone();
