@@ -10,7 +10,7 @@ use crate::impact::rigid::RigidLaw;
 
 /// The rigid limits of a model's contacts, like contacts sharing one
 /// ([`Model::rigid_limits`]).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct RigidLimits {
     /// The distinct limits.
     laws: Vec<RigidLaw>,

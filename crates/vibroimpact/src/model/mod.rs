@@ -448,12 +448,15 @@ impl Model {
         // k/m > r², both sides non-negative.)
         for (i, b) in self.bodies.iter().enumerate() {
             let w2 = k[i] / b.mass;
-            if w2 > fastest.rate * fastest.rate && w2.sqrt() > fastest.rate {
-                fastest = FreeFlightRate {
-                    rate: w2.sqrt(),
-                    body: i,
-                    damping: false,
-                };
+            if w2 > fastest.rate * fastest.rate {
+                let w = w2.sqrt();
+                if w > fastest.rate {
+                    fastest = FreeFlightRate {
+                        rate: w,
+                        body: i,
+                        damping: false,
+                    };
+                }
             }
             let rate = c[i] / b.mass;
             if rate > fastest.rate {

@@ -242,7 +242,7 @@ struct Run<'a> {
     columns: usize,
     /// Per group: time and tangent columns (each of the group's
     /// interleaved rows, one after the other) of its exact motion; the
-    /// set's are in its state. Empty when no columns are carried.
+    /// set's are in its state. Empty when no tangents are given.
     tangents: Vec<(f64, Vec<f64>)>,
     breakpoints: Vec<f64>,
     /// The record of the run's linearisation, when a tape is asked for.
@@ -352,8 +352,12 @@ impl Run<'_> {
 
     /// The time until which check k (a contact with both sides moving
     /// exactly, or a storey moving exactly) surely stays inactive, from
-    /// `t`; None: active now (or so soon that the bound cannot tell).
+    /// `t`; None: active now (or so soon that the bound cannot tell). A
+    /// contact open at rest for good is not counted as checked.
     fn safe_until(&mut self, k: usize, t: f64) -> Option<f64> {
+        if self.open_at_rest(k, |g| self.free.stays_at_rest(g, &self.exact[g].1)) {
+            return Some(f64::INFINITY);
+        }
         self.local.contact_checks += 1;
         self.checks_per_contact[k] += 1;
         // The sides' groups at t: their reference states move there (in
@@ -371,9 +375,6 @@ impl Run<'_> {
             }
         }
         let groups = &groups[..count];
-        if self.open_at_rest(k, |g| self.free.stays_at_rest(g, &self.exact[g].1)) {
-            return Some(f64::INFINITY);
-        }
         if self.defer {
             let at = self.states_at(groups, t);
             self.disarm_if_open(k, |g| {

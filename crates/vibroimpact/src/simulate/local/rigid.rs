@@ -70,9 +70,9 @@ impl Run<'_> {
     /// again (a neighbour may have struck since), its jump taken (true) or
     /// an episode from there (false). Any other check: false.
     pub(super) fn rigid_touch(&mut self, k: usize, t: f64) -> Result<bool, IntegrationError> {
-        if !self.is_rigid(k) {
+        let Some(law) = self.rigid.get(k) else {
             return Ok(false);
-        }
+        };
         // A neighbour integrated: the contact joins it.
         if let Some(other) = self.integrated_neighbour(k) {
             self.open_episode(k, t, EpisodeReason::Cluster { other });
@@ -96,10 +96,7 @@ impl Run<'_> {
             return Ok(false);
         }
         // (The impact at u serves the judging and, at the touch, the jump.)
-        let Some(impact) = self.rigid.get(k).map(|law| law.impact(u)) else {
-            return Ok(false);
-        };
-        let r = impact.map_err(|e| IntegrationError::RigidImpact {
+        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
             t,
             contact: k,
             reason: e.to_string(),
