@@ -1,5 +1,5 @@
 use super::*;
-use crate::model::{Accelerogram, Body, Coupling, HarmonicForce};
+use crate::model::{Accelerogram, Body, Coupling, HarmonicForce, Model};
 use crate::simulate::{simulate, SimulationOptions};
 use modal::Modal;
 use nalgebra::DMatrix;
