@@ -15,7 +15,9 @@ pub(super) type Crossing = Option<(f64, usize)>;
 pub(super) struct BoundaryEnds {
     ta: f64,
     tb: f64,
-    groups: Vec<(usize, Rows, Rows)>,
+    /// (group, state at `ta`, state at `tb`); a set has few boundary
+    /// groups, kept inline.
+    groups: SmallVec<[(usize, Rows, Rows); 2]>,
 }
 
 impl BoundaryEnds {
@@ -78,11 +80,11 @@ impl Run<'_> {
     /// previous step's end where the set went on from there.
     fn boundary_ends(&mut self, set: &mut ActiveSet) -> BoundaryEnds {
         let (ta, tb) = (set.saved.0, set.st.t());
-        let carried = std::mem::take(&mut set.carried);
+        let mut carried = std::mem::take(&mut set.carried);
         let mut ends = BoundaryEnds {
             ta,
             tb,
-            groups: Vec::new(),
+            groups: SmallVec::new(),
         };
         for &k in &set.boundary {
             let c = &self.model.contacts()[k];
@@ -105,11 +107,10 @@ impl Run<'_> {
                 ends.groups.push((g, xa, xb));
             }
         }
-        set.carried = ends
-            .groups
-            .iter()
-            .map(|(g, _, xb)| (*g, tb, xb.clone()))
-            .collect();
+        // (The carried list's buffer is kept from step to step.)
+        carried.clear();
+        carried.extend(ends.groups.iter().map(|(g, _, xb)| (*g, tb, xb.clone())));
+        set.carried = carried;
         ends
     }
 
@@ -258,9 +259,9 @@ impl Run<'_> {
 
     /// The checks (contacts, then storeys `nc + s`) of `groups`, ascending,
     /// each once.
-    pub(super) fn checks_of(&self, groups: &[usize]) -> Vec<usize> {
+    pub(super) fn checks_of(&self, groups: &[usize]) -> SmallVec<[usize; 8]> {
         let nc = self.model.contacts().len();
-        let mut checks: Vec<usize> = groups
+        let mut checks: SmallVec<[usize; 8]> = groups
             .iter()
             .flat_map(|&g| {
                 let storeys = self.group_storeys[g].iter().map(move |s| nc + s);
@@ -320,7 +321,7 @@ impl Run<'_> {
         // A group that joined within the lookahead stays (no chatter); one
         // whose contacts are all rigid (a soft episode) leaves once they
         // have separated, as the global run's episode ends.
-        let mut engaged: Vec<bool> = set
+        let mut engaged: SmallVec<[bool; 8]> = set
             .groups
             .iter()
             .map(|&g| t - self.joined[g] < self.rigid_lookahead(g, lookahead))

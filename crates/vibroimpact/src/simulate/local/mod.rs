@@ -52,6 +52,8 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+use smallvec::SmallVec;
+
 use super::switches::{apply_event, Event, Switches, Verdict};
 use super::*;
 use crate::contact::LawKind;
@@ -273,12 +275,10 @@ struct Run<'a> {
 fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
     let (l, r) = (c.pair.left()?, c.pair.right()?);
     let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
+    // (A body alone in its group: its group's forces and storeys are its.)
     let forced = |i: usize| {
-        model.forces().iter().any(|f| f.body == i)
-            || model
-                .storeys()
-                .iter()
-                .any(|s| s.above == i || s.below == Some(i))
+        let g = free.place(i).0;
+        !free.forces_in(g).is_empty() || !free.storeys_in(g).is_empty()
     };
     if !single(l) || !single(r) || forced(l) || forced(r) {
         return None;
@@ -420,7 +420,7 @@ impl Run<'_> {
     }
 
     /// The states of `groups` at `t` by their exact motion (copies).
-    fn states_at(&self, groups: &[usize], t: f64) -> Vec<(usize, Rows)> {
+    fn states_at(&self, groups: &[usize], t: f64) -> SmallVec<[(usize, Rows); 2]> {
         groups
             .iter()
             .map(|&g| {

@@ -151,7 +151,7 @@ impl Run<'_> {
                 .flatten()
                 .any(|b| mine.contains(&Some(*b)))
         };
-        let mut near: Vec<usize> = self
+        let mut near: SmallVec<[usize; 8]> = self
             .groups_of(k)
             .into_iter()
             .flat_map(|g| self.group_contacts[g].iter().copied())
@@ -204,7 +204,7 @@ impl Run<'_> {
     /// changed there); those active at once (a chain's next touch) are
     /// taken in turn.
     fn reschedule(&mut self, groups: &[usize], t: f64) -> Result<(), IntegrationError> {
-        let mut active = Vec::new();
+        let mut active: SmallVec<[usize; 4]> = SmallVec::new();
         for kk in self.checks_of(groups) {
             if !self.touches_set(kk) && self.schedule(kk, t) {
                 active.push(kk);

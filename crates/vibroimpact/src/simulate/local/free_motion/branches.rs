@@ -18,6 +18,24 @@ pub(super) enum Slot {
     Coupling(usize),
 }
 
+/// A group's storeys and what a change of their branches needs.
+#[derive(Clone, Debug)]
+pub(super) struct Branching {
+    /// Its storeys (model index), where each one's stiffness sits, and
+    /// that stiffness now (its branch's, less its P-Δ stiffness).
+    pub(super) storeys: Vec<(usize, Slot)>,
+    pub(super) stiffness: Vec<f64>,
+    /// The harmonic terms b sin(Ω t + φ) per unit mass: (Ω, φ, b).
+    pub(super) terms: Vec<(f64, f64, Vec<f64>)>,
+    /// The bodies' own springs to the ground (without storeys), and the
+    /// bodies' names (for errors).
+    pub(super) own_stiffness: super::PerBody,
+    pub(super) names: String,
+    /// The propagators of other branches met so far, by their storeys'
+    /// stiffness ([`FreeMotion::set_storey_stiffness`]).
+    pub(super) cache: Vec<(Vec<f64>, Variant)>,
+}
+
 /// What changes with the storeys' stiffness.
 #[derive(Clone, Debug)]
 pub(super) struct Variant {
@@ -169,7 +187,7 @@ impl Group {
     /// Its storeys (model indices), in the order
     /// [`FreeMotion::set_storey_stiffness`] takes their stiffness.
     pub fn storeys(&self) -> impl Iterator<Item = usize> + '_ {
-        self.storeys.iter().map(|&(s, _)| s)
+        (self.branching.iter()).flat_map(|b| b.storeys.iter().map(|&(s, _)| s))
     }
 }
 
@@ -183,35 +201,43 @@ impl FreeMotion {
         let record_step = matches!(self.base, crate::model::BaseExcitation::Record(_))
             .then_some(self.record_step);
         let group = &mut self.groups[g];
-        if group.storey_stiffness == k {
+        // (Without storeys `k` is empty: nothing to change.)
+        let Some(mut br) = group.branching.take() else {
+            return Ok(());
+        };
+        if br.stiffness == k {
+            group.branching = Some(br);
             return Ok(());
         }
         let old = group.take_variant();
-        let key = std::mem::replace(&mut group.storey_stiffness, k.to_vec());
+        let key = std::mem::replace(&mut br.stiffness, k.to_vec());
         // The rest state belongs to the stiffness: set again even for the
         // same forces.
         group.rest_forces.fill(f64::NAN);
-        group.cache.push((key, old));
-        if let Some(i) = group.cache.iter().position(|(key, _)| key == k) {
-            let (_, v) = group.cache.swap_remove(i);
+        br.cache.push((key, old));
+        if let Some(i) = br.cache.iter().position(|(key, _)| key == k) {
+            let (_, v) = br.cache.swap_remove(i);
             group.put_variant(v);
+            group.branching = Some(br);
             return Ok(());
         }
-        group.stiffness.clone_from(&group.own_stiffness);
-        for (&(_, slot), &new) in group.storeys.iter().zip(k) {
+        group.stiffness.clone_from(&br.own_stiffness);
+        for (&(_, slot), &new) in br.storeys.iter().zip(k) {
             match slot {
                 Slot::Ground(j) => group.stiffness[j] += new,
                 Slot::Coupling(c) => group.couplings[c].2 = new,
             }
         }
-        let (propagator, harmonic, rate) = motion(
+        let found = motion(
             &group.mass,
             &group.stiffness,
             &group.damping,
             &group.couplings,
-            &group.terms,
-            &group.names,
-        )?;
+            &br.terms,
+            &br.names,
+        );
+        group.branching = Some(br);
+        let (propagator, harmonic, rate) = found?;
         group.harmonic = harmonic;
         group.rate = rate;
         group.propagator = propagator;

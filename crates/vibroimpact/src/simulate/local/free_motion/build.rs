@@ -235,12 +235,16 @@ impl FreeMotion {
             hold_step: None,
             rest: Rows::from_elem(0.0, 2 * m),
             rest_forces: PerBody::from_elem(0.0, m),
-            storeys,
-            storey_stiffness,
-            terms,
-            own_stiffness,
-            names,
-            cache: Vec::new(),
+            branching: (!storeys.is_empty()).then(|| {
+                Box::new(branches::Branching {
+                    storeys,
+                    stiffness: storey_stiffness,
+                    terms,
+                    own_stiffness,
+                    names,
+                    cache: Vec::new(),
+                })
+            }),
         })
     }
 }
@@ -265,12 +269,7 @@ impl Group {
             hold_step: None,
             rest: smallvec![0.0, 0.0],
             rest_forces: smallvec![0.0],
-            storeys: Vec::new(),
-            storey_stiffness: Vec::new(),
-            terms: Vec::new(),
-            own_stiffness: smallvec![b.stiffness],
-            names: String::new(),
-            cache: Vec::new(),
+            branching: None,
         }
     }
 }

@@ -116,19 +116,9 @@ pub struct Group {
     /// (interleaved; zero without storeys), and those forces.
     rest: Rows,
     rest_forces: PerBody,
-    /// Its storeys (model index), where each one's stiffness sits, and
-    /// that stiffness now (its branch's, less its P-Δ stiffness).
-    storeys: Vec<(usize, branches::Slot)>,
-    storey_stiffness: Vec<f64>,
-    /// The harmonic terms b sin(Ω t + φ) per unit mass: (Ω, φ, b).
-    terms: Vec<(f64, f64, Vec<f64>)>,
-    /// The bodies' own springs to the ground (without storeys), and the
-    /// bodies' names (for errors).
-    own_stiffness: PerBody,
-    names: String,
-    /// The propagators of other branches met so far, by their storeys'
-    /// stiffness ([`FreeMotion::set_storey_stiffness`]).
-    cache: Vec<(Vec<f64>, branches::Variant)>,
+    /// Its storeys and what a change of their branches needs (None
+    /// without storeys: most groups of a row; boxed, a group stays small).
+    branching: Option<Box<branches::Branching>>,
 }
 
 /// The exact free motion of every group of a model.
@@ -276,6 +266,12 @@ impl FreeMotion {
     /// The model's couplings in group `g` (model indices, ascending).
     pub(crate) fn couplings_in(&self, g: usize) -> &[usize] {
         &self.parts.couplings[g]
+    }
+
+    /// The model's storeys in group `g`, by the body above (model indices,
+    /// ascending).
+    pub(crate) fn storeys_in(&self, g: usize) -> &[usize] {
+        &self.parts.storeys[g]
     }
 
     /// The model's harmonic forces on group `g` (model indices,
