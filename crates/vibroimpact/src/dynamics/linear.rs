@@ -84,3 +84,94 @@ impl ChainDynamics {
         })
     }
 }
+
+/// A chain with no contacts, its storeys on linear pieces, as `ẏ = A y +
+/// b − e z̈(t)` (`e`: ones in the velocity rows; docs/theory.md §13): per
+/// body its own spring, damper and constant force, and the links between
+/// bodies (couplings and storeys, with their P-Δ), so that a product with
+/// `A` costs what a right-hand side does.
+#[derive(Clone, Debug, Default)]
+pub struct PiecewiseForm {
+    inv_mass: Vec<f64>,
+    /// Per body: its spring and damper to the ground (N/m, N s/m) and its
+    /// constant force (N).
+    ground: Vec<[f64; 3]>,
+    /// (a, b, k, c): the force k (u_b − u_a) + c (v_b − v_a) on a, its
+    /// opposite on b.
+    links: Vec<(usize, usize, f64, f64)>,
+}
+
+impl PiecewiseForm {
+    /// `out = A x` (without `b` and the base).
+    #[inline]
+    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        for (i, g) in self.ground.iter().enumerate() {
+            out[2 * i] = x[2 * i + 1];
+            out[2 * i + 1] = -g[0] * x[2 * i] - g[1] * x[2 * i + 1];
+        }
+        for &(a, b, k, c) in &self.links {
+            let f = k * (x[2 * b] - x[2 * a]) + c * (x[2 * b + 1] - x[2 * a + 1]);
+            out[2 * a + 1] += f;
+            out[2 * b + 1] -= f;
+        }
+        for (i, w) in self.inv_mass.iter().enumerate() {
+            out[2 * i + 1] *= w;
+        }
+    }
+
+    /// Body i's constant acceleration `b` (its velocity row's).
+    #[inline]
+    pub fn constant(&self, i: usize) -> f64 {
+        self.ground[i][2] * self.inv_mass[i]
+    }
+}
+
+impl ChainDynamics {
+    /// The chain's [`PiecewiseForm`] on its storeys' current pieces, into
+    /// `form`; false where it has none: contacts, harmonic forces or base
+    /// motion, gravity, Bouc–Wen storeys or the energy audit's quadratures.
+    pub fn piecewise_form(&self, form: &mut PiecewiseForm) -> bool {
+        let base = matches!(self.base, BaseExcitation::None | BaseExcitation::Record(_));
+        let storeys = &self.storeys;
+        if !base
+            || !self.contacts.is_empty()
+            || !self.forces.is_empty()
+            || self.energy
+            || storeys.integrated()
+        {
+            return false;
+        }
+        let n = self.n;
+        form.inv_mass.clone_from(&self.inv_mass);
+        form.ground.clear();
+        form.ground
+            .extend((0..n).map(|i| [self.stiffness[i], self.damping[i], 0.0]));
+        form.links.clear();
+        form.links.extend_from_slice(&self.couplings);
+        // (A storey between two bodies a coupling joins joins its link.)
+        let mut link = |a: usize, b: usize, k: f64| match form
+            .links
+            .iter_mut()
+            .find(|l| (l.0, l.1) == (a, b) || (l.0, l.1) == (b, a))
+        {
+            Some(l) => l.2 += k,
+            None => form.links.push((a, b, k, 0.0)),
+        };
+        for k in 0..storeys.len() {
+            let Some((kb, f0)) = storeys.piece(k) else {
+                return false;
+            };
+            let (below, above) = storeys.ends(k);
+            let stiffness = kb - storeys.p_delta(k);
+            form.ground[above][2] -= f0;
+            match below {
+                Some(b) => {
+                    link(above, b, stiffness);
+                    form.ground[b][2] += f0;
+                }
+                None => form.ground[above][0] += stiffness,
+            }
+        }
+        true
+    }
+}

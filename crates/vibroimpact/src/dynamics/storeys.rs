@@ -128,6 +128,11 @@ impl StoreyTerms {
         self.stamp
     }
 
+    /// How many storeys.
+    pub fn len(&self) -> usize {
+        self.terms.len()
+    }
+
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
         self.terms.is_empty()
@@ -322,11 +327,18 @@ impl StoreyTerms {
         (y1, f1): (&[f64], &[f64]),
         h: f64,
     ) -> (f64, f64) {
-        let t = &self.terms[k];
         let ((_, v0), (_, v1)) = (self.drift(k, y0), self.drift(k, y1));
         let ((_, a0), (_, a1)) = (self.drift(k, f0), self.drift(k, f1));
         let acceleration = a0.abs().max(a1.abs()) + (a1 - a0).abs();
         let speed = v0.abs().max(v1.abs()) + 0.5 * acceleration * h;
+        self.switch_rate_bounds_for(k, speed, acceleration)
+    }
+
+    /// Bounds on how fast storey k's two [`StoreyTerms::switch_parts`]
+    /// change while its drift moves no faster than `speed` and its rate
+    /// changes no faster than `acceleration`.
+    pub fn switch_rate_bounds_for(&self, k: usize, speed: f64, acceleration: f64) -> (f64, f64) {
+        let t = &self.terms[k];
         match (&t.law, &t.branch) {
             (StoreyLaw::Imk(m), Branch::Imk(st)) => m.switch_rate_bounds(st, speed, acceleration),
             _ => (speed, acceleration),
@@ -338,6 +350,13 @@ impl StoreyTerms {
     pub fn switch(&mut self, k: usize, y: &[f64]) {
         self.stamp = new_stamp();
         let (d, dd) = self.drift(k, y);
+        if std::env::var("DBGSW").is_ok() {
+            eprintln!(
+                "SW {k} d {d:.9e} dd {dd:.6e} {:?} parts {:?}",
+                self.terms[k].branch,
+                self.switch_parts(k, y)
+            );
+        }
         if let (StoreyLaw::Imk(m), Branch::Imk(mut st)) = (self.terms[k].law, self.terms[k].branch)
         {
             m.switch(&mut st, d, dd);
@@ -412,6 +431,19 @@ impl StoreyTerms {
                 (1.0 - b.post_yield_ratio) * b.stiffness * z,
             )),
             _ => None,
+        }
+    }
+
+    /// Storey k's force on its current piece, F = k_b d + F₀ (the P-Δ
+    /// shear beside it), as [`StoreyTerms::linear_branch`] gives it, and
+    /// also an IMK storey's, whose force is linear in the drift between
+    /// its events ([`Imk::piece_force`](crate::model::hysteresis::imk::Imk::piece_force)):
+    /// (k_b, F₀). None for Bouc–Wen.
+    pub fn piece(&self, k: usize) -> Option<(f64, f64)> {
+        let t = &self.terms[k];
+        match (&t.law, &t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => Some(m.piece_line(st)),
+            _ => self.linear_branch(k),
         }
     }
 

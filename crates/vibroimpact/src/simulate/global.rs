@@ -40,6 +40,9 @@ pub fn simulate_streaming(
         int_opts
             .validate(y0.len())
             .map_err(|e| OptionsError(e.to_string()))?;
+        if exact::qualifies(model, opts) {
+            return Ok(exact::run(model, opts, &y0, &mut sink));
+        }
         return simulate_local(model, opts, method, &y0, breakpoints, &mut sink);
     }
     let mut sys = ChainDynamics::new(model, opts.energy);

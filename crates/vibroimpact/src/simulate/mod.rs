@@ -11,6 +11,9 @@
 //! - `integrator.rs`, `estimate.rs` — which integrator runs; the work of a
 //!   run, estimated before it starts;
 //! - `local/` — the local integrator, exact motion between contacts;
+//! - `exact/` — the exact run of a model linear between its storeys'
+//!   switches (a building alone under a record), which the local
+//!   integrator hands such a model;
 //! - `tests/` — the checks of the global run.
 //!
 //! ## Impacts
@@ -634,6 +637,7 @@ fn simulate_local(
 
 mod estimate;
 mod events;
+mod exact;
 mod extrema;
 mod gauges;
 mod global;

@@ -566,6 +566,16 @@ impl Imk {
         }
     }
 
+    /// The piece as a line in the drift, F = k d + F₀: (k, F₀).
+    pub fn piece_line(&self, s: &ImkState) -> (f64, f64) {
+        if s.failure == 5 {
+            (0.0, 0.0)
+        } else {
+            let k = self.piece_slope(s);
+            (k, s.force - k * s.u)
+        }
+    }
+
     /// The work ∫ F dd up to drift `d` along the piece.
     pub fn piece_work(&self, s: &ImkState, d: f64) -> f64 {
         s.work + 0.5 * (s.force + self.piece_force(s, d)) * (d - s.u)
@@ -703,15 +713,20 @@ impl Imk {
         };
         let slope = self.piece_slope(s);
         let mut at = d;
+        // (Crossed: where the force changed sign, or is within 1e-9 F_y of
+        // zero; the drift located there may be the crossing's to the last
+        // bit, and it is a crossing all the same.)
         let crossing = !s.on_backbone && s.failure > 0 && s.force != 0.0;
-        if crossing && (self.piece_force(s, d) * s.force <= 1e-9 * self.fy() * s.force.abs()) {
+        let crossed =
+            crossing && (self.piece_force(s, d) * s.force <= 1e-9 * self.fy() * s.force.abs());
+        if crossed {
             at = s.u - s.force / slope;
         }
         let f = self.piece_force(s, at);
         s.work += 0.5 * (s.force + f) * (at - s.u);
         s.u = at;
-        s.force = if at == d { f } else { 0.0 };
-        if s.force == 0.0 && crossing && s.failure < 5 {
+        s.force = if crossed { 0.0 } else { f };
+        if crossed && s.failure < 5 {
             s.dir = dir;
             self.excursion(s, dir);
         }

@@ -343,6 +343,50 @@ fn imk_deteriorates_by_the_energy_rule() {
     );
 }
 
+/// A zero-force crossing located at its drift to the last bit is a
+/// crossing: the event there deteriorates the other side as one located a
+/// hair past it does (to 1e-9 of F_y in the force reloading negative).
+/// (It did not: the crossing's force was kept as the piece's, a few
+/// micronewtons, and its excursion skipped; found by the exact run, which
+/// locates events to 4 ulp.)
+#[test]
+fn a_crossing_located_exactly_deteriorates() {
+    let law = imk(2.0);
+    let fy = K * UY;
+    // Reversals from drifts where the piece's force at the crossing's
+    // drift is a rounding, not zero (the case that went wrong).
+    let mut rounded = 0;
+    for j in 0..60 {
+        let d1 = 0.02 + 3e-4 * j as f64;
+        let mut s = law.rest();
+        law.advance(&mut s, d1);
+        // The reversal on the backbone, then unloading to the crossing
+        // (as the law computes it, to the bit).
+        law.switch(&mut s, d1, -1.0);
+        let x_c = s.u - s.force / law.piece_line(&s).0;
+        if law.piece_force(&s, x_c) == 0.0 {
+            continue;
+        }
+        rounded += 1;
+        let mut exact = s;
+        law.switch(&mut exact, x_c, -1.0);
+        let mut past = s;
+        law.switch(&mut past, x_c - 1e-12, -1.0);
+        for x in [x_c - 0.01, -0.02, -0.04] {
+            let (mut a, mut b) = (exact, past);
+            law.advance(&mut a, x);
+            law.advance(&mut b, x);
+            assert!(
+                (a.force - b.force).abs() < 1e-9 * fy,
+                "from {d1}, at {x}: {} against {}",
+                a.force,
+                b.force
+            );
+        }
+    }
+    assert!(rounded >= 10, "{rounded} crossings with a rounded force");
+}
+
 /// A drift past double precision for the law (1e300 m on a stiff storey,
 /// found by the option fuzzer: a force of inf was returned as a loop) is
 /// refused naming the sample, never drawn.

@@ -516,7 +516,7 @@ fn another_branchs_stiffness_moves_as_that_frame() {
         let times: Vec<f64> = (0..300).map(|k| 0.01 * k as f64).collect();
         let values: Vec<f64> = times.iter().map(|t| 3.0 * (5.0 * t).sin()).collect();
         let base = BaseExcitation::Record(Accelerogram::new(times, values, 1.0).unwrap());
-        two_storey_frame([first, bilinear(3e7)], 2e5, base)
+        two_storey_frame([first, bilinear(3e7)], 2e5, base, Vec::new())
     };
     let yielding = frame(bilinear(4e7));
     let soft = frame(StoreyLaw::Elastic { stiffness: 2e6 });

@@ -1,0 +1,453 @@
+//! The exact run of a model that is linear between its storeys' switches
+//! (docs/theory.md §13): no contacts, storeys elastic, bilinear or IMK
+//! (with their P-Δ), under a record's first-order hold or no base motion,
+//! no harmonic forces, no energy audit. Between the record's samples and
+//! the switches its motion is the Taylor series of [`series`]; every
+//! switch is found on that motion (a storey's switch function stays
+//! positive over a piece where its values at the ends exceed its rate's
+//! bound times the piece, the bound from the series' coefficients; else
+//! the piece is halved) and located by Brent to 4 ulp of the time; the
+//! samples, the extrema and the gauges are read on the series. The local
+//! integrator runs such a model this way (a building alone under a
+//! record: no contacts to be local about).
+//!
+//! Files: `mod.rs` (the run), `series.rs` (one interval's series),
+//! `tests.rs` (against closed forms and the global integrator).
+
+mod series;
+#[cfg(test)]
+mod tests;
+
+use series::{Built, Series};
+
+use super::gauges::GaugeScan;
+use super::*;
+use crate::dynamics::{PiecewiseForm, StoreyTerms};
+use crate::numeric::brent;
+
+/// Halvings of a piece before a storey's switch function, positive at
+/// both ends and not excluded by its bound, is taken not to reach zero
+/// inside (a tangency: a yield or reversal that grazes).
+const MAX_HALVINGS: usize = 10;
+
+/// Whether `model` runs exactly under `opts` (see the module
+/// documentation).
+pub(super) fn qualifies(model: &Model, opts: &SimulationOptions) -> bool {
+    !opts.energy && ChainDynamics::new(model, false).piecewise_form(&mut PiecewiseForm::default())
+}
+
+/// What the run reads as it goes: the samples' row, the extrema and the
+/// gauges.
+struct Reader {
+    /// One sample in body order [u.., v..] (then a.. and the storeys'
+    /// forces, as asked).
+    row: Vec<f64>,
+    /// A state.
+    y: Vec<f64>,
+    window: Option<(f64, f64)>,
+    bodies: bool,
+    found: Extrema,
+    gauges: Vec<GaugeScan>,
+}
+
+/// Runs `model` from `y0` as [`simulate_streaming`] does, exactly (the
+/// model [`qualifies`]).
+pub(super) fn run(
+    model: &Model,
+    opts: &SimulationOptions,
+    y0: &[f64],
+    sink: &mut impl FnMut(f64, &[f64]) -> bool,
+) -> Simulation {
+    let mut sys = ChainDynamics::new(model, false);
+    let n = model.bodies().len();
+    let dim = 2 * n;
+    let mut form = PiecewiseForm::default();
+    sys.piecewise_form(&mut form);
+    let breaks = breakpoints(model, opts.t_end);
+    let base = model.base();
+    let mut series = Series::new(dim);
+    let extra = if opts.accelerations { n } else { 0 }
+        + if opts.storey_forces {
+            model.storeys().len()
+        } else {
+            0
+        };
+    let mut reader = Reader {
+        row: vec![0.0; dim + extra],
+        y: vec![0.0; dim],
+        window: opts.extrema_window,
+        bodies: opts.extrema_of_bodies,
+        found: Extrema {
+            max_displacement: vec![0.0; n],
+            max_velocity: vec![0.0; n],
+            impact_margin: Vec::new(),
+            gauges: Vec::new(),
+        },
+        gauges: opts.gauges.iter().copied().map(GaugeScan::new).collect(),
+    };
+    if let Some((from, to)) = reader.window {
+        if from <= 0.0 && 0.0 <= to {
+            for i in 0..n {
+                reader.found.max_displacement[i] = y0[2 * i].abs();
+                reader.found.max_velocity[i] = y0[2 * i + 1].abs();
+            }
+        }
+    }
+    let (mut t, mut y) = (0.0, y0.to_vec());
+    let mut next_sample = 0usize;
+    let mut error = None;
+    if opts.output_step.is_some() && opts.output_from == 0.0 {
+        next_sample = 1;
+        if !reader.sample(opts, &mut sys, 0.0, &y, None, sink) {
+            error = Some(IntegrationError::Interrupted { t: 0.0 });
+        }
+    }
+    let (mut pieces, mut products) = (0u64, 0u64);
+    let mut next_break = 0;
+    let mut cap = f64::INFINITY;
+    // Each storey's switch parts at the last piece's end (NaN: not known).
+    let mut carried = vec![(f64::NAN, f64::NAN); model.storeys().len()];
+    while error.is_none() && t < opts.t_end {
+        if let Some(stop) = &opts.interrupt {
+            if let Err(e) = stop.check(t) {
+                error = Some(e);
+                break;
+            }
+        }
+        pieces += 1;
+        if let Some(e) = crawling(opts, pieces, t) {
+            error = Some(e);
+            break;
+        }
+        while next_break < breaks.len() && breaks[next_break] <= t {
+            next_break += 1;
+        }
+        let end = breaks.get(next_break).copied().unwrap_or(opts.t_end);
+        let h = (end - t).min(cap);
+        let t1 = if h == end - t { end } else { t + h };
+        let a0 = base.at(t);
+        let slope = (base.at(t1) - a0) / h;
+        match series.build(&form, &y, (a0, slope), h) {
+            Built::Done => {
+                products += series_terms(&series);
+                // (Longer where the terms fell fast: a long interval of
+                // no forcing, where the last was halved.)
+                if series.terms() < 20 {
+                    cap *= 2.0;
+                }
+            }
+            Built::TooLong => {
+                cap = 0.5 * h;
+                if cap <= 4.0 * f64::EPSILON * t.abs().max(1e-300) {
+                    error = Some(underflow(t, h, &y));
+                }
+                continue;
+            }
+            Built::NonFinite => {
+                error = Some(underflow(t, h, &y));
+                break;
+            }
+        }
+        let switch = first_switch(sys.storeys(), &series, h, (&mut reader.y, &mut carried));
+        let (tau, t_next) = match switch {
+            Some((tau, _)) => (tau, t + tau),
+            None => (h, t1),
+        };
+        reader.piece(&series, (t, t_next), (a0, slope));
+        let stopped = reader.samples(opts, &mut sys, &series, (t, t_next), &mut next_sample, sink);
+        series.state(tau, &mut y);
+        if y.iter().any(|x| !x.is_finite()) {
+            error = Some(underflow(t, h, &y));
+            break;
+        }
+        t = t_next;
+        if let Some(ts) = stopped {
+            error = Some(IntegrationError::Interrupted { t: ts });
+            break;
+        }
+        if let Some((_, k)) = switch {
+            sys.storeys_mut().switch(k, &y);
+            sys.piecewise_form(&mut form);
+            carried.fill((f64::NAN, f64::NAN));
+        }
+    }
+    let error = error.map(|source| failure(model, source, &y, &[]));
+    let mut found = reader.found;
+    found.gauges = reader.gauges.iter().map(GaugeScan::reading).collect();
+    Simulation {
+        times: Vec::new(),
+        states: Vec::new(),
+        final_time: t,
+        final_displacement: (0..n).map(|i| y[2 * i]).collect(),
+        final_velocity: (0..n).map(|i| y[2 * i + 1]).collect(),
+        impacts: Vec::new(),
+        stats: Stats {
+            rhs_evaluations: products,
+            steps: pieces,
+            ..Stats::default()
+        },
+        contact_evaluations: 0,
+        hysteretic_energy: (0..model.storeys().len())
+            .map(|k| sys.storeys().dissipated_by(k, &y))
+            .collect(),
+        energy: None,
+        error,
+        extrema: opts.extrema_window.map(|_| found),
+        local: None,
+        soft_episodes: Vec::new(),
+    }
+}
+
+/// The products with `A` a series took (a right-hand side's worth each).
+fn series_terms(series: &Series) -> u64 {
+    series.terms() as u64 - 1
+}
+
+/// A state that is not finite, or an interval that cannot be shortened.
+fn underflow(t: f64, h: f64, y: &[f64]) -> IntegrationError {
+    IntegrationError::StepSizeUnderflow {
+        t,
+        h,
+        y: y.to_vec(),
+        reason: crate::integrate::RejectReason::NonFinite,
+    }
+}
+
+/// The run's end where it crawls: its pieces at this pace would exceed
+/// the step limit by [`CRAWL_FACTOR`], or exceed it.
+fn crawling(opts: &SimulationOptions, pieces: u64, t: f64) -> Option<IntegrationError> {
+    if pieces > opts.max_steps {
+        return Some(IntegrationError::TooManySteps { t, steps: pieces });
+    }
+    if pieces % PROGRESS_CHECK == 0 {
+        let projected = pieces as f64 * opts.t_end / t;
+        if projected > CRAWL_FACTOR * opts.max_steps as f64 {
+            return Some(IntegrationError::NoProgress {
+                t,
+                steps: pieces,
+                projected,
+                limit: opts.max_steps,
+            });
+        }
+    }
+    None
+}
+
+/// The first switch of a storey inside `(0, h]` on the series, and the
+/// storey: where its switch function, positive at 0, reaches zero.
+/// `y`: scratch for a state (only the storey's bodies are read);
+/// `carried`: each storey's switch parts at 0 where known (the last
+/// piece's end), set to those at `h` where they are read.
+fn first_switch(
+    storeys: &StoreyTerms,
+    series: &Series,
+    h: f64,
+    (y, carried): (&mut [f64], &mut [(f64, f64)]),
+) -> Option<(f64, usize)> {
+    let mut first: Option<(f64, usize)> = None;
+    for k in storeys.switching() {
+        let (below, above) = storeys.ends(k);
+        let mut parts = |tau: f64| {
+            for i in [Some(above), below].into_iter().flatten() {
+                let (u, v, _) = series.component(2 * i, tau);
+                (y[2 * i], y[2 * i + 1]) = (u, v);
+            }
+            storeys.switch_parts(k, y)
+        };
+        let p0 = match carried[k] {
+            p if p.0.is_nan() => parts(0.0),
+            p => p,
+        };
+        carried[k] = (f64::NAN, f64::NAN);
+        if p0.0.min(p0.1) <= 0.0 {
+            continue;
+        }
+        let b = first.map_or(h, |f| f.0);
+        let p1 = parts(b);
+        if b == h {
+            carried[k] = p1;
+        }
+        let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
+        let bounds = storeys.switch_rate_bounds_for(k, speed, acceleration);
+        if let Some(tau) = root(&mut parts, bounds, (0.0, p0), (b, p1), 0) {
+            if first.is_none_or(|f| tau < f.0) {
+                first = Some((tau, k));
+            }
+        }
+    }
+    first
+}
+
+/// The first zero of `min(parts)` in `(a, b]` (positive at `a`): none
+/// where both parts stay positive by their rate `bounds`; else where it
+/// is not positive at `b`, located by Brent; else in the halves, first to
+/// last.
+fn root(
+    parts: &mut impl FnMut(f64) -> (f64, f64),
+    bounds: (f64, f64),
+    (a, pa): (f64, (f64, f64)),
+    (b, pb): (f64, (f64, f64)),
+    halvings: usize,
+) -> Option<f64> {
+    let g = |p: (f64, f64)| p.0.min(p.1);
+    if g(pb) <= 0.0 {
+        let xtol = 4.0 * f64::EPSILON * b.abs().max(1e-300);
+        let found = brent(|t| g(parts(t)), a, b, g(pa), g(pb), xtol, 200);
+        return Some(found.unwrap_or(b));
+    }
+    let w = b - a;
+    if pa.0 + pb.0 > bounds.0 * w && pa.1 + pb.1 > bounds.1 * w || halvings == MAX_HALVINGS {
+        return None;
+    }
+    let m = 0.5 * (a + b);
+    let pm = parts(m);
+    root(parts, bounds, (a, pa), (m, pm), halvings + 1)
+        .or_else(|| root(parts, bounds, (m, pm), (b, pb), halvings + 1))
+}
+
+impl Reader {
+    /// The extrema and gauges over the piece `(ta, tb)` of the series
+    /// (from `ta`), whose base acceleration is `a0 + s (t − ta)`.
+    fn piece(&mut self, series: &Series, (ta, tb): (f64, f64), (a0, s): (f64, f64)) {
+        let Some((from, to)) = self.window else {
+            return;
+        };
+        let (a, b) = (ta.max(from), tb.min(to));
+        if a > b {
+            return;
+        }
+        if self.bodies {
+            for i in 0..self.found.max_displacement.len() {
+                let at = |t: f64| series.component(2 * i, t - ta);
+                let rate = |t: f64| series.component(2 * i + 1, t - ta);
+                let (ea, eb) = (at(a), at(b));
+                let (ra, rb) = (rate(a), rate(b));
+                let mut max_u = ea.0.abs().max(eb.0.abs());
+                if ea.1 * eb.1 < 0.0 {
+                    if let Ok(t) = brent(
+                        |t| at(t).1,
+                        a,
+                        b,
+                        ea.1,
+                        eb.1,
+                        1e-15 * b.abs().max(1e-300),
+                        200,
+                    ) {
+                        max_u = max_u.max(at(t).0.abs());
+                    }
+                }
+                let mut max_v = ra.0.abs().max(rb.0.abs());
+                if ra.1 * rb.1 < 0.0 {
+                    if let Ok(t) = brent(
+                        |t| rate(t).1,
+                        a,
+                        b,
+                        ra.1,
+                        rb.1,
+                        1e-15 * b.abs().max(1e-300),
+                        200,
+                    ) {
+                        max_v = max_v.max(rate(t).0.abs());
+                    }
+                }
+                let f = &mut self.found;
+                f.max_displacement[i] = f.max_displacement[i].max(max_u);
+                f.max_velocity[i] = f.max_velocity[i].max(max_v);
+            }
+        }
+        for gauge in self.gauges.iter_mut() {
+            let kind = gauge.gauge;
+            let at = |t: f64| match kind {
+                Gauge::Separation { left, right, .. } => {
+                    let (x, r, _) = match left {
+                        Some(l) => series.difference(2 * l, right.map(|j| 2 * j), t - ta),
+                        None => {
+                            let (x, r, q) = series.component(2 * right.unwrap_or(0), t - ta);
+                            (-x, -r, -q)
+                        }
+                    };
+                    (x, r)
+                }
+                Gauge::AbsoluteAcceleration { body } => {
+                    let (_, a, jerk) = series.component(2 * body + 1, t - ta);
+                    (a + a0 + s * (t - ta), jerk + s)
+                }
+            };
+            let ends = (at(a), at(b));
+            gauge.scan_ends((a, b), ends, at);
+        }
+    }
+
+    /// The output samples in `(ta, tb]` of the series (from `ta`), the
+    /// next one's index kept in `next`; the time of the sample at which
+    /// the sink asked to stop, if it did.
+    fn samples(
+        &mut self,
+        opts: &SimulationOptions,
+        sys: &mut ChainDynamics,
+        series: &Series,
+        (ta, tb): (f64, f64),
+        next: &mut usize,
+        sink: &mut impl FnMut(f64, &[f64]) -> bool,
+    ) -> Option<f64> {
+        let dt = opts.output_step?;
+        loop {
+            let ts = opts.output_from + *next as f64 * dt;
+            if ts > tb || ts > opts.t_end {
+                return None;
+            }
+            *next += 1;
+            if ts < ta {
+                continue;
+            }
+            let mut y = std::mem::take(&mut self.y);
+            series.state(ts - ta, &mut y);
+            let go_on = self.sample(opts, sys, ts, &y, Some((series, ts - ta)), sink);
+            self.y = y;
+            if !go_on {
+                return Some(ts);
+            }
+        }
+    }
+
+    /// Hands the state `y` at `t` to the sink (with the accelerations
+    /// relative to the ground from the series at τ, or the right-hand
+    /// side without one, and the storeys' forces, as asked); false if it
+    /// asks to stop.
+    fn sample(
+        &mut self,
+        opts: &SimulationOptions,
+        sys: &mut ChainDynamics,
+        t: f64,
+        y: &[f64],
+        at: Option<(&Series, f64)>,
+        sink: &mut impl FnMut(f64, &[f64]) -> bool,
+    ) -> bool {
+        let n = y.len() / 2;
+        for i in 0..n {
+            self.row[i] = y[2 * i];
+            self.row[n + i] = y[2 * i + 1];
+        }
+        let mut k = 2 * n;
+        if opts.accelerations {
+            let mut rates = Vec::new();
+            if at.is_none() {
+                rates = vec![0.0; y.len()];
+                crate::integrate::OdeSystem::rhs(sys, t, y, &mut rates);
+            }
+            for i in 0..n {
+                self.row[k + i] = match at {
+                    Some((s, tau)) => s.component(2 * i + 1, tau).1,
+                    None => rates[2 * i + 1],
+                };
+            }
+            k += n;
+        }
+        if opts.storey_forces {
+            for (j, f) in self.row[k..].iter_mut().enumerate() {
+                *f = sys.storeys().force(j, y);
+            }
+        }
+        sink(t, &self.row)
+    }
+}

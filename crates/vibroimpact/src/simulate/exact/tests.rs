@@ -1,0 +1,178 @@
+//! The exact run against closed forms and the global integrator.
+
+use super::*;
+use crate::model::{Accelerogram, Body};
+use crate::seismic::pounding::tests::record;
+use crate::seismic::pounding::{parse_row, RunSettings};
+
+/// u'' + 2ζω u' + ω² u = −(a₀ + s τ) from (u₀, v₀): (u, v) at τ.
+fn damped_ramp(
+    (w, z): (f64, f64),
+    (a0, s): (f64, f64),
+    (u0, v0): (f64, f64),
+    tau: f64,
+) -> (f64, f64) {
+    let wd = w * (1.0 - z * z).sqrt();
+    let b = -s / (w * w);
+    let a = (-a0 - 2.0 * z * w * b) / (w * w);
+    let c1 = u0 - a;
+    let c2 = (v0 - b + z * w * c1) / wd;
+    let (e, (sn, cs)) = ((-z * w * tau).exp(), (wd * tau).sin_cos());
+    let u = a + b * tau + e * (c1 * cs + c2 * sn);
+    let v = b + e * ((-z * w) * (c1 * cs + c2 * sn) + wd * (-c1 * sn + c2 * cs));
+    (u, v)
+}
+
+/// One body on a spring under a base of two ramps (0 → 2 m/s² over 1 s,
+/// then to −1 m/s² over 2 s): the exact run's samples are the closed
+/// form's, ramp by ramp, to 1e-13 of the motion's size; its peak |u| is
+/// the closed form's largest on a fine grid (from below, to 1e-9); and
+/// the local integrator runs it this way (no local statistics).
+#[test]
+fn a_body_under_two_ramps_moves_as_the_closed_form() {
+    let (w, z) = (2.0 * std::f64::consts::PI, 0.05);
+    let base = Accelerogram::new(vec![0.0, 1.0, 3.0], vec![0.0, 2.0, -1.0], 1.0).unwrap();
+    let model = Model::new(
+        vec![Body::from_frequency("b", 1.0, w, z)],
+        Vec::new(),
+        Vec::new(),
+        BaseExcitation::Record(base),
+        Vec::new(),
+        vec![0.0],
+        vec![0.0],
+    )
+    .unwrap();
+    let opts = SimulationOptions {
+        t_end: 3.0,
+        output_step: Some(0.125),
+        integrator: Integrator::Local,
+        extrema_window: Some((0.0, 3.0)),
+        ..Default::default()
+    };
+    assert!(qualifies(&model, &opts));
+    let sim = simulate(&model, &opts).unwrap();
+    assert!(
+        sim.error.is_none() && sim.local.is_none(),
+        "{:?}",
+        sim.error
+    );
+    let at_one = damped_ramp((w, z), (0.0, 2.0), (0.0, 0.0), 1.0);
+    let closed = |t: f64| match t <= 1.0 {
+        true => damped_ramp((w, z), (0.0, 2.0), (0.0, 0.0), t),
+        false => damped_ramp((w, z), (2.0, -1.5), at_one, t - 1.0),
+    };
+    let size = 0.1;
+    for (k, &t) in sim.times.iter().enumerate() {
+        let (u, v) = closed(t);
+        let (su, sv) = (sim.states[2 * k], sim.states[2 * k + 1]);
+        assert!((su - u).abs() < 1e-13 * size, "t {t}: u {su} against {u}");
+        assert!(
+            (sv - v).abs() < 1e-12 * size * w,
+            "t {t}: v {sv} against {v}"
+        );
+    }
+    assert_eq!(sim.times.len(), 25);
+    let fine = (0..=300_000)
+        .map(|k| closed(3.0 * k as f64 / 300_000.0).0.abs())
+        .fold(0.0, f64::max);
+    let peak = sim.extrema.unwrap().max_displacement[0];
+    assert!(
+        peak >= fine * (1.0 - 1e-12) && peak - fine < 1e-9 * fine,
+        "{peak} against {fine}"
+    );
+}
+
+/// A two-storey building alone, `law` storeys with P-Δ, under a burst
+/// that yields it: peaks, residual drifts and floor accelerations (exact
+/// on either motion), the storeys' dissipated energy and the time of
+/// every switch (through the loops' hysteretic energy) as the global
+/// integrator gives them at rtol 1e-11, to 1e-8 of their size.
+fn as_the_global_integrator(law: &str) {
+    let text = format!(
+        "[[building]]\nname = \"F\"\nmasses = [1e5, 1e5]\nstiffnesses = [4e7, 3e7]\n\
+         damping_ratio = 0.05\nheights = [4.0, 3.5]\np_delta = true\n\
+         storeys = [{law}, {law}]\n"
+    );
+    let row = parse_row(&text, "frame.toml").unwrap();
+    let run = |integrator| {
+        let mut settings = RunSettings::new(0.01, 1e-11);
+        settings.integrator = integrator;
+        row.respond(&record(), 1.5, true, &settings).unwrap()
+    };
+    let (g, x) = (run(Integrator::Global), run(Integrator::Local));
+    let close = |a: &[Vec<f64>], b: &[Vec<f64>], what: &str| {
+        for (a, b) in a.iter().flatten().zip(b.iter().flatten()) {
+            // (A residual drift not judged is NaN on both.)
+            let same = (a.is_nan() && b.is_nan()) || (a - b).abs() <= 1e-8 * a.abs().max(1e-6);
+            assert!(same, "{law}, {what}: {a} against {b}");
+        }
+    };
+    close(&g.drift, &x.drift, "peak drifts");
+    close(&g.residual_drift, &x.residual_drift, "residual drifts");
+    close(&g.acceleration, &x.acceleration, "accelerations");
+    close(
+        &g.hysteretic_energy,
+        &x.hysteretic_energy,
+        "hysteretic energy",
+    );
+    let yielded = g
+        .hysteretic_energy
+        .iter()
+        .flatten()
+        .filter(|e| **e > 0.0)
+        .count();
+    assert_eq!(yielded, 2, "{law}: {:?}", g.hysteretic_energy);
+}
+
+#[test]
+fn a_bilinear_building_runs_as_the_global_integrator() {
+    as_the_global_integrator(
+        "{ law = \"bilinear\", yield_drift = 0.004, post_yield_ratio = 0.05 }",
+    );
+}
+
+#[test]
+fn an_imk_building_runs_as_the_global_integrator() {
+    as_the_global_integrator(
+        "{ law = \"imk\", yield_drift = 0.004, cap_ratio = 1.1, plastic_drift = 0.01, \
+         post_capping_drift = 0.05, residual_ratio = 0.4, ultimate_drift = 0.1, \
+         lambda_s = 0.5, lambda_c = 0.5, lambda_k = 0.5 }",
+    );
+}
+
+/// What does not qualify: a contact, harmonic base motion, a Bouc–Wen
+/// storey, the energy audit.
+#[test]
+fn the_exact_run_is_for_linear_pieces_under_a_record() {
+    let text = |storey: &str| {
+        format!(
+            "[[building]]\nname = \"F\"\nmasses = [1e5]\nstiffnesses = [4e7]\n\
+             damping_ratio = 0.05\nstoreys = [{storey}]\n"
+        )
+    };
+    let model = |storey: &str| {
+        let row = parse_row(&text(storey), "f.toml").unwrap();
+        row.model(&record(), 1.0, true).unwrap().model
+    };
+    let opts = SimulationOptions::default();
+    let bilinear = model("{ law = \"bilinear\", yield_drift = 0.004, post_yield_ratio = 0.05 }");
+    assert!(qualifies(&bilinear, &opts));
+    assert!(!qualifies(
+        &bilinear,
+        &SimulationOptions {
+            energy: true,
+            ..opts.clone()
+        }
+    ));
+    let bouc_wen =
+        model("{ law = \"bouc-wen\", yield_drift = 0.004, post_yield_ratio = 0.05, exponent = 2 }");
+    assert!(!qualifies(&bouc_wen, &opts));
+    let harmonic = bilinear.clone().with_base(BaseExcitation::Harmonic {
+        amplitude: 1.0,
+        frequency: 10.0,
+        phase: 0.0,
+    });
+    assert!(!qualifies(&harmonic, &opts));
+    let pair = crate::model::reference::r2(2, crate::model::reference::CLEARANCE, 1.0).unwrap();
+    assert!(!qualifies(&pair, &opts));
+}
