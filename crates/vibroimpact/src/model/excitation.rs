@@ -149,6 +149,19 @@ impl Accelerogram {
         self.at(t)
     }
 
+    /// The scaled acceleration on the segment that holds `t` inside it:
+    /// its value at `t` and its slope; zero before the first sample and
+    /// after the last (where the record is zero).
+    pub fn line_at(&self, t: f64) -> (f64, f64) {
+        let n = self.times.len();
+        if !(t > self.times[0] && t < self.times[n - 1]) {
+            return (0.0, 0.0);
+        }
+        let k = self.segment(t);
+        let [a0, slope] = self.lines[k];
+        (a0 + slope * (t - self.times[k - 1]), slope)
+    }
+
     /// Sample times (the interpolant's breakpoints).
     pub fn times(&self) -> &[f64] {
         &self.times
@@ -206,6 +219,24 @@ impl BaseExcitation {
         match self {
             BaseExcitation::Record(r) => r.at_from(t, hint),
             _ => self.at(t),
+        }
+    }
+
+    /// z̈ on the line that holds `t` inside it, and its slope: a record's
+    /// segment ([`Accelerogram::line_at`]); none's zero; a harmonic's
+    /// tangent.
+    pub fn line_at(&self, t: f64) -> (f64, f64) {
+        match self {
+            BaseExcitation::None => (0.0, 0.0),
+            BaseExcitation::Harmonic {
+                amplitude,
+                frequency,
+                phase,
+            } => {
+                let (s, c) = (frequency * t + phase).sin_cos();
+                (amplitude * s, amplitude * frequency * c)
+            }
+            BaseExcitation::Record(r) => r.line_at(t),
         }
     }
 

@@ -125,8 +125,10 @@ pub(super) fn run(
         let end = breaks.get(next_break).copied().unwrap_or(opts.t_end);
         let h = (end - t).min(cap);
         let t1 = if h == end - t { end } else { t + h };
-        let a0 = base.at(t);
-        let slope = (base.at(t1) - a0) / h;
+        // (The record's line inside the interval: zero before its first
+        // sample, where it jumps.)
+        let (am, slope) = base.line_at(t + 0.5 * h);
+        let a0 = am - slope * 0.5 * h;
         match series.build(&form, &y, (a0, slope), h) {
             Built::Done => {
                 products += series_terms(&series);

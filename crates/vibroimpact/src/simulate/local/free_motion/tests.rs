@@ -11,6 +11,7 @@ fn integrated(model: &Model, t_end: f64) -> Vec<f64> {
         t_end,
         rtol: 1e-13,
         atol: 1e-16,
+        integrator: crate::simulate::Integrator::Global,
         ..SimulationOptions::default()
     };
     let sim = simulate(model, &opts).unwrap();
