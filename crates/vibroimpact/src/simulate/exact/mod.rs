@@ -310,6 +310,21 @@ fn root(
         .or_else(|| root(parts, bounds, (m, pm), (b, pb), halvings + 1))
 }
 
+/// The largest |x| over `[a, b]` of a component `at(t)` (value, rate,
+/// second derivative): at the ends, and inside where its rate changes
+/// sign (Brent on the rate).
+fn largest(at: impl Fn(f64) -> (f64, f64, f64), (a, b): (f64, f64)) -> f64 {
+    let (ea, eb) = (at(a), at(b));
+    let mut x = ea.0.abs().max(eb.0.abs());
+    if ea.1 * eb.1 < 0.0 {
+        let xtol = 1e-15 * b.abs().max(1e-300);
+        if let Ok(t) = brent(|t| at(t).1, a, b, ea.1, eb.1, xtol, 200) {
+            x = x.max(at(t).0.abs());
+        }
+    }
+    x
+}
+
 impl Reader {
     /// The extrema and gauges over the piece `(ta, tb)` of the series
     /// (from `ta`), whose base acceleration is `a0 + s (t − ta)`.
@@ -323,38 +338,8 @@ impl Reader {
         }
         if self.bodies {
             for i in 0..self.found.max_displacement.len() {
-                let at = |t: f64| series.component(2 * i, t - ta);
-                let rate = |t: f64| series.component(2 * i + 1, t - ta);
-                let (ea, eb) = (at(a), at(b));
-                let (ra, rb) = (rate(a), rate(b));
-                let mut max_u = ea.0.abs().max(eb.0.abs());
-                if ea.1 * eb.1 < 0.0 {
-                    if let Ok(t) = brent(
-                        |t| at(t).1,
-                        a,
-                        b,
-                        ea.1,
-                        eb.1,
-                        1e-15 * b.abs().max(1e-300),
-                        200,
-                    ) {
-                        max_u = max_u.max(at(t).0.abs());
-                    }
-                }
-                let mut max_v = ra.0.abs().max(rb.0.abs());
-                if ra.1 * rb.1 < 0.0 {
-                    if let Ok(t) = brent(
-                        |t| rate(t).1,
-                        a,
-                        b,
-                        ra.1,
-                        rb.1,
-                        1e-15 * b.abs().max(1e-300),
-                        200,
-                    ) {
-                        max_v = max_v.max(rate(t).0.abs());
-                    }
-                }
+                let max_u = largest(|t| series.component(2 * i, t - ta), (a, b));
+                let max_v = largest(|t| series.component(2 * i + 1, t - ta), (a, b));
                 let f = &mut self.found;
                 f.max_displacement[i] = f.max_displacement[i].max(max_u);
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
