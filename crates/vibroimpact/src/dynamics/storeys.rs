@@ -350,13 +350,6 @@ impl StoreyTerms {
     pub fn switch(&mut self, k: usize, y: &[f64]) {
         self.stamp = new_stamp();
         let (d, dd) = self.drift(k, y);
-        if std::env::var("DBGSW").is_ok() {
-            eprintln!(
-                "SW {k} d {d:.9e} dd {dd:.6e} {:?} parts {:?}",
-                self.terms[k].branch,
-                self.switch_parts(k, y)
-            );
-        }
         if let (StoreyLaw::Imk(m), Branch::Imk(mut st)) = (self.terms[k].law, self.terms[k].branch)
         {
             m.switch(&mut st, d, dd);

@@ -109,7 +109,7 @@ pub(super) fn run(
     let mut next_break = 0;
     let mut cap = f64::INFINITY;
     // Each storey's switch parts at the last piece's end (NaN: not known).
-    let mut carried = vec![(f64::NAN, f64::NAN); model.storeys().len()];
+    let mut carried = vec![(f64::NAN, f64::NAN, f64::NAN); model.storeys().len()];
     while error.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
@@ -136,8 +136,11 @@ pub(super) fn run(
             Built::Done => {
                 products += series_terms(&series);
                 // (Longer where the terms fell fast: a long interval of
-                // no forcing, where the last was halved.)
-                if series.terms() < 20 {
+                // no forcing, where the last was halved. Kept to about 13
+                // terms, ω h below 1/2 as within the record: a piece's
+                // extrema and gauges are sought where their rates change
+                // sign at its ends.)
+                if series.terms() < 14 {
                     cap *= 2.0;
                 }
             }
@@ -173,7 +176,7 @@ pub(super) fn run(
         if let Some((_, k)) = switch {
             sys.storeys_mut().switch(k, &y);
             sys.piecewise_form(&mut form);
-            carried.fill((f64::NAN, f64::NAN));
+            carried.fill((f64::NAN, f64::NAN, f64::NAN));
         }
     }
     let error = error.map(|source| failure(model, source, &y, &[]));
@@ -247,7 +250,7 @@ fn first_switch(
     storeys: &StoreyTerms,
     series: &Series,
     h: f64,
-    (y, carried): (&mut [f64], &mut [(f64, f64)]),
+    (y, carried): (&mut [f64], &mut [Parts]),
 ) -> Option<(f64, usize)> {
     let mut first: Option<(f64, usize)> = None;
     for k in storeys.switching() {
@@ -257,13 +260,15 @@ fn first_switch(
                 let (u, v, _) = series.component(2 * i, tau);
                 (y[2 * i], y[2 * i + 1]) = (u, v);
             }
-            storeys.switch_parts(k, y)
+            let (d, r) = storeys.switch_parts(k, y);
+            let rate = y[2 * above + 1] - below.map_or(0.0, |j| y[2 * j + 1]);
+            (d, r, rate)
         };
         let p0 = match carried[k] {
             p if p.0.is_nan() => parts(0.0),
             p => p,
         };
-        carried[k] = (f64::NAN, f64::NAN);
+        carried[k] = (f64::NAN, f64::NAN, f64::NAN);
         if p0.0.min(p0.1) <= 0.0 {
             continue;
         }
@@ -274,6 +279,7 @@ fn first_switch(
         }
         let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
         let bounds = storeys.switch_rate_bounds_for(k, speed, acceleration);
+        let bounds = (bounds.0, bounds.1, acceleration);
         if let Some(tau) = root(&mut parts, bounds, (0.0, p0), (b, p1), 0) {
             if first.is_none_or(|f| tau < f.0) {
                 first = Some((tau, k));
@@ -283,29 +289,42 @@ fn first_switch(
     first
 }
 
+/// A storey's switch parts (the drift terms, the reversal's) and its
+/// drift rate at a point.
+type Parts = (f64, f64, f64);
+
 /// The first zero of `min(parts)` in `(a, b]` (positive at `a`): none
-/// where both parts stay positive by their rate `bounds`; else where it
-/// is not positive at `b`, located by Brent; else in the halves, first to
-/// last.
+/// where both parts stay positive by their rate `bounds` (and the bound on
+/// the drift's acceleration); else where it is not positive at `b`,
+/// located by Brent; else in the halves, first to last. The drift terms
+/// of an IMK storey off its backbone jump where the drift rate changes
+/// sign (they measure to the bound ahead): where the rate may vanish
+/// inside, each end must clear the bound on its own.
 fn root(
-    parts: &mut impl FnMut(f64) -> (f64, f64),
-    bounds: (f64, f64),
-    (a, pa): (f64, (f64, f64)),
-    (b, pb): (f64, (f64, f64)),
+    parts: &mut impl FnMut(f64) -> Parts,
+    (ld, lr, acceleration): (f64, f64, f64),
+    (a, pa): (f64, Parts),
+    (b, pb): (f64, Parts),
     halvings: usize,
 ) -> Option<f64> {
-    let g = |p: (f64, f64)| p.0.min(p.1);
+    let g = |p: Parts| p.0.min(p.1);
     if g(pb) <= 0.0 {
         let xtol = 4.0 * f64::EPSILON * b.abs().max(1e-300);
         let found = brent(|t| g(parts(t)), a, b, g(pa), g(pb), xtol, 200);
         return Some(found.unwrap_or(b));
     }
     let w = b - a;
-    if pa.0 + pb.0 > bounds.0 * w && pa.1 + pb.1 > bounds.1 * w || halvings == MAX_HALVINGS {
+    let turns = pa.2.abs().max(pb.2.abs()) <= acceleration * w;
+    let drift = match turns {
+        false => pa.0 + pb.0 > ld * w,
+        true => pa.0 > ld * w && pb.0 > ld * w,
+    };
+    if drift && pa.1 + pb.1 > lr * w || halvings == MAX_HALVINGS {
         return None;
     }
     let m = 0.5 * (a + b);
     let pm = parts(m);
+    let bounds = (ld, lr, acceleration);
     root(parts, bounds, (a, pa), (m, pm), halvings + 1)
         .or_else(|| root(parts, bounds, (m, pm), (b, pb), halvings + 1))
 }
