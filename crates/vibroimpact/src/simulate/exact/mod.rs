@@ -257,7 +257,7 @@ fn first_switch(
         let (below, above) = storeys.ends(k);
         let mut parts = |tau: f64| {
             for i in [Some(above), below].into_iter().flatten() {
-                let (u, v, _) = series.component(2 * i, tau);
+                let (u, v) = series.value_rate(2 * i, None, tau);
                 (y[2 * i], y[2 * i + 1]) = (u, v);
             }
             let (d, r) = storeys.switch_parts(k, y);
@@ -367,16 +367,13 @@ impl Reader {
         for gauge in self.gauges.iter_mut() {
             let kind = gauge.gauge;
             let at = |t: f64| match kind {
-                Gauge::Separation { left, right, .. } => {
-                    let (x, r, _) = match left {
-                        Some(l) => series.difference(2 * l, right.map(|j| 2 * j), t - ta),
-                        None => {
-                            let (x, r, q) = series.component(2 * right.unwrap_or(0), t - ta);
-                            (-x, -r, -q)
-                        }
-                    };
-                    (x, r)
-                }
+                Gauge::Separation { left, right, .. } => match left {
+                    Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), t - ta),
+                    None => {
+                        let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, t - ta);
+                        (-x, -r)
+                    }
+                },
                 Gauge::AbsoluteAcceleration { body } => {
                     let (_, a, jerk) = series.component(2 * body + 1, t - ta);
                     (a + a0 + s * (t - ta), jerk + s)

@@ -37,8 +37,10 @@ pub(super) struct Series {
     c: Vec<f64>,
     /// How many.
     terms: usize,
-    /// The interval's length.
+    /// The interval's length, its inverse and its inverse squared.
     h: f64,
+    inv_h: f64,
+    inv_h2: f64,
     /// Every component's value and first two derivatives at its end, τ =
     /// h (read at every piece's end: the samples, the gauges, the
     /// switches and the next state).
@@ -53,6 +55,8 @@ impl Series {
             c: vec![0.0; dim * MAX_TERMS],
             terms: 0,
             h: 0.0,
+            inv_h: 0.0,
+            inv_h2: 0.0,
             end: vec![[0.0; 3]; dim],
         }
     }
@@ -68,6 +72,8 @@ impl Series {
     ) -> Built {
         let d = self.dim;
         self.h = h;
+        self.inv_h = 1.0 / h;
+        self.inv_h2 = self.inv_h * self.inv_h;
         self.c[..d].copy_from_slice(y);
         let mut largest = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for j in 1..MAX_TERMS {
@@ -114,7 +120,7 @@ impl Series {
                 e[2] += jf * (jf - 1.0) * c;
             }
         }
-        let (r, q) = (1.0 / self.h, 1.0 / (self.h * self.h));
+        let (r, q) = (self.inv_h, self.inv_h2);
         for e in self.end.iter_mut() {
             e[1] *= r;
             e[2] *= q;
@@ -146,22 +152,28 @@ impl Series {
     }
 
     /// Component i at τ and its first two derivatives.
-    #[inline]
+    #[inline(always)]
     pub(super) fn component(&self, i: usize, tau: f64) -> (f64, f64, f64) {
         let d = self.dim;
-        let h = self.h;
         if tau == 0.0 {
             return (
                 self.c[i],
-                self.c[d + i] / h,
-                2.0 * self.c[2 * d + i] / (h * h),
+                self.c[d + i] * self.inv_h,
+                2.0 * self.c[2 * d + i] * self.inv_h2,
             );
         }
-        if tau == h {
+        if tau == self.h {
             let [x, r, q] = self.end[i];
             return (x, r, q);
         }
-        let theta = tau / h;
+        self.component_inside(i, tau)
+    }
+
+    /// [`Series::component`] inside the interval, by Horner.
+    #[inline(never)]
+    fn component_inside(&self, i: usize, tau: f64) -> (f64, f64, f64) {
+        let d = self.dim;
+        let theta = tau / self.h;
         let (mut x, mut dx, mut ddx) = (0.0, 0.0, 0.0);
         for j in (0..self.terms).rev() {
             let c = self.c[j * d + i];
@@ -169,19 +181,33 @@ impl Series {
             dx = dx * theta + x;
             x = x * theta + c;
         }
-        (x, dx / h, ddx / (h * h))
+        (x, dx * self.inv_h, ddx * self.inv_h2)
     }
 
-    /// `component(i) − component(j)` (j None: zero).
-    pub(super) fn difference(&self, i: usize, j: Option<usize>, tau: f64) -> (f64, f64, f64) {
-        let a = self.component(i, tau);
-        match j {
-            Some(j) => {
-                let b = self.component(j, tau);
-                (a.0 - b.0, a.1 - b.1, a.2 - b.2)
-            }
-            None => a,
+    /// `component(i) − component(j)` (j None: zero) at τ and its rate.
+    #[inline(always)]
+    pub(super) fn value_rate(&self, i: usize, j: Option<usize>, tau: f64) -> (f64, f64) {
+        if tau == 0.0 || tau == self.h {
+            let a = self.component(i, tau);
+            let b = j.map_or((0.0, 0.0, 0.0), |j| self.component(j, tau));
+            return (a.0 - b.0, a.1 - b.1);
         }
+        self.value_rate_inside(i, j, tau)
+    }
+
+    /// [`Series::value_rate`] inside the interval, by Horner on the
+    /// difference's coefficients.
+    #[inline(never)]
+    fn value_rate_inside(&self, i: usize, j: Option<usize>, tau: f64) -> (f64, f64) {
+        let d = self.dim;
+        let theta = tau / self.h;
+        let (mut x, mut dx) = (0.0, 0.0);
+        for k in (0..self.terms).rev() {
+            let c = self.c[k * d + i] - j.map_or(0.0, |j| self.c[k * d + j]);
+            dx = dx * theta + x;
+            x = x * theta + c;
+        }
+        (x, dx * self.inv_h)
     }
 
     /// Bounds over the whole interval on the first and second derivatives
@@ -196,6 +222,6 @@ impl Series {
             first += kf * c;
             second += kf * (kf - 1.0) * c;
         }
-        (first / self.h, second / (self.h * self.h))
+        (first * self.inv_h, second * self.inv_h2)
     }
 }
