@@ -278,8 +278,17 @@ fn first_switch(
             carried[k] = p1;
         }
         let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
-        let bounds = storeys.switch_rate_bounds_for(k, speed, acceleration);
-        let bounds = (bounds.0, bounds.1, acceleration);
+        let (drift, turn) = storeys.switch_rate_bounds_for(k, speed, acceleration);
+        // (The drift terms are lines in the drift: their second
+        // derivatives are bounded as their rates are, by the drift's
+        // acceleration in place of its speed.)
+        let bend = storeys.switch_rate_bounds_for(k, acceleration, 0.0).0;
+        let bounds = Rates {
+            drift,
+            bend,
+            turn,
+            acceleration,
+        };
         if let Some(tau) = root(&mut parts, bounds, (0.0, p0), (b, p1), 0) {
             if first.is_none_or(|f| tau < f.0) {
                 first = Some((tau, k));
@@ -293,16 +302,30 @@ fn first_switch(
 /// drift rate at a point.
 type Parts = (f64, f64, f64);
 
+/// Bounds over a piece on how a storey's switch parts change: the drift
+/// terms' rate and second derivative, the reversal's rate, and the
+/// drift's acceleration.
+#[derive(Clone, Copy, Debug)]
+struct Rates {
+    drift: f64,
+    bend: f64,
+    turn: f64,
+    acceleration: f64,
+}
+
 /// The first zero of `min(parts)` in `(a, b]` (positive at `a`): none
-/// where both parts stay positive by their rate `bounds` (and the bound on
-/// the drift's acceleration); else where it is not positive at `b`,
-/// located by Brent; else in the halves, first to last. The drift terms
-/// of an IMK storey off its backbone jump where the drift rate changes
-/// sign (they measure to the bound ahead): where the rate may vanish
-/// inside, each end must clear the bound on its own.
+/// where both parts stay positive by their `bounds`; else where it is not
+/// positive at `b`, located by Brent; else in the halves, first to last.
+/// The drift terms stay positive where the ends' values exceed their
+/// rate's bound times the piece, or where the lesser exceeds their second
+/// derivative's bound times w²/8 (each term lies above the line through
+/// its ends less that). The drift terms of an IMK storey off its backbone
+/// jump where the drift rate changes sign (they measure to the bound
+/// ahead): where the rate may vanish inside, each end must clear the rate
+/// bound on its own.
 fn root(
     parts: &mut impl FnMut(f64) -> Parts,
-    (ld, lr, acceleration): (f64, f64, f64),
+    bounds: Rates,
     (a, pa): (f64, Parts),
     (b, pb): (f64, Parts),
     halvings: usize,
@@ -314,17 +337,16 @@ fn root(
         return Some(found.unwrap_or(b));
     }
     let w = b - a;
-    let turns = pa.2.abs().max(pb.2.abs()) <= acceleration * w;
+    let turns = pa.2.abs().max(pb.2.abs()) <= bounds.acceleration * w;
     let drift = match turns {
-        false => pa.0 + pb.0 > ld * w,
-        true => pa.0 > ld * w && pb.0 > ld * w,
+        false => pa.0 + pb.0 > bounds.drift * w || pa.0.min(pb.0) > 0.125 * bounds.bend * w * w,
+        true => pa.0 > bounds.drift * w && pb.0 > bounds.drift * w,
     };
-    if drift && pa.1 + pb.1 > lr * w || halvings == MAX_HALVINGS {
+    if drift && pa.1 + pb.1 > bounds.turn * w || halvings == MAX_HALVINGS {
         return None;
     }
     let m = 0.5 * (a + b);
     let pm = parts(m);
-    let bounds = (ld, lr, acceleration);
     root(parts, bounds, (a, pa), (m, pm), halvings + 1)
         .or_else(|| root(parts, bounds, (m, pm), (b, pb), halvings + 1))
 }
