@@ -86,11 +86,18 @@ impl Series {
                 _ => {}
             }
             let w = h / j as f64;
-            let mut top = 0.0f64;
-            for x in next.iter_mut() {
-                *x *= w;
-                top = top.max(x.abs());
+            // (The largest term by pairs, two short chains of plain
+            // comparisons: a NaN is passed over, as by `f64::max`, and
+            // caught in the state.)
+            let mut top = [0.0f64; 2];
+            for p in next.chunks_exact_mut(2) {
+                p[0] *= w;
+                p[1] *= w;
+                let (a, b) = (p[0].abs(), p[1].abs());
+                top[0] = if a > top[0] { a } else { top[0] };
+                top[1] = if b > top[1] { b } else { top[1] };
             }
+            let top = if top[0] > top[1] { top[0] } else { top[1] };
             if !top.is_finite() {
                 return Built::NonFinite;
             }
