@@ -45,6 +45,10 @@ pub(super) struct Series {
     /// h (read at every piece's end: the samples, the gauges, the
     /// switches and the next state).
     end: Vec<[f64; 3]>,
+    /// `Σ_{j≥4} j m_j` and `Σ_{j≥4} j (j−1) m_j`, m_j the largest
+    /// displacement's coefficient of term j: the tails of
+    /// [`Series::rate_bounds`].
+    tails: (f64, f64),
 }
 
 impl Series {
@@ -58,6 +62,7 @@ impl Series {
             inv_h: 0.0,
             inv_h2: 0.0,
             end: vec![[0.0; 3]; dim],
+            tails: (0.0, 0.0),
         }
     }
 
@@ -76,6 +81,7 @@ impl Series {
         self.inv_h2 = self.inv_h * self.inv_h;
         self.c[..d].copy_from_slice(y);
         let mut largest = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        self.tails = (0.0, 0.0);
         for j in 1..MAX_TERMS {
             let (before, after) = self.c.split_at_mut(j * d);
             let (prev, next) = (&before[(j - 1) * d..], &mut after[..d]);
@@ -96,6 +102,11 @@ impl Series {
                 let (a, b) = (p[0].abs(), p[1].abs());
                 top[0] = if a > top[0] { a } else { top[0] };
                 top[1] = if b > top[1] { b } else { top[1] };
+            }
+            if j >= 4 {
+                let jf = j as f64;
+                self.tails.0 += jf * top[0];
+                self.tails.1 += jf * (jf - 1.0) * top[0];
             }
             let top = if top[0] > top[1] { top[0] } else { top[1] };
             if !top.is_finite() {
@@ -218,17 +229,24 @@ impl Series {
     }
 
     /// Bounds over the whole interval on the first and second derivatives
-    /// of `component(i) − component(j)`, from the coefficients' magnitudes
-    /// (`Σ j |c_j| h^{j−1}`: rigorous for the series).
+    /// of `component(i) − component(j)`, two displacements (i, j even),
+    /// from the coefficients' magnitudes: `Σ k |c_k| h^{k−1}` and `Σ k (k−1)
+    /// |c_k| h^{k−2}` of the difference, rigorous for the series; beyond
+    /// the third term by the largest displacement's coefficients, once for
+    /// each side.
     pub(super) fn rate_bounds(&self, i: usize, j: Option<usize>) -> (f64, f64) {
+        debug_assert!(i % 2 == 0 && j.is_none_or(|j| j % 2 == 0));
         let d = self.dim;
         let (mut first, mut second) = (0.0, 0.0);
-        for k in 1..self.terms {
+        for k in 1..self.terms.min(4) {
             let c = (self.c[k * d + i] - j.map_or(0.0, |j| self.c[k * d + j])).abs();
             let kf = k as f64;
             first += kf * c;
             second += kf * (kf - 1.0) * c;
         }
+        let sides = if j.is_some() { 2.0 } else { 1.0 };
+        first += sides * self.tails.0;
+        second += sides * self.tails.1;
         (first * self.inv_h, second * self.inv_h2)
     }
 }
