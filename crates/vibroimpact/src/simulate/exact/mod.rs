@@ -110,6 +110,8 @@ pub(super) fn run(
     let mut cap = f64::INFINITY;
     // Each storey's switch parts at the last piece's end (NaN: not known).
     let mut carried = vec![(f64::NAN, f64::NAN, f64::NAN); model.storeys().len()];
+    let mut slopes = vec![(0.0, 0.0); model.storeys().len()];
+    slopes_of(sys.storeys(), &mut slopes);
     while error.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
             if let Err(e) = stop.check(t) {
@@ -156,7 +158,12 @@ pub(super) fn run(
                 break;
             }
         }
-        let switch = first_switch(sys.storeys(), &series, h, (&mut reader.y, &mut carried));
+        let switch = first_switch(
+            sys.storeys(),
+            &series,
+            h,
+            (&mut reader.y, &mut carried, &slopes),
+        );
         let (tau, t_next) = match switch {
             Some((tau, _)) => (tau, t + tau),
             None => (h, t1),
@@ -177,6 +184,7 @@ pub(super) fn run(
             sys.storeys_mut().switch(k, &y);
             sys.piecewise_form(&mut form);
             carried.fill((f64::NAN, f64::NAN, f64::NAN));
+            slopes_of(sys.storeys(), &mut slopes);
         }
     }
     let error = error.map(|source| failure(model, source, &y, &[]));
@@ -245,12 +253,14 @@ fn crawling(opts: &SimulationOptions, pieces: u64, t: f64) -> Option<Integration
 /// storey: where its switch function, positive at 0, reaches zero.
 /// `y`: scratch for a state (only the storey's bodies are read);
 /// `carried`: each storey's switch parts at 0 where known (the last
-/// piece's end), set to those at `h` where they are read.
+/// piece's end), set to those at `h` where they are read; `slopes`: each
+/// storey's [`StoreyTerms::switch_rate_bounds_for`] at unit speed and
+/// acceleration (they scale with them; they change where it switches).
 fn first_switch(
     storeys: &StoreyTerms,
     series: &Series,
     h: f64,
-    (y, carried): (&mut [f64], &mut [Parts]),
+    (y, carried, slopes): (&mut [f64], &mut [Parts], &[(f64, f64)]),
 ) -> Option<(f64, usize)> {
     let mut first: Option<(f64, usize)> = None;
     for k in storeys.switching() {
@@ -278,17 +288,24 @@ fn first_switch(
             carried[k] = p1;
         }
         let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
-        let (drift, turn) = storeys.switch_rate_bounds_for(k, speed, acceleration);
         // (The drift terms are lines in the drift: their second
         // derivatives are bounded as their rates are, by the drift's
         // acceleration in place of its speed.)
-        let bend = storeys.switch_rate_bounds_for(k, acceleration, 0.0).0;
+        let (lines, turn) = slopes[k];
+        debug_assert!({
+            let (d, t) = storeys.switch_rate_bounds_for(k, speed, acceleration);
+            let near = |x: f64, y: f64| (x - y).abs() <= 1e-12 * x.abs().max(y.abs());
+            near(d, lines * speed) && near(t, turn * acceleration)
+        });
         let bounds = Rates {
-            drift,
-            bend,
-            turn,
+            drift: lines * speed,
+            bend: lines * acceleration,
+            turn: turn * acceleration,
             acceleration,
         };
+        if p1.0.min(p1.1) > 0.0 && clear(bounds, (0.0, p0), (b, p1)) {
+            continue;
+        }
         if let Some(tau) = root(&mut parts, bounds, (0.0, p0), (b, p1), 0) {
             if first.is_none_or(|f| tau < f.0) {
                 first = Some((tau, k));
@@ -298,9 +315,31 @@ fn first_switch(
     first
 }
 
+/// Each storey's [`StoreyTerms::switch_rate_bounds_for`] at unit speed
+/// and acceleration, into `slopes` (the bounds are the speed and the
+/// acceleration times these).
+fn slopes_of(storeys: &StoreyTerms, slopes: &mut [(f64, f64)]) {
+    for (k, s) in slopes.iter_mut().enumerate() {
+        *s = storeys.switch_rate_bounds_for(k, 1.0, 1.0);
+    }
+}
+
 /// A storey's switch parts (the drift terms, the reversal's) and its
 /// drift rate at a point.
 type Parts = (f64, f64, f64);
+
+/// Whether both parts, positive at `a` and `b`, stay positive between
+/// by their `bounds` (see [`root`]).
+#[inline]
+fn clear(bounds: Rates, (a, pa): (f64, Parts), (b, pb): (f64, Parts)) -> bool {
+    let w = b - a;
+    let turns = pa.2.abs().max(pb.2.abs()) <= bounds.acceleration * w;
+    let drift = match turns {
+        false => pa.0 + pb.0 > bounds.drift * w || pa.0.min(pb.0) > 0.125 * bounds.bend * w * w,
+        true => pa.0 > bounds.drift * w && pb.0 > bounds.drift * w,
+    };
+    drift && pa.1 + pb.1 > bounds.turn * w
+}
 
 /// Bounds over a piece on how a storey's switch parts change: the drift
 /// terms' rate and second derivative, the reversal's rate, and the
@@ -336,13 +375,7 @@ fn root(
         let found = brent(|t| g(parts(t)), a, b, g(pa), g(pb), xtol, 200);
         return Some(found.unwrap_or(b));
     }
-    let w = b - a;
-    let turns = pa.2.abs().max(pb.2.abs()) <= bounds.acceleration * w;
-    let drift = match turns {
-        false => pa.0 + pb.0 > bounds.drift * w || pa.0.min(pb.0) > 0.125 * bounds.bend * w * w,
-        true => pa.0 > bounds.drift * w && pb.0 > bounds.drift * w,
-    };
-    if drift && pa.1 + pb.1 > bounds.turn * w || halvings == MAX_HALVINGS {
+    if halvings == MAX_HALVINGS || clear(bounds, (a, pa), (b, pb)) {
         return None;
     }
     let m = 0.5 * (a + b);
