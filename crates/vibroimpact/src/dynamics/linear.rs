@@ -99,12 +99,20 @@ pub struct PiecewiseForm {
     /// (a, b, k, c): the force k (u_b − u_a) + c (v_b − v_a) on a, its
     /// opposite on b.
     links: Vec<(usize, usize, f64, f64)>,
+    /// Where the links join each body to the next and no other (a
+    /// building: its storeys), link i's (k, c) between bodies i and i + 1
+    /// (the force k (u_{i+1} − u_i) + c (v_{i+1} − v_i) on i): the product
+    /// then walks the bodies once.
+    chain: Option<Vec<[f64; 2]>>,
 }
 
 impl PiecewiseForm {
     /// `out = A x` (without `b` and the base).
     #[inline]
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        if let Some(chain) = &self.chain {
+            return self.apply_chain(chain, x, out);
+        }
         for (i, g) in self.ground.iter().enumerate() {
             out[2 * i] = x[2 * i + 1];
             out[2 * i + 1] = -g[0] * x[2 * i] - g[1] * x[2 * i + 1];
@@ -117,6 +125,67 @@ impl PiecewiseForm {
         for (i, w) in self.inv_mass.iter().enumerate() {
             out[2 * i + 1] *= w;
         }
+    }
+
+    /// [`PiecewiseForm::apply`] on a chain: each body's links to the one
+    /// below and the one above, in one pass.
+    #[inline]
+    fn apply_chain(&self, chain: &[[f64; 2]], x: &[f64], out: &mut [f64]) {
+        let n = self.ground.len();
+        let (x, out) = (&x[..2 * n], &mut out[..2 * n]);
+        let mut below = 0.0;
+        for i in 0..n {
+            let (u, v) = (x[2 * i], x[2 * i + 1]);
+            let above = match (chain.get(i), x.get(2 * i + 2..2 * i + 4)) {
+                (Some(&[k, c]), Some(next)) => k * (next[0] - u) + c * (next[1] - v),
+                _ => 0.0,
+            };
+            let g = self.ground[i];
+            out[2 * i] = v;
+            out[2 * i + 1] = (-g[0] * u - g[1] * v + above - below) * self.inv_mass[i];
+            below = above;
+        }
+    }
+
+    /// Whether its links are taken as a chain.
+    #[cfg(test)]
+    pub(crate) fn is_chain(&self) -> bool {
+        self.chain.is_some()
+    }
+
+    /// The same form with its links taken one by one (a chain's product
+    /// checked against them).
+    #[cfg(test)]
+    pub(crate) fn unchained(&self) -> Self {
+        Self {
+            chain: None,
+            ..self.clone()
+        }
+    }
+
+    /// The links as a chain, if they are one (see `chain`).
+    fn chain_of(&mut self) {
+        let n = self.ground.len();
+        let mut chain = vec![[0.0; 2]; n.saturating_sub(1)];
+        let mut seen = vec![false; chain.len()];
+        for &(a, b, k, c) in &self.links {
+            // (k (u_b − u_a) on a is k (u_{lo+1} − u_lo) on lo either way.)
+            let lo = match (a + 1 == b, b + 1 == a) {
+                (true, _) => a,
+                (_, true) => b,
+                _ => {
+                    self.chain = None;
+                    return;
+                }
+            };
+            if seen[lo] {
+                self.chain = None;
+                return;
+            }
+            seen[lo] = true;
+            chain[lo] = [k, c];
+        }
+        self.chain = Some(chain);
     }
 
     /// Body i's constant acceleration `b` (its velocity row's).
@@ -172,6 +241,7 @@ impl ChainDynamics {
                 None => form.ground[above][0] += stiffness,
             }
         }
+        form.chain_of();
         true
     }
 }

@@ -212,3 +212,32 @@ fn the_exact_run_is_for_linear_pieces_under_a_record() {
     let pair = crate::model::reference::r2(2, crate::model::reference::CLEARANCE, 1.0).unwrap();
     assert!(!qualifies(&pair, &opts));
 }
+
+/// A building's storeys are a chain: its product with `A`, one pass over
+/// the floors, is the links' one by one (P-Δ, Rayleigh damping and IMK
+/// storeys of the 4-storey frame) to 1e-15 of its size; a row of two
+/// buildings without their contacts is one too (no link between them).
+#[test]
+fn a_chain_multiplies_as_its_links() {
+    for file in ["moment-frame-4.toml", "pounding-frames.toml"] {
+        let path = format!("{}/../../examples/{file}", env!("CARGO_MANIFEST_DIR"));
+        let row = parse_row(&std::fs::read_to_string(&path).unwrap(), file).unwrap();
+        let model = row.model(&record(), 1.0, false).unwrap().model;
+        let sys = ChainDynamics::new(&model, false);
+        let mut form = PiecewiseForm::default();
+        assert!(sys.piecewise_form(&mut form), "{file}");
+        assert!(form.is_chain(), "{file}");
+        let plain = form.unchained();
+        let d = 2 * model.bodies().len();
+        let x: Vec<f64> = (0..d)
+            .map(|i| ((i * 7 + 3) % 11) as f64 / 11.0 - 0.4)
+            .collect();
+        let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
+        form.apply(&x, &mut a);
+        plain.apply(&x, &mut b);
+        let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (p, q) in a.iter().zip(&b) {
+            assert!((p - q).abs() <= 1e-15 * size, "{file}: {p} against {q}");
+        }
+    }
+}
