@@ -49,6 +49,10 @@ struct Reader {
     bodies: bool,
     found: Extrema,
     gauges: Vec<GaugeScan>,
+    /// Each gauge's time, value and rate where the last piece ended (NaN
+    /// time: none): a separation's rate is continuous, so the next piece
+    /// starts from them.
+    ends: Vec<(f64, (f64, f64))>,
 }
 
 /// Runs `model` from `y0` as [`simulate_streaming`] does, exactly (the
@@ -87,6 +91,7 @@ pub(super) fn run(
             gauges: Vec::new(),
         },
         gauges: opts.gauges.iter().copied().map(GaugeScan::new).collect(),
+        ends: vec![(f64::NAN, (0.0, 0.0)); opts.gauges.len()],
     };
     if let Some((from, to)) = reader.window {
         if from <= 0.0 && 0.0 <= to {
@@ -419,7 +424,7 @@ impl Reader {
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
         }
-        for gauge in self.gauges.iter_mut() {
+        for (gauge, end) in self.gauges.iter_mut().zip(self.ends.iter_mut()) {
             let kind = gauge.gauge;
             let at = |t: f64| match kind {
                 Gauge::Separation { left, right, .. } => match left {
@@ -434,7 +439,12 @@ impl Reader {
                     (a + a0 + s * (t - ta), jerk + s)
                 }
             };
-            let ends = (at(a), at(b));
+            let start = match (kind, *end) {
+                (Gauge::Separation { .. }, (t, x)) if t == a => x,
+                _ => at(a),
+            };
+            let ends = (start, at(b));
+            *end = (b, ends.1);
             gauge.scan_ends((a, b), ends, at);
         }
     }
