@@ -345,6 +345,19 @@ impl StoreyTerms {
         }
     }
 
+    /// Whether, while its drift moves one way, storey k's drift terms
+    /// ([`StoreyTerms::switch_parts`]' first) are each least at an end of
+    /// every interval of it on its current piece: a bilinear storey's
+    /// (|z| against its yield drift, a minimum of two lines); an IMK
+    /// storey's as its law's `drift_terms_least_at_ends` says.
+    pub fn drift_terms_least_at_ends(&self, k: usize) -> bool {
+        let t = &self.terms[k];
+        match (&t.law, &t.branch) {
+            (StoreyLaw::Imk(m), Branch::Imk(st)) => m.drift_terms_least_at_ends(st),
+            _ => true,
+        }
+    }
+
     /// Switches bilinear storey k's branch in the state `y` where its
     /// switch function vanished.
     pub fn switch(&mut self, k: usize, y: &[f64]) {

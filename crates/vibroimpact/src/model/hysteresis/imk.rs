@@ -602,6 +602,23 @@ impl Imk {
         (2.0 * steepest * speed, self.stiffness * acceleration)
     }
 
+    /// Whether, while the drift moves one way, [`Imk::switch_parts`]' drift
+    /// terms are each least at an end of every interval of it (so that
+    /// positive ends exclude a switch between them): on the backbone they
+    /// are lines (a concave minimum of them); after failure constant; off
+    /// the backbone the term to the bound of the direction of motion, whose
+    /// corners where a line meets the residual are convex, falls
+    /// monotonically while no slope of either bound exceeds the unloading
+    /// stiffness (post-capping slopes are not positive), the others being
+    /// lines.
+    pub fn drift_terms_least_at_ends(&self, s: &ImkState) -> bool {
+        s.on_backbone
+            || s.failure == 5
+            || [s.pos, s.neg]
+                .iter()
+                .all(|side| side.kp.abs() <= s.kunload && side.kpc <= 0.0)
+    }
+
     /// The switch function of the piece at drift `d` moving at `rate`:
     /// positive while the piece holds, zero where it ends. On the backbone:
     /// a reversal (the rate turns), its next corner, zero force without a

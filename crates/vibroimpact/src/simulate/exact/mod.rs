@@ -115,7 +115,7 @@ pub(super) fn run(
     let mut cap = f64::INFINITY;
     // Each storey's switch parts at the last piece's end (NaN: not known).
     let mut carried = vec![(f64::NAN, f64::NAN, f64::NAN); model.storeys().len()];
-    let mut slopes = vec![(0.0, 0.0); model.storeys().len()];
+    let mut slopes = vec![(0.0, 0.0, false); model.storeys().len()];
     slopes_of(sys.storeys(), &mut slopes);
     while error.is_none() && t < opts.t_end {
         if let Some(stop) = &opts.interrupt {
@@ -265,7 +265,7 @@ fn first_switch(
     storeys: &StoreyTerms,
     series: &Series,
     h: f64,
-    (y, carried, slopes): (&mut [f64], &mut [Parts], &[(f64, f64)]),
+    (y, carried, slopes): (&mut [f64], &mut [Parts], &[Slopes]),
 ) -> Option<(f64, usize)> {
     let mut first: Option<(f64, usize)> = None;
     for k in storeys.switching() {
@@ -293,18 +293,17 @@ fn first_switch(
             carried[k] = p1;
         }
         let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
-        // (The drift terms are lines in the drift: their second
-        // derivatives are bounded as their rates are, by the drift's
-        // acceleration in place of its speed.)
-        let (lines, turn) = slopes[k];
+        let (lines, turn, least_at_ends) = slopes[k];
         debug_assert!({
             let (d, t) = storeys.switch_rate_bounds_for(k, speed, acceleration);
             let near = |x: f64, y: f64| (x - y).abs() <= 1e-12 * x.abs().max(y.abs());
-            near(d, lines * speed) && near(t, turn * acceleration)
+            // (Not finite: the state's check reports it.)
+            !(d.is_finite() && t.is_finite())
+                || near(d, lines * speed) && near(t, turn * acceleration)
         });
         let bounds = Rates {
             drift: lines * speed,
-            bend: lines * acceleration,
+            least_at_ends,
             turn: turn * acceleration,
             acceleration,
         };
@@ -321,17 +320,24 @@ fn first_switch(
 }
 
 /// Each storey's [`StoreyTerms::switch_rate_bounds_for`] at unit speed
-/// and acceleration, into `slopes` (the bounds are the speed and the
-/// acceleration times these).
-fn slopes_of(storeys: &StoreyTerms, slopes: &mut [(f64, f64)]) {
+/// and acceleration (the bounds are the speed and the acceleration times
+/// these), and whether its drift terms are least at the ends of an
+/// interval the drift moves over one way
+/// ([`StoreyTerms::drift_terms_least_at_ends`]), into `slopes`.
+fn slopes_of(storeys: &StoreyTerms, slopes: &mut [Slopes]) {
     for (k, s) in slopes.iter_mut().enumerate() {
-        *s = storeys.switch_rate_bounds_for(k, 1.0, 1.0);
+        let (lines, turn) = storeys.switch_rate_bounds_for(k, 1.0, 1.0);
+        *s = (lines, turn, storeys.drift_terms_least_at_ends(k));
     }
 }
 
 /// A storey's switch parts (the drift terms, the reversal's) and its
 /// drift rate at a point.
 type Parts = (f64, f64, f64);
+
+/// A storey's rate bounds at unit speed and acceleration, and whether its
+/// drift terms are least at the ends of a move one way ([`slopes_of`]).
+type Slopes = (f64, f64, bool);
 
 /// Whether both parts, positive at `a` and `b`, stay positive between
 /// by their `bounds` (see [`root`]).
@@ -340,19 +346,20 @@ fn clear(bounds: Rates, (a, pa): (f64, Parts), (b, pb): (f64, Parts)) -> bool {
     let w = b - a;
     let turns = pa.2.abs().max(pb.2.abs()) <= bounds.acceleration * w;
     let drift = match turns {
-        false => pa.0 + pb.0 > bounds.drift * w || pa.0.min(pb.0) > 0.125 * bounds.bend * w * w,
+        false => bounds.least_at_ends || pa.0 + pb.0 > bounds.drift * w,
         true => pa.0 > bounds.drift * w && pb.0 > bounds.drift * w,
     };
     drift && pa.1 + pb.1 > bounds.turn * w
 }
 
 /// Bounds over a piece on how a storey's switch parts change: the drift
-/// terms' rate and second derivative, the reversal's rate, and the
-/// drift's acceleration.
+/// terms' rate, whether they are least at the ends of an interval the
+/// drift moves over one way, the reversal's rate, and the drift's
+/// acceleration.
 #[derive(Clone, Copy, Debug)]
 struct Rates {
     drift: f64,
-    bend: f64,
+    least_at_ends: bool,
     turn: f64,
     acceleration: f64,
 }
@@ -361,9 +368,11 @@ struct Rates {
 /// where both parts stay positive by their `bounds`; else where it is not
 /// positive at `b`, located by Brent; else in the halves, first to last.
 /// The drift terms stay positive where the ends' values exceed their
-/// rate's bound times the piece, or where the lesser exceeds their second
-/// derivative's bound times w²/8 (each term lies above the line through
-/// its ends less that). The drift terms of an IMK storey off its backbone
+/// rate's bound times the piece; or, where the drift rate keeps its sign
+/// and each term is least at an end of an interval the drift moves over
+/// one way (a line, a concave minimum of lines, a monotone function:
+/// [`StoreyTerms::drift_terms_least_at_ends`]), wherever both ends are
+/// positive. The drift terms of an IMK storey off its backbone
 /// jump where the drift rate changes sign (they measure to the bound
 /// ahead): where the rate may vanish inside, each end must clear the rate
 /// bound on its own.

@@ -176,6 +176,85 @@ fn an_imk_building_runs_as_the_global_integrator() {
     );
 }
 
+/// An IMK law whose hardening line, drawn back, falls below its residual
+/// (cap 3 F_y one yield drift past yield, residual 0.2 F_y): off the
+/// backbone its bound of the direction of motion has a convex corner
+/// where that line meets the residual, so the elastic line meets the
+/// bound at 0.2 u_y and the hardening line takes over at u_y. A storey
+/// sent from 0.025 u_y at 0.5 m/s crosses that stretch within its first
+/// 0.01 s with its drift terms positive at both ends; the exact run must
+/// find the yield at 0.2 u_y, as the global integrator does, and end on
+/// the hardening line 2 k u − F_y (before the drift terms' shortcut was
+/// kept to a minimum of lines, it stayed on the elastic line k u).
+#[test]
+fn a_yield_between_two_positive_ends_is_found() {
+    use crate::model::hysteresis::StoreySpec;
+    let k = 4e6;
+    let spec = StoreySpec::imk(
+        Some(0.004),
+        [Some(3.0), Some(0.004), Some(0.05), Some(0.2), Some(0.1)],
+        [None; 3],
+        [1.0; 3],
+    )
+    .unwrap();
+    let model = Model::new(
+        vec![Body {
+            name: "floor".into(),
+            mass: 1e5,
+            stiffness: 0.0,
+            damping: 0.0,
+        }],
+        Vec::new(),
+        Vec::new(),
+        BaseExcitation::None,
+        Vec::new(),
+        vec![1e-4],
+        vec![0.5],
+    )
+    .unwrap()
+    .with_storeys(vec![crate::model::Storey {
+        below: None,
+        above: 0,
+        law: spec.law(k).unwrap(),
+        p_delta: 0.0,
+    }])
+    .unwrap();
+    let run = |integrator, rtol| {
+        let opts = SimulationOptions {
+            t_end: 0.01,
+            rtol,
+            atol: rtol * 1e-4,
+            output_step: Some(0.01),
+            storey_forces: true,
+            integrator,
+            ..Default::default()
+        };
+        let mut last = Vec::new();
+        let sim = simulate_streaming(&model, &opts, |_, row| {
+            last = row.to_vec();
+            true
+        })
+        .unwrap();
+        assert!(sim.error.is_none(), "{:?}", sim.error);
+        last
+    };
+    let (exact, global) = (run(Integrator::Local, 1e-8), run(Integrator::Global, 1e-12));
+    // [u, v, force]: the force on the hardening line at the end.
+    let fy = k * 0.004;
+    let on_bound = 2.0 * k * exact[0] - fy;
+    assert!(
+        (exact[2] - on_bound).abs() <= 1e-6 * fy,
+        "force {} F_y",
+        exact[2] / fy
+    );
+    for (a, b) in exact.iter().zip(&global) {
+        assert!(
+            (a - b).abs() <= 1e-7 * b.abs().max(1e-3),
+            "{exact:?} against {global:?}"
+        );
+    }
+}
+
 /// What does not qualify: a contact, harmonic base motion, a Bouc–Wen
 /// storey, the energy audit.
 #[test]
