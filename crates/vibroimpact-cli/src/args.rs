@@ -156,6 +156,7 @@ impl RowRunArgs {
             method: self.method.method(),
             integrator: self.integrator.integrator(),
             interrupt: Some(crate::interrupt::on_ctrl_c()),
+            loops: false,
         })
     }
 }

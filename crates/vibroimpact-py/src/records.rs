@@ -119,6 +119,7 @@ pub(crate) fn pair_and_run(
         method: crate::convert::method(method)?,
         integrator: integrator.parse().map_err(value_error)?,
         interrupt: None,
+        loops: false,
     };
     let pair =
         vibroimpact::seismic::pounding::parse_row(pair_text, source).map_err(pounding_error)?;

@@ -12,8 +12,8 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::Value;
 use vibroimpact::seismic::pounding::{
-    documents, quantile, value_range, MoatCell, Outcome, Row, SpectrumCell, StoreyLoop, Study,
-    GRAVITY,
+    documents, quantile, value_range, MoatCell, Outcome, Row, RunSettings, SpectrumCell,
+    StoreyLoop, Study, GRAVITY,
 };
 
 use crate::args::RowRunArgs;
@@ -286,7 +286,11 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             args.scale
         )));
     }
-    let run = args.run.settings()?;
+    let run = RunSettings {
+        // (The loops are drawn where figures are written.)
+        loops: args.out.is_some(),
+        ..args.run.settings()?
+    };
     let row: Row = records::row(&args.pair)?;
     let runs = args
         .records

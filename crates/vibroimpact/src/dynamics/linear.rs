@@ -106,13 +106,44 @@ pub struct PiecewiseForm {
     chain: Option<Vec<[f64; 2]>>,
 }
 
+/// What a term of a series adds to each body's velocity row before it is
+/// scaled (docs/theory.md §13).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Added {
+    /// Nothing (the third term on).
+    Nothing,
+    /// The body's constant acceleration `b` less the base's `a₀` (the
+    /// first term).
+    ConstantLess(f64),
+    /// Minus this (the second term: the base's jerk times the interval).
+    Less(f64),
+}
+
 impl PiecewiseForm {
-    /// `out = A x` (without `b` and the base).
+    /// `out = (A x + added) w` (without the base but as `added` says), and
+    /// the largest |out| over the displacements and over the velocities
+    /// (a NaN passed over, as by `f64::max`): a term of a series
+    /// (docs/theory.md §13).
     #[inline]
-    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+    pub fn scaled_term(&self, x: &[f64], out: &mut [f64], added: Added, w: f64) -> [f64; 2] {
         if let Some(chain) = &self.chain {
-            return self.apply_chain(chain, x, out);
+            return self.chain_term(chain, x, out, added, w);
         }
+        self.apply_links(x, out);
+        let mut top = [0.0f64; 2];
+        for (i, o) in out[..2 * self.ground.len()].chunks_exact_mut(2).enumerate() {
+            o[1] = match added {
+                Added::Nothing => o[1],
+                Added::ConstantLess(a0) => o[1] + (self.constant(i) - a0),
+                Added::Less(x) => o[1] - x,
+            };
+            scaled(o, w, &mut top);
+        }
+        top
+    }
+
+    /// `out = A x` by the links one by one.
+    fn apply_links(&self, x: &[f64], out: &mut [f64]) {
         for (i, g) in self.ground.iter().enumerate() {
             out[2 * i] = x[2 * i + 1];
             out[2 * i + 1] = -g[0] * x[2 * i] - g[1] * x[2 * i + 1];
@@ -127,24 +158,52 @@ impl PiecewiseForm {
         }
     }
 
-    /// [`PiecewiseForm::apply`] on a chain: each body's links to the one
-    /// below and the one above, in one pass.
+    /// [`PiecewiseForm::scaled_term`] on a chain: each link's force once,
+    /// in one pass over the bodies, a body's row written when the link
+    /// above it is known (iterators throughout: no index to check).
     #[inline]
-    fn apply_chain(&self, chain: &[[f64; 2]], x: &[f64], out: &mut [f64]) {
+    fn chain_term(
+        &self,
+        chain: &[[f64; 2]],
+        x: &[f64],
+        out: &mut [f64],
+        added: Added,
+        w: f64,
+    ) -> [f64; 2] {
+        let mut top = [0.0f64; 2];
         let n = self.ground.len();
         let (x, out) = (&x[..2 * n], &mut out[..2 * n]);
+        let mut rows = out
+            .chunks_exact_mut(2)
+            .zip(self.ground.iter().zip(&self.inv_mass));
+        let (Some(&[mut u, mut v]), Some((mut o, (mut g, mut m)))) =
+            (x.first_chunk::<2>(), rows.next())
+        else {
+            return top;
+        };
         let mut below = 0.0;
-        for i in 0..n {
-            let (u, v) = (x[2 * i], x[2 * i + 1]);
-            let above = match (chain.get(i), x.get(2 * i + 2..2 * i + 4)) {
-                (Some(&[k, c]), Some(next)) => k * (next[0] - u) + c * (next[1] - v),
-                _ => 0.0,
+        // (The sum in the order of the links one by one, to the bit.)
+        let mut row =
+            |o: &mut [f64], (u, v): (f64, f64), g: &[f64; 3], m: f64, (f, b): (f64, f64)| {
+                let a = (-g[0] * u - g[1] * v + f - b) * m;
+                o[0] = v;
+                o[1] = match added {
+                    Added::Nothing => a,
+                    Added::ConstantLess(a0) => a + (g[2] * m - a0),
+                    Added::Less(x) => a - x,
+                };
+                scaled(o, w, &mut top);
             };
-            let g = self.ground[i];
-            out[2 * i] = v;
-            out[2 * i + 1] = (-g[0] * u - g[1] * v + above - below) * self.inv_mass[i];
-            below = above;
+        for ((next, &[k, c]), (o_next, (g_next, m_next))) in
+            x[2..].chunks_exact(2).zip(chain).zip(rows)
+        {
+            let above = k * (next[0] - u) + c * (next[1] - v);
+            row(o, (u, v), g, *m, (above, below));
+            (u, v, below) = (next[0], next[1], above);
+            (o, g, m) = (o_next, g_next, m_next);
         }
+        row(o, (u, v), g, *m, (0.0, below));
+        top
     }
 
     /// Whether its links are taken as a chain.
@@ -193,6 +252,17 @@ impl PiecewiseForm {
     pub fn constant(&self, i: usize) -> f64 {
         self.ground[i][2] * self.inv_mass[i]
     }
+}
+
+/// A row `o` times `w`, its parts' sizes kept in `top` if larger (two
+/// short chains of plain comparisons).
+#[inline(always)]
+fn scaled(o: &mut [f64], w: f64, top: &mut [f64; 2]) {
+    o[0] *= w;
+    o[1] *= w;
+    let (a, b) = (o[0].abs(), o[1].abs());
+    top[0] = if a > top[0] { a } else { top[0] };
+    top[1] = if b > top[1] { b } else { top[1] };
 }
 
 impl ChainDynamics {

@@ -76,8 +76,8 @@ pub const MIN_RTOL: f64 = 1e-13;
 /// How a pounding run is computed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunSettings {
-    /// Sampling step of drifts, floor accelerations and displacements (s);
-    /// impact forces are the impact log's exact peaks whatever the step.
+    /// Sampling step of the hysteresis loops (s); peaks, residuals and
+    /// impact forces are exact whatever the step.
     pub sample: f64,
     /// Relative tolerance of the integration (the absolute one is
     /// `rtol · 1e-4 · max(smallest gap, 1 mm)`, 1 mm without gaps).
@@ -91,10 +91,15 @@ pub struct RunSettings {
     /// A stop request (Ctrl-C): every run of the study ends at its next
     /// step with [`PoundingError::Interrupted`].
     pub interrupt: Option<Interrupt>,
+    /// Whether a run keeps its hysteretic storeys' loops at the samples
+    /// (the CLI's figures): the peaks need none, and a run without them
+    /// evaluates no storey force at the samples.
+    pub loops: bool,
 }
 
 impl RunSettings {
-    /// Sampling every `sample` s at tolerance `rtol` with DOP853, global.
+    /// Sampling every `sample` s at tolerance `rtol` with DOP853, global,
+    /// without the loops.
     pub fn new(sample: f64, rtol: f64) -> Self {
         Self {
             sample,
@@ -102,6 +107,7 @@ impl RunSettings {
             method: Method::Dop853,
             integrator: Integrator::Global,
             interrupt: None,
+            loops: false,
         }
     }
 }
@@ -452,7 +458,7 @@ impl Row {
     ) -> Result<Option<WorkEstimate>, PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let opts = SimulationOptions {
-            storey_forces: true,
+            storey_forces: run.loops,
             ..self.options(record, run)?
         };
         Ok(estimate_work(&rm.model, &opts))
@@ -475,10 +481,10 @@ impl Row {
     ) -> Result<(Response, Stop), PoundingError> {
         let rm = self.model(record, scale, contacts)?;
         let mut opts = SimulationOptions {
-            storey_forces: true,
+            storey_forces: run.loops,
             ..self.options(record, run)?
         };
-        let mut peaks = Peaks::new(self, &rm, opts.t_end);
+        let mut peaks = Peaks::new(self, &rm, opts.t_end, run.loops);
         opts.gauges = peaks.gauges();
         opts.extrema_window = Some((0.0, opts.t_end));
         opts.extrema_of_bodies = false;
@@ -519,7 +525,7 @@ impl Row {
         let (mut passed, mut collapse, mut k) = (None, None, 0u64);
         let sim = simulate_streaming(model, &opts, |t, row| {
             let (worst, building, storey) = peaks.check(row, &bounds);
-            if k % every == 0 {
+            if run.loops && k % every == 0 {
                 peaks.sample(row);
             }
             k += 1;
@@ -571,7 +577,7 @@ impl Row {
             ..self.options(record, run)?
         };
         let n = rm.model.bodies().len();
-        let mut peaks = Peaks::new(self, &rm, opts.t_end);
+        let mut peaks = Peaks::new(self, &rm, opts.t_end, true);
         let (mut times, mut displacement) = (Vec::new(), Vec::new());
         let model = &rm.model;
         let sim = simulate_streaming(model, &opts, |t, row| {

@@ -14,17 +14,20 @@ pub(super) struct Peaks {
     layout: Vec<(usize, Option<usize>, usize)>,
     /// The gauges, in order: per building, per floor, its storey's drift
     /// (with its mean over the building's last fundamental period), its
-    /// absolute acceleration and its displacement, then its slab's
-    /// displacement (with its mean) if isolated; then per joint, per
-    /// floor, its closing.
+    /// absolute acceleration and its displacement (but the first floor's of
+    /// a fixed building, its drift), then its slab's displacement (with
+    /// its mean) if isolated; then per joint, per floor, its closing.
     gauges: Vec<Gauge>,
-    /// Per building, its first gauge.
-    building_gauges: Vec<usize>,
+    /// Per building, per floor, its drift, acceleration and displacement
+    /// gauges (a first floor's drift is its displacement where the
+    /// building is fixed: one gauge).
+    floor_gauges: Vec<Vec<[usize; 3]>>,
     /// Per building, the index of its slab's gauge, if isolated.
     slab_gauges: Vec<Option<usize>>,
     /// Per joint, its first closing gauge and how many.
     joint_gauges: Vec<(usize, usize)>,
-    /// Per hysteretic storey of the model (its order).
+    /// Per hysteretic storey of the model (its order), where the loops
+    /// are kept (the samples then carry the storeys' forces); else none.
     loops: Vec<Tracked>,
 }
 
@@ -33,34 +36,45 @@ pub(super) struct Peaks {
 type Tracked = (Option<usize>, usize, StoreyLoop);
 
 impl Peaks {
-    /// The peaks of `row` run as `rm` up to `t_end`.
-    pub(super) fn new(row: &Row, rm: &RowModel, t_end: f64) -> Self {
+    /// The peaks of `row` run as `rm` up to `t_end`, with the hysteretic
+    /// storeys' loops where `loops`.
+    pub(super) fn new(row: &Row, rm: &RowModel, t_end: f64, loops: bool) -> Self {
         let layout: Vec<_> = rm
             .placements
             .iter()
             .zip(&row.buildings)
             .map(|(p, b)| (p.first_floor, p.base, b.floors()))
             .collect();
-        let (mut gauges, mut building_gauges, mut slab_gauges) =
-            (Vec::new(), Vec::new(), Vec::new());
+        let (mut gauges, mut floor_gauges, mut slab_gauges) = (Vec::new(), Vec::new(), Vec::new());
         for (&(first, base, floors), b) in layout.iter().zip(&row.buildings) {
             // The residual window: the building's last fundamental period.
             let mean_from = Some(t_end - b.period());
-            building_gauges.push(gauges.len());
-            for i in 0..floors {
-                let right = if i == 0 { base } else { Some(first + i - 1) };
-                gauges.push(Gauge::Separation {
-                    left: Some(first + i),
-                    right,
-                    mean_from,
-                });
-                gauges.push(Gauge::AbsoluteAcceleration { body: first + i });
-                gauges.push(Gauge::Separation {
-                    left: Some(first + i),
-                    right: None,
-                    mean_from: None,
-                });
-            }
+            let mut push = |g: Gauge| {
+                gauges.push(g);
+                gauges.len() - 1
+            };
+            let mine = (0..floors)
+                .map(|i| {
+                    let right = if i == 0 { base } else { Some(first + i - 1) };
+                    let left = Some(first + i);
+                    let drift = push(Gauge::Separation {
+                        left,
+                        right,
+                        mean_from,
+                    });
+                    let acceleration = push(Gauge::AbsoluteAcceleration { body: first + i });
+                    let displacement = match right {
+                        None => drift,
+                        Some(_) => push(Gauge::Separation {
+                            left,
+                            right: None,
+                            mean_from: None,
+                        }),
+                    };
+                    [drift, acceleration, displacement]
+                })
+                .collect();
+            floor_gauges.push(mine);
             slab_gauges.push(base.map(|slab| {
                 gauges.push(Gauge::Separation {
                     left: Some(slab),
@@ -82,8 +96,8 @@ impl Peaks {
                 });
             }
         }
-        let mut loops: Vec<(usize, Tracked)> = Vec::new();
-        for (k, p) in rm.placements.iter().enumerate() {
+        let mut tracked: Vec<(usize, Tracked)> = Vec::new();
+        for (k, p) in rm.placements.iter().enumerate().filter(|_| loops) {
             for &(s, storey) in &p.storeys {
                 let (below, above) = match storey {
                     None => (None, p.base.unwrap_or(p.first_floor)),
@@ -96,14 +110,14 @@ impl Peaks {
                     drift: Vec::new(),
                     force: Vec::new(),
                 };
-                loops.push((s, (below, above, empty)));
+                tracked.push((s, (below, above, empty)));
             }
         }
-        loops.sort_by_key(|l| l.0);
+        tracked.sort_by_key(|l| l.0);
         Self {
-            loops: loops.into_iter().map(|l| l.1).collect(),
+            loops: tracked.into_iter().map(|l| l.1).collect(),
             gauges,
-            building_gauges,
+            floor_gauges,
             slab_gauges,
             joint_gauges,
             layout,
@@ -182,11 +196,11 @@ impl Peaks {
                 .map(|(k, l)| (0..l.2).map(|i| f(k, i)).collect())
                 .collect()
         };
-        let drift_gauge = |k: usize, i: usize| self.building_gauges[k] + 3 * i;
-        let drift = per_floor(&|k, i| read(drift_gauge(k, i)).peak());
-        let residual = per_floor(&|k, i| mean(drift_gauge(k, i)));
-        let acceleration = per_floor(&|k, i| read(drift_gauge(k, i) + 1).peak());
-        let displacement = per_floor(&|k, i| read(drift_gauge(k, i) + 2).peak());
+        let gauge = |k: usize, i: usize, q: usize| self.floor_gauges[k][i][q];
+        let drift = per_floor(&|k, i| read(gauge(k, i, 0)).peak());
+        let residual = per_floor(&|k, i| mean(gauge(k, i, 0)));
+        let acceleration = per_floor(&|k, i| read(gauge(k, i, 1)).peak());
+        let displacement = per_floor(&|k, i| read(gauge(k, i, 2)).peak());
         let isolators = rm
             .placements
             .iter()

@@ -114,7 +114,7 @@ pub(super) fn run(
     let mut next_break = 0;
     let mut cap = f64::INFINITY;
     // Each storey's switch parts at the last piece's end (NaN: not known).
-    let mut carried = vec![(f64::NAN, f64::NAN, f64::NAN); model.storeys().len()];
+    let mut carried = vec![Known::Nothing; model.storeys().len()];
     let mut slopes = vec![(0.0, 0.0, false); model.storeys().len()];
     slopes_of(sys.storeys(), &mut slopes);
     while error.is_none() && t < opts.t_end {
@@ -188,7 +188,7 @@ pub(super) fn run(
         if let Some((_, k)) = switch {
             sys.storeys_mut().switch(k, &y);
             sys.piecewise_form(&mut form);
-            carried.fill((f64::NAN, f64::NAN, f64::NAN));
+            carried.fill(Known::Nothing);
             slopes_of(sys.storeys(), &mut slopes);
         }
     }
@@ -257,15 +257,15 @@ fn crawling(opts: &SimulationOptions, pieces: u64, t: f64) -> Option<Integration
 /// The first switch of a storey inside `(0, h]` on the series, and the
 /// storey: where its switch function, positive at 0, reaches zero.
 /// `y`: scratch for a state (only the storey's bodies are read);
-/// `carried`: each storey's switch parts at 0 where known (the last
-/// piece's end), set to those at `h` where they are read; `slopes`: each
+/// `carried`: what each storey's switch parts are known to be at 0 (from
+/// the last piece's end), set to what is known at `h`; `slopes`: each
 /// storey's [`StoreyTerms::switch_rate_bounds_for`] at unit speed and
 /// acceleration (they scale with them; they change where it switches).
 fn first_switch(
     storeys: &StoreyTerms,
     series: &Series,
     h: f64,
-    (y, carried, slopes): (&mut [f64], &mut [Parts], &[Slopes]),
+    (y, carried, slopes): (&mut [f64], &mut [Known], &[Slopes]),
 ) -> Option<(f64, usize)> {
     let mut first: Option<(f64, usize)> = None;
     for k in storeys.switching() {
@@ -279,19 +279,11 @@ fn first_switch(
             let rate = y[2 * above + 1] - below.map_or(0.0, |j| y[2 * j + 1]);
             (d, r, rate)
         };
-        let p0 = match carried[k] {
-            p if p.0.is_nan() => parts(0.0),
-            p => p,
+        let start = match std::mem::replace(&mut carried[k], Known::Nothing) {
+            Known::Nothing => Known::Exact(parts(0.0)),
+            known => known,
         };
-        carried[k] = (f64::NAN, f64::NAN, f64::NAN);
-        if p0.0.min(p0.1) <= 0.0 {
-            continue;
-        }
         let b = first.map_or(h, |f| f.0);
-        let p1 = parts(b);
-        if b == h {
-            carried[k] = p1;
-        }
         let (speed, acceleration) = series.rate_bounds(2 * above, below.map(|j| 2 * j));
         let (lines, turn, least_at_ends) = slopes[k];
         debug_assert!({
@@ -307,6 +299,29 @@ fn first_switch(
             turn: turn * acceleration,
             acceleration,
         };
+        // Moving one way and further from its switches than its parts can
+        // move over the piece, a storey clears on what it carries, its
+        // parts at the end not read: it carries their lower bounds on.
+        let (g, r, ra) = start.lower();
+        let rb = series.value_rate(2 * above, below.map(|j| 2 * j), b).1;
+        let one_way = ra.abs().max(rb.abs()) > acceleration * b;
+        if one_way && g > bounds.drift * b && r > bounds.turn * b {
+            if b == h {
+                carried[k] = Known::Above(g - bounds.drift * h, r - bounds.turn * h, rb);
+            }
+            continue;
+        }
+        let p0 = match start {
+            Known::Exact(p) => p,
+            _ => parts(0.0),
+        };
+        if p0.0.min(p0.1) <= 0.0 {
+            continue;
+        }
+        let p1 = parts(b);
+        if b == h {
+            carried[k] = Known::Exact(p1);
+        }
         if p1.0.min(p1.1) > 0.0 && clear(bounds, (0.0, p0), (b, p1)) {
             continue;
         }
@@ -317,6 +332,30 @@ fn first_switch(
         }
     }
     first
+}
+
+/// What is known of a storey's switch parts at a piece's start.
+#[derive(Clone, Copy, Debug)]
+enum Known {
+    /// Nothing: they are read.
+    Nothing,
+    /// Their values (the last piece's end).
+    Exact(Parts),
+    /// Lower bounds on the two parts, and the drift rate: carried over
+    /// pieces the drift moved one way over (the drift terms continuous).
+    Above(f64, f64, f64),
+}
+
+impl Known {
+    /// Lower bounds on the two parts (−∞ where nothing is known) and the
+    /// drift rate (NaN where not known: no piece then moves one way).
+    fn lower(self) -> Parts {
+        match self {
+            Known::Nothing => (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NAN),
+            Known::Exact(p) => p,
+            Known::Above(g, r, rate) => (g, r, rate),
+        }
+    }
 }
 
 /// Each storey's [`StoreyTerms::switch_rate_bounds_for`] at unit speed

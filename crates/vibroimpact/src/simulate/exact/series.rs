@@ -8,7 +8,7 @@
 //! [0, 1]): a term's size is then the coefficient's, and the values at
 //! the interval's end are sums.
 
-use crate::dynamics::PiecewiseForm;
+use crate::dynamics::{Added, PiecewiseForm};
 
 /// Most terms of a series; an interval whose terms have not fallen by
 /// then is too long for it ([`Built::TooLong`]).
@@ -85,24 +85,12 @@ impl Series {
         for j in 1..MAX_TERMS {
             let (before, after) = self.c.split_at_mut(j * d);
             let (prev, next) = (&before[(j - 1) * d..], &mut after[..d]);
-            form.apply(prev, next);
-            match j {
-                1 => (0..d / 2).for_each(|i| next[2 * i + 1] += form.constant(i) - a0),
-                2 => (0..d / 2).for_each(|i| next[2 * i + 1] -= s * h),
-                _ => {}
-            }
-            let w = h / j as f64;
-            // (The largest term by pairs, two short chains of plain
-            // comparisons: a NaN is passed over, as by `f64::max`, and
-            // caught in the state.)
-            let mut top = [0.0f64; 2];
-            for p in next.chunks_exact_mut(2) {
-                p[0] *= w;
-                p[1] *= w;
-                let (a, b) = (p[0].abs(), p[1].abs());
-                top[0] = if a > top[0] { a } else { top[0] };
-                top[1] = if b > top[1] { b } else { top[1] };
-            }
+            let added = match j {
+                1 => Added::ConstantLess(a0),
+                2 => Added::Less(s * h),
+                _ => Added::Nothing,
+            };
+            let top = form.scaled_term(prev, next, added, h / j as f64);
             if j >= 4 {
                 let jf = j as f64;
                 self.tails.0 += jf * top[0];

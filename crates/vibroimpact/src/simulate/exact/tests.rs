@@ -1,6 +1,7 @@
 //! The exact run against closed forms and the global integrator.
 
 use super::*;
+use crate::dynamics::Added;
 use crate::model::{Accelerogram, Body};
 use crate::seismic::pounding::tests::record;
 use crate::seismic::pounding::{parse_row, RunSettings};
@@ -292,10 +293,11 @@ fn the_exact_run_is_for_linear_pieces_under_a_record() {
     assert!(!qualifies(&pair, &opts));
 }
 
-/// A building's storeys are a chain: its product with `A`, one pass over
-/// the floors, is the links' one by one (P-Δ, Rayleigh damping and IMK
-/// storeys of the 4-storey frame) to 1e-15 of its size; a row of two
-/// buildings without their contacts is one too (no link between them).
+/// A building's storeys are a chain: a term of its series (a product
+/// with `A` in one pass over the floors, with each kind of forcing) is the
+/// links' one by one (P-Δ, Rayleigh damping and IMK storeys of the
+/// 4-storey frame) to 1e-15 of its size, with its rows' sizes; a row of
+/// two buildings without their contacts is one too (no link between them).
 #[test]
 fn a_chain_multiplies_as_its_links() {
     for file in ["moment-frame-4.toml", "pounding-frames.toml"] {
@@ -311,12 +313,24 @@ fn a_chain_multiplies_as_its_links() {
         let x: Vec<f64> = (0..d)
             .map(|i| ((i * 7 + 3) % 11) as f64 / 11.0 - 0.4)
             .collect();
-        let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
-        form.apply(&x, &mut a);
-        plain.apply(&x, &mut b);
-        let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (p, q) in a.iter().zip(&b) {
-            assert!((p - q).abs() <= 1e-15 * size, "{file}: {p} against {q}");
+        for added in [Added::Nothing, Added::ConstantLess(0.7), Added::Less(-1.3)] {
+            let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
+            let top = form.scaled_term(&x, &mut a, added, 0.3);
+            plain.scaled_term(&x, &mut b, added, 0.3);
+            let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (p, q) in a.iter().zip(&b) {
+                assert!(
+                    (p - q).abs() <= 1e-15 * size,
+                    "{file} {added:?}: {p} against {q}"
+                );
+            }
+            let largest = |k: usize| {
+                a.iter()
+                    .skip(k)
+                    .step_by(2)
+                    .fold(0.0f64, |m, v| m.max(v.abs()))
+            };
+            assert_eq!(top, [largest(0), largest(1)], "{file} {added:?}");
         }
     }
 }

@@ -474,7 +474,10 @@ fn yielding_storeys_in_the_pair() {
     let elastic = parse_row(&plain, "e.toml").unwrap();
     let never = parse_row(&text.replace("YD", "10.0"), "n.toml").unwrap();
     let yielding = parse_row(&text.replace("YD", "0.002"), "y.toml").unwrap();
-    let run = RunSettings::new(0.005, 1e-9);
+    let run = RunSettings {
+        loops: true,
+        ..RunSettings::new(0.005, 1e-9)
+    };
     let rec = record();
     let a = elastic.respond(&rec, 1.0, false, &run).unwrap();
     let b = never.respond(&rec, 1.0, false, &run).unwrap();
@@ -510,6 +513,15 @@ fn yielding_storeys_in_the_pair() {
     // (trapezoids, ending at rest) is the hysteretic energy from the
     // storey's state to 2 % (the sampling of a 5 ms grid).
     assert_eq!(c.loops.len(), 2);
+    // Without the loops, the same peaks to the bit, and no loops.
+    let bare = yielding
+        .respond(&rec, 1.0, false, &RunSettings::new(0.005, 1e-9))
+        .unwrap();
+    assert!(bare.loops.is_empty());
+    assert_eq!(
+        (&bare.drift, &bare.residual_drift, &bare.acceleration),
+        (&c.drift, &c.residual_drift, &c.acceleration)
+    );
     for l in &c.loops {
         let i = l.storey.unwrap();
         let k = [4e7, 3e7][i];
