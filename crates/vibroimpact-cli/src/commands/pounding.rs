@@ -286,11 +286,7 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             args.scale
         )));
     }
-    let run = RunSettings {
-        // (The loops are drawn where figures are written.)
-        loops: args.out.is_some(),
-        ..args.run.settings()?
-    };
+    let run = args.run.settings()?;
     let row: Row = records::row(&args.pair)?;
     let runs = args
         .records
@@ -307,6 +303,11 @@ pub fn run(args: &PoundingArgs) -> Result<(), CliError> {
             gaps: range("moat_gaps", g)?,
         },
         _ => Study::Runs { free: args.free },
+    };
+    let run = RunSettings {
+        // (The runs' loops are drawn where figures are written.)
+        loops: args.out.is_some() && matches!(study, Study::Runs { .. }),
+        ..run
     };
     crate::progress::announce_long_as(
         study.estimate(&row, &runs, &run).map_err(pounding_error)?,

@@ -76,8 +76,9 @@ pub const MIN_RTOL: f64 = 1e-13;
 /// How a pounding run is computed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunSettings {
-    /// Sampling step of the hysteresis loops (s); peaks, residuals and
-    /// impact forces are exact whatever the step.
+    /// Sampling step of the hysteresis loops (s), and of the storeys'
+    /// drift checks where finer than the record's step; peaks, residuals
+    /// and impact forces are exact whatever the step.
     pub sample: f64,
     /// Relative tolerance of the integration (the absolute one is
     /// `rtol · 1e-4 · max(smallest gap, 1 mm)`, 1 mm without gaps).

@@ -113,7 +113,7 @@ pub(super) fn run(
     let (mut pieces, mut products) = (0u64, 0u64);
     let mut next_break = 0;
     let mut cap = f64::INFINITY;
-    // Each storey's switch parts at the last piece's end (NaN: not known).
+    // What each storey's switch parts are known to be at the last piece's end.
     let mut carried = vec![Known::Nothing; model.storeys().len()];
     let mut slopes = vec![(0.0, 0.0, false); model.storeys().len()];
     slopes_of(sys.storeys(), &mut slopes);
@@ -299,15 +299,17 @@ fn first_switch(
             turn: turn * acceleration,
             acceleration,
         };
-        // Moving one way and further from its switches than its parts can
-        // move over the piece, a storey clears on what it carries, its
-        // parts at the end not read: it carries their lower bounds on.
-        let (g, r, ra) = start.lower();
-        let rb = series.value_rate(2 * above, below.map(|j| 2 * j), b).1;
-        let one_way = ra.abs().max(rb.abs()) > acceleration * b;
+        // Moving one way on one side of zero drift, and further from its
+        // switches than its parts can move over the piece, a storey clears
+        // on what it carries, its parts at the end not read: it carries
+        // their lower bounds on.
+        let (g, r) = start.lower();
+        let drift = |tau: f64| series.value_rate(2 * above, below.map(|j| 2 * j), tau);
+        let ((da, ra), (db, rb)) = (drift(0.0), drift(b));
+        let one_way = ra.abs().max(rb.abs()) > acceleration * b && da * db > 0.0;
         if one_way && g > bounds.drift * b && r > bounds.turn * b {
             if b == h {
-                carried[k] = Known::Above(g - bounds.drift * h, r - bounds.turn * h, rb);
+                carried[k] = Known::Above(g - bounds.drift * h, r - bounds.turn * h);
             }
             continue;
         }
@@ -341,19 +343,18 @@ enum Known {
     Nothing,
     /// Their values (the last piece's end).
     Exact(Parts),
-    /// Lower bounds on the two parts, and the drift rate: carried over
-    /// pieces the drift moved one way over (the drift terms continuous).
-    Above(f64, f64, f64),
+    /// Lower bounds on the two parts, carried over pieces the drift moved
+    /// one way over without crossing zero (the drift terms continuous
+    /// there: docs/theory.md §13).
+    Above(f64, f64),
 }
 
 impl Known {
-    /// Lower bounds on the two parts (−∞ where nothing is known) and the
-    /// drift rate (NaN where not known: no piece then moves one way).
-    fn lower(self) -> Parts {
+    /// Lower bounds on the two parts (−∞ where nothing is known).
+    fn lower(self) -> (f64, f64) {
         match self {
-            Known::Nothing => (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NAN),
-            Known::Exact(p) => p,
-            Known::Above(g, r, rate) => (g, r, rate),
+            Known::Nothing => (f64::NEG_INFINITY, f64::NEG_INFINITY),
+            Known::Exact((g, r, _)) | Known::Above(g, r) => (g, r),
         }
     }
 }
