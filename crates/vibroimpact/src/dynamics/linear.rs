@@ -104,105 +104,109 @@ pub struct PiecewiseForm {
     /// (the force k (u_{i+1} − u_i) + c (v_{i+1} − v_i) on i): the product
     /// then walks the bodies once.
     chain: Option<Vec<[f64; 2]>>,
+    /// The largest row sums of |K| and |C|, the velocity rows of `A` on
+    /// the displacements and on the velocities ([`PiecewiseForm::norms`]).
+    norms: (f64, f64),
 }
 
-/// What a term of a series adds to each body's velocity row before it is
-/// scaled (docs/theory.md §13).
+/// What a term of a series adds to each body's row (docs/theory.md §13).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Added {
-    /// Nothing (the third term on).
+    /// Nothing (the fourth term on).
     Nothing,
-    /// The body's constant acceleration `b` less the base's `a₀` (the
-    /// first term).
-    ConstantLess(f64),
-    /// Minus this (the second term: the base's jerk times the interval).
+    /// The body's constant acceleration `b` less the base's `a₀`, times
+    /// the weight given (the third term).
+    ConstantLess(f64, f64),
+    /// Minus this (the fourth term: the base's jerk, weighted).
     Less(f64),
 }
 
 impl PiecewiseForm {
-    /// `out = (A x + added) w` (without the base but as `added` says), and
-    /// the largest |out| over the displacements and over the velocities
-    /// (a NaN passed over, as by `f64::max`): a term of a series
+    /// `out = (K x) wx + (C z) wz + added` per body, `K` and `C` the
+    /// velocity rows of `A` on the displacements and on the velocities
+    /// (without the base but as `added` says), and the largest |out| (a
+    /// NaN passed over, as by `f64::max`): a displacement term of a series
     /// (docs/theory.md §13).
     #[inline]
-    pub fn scaled_term(&self, x: &[f64], out: &mut [f64], added: Added, w: f64) -> [f64; 2] {
+    pub fn displacement_term(
+        &self,
+        (x, wx): (&[f64], f64),
+        (z, wz): (&[f64], f64),
+        out: &mut [f64],
+        added: Added,
+    ) -> f64 {
         if let Some(chain) = &self.chain {
-            return self.chain_term(chain, x, out, added, w);
+            return self.chain_term(chain, (x, wx), (z, wz), out, added);
         }
-        self.apply_links(x, out);
-        let mut top = [0.0f64; 2];
-        for (i, o) in out[..2 * self.ground.len()].chunks_exact_mut(2).enumerate() {
-            o[1] = match added {
-                Added::Nothing => o[1],
-                Added::ConstantLess(a0) => o[1] + (self.constant(i) - a0),
-                Added::Less(x) => o[1] - x,
-            };
-            scaled(o, w, &mut top);
+        let n = self.ground.len();
+        let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
+        for ((o, g), (x, z)) in out.iter_mut().zip(&self.ground).zip(x.iter().zip(z)) {
+            *o = (-g[0] * x) * wx + (-g[1] * z) * wz;
+        }
+        for &(a, b, k, c) in &self.links {
+            let f = k * (x[b] - x[a]) * wx + c * (z[b] - z[a]) * wz;
+            out[a] += f;
+            out[b] -= f;
+        }
+        let mut top = 0.0f64;
+        for (i, (o, m)) in out.iter_mut().zip(&self.inv_mass).enumerate() {
+            *o = *o * m + self.added(i, added);
+            top = larger(*o, top);
         }
         top
     }
 
-    /// `out = A x` by the links one by one.
-    fn apply_links(&self, x: &[f64], out: &mut [f64]) {
-        for (i, g) in self.ground.iter().enumerate() {
-            out[2 * i] = x[2 * i + 1];
-            out[2 * i + 1] = -g[0] * x[2 * i] - g[1] * x[2 * i + 1];
-        }
-        for &(a, b, k, c) in &self.links {
-            let f = k * (x[2 * b] - x[2 * a]) + c * (x[2 * b + 1] - x[2 * a + 1]);
-            out[2 * a + 1] += f;
-            out[2 * b + 1] -= f;
-        }
-        for (i, w) in self.inv_mass.iter().enumerate() {
-            out[2 * i + 1] *= w;
+    /// What `added` adds to body i's row.
+    #[inline(always)]
+    fn added(&self, i: usize, added: Added) -> f64 {
+        match added {
+            Added::Nothing => 0.0,
+            Added::ConstantLess(a0, w) => (self.constant(i) - a0) * w,
+            Added::Less(x) => -x,
         }
     }
 
-    /// [`PiecewiseForm::scaled_term`] on a chain: each link's force once,
-    /// in one pass over the bodies, a body's row written when the link
-    /// above it is known (iterators throughout: no index to check).
+    /// [`PiecewiseForm::displacement_term`] on a chain: each link's force
+    /// once, in one pass over the bodies, a body's row written when the
+    /// link above it is known (iterators throughout: no index to check).
     #[inline]
     fn chain_term(
         &self,
         chain: &[[f64; 2]],
-        x: &[f64],
+        (x, wx): (&[f64], f64),
+        (z, wz): (&[f64], f64),
         out: &mut [f64],
         added: Added,
-        w: f64,
-    ) -> [f64; 2] {
-        let mut top = [0.0f64; 2];
+    ) -> f64 {
+        let mut top = 0.0f64;
         let n = self.ground.len();
-        let (x, out) = (&x[..2 * n], &mut out[..2 * n]);
-        let mut rows = out
-            .chunks_exact_mut(2)
-            .zip(self.ground.iter().zip(&self.inv_mass));
-        let (Some(&[mut u, mut v]), Some((mut o, (mut g, mut m)))) =
-            (x.first_chunk::<2>(), rows.next())
+        let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
+        let mut rows = out.iter_mut().zip(self.ground.iter().zip(&self.inv_mass));
+        let (Some(&(mut u)), Some(&(mut v)), Some((mut o, (mut g, mut m)))) =
+            (x.first(), z.first(), rows.next())
         else {
             return top;
         };
-        let mut below = 0.0;
-        // (The sum in the order of the links one by one, to the bit.)
-        let mut row =
-            |o: &mut [f64], (u, v): (f64, f64), g: &[f64; 3], m: f64, (f, b): (f64, f64)| {
-                let a = (-g[0] * u - g[1] * v + f - b) * m;
-                o[0] = v;
-                o[1] = match added {
-                    Added::Nothing => a,
-                    Added::ConstantLess(a0) => a + (g[2] * m - a0),
-                    Added::Less(x) => a - x,
-                };
-                scaled(o, w, &mut top);
+        let mut below = (0.0, 0.0);
+        let mut row = |o: &mut f64, (u, v): (f64, f64), g: &[f64; 3], m: f64, above: (f64, f64)| {
+            let a =
+                ((-g[0] * u + above.0 - below.0) * wx + (-g[1] * v + above.1 - below.1) * wz) * m;
+            *o = match added {
+                Added::Nothing => a,
+                Added::ConstantLess(a0, w) => a + (g[2] * m - a0) * w,
+                Added::Less(x) => a - x,
             };
-        for ((next, &[k, c]), (o_next, (g_next, m_next))) in
-            x[2..].chunks_exact(2).zip(chain).zip(rows)
+            top = larger(*o, top);
+            below = above;
+        };
+        for (((&xn, &zn), &[k, c]), (o_next, (g_next, m_next))) in
+            x[1..].iter().zip(&z[1..]).zip(chain).zip(rows)
         {
-            let above = k * (next[0] - u) + c * (next[1] - v);
-            row(o, (u, v), g, *m, (above, below));
-            (u, v, below) = (next[0], next[1], above);
+            row(o, (u, v), g, *m, (k * (xn - u), c * (zn - v)));
+            (u, v) = (xn, zn);
             (o, g, m) = (o_next, g_next, m_next);
         }
-        row(o, (u, v), g, *m, (0.0, below));
+        row(o, (u, v), g, *m, (0.0, 0.0));
         top
     }
 
@@ -247,6 +251,35 @@ impl PiecewiseForm {
         self.chain = Some(chain);
     }
 
+    /// The infinity norms of `K` and `C`, the velocity rows of `A` on the
+    /// displacements and on the velocities: `|K x|∞ ≤ norms.0 |x|∞`, and
+    /// the same for `C` (a series' tail bounded by them:
+    /// docs/theory.md §13).
+    pub fn norms(&self) -> (f64, f64) {
+        self.norms
+    }
+
+    /// [`PiecewiseForm::norms`] from the ground and the links.
+    fn norms_of(&mut self) {
+        let mut rows: Vec<[f64; 2]> = self
+            .ground
+            .iter()
+            .map(|g| [g[0].abs(), g[1].abs()])
+            .collect();
+        for &(a, b, k, c) in &self.links {
+            for i in [a, b] {
+                rows[i][0] += 2.0 * k.abs();
+                rows[i][1] += 2.0 * c.abs();
+            }
+        }
+        self.norms = rows
+            .iter()
+            .zip(&self.inv_mass)
+            .fold((0.0, 0.0), |(nk, nc), (r, m)| {
+                (f64::max(nk, r[0] * m.abs()), f64::max(nc, r[1] * m.abs()))
+            });
+    }
+
     /// Body i's constant acceleration `b` (its velocity row's).
     #[inline]
     pub fn constant(&self, i: usize) -> f64 {
@@ -254,15 +287,15 @@ impl PiecewiseForm {
     }
 }
 
-/// A row `o` times `w`, its parts' sizes kept in `top` if larger (two
-/// short chains of plain comparisons).
+/// The larger of |x| and `top` (a plain comparison: a NaN passed over).
 #[inline(always)]
-fn scaled(o: &mut [f64], w: f64, top: &mut [f64; 2]) {
-    o[0] *= w;
-    o[1] *= w;
-    let (a, b) = (o[0].abs(), o[1].abs());
-    top[0] = if a > top[0] { a } else { top[0] };
-    top[1] = if b > top[1] { b } else { top[1] };
+fn larger(x: f64, top: f64) -> f64 {
+    let a = x.abs();
+    if a > top {
+        a
+    } else {
+        top
+    }
 }
 
 impl ChainDynamics {
@@ -312,6 +345,7 @@ impl ChainDynamics {
             }
         }
         form.chain_of();
+        form.norms_of();
         true
     }
 }

@@ -168,6 +168,7 @@ impl GaugeScan {
     }
 
     /// Notes a value.
+    #[inline]
     pub(super) fn note(&mut self, x: f64) {
         self.min = self.min.min(x);
         self.max = self.max.max(x);
@@ -191,35 +192,50 @@ impl GaugeScan {
         self.scan_ends((a, b), ends, at);
     }
 
-    /// [`GaugeScan::scan`] with the values and rates at the ends given.
+    /// [`GaugeScan::scan`] with the values and rates at the ends given
+    /// (inline: most pieces only note their ends).
+    #[inline]
     pub(super) fn scan_ends(
+        &mut self,
+        (a, b): (f64, f64),
+        ((xa, ra), (xb, rb)): ((f64, f64), (f64, f64)),
+        at: impl FnMut(f64) -> (f64, f64),
+    ) {
+        self.note(xa);
+        self.note(xb);
+        if ra * rb < 0.0 {
+            self.turning((a, b), ((xa, ra), (xb, rb)), at);
+        } else if self.gauge.mean_from().is_some() {
+            self.mean_part((a, b), at);
+        }
+    }
+
+    /// [`GaugeScan::scan_ends`] where the rate changes sign between the
+    /// ends: the cubic's stationary point, then one secant step on the
+    /// rate from the side of the bracket it leaves; skipped where the
+    /// cubic's extremum stays a hundredth of the reading's size inside
+    /// what was read (the cubic is within about (ωh)⁴/384 of the motion:
+    /// 3e-3 even at ωh = 1, and the local integrator's pieces keep ωh
+    /// below 0.4). Then the mean's part.
+    #[inline(never)]
+    fn turning(
         &mut self,
         (a, b): (f64, f64),
         ((xa, ra), (xb, rb)): ((f64, f64), (f64, f64)),
         mut at: impl FnMut(f64) -> (f64, f64),
     ) {
-        self.note(xa);
-        self.note(xb);
-        if ra * rb < 0.0 {
-            // The cubic's stationary point, then one secant step on the
-            // rate from the side of the bracket it leaves; skipped where the
-            // cubic's extremum stays a hundredth of the reading's size
-            // inside what was read (the cubic is within about (ωh)⁴/384 of
-            // the motion: 3e-3 even at ωh = 1, and the local integrator's
-            // pieces keep ωh below 0.4).
-            let (t1, guess) = hermite_stationary((a, b), (xa, ra), (xb, rb));
-            let margin = 1e-2 * self.min.abs().max(self.max.abs());
-            if guess < self.max - margin && guess > self.min + margin {
-                return self.mean_part((a, b), at);
-            }
-            let (x1, r1) = at(t1);
-            self.note(x1);
-            let (tc, rc) = if r1 * ra < 0.0 { (a, ra) } else { (b, rb) };
-            if r1 != 0.0 && r1 != rc {
-                let t2 = t1 - r1 * (t1 - tc) / (r1 - rc);
-                if t2 > a && t2 < b {
-                    self.note(at(t2).0);
-                }
+        let (t1, guess) = hermite_stationary((a, b), (xa, ra), (xb, rb));
+        let margin = 1e-2 * self.min.abs().max(self.max.abs());
+        if guess < self.max - margin && guess > self.min + margin {
+            return self.mean_part((a, b), at);
+        }
+        let (x1, r1) = at(t1);
+        self.note(x1);
+        let (tc, rc) = if r1 * ra < 0.0 { (a, ra) } else { (b, rb) };
+        if r1 != 0.0 && r1 != rc {
+            let t2 = t1 - r1 * (t1 - tc) / (r1 - rc);
+            if t2 > a && t2 < b {
+                self.note(at(t2).0);
             }
         }
         self.mean_part((a, b), at);

@@ -143,11 +143,11 @@ pub(super) fn run(
             Built::Done => {
                 products += series_terms(&series);
                 // (Longer where the terms fell fast: a long interval of
-                // no forcing, where the last was halved. Kept to about 13
+                // no forcing, where the last was halved. Kept to about 14
                 // terms, ω h below 1/2 as within the record: a piece's
                 // extrema and gauges are sought where their rates change
                 // sign at its ends.)
-                if series.terms() < 14 {
+                if series.terms() < 15 {
                     cap *= 2.0;
                 }
             }
@@ -173,7 +173,7 @@ pub(super) fn run(
             Some((tau, _)) => (tau, t + tau),
             None => (h, t1),
         };
-        reader.piece(&series, (t, t_next), (a0, slope));
+        reader.piece(&series, (t, t_next, tau), (a0, slope));
         let stopped = reader.samples(opts, &mut sys, &series, (t, t_next), &mut next_sample, sink);
         series.state(tau, &mut y);
         if y.iter().any(|x| !x.is_finite()) {
@@ -219,9 +219,10 @@ pub(super) fn run(
     }
 }
 
-/// The products with `A` a series took (a right-hand side's worth each).
+/// The products with `A` a series took (a right-hand side's worth each:
+/// its terms past the first two, which are the state).
 fn series_terms(series: &Series) -> u64 {
-    series.terms() as u64 - 1
+    series.terms() as u64 - 2
 }
 
 /// A state that is not finite, or an interval that cannot be shortened.
@@ -455,8 +456,9 @@ fn largest(at: impl Fn(f64) -> (f64, f64, f64), (a, b): (f64, f64)) -> f64 {
 
 impl Reader {
     /// The extrema and gauges over the piece `(ta, tb)` of the series
-    /// (from `ta`), whose base acceleration is `a0 + s (t − ta)`.
-    fn piece(&mut self, series: &Series, (ta, tb): (f64, f64), (a0, s): (f64, f64)) {
+    /// (from `ta`; `tb` at its τ = `tau`), whose base acceleration is `a0 +
+    /// s (t − ta)`.
+    fn piece(&mut self, series: &Series, (ta, tb, tau): (f64, f64, f64), (a0, s): (f64, f64)) {
         let Some((from, to)) = self.window else {
             return;
         };
@@ -473,26 +475,30 @@ impl Reader {
                 f.max_velocity[i] = f.max_velocity[i].max(max_v);
             }
         }
+        // (The piece's end read at its own τ: tb − ta may differ from it
+        // in the last bit, and at the series' end that is its sums.)
+        let end_tau = if b == tb { tau } else { b - ta };
         for (gauge, end) in self.gauges.iter_mut().zip(self.ends.iter_mut()) {
             let kind = gauge.gauge;
-            let at = |t: f64| match kind {
+            let at_tau = |tau: f64| match kind {
                 Gauge::Separation { left, right, .. } => match left {
-                    Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), t - ta),
+                    Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), tau),
                     None => {
-                        let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, t - ta);
+                        let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, tau);
                         (-x, -r)
                     }
                 },
                 Gauge::AbsoluteAcceleration { body } => {
-                    let (_, a, jerk) = series.component(2 * body + 1, t - ta);
-                    (a + a0 + s * (t - ta), jerk + s)
+                    let (_, a, jerk) = series.component(2 * body + 1, tau);
+                    (a + a0 + s * tau, jerk + s)
                 }
             };
+            let at = |t: f64| at_tau(t - ta);
             let start = match (kind, *end) {
                 (Gauge::Separation { .. }, (t, x)) if t == a => x,
                 _ => at(a),
             };
-            let ends = (start, at(b));
+            let ends = (start, at_tau(end_tau));
             *end = (b, ends.1);
             gauge.scan_ends((a, b), ends, at);
         }
@@ -557,7 +563,7 @@ impl Reader {
             }
             for i in 0..n {
                 self.row[k + i] = match at {
-                    Some((s, tau)) => s.component(2 * i + 1, tau).1,
+                    Some((s, tau)) => s.acceleration(i, tau),
                     None => rates[2 * i + 1],
                 };
             }

@@ -1,21 +1,33 @@
 //! The motion over one interval as its Taylor series (docs/theory.md §13):
-//! `ẏ = A y + b − e (a₀ + s τ)` from `y` at τ = 0 moves as `y(τ) = Σ c_j
-//! τ^j` with `c₀ = y`, `c₁ = A y + b − e a₀`, `c₂ = (A c₁ − e s)/2` and
-//! `c_j = A c_{j−1}/j` beyond, exactly (the series of a linear system with
-//! a forcing linear in time): summed to the first term below 1e-16 of the
-//! largest, it is the motion to rounding, and so are its derivatives. The
+//! `ẏ = A y + b − e (a₀ + s τ)` from `y = (u, v)` at τ = 0 moves as
+//! `u(τ) = Σ c_j τ^j` (the velocities its derivative), with `c₀ = u`,
+//! `c₁ = v` and, from the velocity rows of A (`K` on displacements, `C`
+//! on velocities: `v̇ = K u + C v + b − a₀ − s τ`),
+//! `c_{j+2} = (K c_j + (j+1) C c_{j+1} + f_j)/((j+1)(j+2))`, `f₀ = b − a₀`,
+//! `f₁ = −s`, exactly (the series of a linear system with a forcing
+//! linear in time): summed to the first term below 1e-16 of the largest,
+//! it is the motion to rounding, and so are its derivatives. The
 //! coefficients are kept scaled, `c_j h^j` (a polynomial in θ = τ/h on
 //! [0, 1]): a term's size is then the coefficient's, and the values at
-//! the interval's end are sums.
+//! the interval's end are sums. Displacements alone are kept: a velocity
+//! coefficient is the next displacement's times (j+1)/h, so a term costs
+//! one row per body.
 
 use crate::dynamics::{Added, PiecewiseForm};
 
 /// Most terms of a series; an interval whose terms have not fallen by
 /// then is too long for it ([`Built::TooLong`]).
 const MAX_TERMS: usize = 40;
-/// Where a series is cut: at the first term (from the third) below this
-/// part of the largest over the interval (the terms then fall by more
-/// than a factor 10 each, so what is left is below rounding).
+/// Where a series is cut: at the first term k (from the fifth) past
+/// which the terms' sum on the displacements and on the velocities times
+/// h, `Σ_{i>k} i |c_i h^i|`, is bounded below this part of the largest
+/// term over the interval (what is left is then below rounding). The
+/// bound: from the recurrence, `M_{i+2} ≤ α_i M_i + β_i M_{i+1}` (M_i the
+/// largest coefficient of term i, `α_i = |K| h²/((i+1)(i+2))` and `β_i =
+/// |C| h/(i+2)` falling with i), so that every two terms past k are at
+/// most ρ = α_{k−1} + β_{k−1} times the two before, and the sum is at
+/// most `2 e ρ (k + 2)/(1 − ρ)²`, e the larger of terms k − 1 and k
+/// (taken where ρ < 1/2).
 const CUT: f64 = 1e-16;
 
 /// How a series was built.
@@ -32,19 +44,24 @@ pub(super) enum Built {
 /// The series of one interval.
 #[derive(Clone, Debug)]
 pub(super) struct Series {
-    dim: usize,
-    /// The scaled coefficients `c_j h^j`, one state after the other.
+    /// Bodies.
+    n: usize,
+    /// The scaled displacement coefficients `c_j h^j`, one term's bodies
+    /// after the other.
     c: Vec<f64>,
-    /// How many.
+    /// The velocities at τ = 0 (exactly as given: `c₁ h / h` may differ
+    /// in the last bit).
+    v0: Vec<f64>,
+    /// How many terms.
     terms: usize,
-    /// The interval's length, its inverse and its inverse squared.
+    /// The interval's length and the powers of its inverse (1, 1/h, 1/h²,
+    /// 1/h³).
     h: f64,
-    inv_h: f64,
-    inv_h2: f64,
-    /// Every component's value and first two derivatives at its end, τ =
-    /// h (read at every piece's end: the samples, the gauges, the
-    /// switches and the next state).
-    end: Vec<[f64; 3]>,
+    inv: [f64; 4],
+    /// Every body's displacement and its first three derivatives at the
+    /// end, τ = h (read at every piece's end: the samples, the gauges,
+    /// the switches and the next state).
+    end: Vec<[f64; 4]>,
     /// `Σ_{j≥4} j m_j` and `Σ_{j≥4} j (j−1) m_j`, m_j the largest
     /// displacement's coefficient of term j: the tails of
     /// [`Series::rate_bounds`].
@@ -52,16 +69,17 @@ pub(super) struct Series {
 }
 
 impl Series {
-    /// Room for states of `dim` values.
+    /// Room for states of `dim` values (`dim / 2` bodies).
     pub(super) fn new(dim: usize) -> Self {
+        let n = dim / 2;
         Self {
-            dim,
-            c: vec![0.0; dim * MAX_TERMS],
+            n,
+            c: vec![0.0; n * MAX_TERMS],
+            v0: vec![0.0; n],
             terms: 0,
             h: 0.0,
-            inv_h: 0.0,
-            inv_h2: 0.0,
-            end: vec![[0.0; 3]; dim],
+            inv: [1.0; 4],
+            end: vec![[0.0; 4]; n],
             tails: (0.0, 0.0),
         }
     }
@@ -75,34 +93,72 @@ impl Series {
         (a0, s): (f64, f64),
         h: f64,
     ) -> Built {
-        let d = self.dim;
+        let n = self.n;
         self.h = h;
-        self.inv_h = 1.0 / h;
-        self.inv_h2 = self.inv_h * self.inv_h;
-        self.c[..d].copy_from_slice(y);
-        let mut largest = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let r = 1.0 / h;
+        self.inv = [1.0, r, r * r, r * r * r];
+        let (c0, rest) = self.c.split_at_mut(n);
+        let c1 = &mut rest[..n];
+        let mut largest = 0.0f64;
+        for (((u, v), (c0, c1)), v0) in y
+            .iter()
+            .step_by(2)
+            .zip(y.iter().skip(1).step_by(2))
+            .zip(c0.iter_mut().zip(c1.iter_mut()))
+            .zip(self.v0.iter_mut())
+        {
+            (*c0, *c1, *v0) = (*u, v * h, *v);
+            largest = largest.max(u.abs()).max(c1.abs());
+        }
         self.tails = (0.0, 0.0);
-        for j in 1..MAX_TERMS {
-            let (before, after) = self.c.split_at_mut(j * d);
-            let (prev, next) = (&before[(j - 1) * d..], &mut after[..d]);
+        // (The last term's largest coefficient.)
+        let mut previous = f64::INFINITY;
+        let norms = form.norms();
+        // (c_{j+2} h^{j+2} = K c_j h^j wx_j + C c_{j+1} h^{j+1} wz_j + f_j
+        // h^{j+2}/((j+1)(j+2)), wx_j = h²/((j+1)(j+2)), wz_j = h/(j+2).)
+        let weights = |j: usize| {
+            let jf = j as f64;
+            (h * h / ((jf + 1.0) * (jf + 2.0)), h / (jf + 2.0))
+        };
+        let (mut wx, mut wz) = weights(0);
+        for j in 0..MAX_TERMS - 2 {
+            let (before, after) = self.c.split_at_mut((j + 2) * n);
+            let next = &mut after[..n];
+            let x = &before[j * n..(j + 1) * n];
+            let z = match j {
+                0 => &self.v0[..],
+                _ => &before[(j + 1) * n..],
+            };
             let added = match j {
-                1 => Added::ConstantLess(a0),
-                2 => Added::Less(s * h),
+                0 => Added::ConstantLess(a0, wx),
+                1 => Added::Less(s * h * wx),
                 _ => Added::Nothing,
             };
-            let top = form.scaled_term(prev, next, added, h / j as f64);
-            if j >= 4 {
-                let jf = j as f64;
-                self.tails.0 += jf * top[0];
-                self.tails.1 += jf * (jf - 1.0) * top[0];
-            }
-            let top = if top[0] > top[1] { top[0] } else { top[1] };
+            // (The velocity's weight in the first term is h²/2: c₁ is v,
+            // not v h.)
+            let wv = if j == 0 { wx } else { wz };
+            let top = form.displacement_term((x, wx), (z, wv), next, added);
+            (wx, wz) = weights(j + 1);
+            let k = (j + 2) as f64;
             if !top.is_finite() {
                 return Built::NonFinite;
             }
-            largest = largest.max(top);
-            if j >= 3 && top <= CUT * largest {
-                self.terms = j + 1;
+            largest = largest.max(k * top);
+            let last = std::mem::replace(&mut previous, top);
+            if j < 2 {
+                continue;
+            }
+            self.tails.0 += k * top;
+            self.tails.1 += k * (k - 1.0) * top;
+            // (The tail past term k: every two terms at most ρ times the
+            // two before, ρ = |K| wx_{k−1} + |C| wz_{k−1} (see
+            // `CUT`).)
+            let rho = norms.0 * wx + norms.1 * wz;
+            if rho < 0.5
+                && 2.0 * top.max(last) * rho * (k + 2.0)
+                    <= CUT * largest * (1.0 - rho) * (1.0 - rho)
+            {
+                self.terms = j + 3;
                 self.ends();
                 return Built::Done;
             }
@@ -110,110 +166,137 @@ impl Series {
         Built::TooLong
     }
 
-    /// Every component's value and first two derivatives at `h` into
-    /// `end`: at θ = 1 sums of the coefficients.
+    /// Every body's displacement and its first three derivatives at `h`
+    /// into `end`: at θ = 1 sums of the coefficients.
     fn ends(&mut self) {
-        let d = self.dim;
+        let n = self.n;
         for e in self.end.iter_mut() {
-            *e = [0.0; 3];
+            *e = [0.0; 4];
         }
         for j in (0..self.terms).rev() {
             let jf = j as f64;
-            let c = &self.c[j * d..(j + 1) * d];
-            for (e, c) in self.end.iter_mut().zip(c) {
-                e[0] += c;
-                e[1] += jf * c;
-                e[2] += jf * (jf - 1.0) * c;
+            let (w2, w3) = (jf * (jf - 1.0), jf * (jf - 1.0) * (jf - 2.0));
+            for (e, &c) in self.end.iter_mut().zip(&self.c[j * n..(j + 1) * n]) {
+                *e = [e[0] + c, e[1] + jf * c, e[2] + w2 * c, e[3] + w3 * c];
             }
         }
-        let (r, q) = (self.inv_h, self.inv_h2);
+        let [_, r, q, p] = self.inv;
         for e in self.end.iter_mut() {
-            e[1] *= r;
-            e[2] *= q;
+            *e = [e[0], e[1] * r, e[2] * q, e[3] * p];
         }
     }
 
-    /// How many terms it has.
+    /// How many terms it has (displacement coefficients).
     pub(super) fn terms(&self) -> usize {
         self.terms
     }
 
-    /// The state at τ into `out`.
+    /// The state at τ into `out` (`[u, v]` per body).
     pub(super) fn state(&self, tau: f64, out: &mut [f64]) {
-        let d = self.dim;
-        if tau == self.h {
-            for (o, e) in out.iter_mut().zip(&self.end) {
-                *o = e[0];
+        if let Some(dt) = self.before_end(tau) {
+            for (o, e) in out.chunks_exact_mut(2).zip(&self.end) {
+                let e = shifted(e, dt);
+                (o[0], o[1]) = (e[0], e[1]);
             }
             return;
         }
-        let theta = tau / self.h;
-        out.copy_from_slice(&self.c[(self.terms - 1) * d..self.terms * d]);
-        for j in (0..self.terms - 1).rev() {
-            let c = &self.c[j * d..(j + 1) * d];
-            for (o, c) in out.iter_mut().zip(c) {
-                *o = *o * theta + c;
-            }
+        for (b, o) in out.chunks_exact_mut(2).enumerate() {
+            (o[0], o[1]) = self.value_rate_inside(b, None, tau);
         }
     }
 
-    /// Component i at τ and its first two derivatives.
+    /// Body b's acceleration at τ.
+    pub(super) fn acceleration(&self, b: usize, tau: f64) -> f64 {
+        match self.before_end(tau) {
+            Some(dt) => shifted(&self.end[b], dt)[2],
+            None => self.component(2 * b + 1, tau).1,
+        }
+    }
+
+    /// `τ − h` where τ is within 1e-9 h of the end (a sample's time and
+    /// the piece's end apart by rounding): a Taylor step from the end's
+    /// four derivatives is then the series to rounding (what it leaves out
+    /// is below (1e-9 ω h)² of the acceleration, ω h ≤ 1/2).
+    #[inline(always)]
+    fn before_end(&self, tau: f64) -> Option<f64> {
+        let dt = tau - self.h;
+        (dt.abs() <= 1e-9 * self.h).then_some(dt)
+    }
+
+    /// Component i of the state (`2 b`: body b's displacement, `2 b + 1`:
+    /// its velocity) at τ and its first two derivatives.
     #[inline(always)]
     pub(super) fn component(&self, i: usize, tau: f64) -> (f64, f64, f64) {
-        let d = self.dim;
+        let (b, d) = (i / 2, i % 2);
+        let n = self.n;
         if tau == 0.0 {
-            return (
-                self.c[i],
-                self.c[d + i] * self.inv_h,
-                2.0 * self.c[2 * d + i] * self.inv_h2,
-            );
+            let [_, _, q, p] = self.inv;
+            let (c2, c3) = (self.c[2 * n + b], self.c[3 * n + b]);
+            return match d {
+                0 => (self.c[b], self.v0[b], 2.0 * c2 * q),
+                _ => (self.v0[b], 2.0 * c2 * q, 6.0 * c3 * p),
+            };
         }
-        if tau == self.h {
-            let [x, r, q] = self.end[i];
-            return (x, r, q);
-        }
-        self.component_inside(i, tau)
+        let e = if tau == self.h {
+            self.end[b]
+        } else {
+            self.derivatives_inside(b, tau)
+        };
+        (e[d], e[d + 1], e[d + 2])
     }
 
-    /// [`Series::component`] inside the interval, by Horner.
+    /// Body b's displacement and its first three derivatives inside the
+    /// interval, by Horner.
     #[inline(never)]
-    fn component_inside(&self, i: usize, tau: f64) -> (f64, f64, f64) {
-        let d = self.dim;
+    fn derivatives_inside(&self, b: usize, tau: f64) -> [f64; 4] {
+        let n = self.n;
         let theta = tau / self.h;
-        let (mut x, mut dx, mut ddx) = (0.0, 0.0, 0.0);
+        let mut e = [0.0; 4];
         for j in (0..self.terms).rev() {
-            let c = self.c[j * d + i];
-            ddx = ddx * theta + 2.0 * dx;
-            dx = dx * theta + x;
-            x = x * theta + c;
+            let c = self.c[j * n + b];
+            e[3] = e[3] * theta + 3.0 * e[2];
+            e[2] = e[2] * theta + 2.0 * e[1];
+            e[1] = e[1] * theta + e[0];
+            e[0] = e[0] * theta + c;
         }
-        (x, dx * self.inv_h, ddx * self.inv_h2)
+        for (e, r) in e.iter_mut().zip(self.inv) {
+            *e *= r;
+        }
+        e
     }
 
-    /// `component(i) − component(j)` (j None: zero) at τ and its rate.
+    /// `component(i) − component(j)` (j None: zero), two displacements
+    /// (i, j even), at τ and its rate.
     #[inline(always)]
     pub(super) fn value_rate(&self, i: usize, j: Option<usize>, tau: f64) -> (f64, f64) {
-        if tau == 0.0 || tau == self.h {
-            let a = self.component(i, tau);
-            let b = j.map_or((0.0, 0.0, 0.0), |j| self.component(j, tau));
-            return (a.0 - b.0, a.1 - b.1);
+        debug_assert!(i % 2 == 0 && j.is_none_or(|j| j % 2 == 0));
+        let (a, b) = (i / 2, j.map(|j| j / 2));
+        if tau == 0.0 {
+            let at = |b: usize| (self.c[b], self.v0[b]);
+            let (x, r) = at(a);
+            let (y, q) = b.map_or((0.0, 0.0), at);
+            return (x - y, r - q);
         }
-        self.value_rate_inside(i, j, tau)
+        if tau == self.h {
+            let (x, y) = (self.end[a], b.map_or([0.0; 4], |b| self.end[b]));
+            return (x[0] - y[0], x[1] - y[1]);
+        }
+        self.value_rate_inside(a, b, tau)
     }
 
-    /// [`Series::value_rate`] inside the interval, by Horner on the
-    /// difference's coefficients.
+    /// [`Series::value_rate`] inside the interval (bodies a and b), by
+    /// Horner on the difference's coefficients.
     #[inline(never)]
-    fn value_rate_inside(&self, i: usize, j: Option<usize>, tau: f64) -> (f64, f64) {
-        let d = self.dim;
+    fn value_rate_inside(&self, a: usize, b: Option<usize>, tau: f64) -> (f64, f64) {
+        let n = self.n;
         let theta = tau / self.h;
         let (mut x, mut dx) = (0.0, 0.0);
         for k in (0..self.terms).rev() {
-            let c = self.c[k * d + i] - j.map_or(0.0, |j| self.c[k * d + j]);
+            let c = self.c[k * n + a] - b.map_or(0.0, |b| self.c[k * n + b]);
             dx = dx * theta + x;
             x = x * theta + c;
         }
-        (x, dx * self.inv_h)
+        (x, dx * self.inv[1])
     }
 
     /// Bounds over the whole interval on the first and second derivatives
@@ -224,17 +307,30 @@ impl Series {
     /// each side.
     pub(super) fn rate_bounds(&self, i: usize, j: Option<usize>) -> (f64, f64) {
         debug_assert!(i % 2 == 0 && j.is_none_or(|j| j % 2 == 0));
-        let d = self.dim;
+        let n = self.n;
+        let (a, b) = (i / 2, j.map(|j| j / 2));
         let (mut first, mut second) = (0.0, 0.0);
         for k in 1..self.terms.min(4) {
-            let c = (self.c[k * d + i] - j.map_or(0.0, |j| self.c[k * d + j])).abs();
+            let c = (self.c[k * n + a] - b.map_or(0.0, |b| self.c[k * n + b])).abs();
             let kf = k as f64;
             first += kf * c;
             second += kf * (kf - 1.0) * c;
         }
-        let sides = if j.is_some() { 2.0 } else { 1.0 };
+        let sides = if b.is_some() { 2.0 } else { 1.0 };
         first += sides * self.tails.0;
         second += sides * self.tails.1;
-        (first * self.inv_h, second * self.inv_h2)
+        (first * self.inv[1], second * self.inv[2])
     }
+}
+
+/// A displacement's value and first two derivatives `dt` from where they
+/// and the third are `e` (the third taken as constant over `dt`).
+#[inline(always)]
+fn shifted(e: &[f64; 4], dt: f64) -> [f64; 3] {
+    let half = 0.5 * dt;
+    [
+        e[0] + dt * (e[1] + half * (e[2] + dt / 3.0 * e[3])),
+        e[1] + dt * (e[2] + half * e[3]),
+        e[2] + dt * e[3],
+    ]
 }
