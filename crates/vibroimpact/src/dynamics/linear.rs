@@ -104,20 +104,21 @@ pub struct PiecewiseForm {
     /// (the force k (u_{i+1} − u_i) + c (v_{i+1} − v_i) on i): the product
     /// then walks the bodies once.
     chain: Option<Vec<[f64; 2]>>,
-    /// The largest row sums of |K| and |C|, the velocity rows of `A` on
-    /// the displacements and on the velocities ([`PiecewiseForm::norms`]).
+    /// Upper bounds on the largest row sums of |K| and |C|, the velocity
+    /// rows of `A` on the displacements and on the velocities
+    /// ([`PiecewiseForm::norms`]).
     norms: (f64, f64),
 }
 
 /// What a term of a series adds to each body's row (docs/theory.md §13).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Added {
-    /// Nothing (the fourth term on).
+    /// Nothing (the fifth term on).
     Nothing,
     /// The body's constant acceleration `b` less the base's `a₀`, times
-    /// the weight given (the third term).
+    /// the weight given (the third term, c₂).
     ConstantLess(f64, f64),
-    /// Minus this (the fourth term: the base's jerk, weighted).
+    /// Minus this (the fourth term, c₃: the base's jerk, weighted).
     Less(f64),
 }
 
@@ -251,8 +252,9 @@ impl PiecewiseForm {
         self.chain = Some(chain);
     }
 
-    /// The infinity norms of `K` and `C`, the velocity rows of `A` on the
-    /// displacements and on the velocities: `|K x|∞ ≤ norms.0 |x|∞`, and
+    /// Upper bounds on the infinity norms of `K` and `C`, the velocity rows
+    /// of `A` on the displacements and on the velocities: `|K x|∞ ≤
+    /// norms.0 |x|∞`, and
     /// the same for `C` (a series' tail bounded by them:
     /// docs/theory.md §13).
     pub fn norms(&self) -> (f64, f64) {

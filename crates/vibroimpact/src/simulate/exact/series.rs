@@ -5,8 +5,9 @@
 //! on velocities: `v̇ = K u + C v + b − a₀ − s τ`),
 //! `c_{j+2} = (K c_j + (j+1) C c_{j+1} + f_j)/((j+1)(j+2))`, `f₀ = b − a₀`,
 //! `f₁ = −s`, exactly (the series of a linear system with a forcing
-//! linear in time): summed to the first term below 1e-16 of the largest,
-//! it is the motion to rounding, and so are its derivatives. The
+//! linear in time): summed until a bound on what the terms left would add
+//! is below 1e-16 of the largest ([`CUT`]), it is the motion to rounding,
+//! and so are its derivatives. The
 //! coefficients are kept scaled, `c_j h^j` (a polynomial in θ = τ/h on
 //! [0, 1]): a term's size is then the coefficient's, and the values at
 //! the interval's end are sums. Displacements alone are kept: a velocity
@@ -21,19 +22,22 @@ const MAX_TERMS: usize = 40;
 /// Where a series is cut: at the first term k (from the fifth) past
 /// which the terms' sum on the displacements and on the velocities times
 /// h, `Σ_{i>k} i |c_i h^i|`, is bounded below this part of the largest
-/// term over the interval (what is left is then below rounding). The
+/// `i |c_i h^i|` over the interval, with |u| and |v h| (what is left is
+/// then below rounding). The
 /// bound: from the recurrence, `M_{i+2} ≤ α_i M_i + β_i M_{i+1}` (M_i the
 /// largest coefficient of term i, `α_i = |K| h²/((i+1)(i+2))` and `β_i =
 /// |C| h/(i+2)` falling with i), so that every two terms past k are at
 /// most ρ = α_{k−1} + β_{k−1} times the two before, and the sum is at
 /// most `2 e ρ (k + 2)/(1 − ρ)²`, e the larger of terms k − 1 and k
-/// (taken where ρ < 1/2).
+/// (taken where ρ < 1/2; where both are zero, so is every term after).
+/// |K| and |C| are upper bounds on the infinity norms
+/// ([`PiecewiseForm::norms`]).
 const CUT: f64 = 1e-16;
 
 /// How a series was built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Built {
-    /// Its terms fell below [`CUT`].
+    /// Its tail's bound fell below [`CUT`].
     Done,
     /// They did not by [`MAX_TERMS`]: halve the interval.
     TooLong,
@@ -154,9 +158,10 @@ impl Series {
             // two before, ρ = |K| wx_{k−1} + |C| wz_{k−1} (see
             // `CUT`).)
             let rho = norms.0 * wx + norms.1 * wz;
-            if rho < 0.5
-                && 2.0 * top.max(last) * rho * (k + 2.0)
-                    <= CUT * largest * (1.0 - rho) * (1.0 - rho)
+            let e = top.max(last);
+            if e == 0.0
+                || rho < 0.5
+                    && 2.0 * e * rho * (k + 2.0) <= CUT * largest * (1.0 - rho) * (1.0 - rho)
             {
                 self.terms = j + 3;
                 self.ends();
@@ -193,6 +198,12 @@ impl Series {
 
     /// The state at τ into `out` (`[u, v]` per body).
     pub(super) fn state(&self, tau: f64, out: &mut [f64]) {
+        if tau == 0.0 {
+            for ((o, u), v) in out.chunks_exact_mut(2).zip(&self.c).zip(&self.v0) {
+                (o[0], o[1]) = (*u, *v);
+            }
+            return;
+        }
         if let Some(dt) = self.before_end(tau) {
             for (o, e) in out.chunks_exact_mut(2).zip(&self.end) {
                 let e = shifted(e, dt);
@@ -216,7 +227,8 @@ impl Series {
     /// `τ − h` where τ is within 1e-9 h of the end (a sample's time and
     /// the piece's end apart by rounding): a Taylor step from the end's
     /// four derivatives is then the series to rounding (what it leaves out
-    /// is below (1e-9 ω h)² of the acceleration, ω h ≤ 1/2).
+    /// is about (1e-9 ω h)² of the acceleration: ω h is below 1/2 within
+    /// the record, and a few past it).
     #[inline(always)]
     fn before_end(&self, tau: f64) -> Option<f64> {
         let dt = tau - self.h;
@@ -324,9 +336,13 @@ impl Series {
 }
 
 /// A displacement's value and first two derivatives `dt` from where they
-/// and the third are `e` (the third taken as constant over `dt`).
+/// and the third are `e` (the third taken as constant over `dt`; at
+/// `dt` = 0 themselves, whatever the third).
 #[inline(always)]
 fn shifted(e: &[f64; 4], dt: f64) -> [f64; 3] {
+    if dt == 0.0 {
+        return [e[0], e[1], e[2]];
+    }
     let half = 0.5 * dt;
     [
         e[0] + dt * (e[1] + half * (e[2] + dt / 3.0 * e[3])),
