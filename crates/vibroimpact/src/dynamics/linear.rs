@@ -125,9 +125,10 @@ pub enum Added {
 impl PiecewiseForm {
     /// `out = (K x) wx + (C z) wz + added` per body, `K` and `C` the
     /// velocity rows of `A` on the displacements and on the velocities
-    /// (without the base but as `added` says), and the largest |out| (a
-    /// NaN passed over, as by `f64::max`): a displacement term of a series
-    /// (docs/theory.md §13).
+    /// (without the base but as `added` says), each body's `out_i w` added
+    /// to `sums[i]` (the series' sums at its end, met while the row is at
+    /// hand), and the largest |out| (a NaN passed over, as by `f64::max`):
+    /// a displacement term of a series (docs/theory.md §13).
     #[inline]
     pub fn displacement_term(
         &self,
@@ -135,9 +136,10 @@ impl PiecewiseForm {
         (z, wz): (&[f64], f64),
         out: &mut [f64],
         added: Added,
+        (sums, w): (&mut [[f64; 4]], [f64; 4]),
     ) -> f64 {
         if let Some(chain) = &self.chain {
-            return self.chain_term(chain, (x, wx), (z, wz), out, added);
+            return self.chain_term(chain, (x, wx), (z, wz), out, added, (sums, w));
         }
         let n = self.ground.len();
         let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
@@ -150,9 +152,10 @@ impl PiecewiseForm {
             out[b] -= f;
         }
         let mut top = 0.0f64;
-        for (i, (o, m)) in out.iter_mut().zip(&self.inv_mass).enumerate() {
+        for (i, ((o, m), e)) in out.iter_mut().zip(&self.inv_mass).zip(sums).enumerate() {
             *o = *o * m + self.added(i, added);
             top = larger(*o, top);
+            add_weighted(e, *o, w);
         }
         top
     }
@@ -178,18 +181,26 @@ impl PiecewiseForm {
         (z, wz): (&[f64], f64),
         out: &mut [f64],
         added: Added,
+        (sums, w): (&mut [[f64; 4]], [f64; 4]),
     ) -> f64 {
         let mut top = 0.0f64;
         let n = self.ground.len();
         let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
-        let mut rows = out.iter_mut().zip(self.ground.iter().zip(&self.inv_mass));
+        let mut rows = out
+            .iter_mut()
+            .zip(sums)
+            .zip(self.ground.iter().zip(&self.inv_mass));
         let (Some(&(mut u)), Some(&(mut v)), Some((mut o, (mut g, mut m)))) =
             (x.first(), z.first(), rows.next())
         else {
             return top;
         };
         let mut below = (0.0, 0.0);
-        let mut row = |o: &mut f64, (u, v): (f64, f64), g: &[f64; 3], m: f64, above: (f64, f64)| {
+        let mut row = |(o, e): (&mut f64, &mut [f64; 4]),
+                       (u, v): (f64, f64),
+                       g: &[f64; 3],
+                       m: f64,
+                       above: (f64, f64)| {
             let a =
                 ((-g[0] * u + above.0 - below.0) * wx + (-g[1] * v + above.1 - below.1) * wz) * m;
             *o = match added {
@@ -198,6 +209,7 @@ impl PiecewiseForm {
                 Added::Less(x) => a - x,
             };
             top = larger(*o, top);
+            add_weighted(e, *o, w);
             below = above;
         };
         for (((&xn, &zn), &[k, c]), (o_next, (g_next, m_next))) in
@@ -287,6 +299,17 @@ impl PiecewiseForm {
     pub fn constant(&self, i: usize) -> f64 {
         self.ground[i][2] * self.inv_mass[i]
     }
+}
+
+/// `e += c w`, element by element.
+#[inline(always)]
+fn add_weighted(e: &mut [f64; 4], c: f64, w: [f64; 4]) {
+    *e = [
+        e[0] + c * w[0],
+        e[1] + c * w[1],
+        e[2] + c * w[2],
+        e[3] + c * w[3],
+    ];
 }
 
 /// The larger of |x| and `top` (a plain comparison: a NaN passed over).

@@ -34,6 +34,32 @@ const MAX_TERMS: usize = 40;
 /// ([`PiecewiseForm::norms`]).
 const CUT: f64 = 1e-16;
 
+/// Per recurrence step j, `1/((j+1)(j+2))` and `1/(j+2)`: its weights
+/// `wx_j` and `wz_j` over h² and h (see `Series::build`).
+const STEPS: [[f64; 2]; MAX_TERMS] = {
+    let mut w = [[0.0; 2]; MAX_TERMS];
+    let mut j = 0;
+    while j < MAX_TERMS {
+        let jf = j as f64;
+        w[j] = [1.0 / ((jf + 1.0) * (jf + 2.0)), 1.0 / (jf + 2.0)];
+        j += 1;
+    }
+    w
+};
+
+/// Per term k, its weights in the sums at the end: θ^k and its first
+/// three derivatives at θ = 1.
+const AT_END: [[f64; 4]; MAX_TERMS] = {
+    let mut w = [[0.0; 4]; MAX_TERMS];
+    let mut k = 0;
+    while k < MAX_TERMS {
+        let kf = k as f64;
+        w[k] = [1.0, kf, kf * (kf - 1.0), kf * (kf - 1.0) * (kf - 2.0)];
+        k += 1;
+    }
+    w
+};
+
 /// How a series was built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Built {
@@ -64,7 +90,8 @@ pub(super) struct Series {
     inv: [f64; 4],
     /// Every body's displacement and its first three derivatives at the
     /// end, τ = h (read at every piece's end: the samples, the gauges,
-    /// the switches and the next state).
+    /// the switches and the next state); while the series is built, the
+    /// sums at θ = 1 that give them.
     end: Vec<[f64; 4]>,
     /// `Σ_{j≥4} j m_j` and `Σ_{j≥4} j (j−1) m_j`, m_j the largest
     /// displacement's coefficient of term j: the tails of
@@ -104,15 +131,17 @@ impl Series {
         let (c0, rest) = self.c.split_at_mut(n);
         let c1 = &mut rest[..n];
         let mut largest = 0.0f64;
-        for (((u, v), (c0, c1)), v0) in y
+        for ((((u, v), (c0, c1)), v0), e) in y
             .iter()
             .step_by(2)
             .zip(y.iter().skip(1).step_by(2))
             .zip(c0.iter_mut().zip(c1.iter_mut()))
             .zip(self.v0.iter_mut())
+            .zip(self.end.iter_mut())
         {
             (*c0, *c1, *v0) = (*u, v * h, *v);
             largest = largest.max(u.abs()).max(c1.abs());
+            *e = [*c0 + *c1, *c1, 0.0, 0.0];
         }
         self.tails = (0.0, 0.0);
         // (The last term's largest coefficient.)
@@ -120,12 +149,10 @@ impl Series {
         let norms = form.norms();
         // (c_{j+2} h^{j+2} = K c_j h^j wx_j + C c_{j+1} h^{j+1} wz_j + f_j
         // h^{j+2}/((j+1)(j+2)), wx_j = h²/((j+1)(j+2)), wz_j = h/(j+2).)
-        let weights = |j: usize| {
-            let jf = j as f64;
-            (h * h / ((jf + 1.0) * (jf + 2.0)), h / (jf + 2.0))
-        };
-        let (mut wx, mut wz) = weights(0);
-        for j in 0..MAX_TERMS - 2 {
+        let h2 = h * h;
+        let weights = |[a, b]: [f64; 2]| (h2 * a, h * b);
+        let (mut wx, mut wz) = weights(STEPS[0]);
+        for (j, (&step, &w)) in STEPS[1..].iter().zip(&AT_END[2..]).enumerate() {
             let (before, after) = self.c.split_at_mut((j + 2) * n);
             let next = &mut after[..n];
             let x = &before[j * n..(j + 1) * n];
@@ -141,9 +168,9 @@ impl Series {
             // (The velocity's weight in the first term is h²/2: c₁ is v,
             // not v h.)
             let wv = if j == 0 { wx } else { wz };
-            let top = form.displacement_term((x, wx), (z, wv), next, added);
-            (wx, wz) = weights(j + 1);
-            let k = (j + 2) as f64;
+            let k = w[1];
+            let top = form.displacement_term((x, wx), (z, wv), next, added, (&mut self.end, w));
+            (wx, wz) = weights(step);
             if !top.is_finite() {
                 return Built::NonFinite;
             }
@@ -153,7 +180,7 @@ impl Series {
                 continue;
             }
             self.tails.0 += k * top;
-            self.tails.1 += k * (k - 1.0) * top;
+            self.tails.1 += w[2] * top;
             // (The tail past term k: every two terms at most ρ times the
             // two before, ρ = |K| wx_{k−1} + |C| wz_{k−1} (see
             // `CUT`).)
@@ -172,19 +199,8 @@ impl Series {
     }
 
     /// Every body's displacement and its first three derivatives at `h`
-    /// into `end`: at θ = 1 sums of the coefficients.
+    /// in `end`, from their sums at θ = 1 (met as the terms were built).
     fn ends(&mut self) {
-        let n = self.n;
-        for e in self.end.iter_mut() {
-            *e = [0.0; 4];
-        }
-        for j in (0..self.terms).rev() {
-            let jf = j as f64;
-            let (w2, w3) = (jf * (jf - 1.0), jf * (jf - 1.0) * (jf - 2.0));
-            for (e, &c) in self.end.iter_mut().zip(&self.c[j * n..(j + 1) * n]) {
-                *e = [e[0] + c, e[1] + jf * c, e[2] + w2 * c, e[3] + w3 * c];
-            }
-        }
         let [_, r, q, p] = self.inv;
         for e in self.end.iter_mut() {
             *e = [e[0], e[1] * r, e[2] * q, e[3] * p];

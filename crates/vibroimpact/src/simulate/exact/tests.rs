@@ -322,14 +322,28 @@ fn a_chain_multiplies_as_its_links() {
             Added::Less(-1.3),
         ] {
             let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-            let top = form.displacement_term((&x, 0.3), (&z, 0.6), &mut a, added);
-            plain.displacement_term((&x, 0.3), (&z, 0.6), &mut b, added);
+            // (Each row weighted into sums that hold a row already.)
+            let w = [1.0, 2.0, -0.5, 3.0];
+            let mut sums_a: Vec<[f64; 4]> = x.iter().map(|&v| [v, 0.0, -v, 1.0]).collect();
+            let mut sums_b = sums_a.clone();
+            let top = form.displacement_term((&x, 0.3), (&z, 0.6), &mut a, added, (&mut sums_a, w));
+            plain.displacement_term((&x, 0.3), (&z, 0.6), &mut b, added, (&mut sums_b, w));
             let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (p, q) in a.iter().zip(&b) {
                 assert!(
                     (p - q).abs() <= 1e-15 * size,
                     "{file} {added:?}: {p} against {q}"
                 );
+            }
+            for ((s, t), (&v, &o)) in sums_a.iter().zip(&sums_b).zip(x.iter().zip(&b)) {
+                let by_hand = [v + o, 2.0 * o, -v - 0.5 * o, 1.0 + 3.0 * o];
+                for ((p, q), r) in s.iter().zip(t).zip(by_hand) {
+                    assert!(
+                        (p - r).abs() <= 1e-15 * (size + 1.0)
+                            && (q - r).abs() <= 1e-15 * (size + 1.0),
+                        "{file} {added:?}: sums {p} and {q} against {r}"
+                    );
+                }
             }
             let largest = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             assert_eq!(top, largest, "{file} {added:?}");
