@@ -125,18 +125,19 @@ pub enum Added {
 impl PiecewiseForm {
     /// `out = (K x) wx + (C z) wz + added` per body, `K` and `C` the
     /// velocity rows of `A` on the displacements and on the velocities
-    /// (without the base but as `added` says), each body's `out_i w` added
-    /// to `sums[i]` (the series' sums at its end, met while the row is at
-    /// hand), and the largest |out| (a NaN passed over, as by `f64::max`):
-    /// a displacement term of a series (docs/theory.md §13).
-    #[inline]
+    /// (without the base but as `added` says), each body's `out_i (1, w)`
+    /// added to `sums[i]` (the series' sums at its end, met while the row
+    /// is at hand), and the largest |out| (a NaN passed over, as by `f64::max`):
+    /// a displacement term of a series (docs/theory.md §13). (Inlined
+    /// always: where `added` is known, its match goes.)
+    #[inline(always)]
     pub fn displacement_term(
         &self,
         (x, wx): (&[f64], f64),
         (z, wz): (&[f64], f64),
         out: &mut [f64],
         added: Added,
-        (sums, w): (&mut [[f64; 4]], [f64; 4]),
+        (sums, w): (&mut [[f64; 4]], [f64; 3]),
     ) -> f64 {
         if let Some(chain) = &self.chain {
             return self.chain_term(chain, (x, wx), (z, wz), out, added, (sums, w));
@@ -173,7 +174,7 @@ impl PiecewiseForm {
     /// [`PiecewiseForm::displacement_term`] on a chain: each link's force
     /// once, in one pass over the bodies, a body's row written when the
     /// link above it is known (iterators throughout: no index to check).
-    #[inline]
+    #[inline(always)]
     fn chain_term(
         &self,
         chain: &[[f64; 2]],
@@ -181,7 +182,7 @@ impl PiecewiseForm {
         (z, wz): (&[f64], f64),
         out: &mut [f64],
         added: Added,
-        (sums, w): (&mut [[f64; 4]], [f64; 4]),
+        (sums, w): (&mut [[f64; 4]], [f64; 3]),
     ) -> f64 {
         let mut top = 0.0f64;
         let n = self.ground.len();
@@ -301,15 +302,11 @@ impl PiecewiseForm {
     }
 }
 
-/// `e += c w`, element by element.
+/// `e += c (1, w₁, w₂, w₃)`, element by element (a term's first weight
+/// in the sums at θ = 1, θ^k's value there, is one).
 #[inline(always)]
-fn add_weighted(e: &mut [f64; 4], c: f64, w: [f64; 4]) {
-    *e = [
-        e[0] + c * w[0],
-        e[1] + c * w[1],
-        e[2] + c * w[2],
-        e[3] + c * w[3],
-    ];
+fn add_weighted(e: &mut [f64; 4], c: f64, w: [f64; 3]) {
+    *e = [e[0] + c, e[1] + c * w[0], e[2] + c * w[1], e[3] + c * w[2]];
 }
 
 /// The larger of |x| and `top` (a plain comparison: a NaN passed over).

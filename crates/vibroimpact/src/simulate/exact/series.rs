@@ -47,14 +47,14 @@ const STEPS: [[f64; 2]; MAX_TERMS] = {
     w
 };
 
-/// Per term k, its weights in the sums at the end: θ^k and its first
-/// three derivatives at θ = 1.
-const AT_END: [[f64; 4]; MAX_TERMS] = {
-    let mut w = [[0.0; 4]; MAX_TERMS];
+/// Per term k, its weights in the sums at the end: θ^k's first three
+/// derivatives at θ = 1 (its value there is one).
+const AT_END: [[f64; 3]; MAX_TERMS] = {
+    let mut w = [[0.0; 3]; MAX_TERMS];
     let mut k = 0;
     while k < MAX_TERMS {
         let kf = k as f64;
-        w[k] = [1.0, kf, kf * (kf - 1.0), kf * (kf - 1.0) * (kf - 2.0)];
+        w[k] = [kf, kf * (kf - 1.0), kf * (kf - 1.0) * (kf - 2.0)];
         k += 1;
     }
     w
@@ -144,46 +144,36 @@ impl Series {
             *e = [*c0 + *c1, *c1, 0.0, 0.0];
         }
         self.tails = (0.0, 0.0);
-        // (The last term's largest coefficient.)
-        let mut previous = f64::INFINITY;
         let norms = form.norms();
         // (c_{j+2} h^{j+2} = K c_j h^j wx_j + C c_{j+1} h^{j+1} wz_j + f_j
         // h^{j+2}/((j+1)(j+2)), wx_j = h²/((j+1)(j+2)), wz_j = h/(j+2).)
         let h2 = h * h;
         let weights = |[a, b]: [f64; 2]| (h2 * a, h * b);
-        let (mut wx, mut wz) = weights(STEPS[0]);
-        for (j, (&step, &w)) in STEPS[1..].iter().zip(&AT_END[2..]).enumerate() {
-            let (before, after) = self.c.split_at_mut((j + 2) * n);
-            let next = &mut after[..n];
-            let x = &before[j * n..(j + 1) * n];
-            let z = match j {
-                0 => &self.v0[..],
-                _ => &before[(j + 1) * n..],
-            };
-            let added = match j {
-                0 => Added::ConstantLess(a0, wx),
-                1 => Added::Less(s * h * wx),
-                _ => Added::Nothing,
-            };
-            // (The velocity's weight in the first term is h²/2: c₁ is v,
-            // not v h.)
-            let wv = if j == 0 { wx } else { wz };
-            let k = w[1];
-            let top = form.displacement_term((x, wx), (z, wv), next, added, (&mut self.end, w));
-            (wx, wz) = weights(step);
+        // (The base in the first two: c₂ the constant acceleration less
+        // a₀, c₃ the jerk; the velocity's weight in the first is h²/2, c₁
+        // being v, not v h.)
+        let (wx, _) = weights(STEPS[0]);
+        let mut last = self.term(form, 0, (wx, wx), Added::ConstantLess(a0, wx));
+        let (wx, wz) = weights(STEPS[1]);
+        let mut top = self.term(form, 1, (wx, wz), Added::Less(s * h * wx));
+        if !(last.is_finite() && top.is_finite()) {
+            return Built::NonFinite;
+        }
+        largest = largest.max(2.0 * last).max(3.0 * top);
+        for j in 2..MAX_TERMS - 2 {
+            let (wx, wz) = weights(STEPS[j]);
+            (last, top) = (top, self.term(form, j, (wx, wz), Added::Nothing));
             if !top.is_finite() {
                 return Built::NonFinite;
             }
+            let [k, k2, _] = AT_END[j + 2];
             largest = largest.max(k * top);
-            let last = std::mem::replace(&mut previous, top);
-            if j < 2 {
-                continue;
-            }
             self.tails.0 += k * top;
-            self.tails.1 += w[2] * top;
+            self.tails.1 += k2 * top;
             // (The tail past term k: every two terms at most ρ times the
             // two before, ρ = |K| wx_{k−1} + |C| wz_{k−1} (see
             // `CUT`).)
+            let (wx, wz) = weights(STEPS[j + 1]);
             let rho = norms.0 * wx + norms.1 * wz;
             let e = top.max(last);
             if e == 0.0
@@ -196,6 +186,26 @@ impl Series {
             }
         }
         Built::TooLong
+    }
+
+    /// Term j + 2 from terms j and j + 1 (the velocities for j = 0) with
+    /// the weights `wx`, `wz` and what `added` says, into its row and the
+    /// end's sums: its largest coefficient (see [`Series::build`]).
+    #[inline(always)]
+    fn term(&mut self, form: &PiecewiseForm, j: usize, (wx, wz): (f64, f64), added: Added) -> f64 {
+        let n = self.n;
+        let (before, after) = self.c.split_at_mut((j + 2) * n);
+        let z = match j {
+            0 => &self.v0[..],
+            _ => &before[(j + 1) * n..],
+        };
+        form.displacement_term(
+            (&before[j * n..(j + 1) * n], wx),
+            (z, wz),
+            &mut after[..n],
+            added,
+            (&mut self.end, AT_END[j + 2]),
+        )
     }
 
     /// Every body's displacement and its first three derivatives at `h`

@@ -323,7 +323,7 @@ fn a_chain_multiplies_as_its_links() {
         ] {
             let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
             // (Each row weighted into sums that hold a row already.)
-            let w = [1.0, 2.0, -0.5, 3.0];
+            let w = [2.0, -0.5, 3.0];
             let mut sums_a: Vec<[f64; 4]> = x.iter().map(|&v| [v, 0.0, -v, 1.0]).collect();
             let mut sums_b = sums_a.clone();
             let top = form.displacement_term((&x, 0.3), (&z, 0.6), &mut a, added, (&mut sums_a, w));
