@@ -39,9 +39,13 @@ that yield"):
   at dt_rec / m, m = 1 ... 16); ours scanned (integrator global or local;
   method DOP853 or DOPRI5; rtol 1e-3 ... 1e-8; sampling dt_rec, dt_rec/2,
   dt_rec/4); each side's fastest within 1 % of the reference;
-* speed: the ratio of the two best median times (ours ``free=False``, the
-  run alone; OpenSees' model build and analysis), then the two retimed in
-  alternating rounds. The target for ``imk``: >= 10x.
+* speed: the two best settings (ours ``free=False``, the run alone;
+  OpenSees' model build and analysis) retimed in alternating rounds: the
+  ratio of their medians over the idle rounds (over all where none was
+  idle) is the result, ``ratio``. The scan's own ratio, ``scan_ratio``, is
+  kept but not used: our exact run ignores rtol and method, so its 36
+  local settings time one computation 36 times, and the least of their
+  medians favours us. The target for ``imk``: >= 10x.
 
 Timing waits for an idle machine: before each timed phase, until no
 process named like ``frame_peer``, ``pounding_peer``, ``isolated_peer``,
@@ -285,7 +289,7 @@ def study(name, record, quick, waits, timing=True):
                     print(f"  {integrator} {method} rtol {rtol:.0e} sample dt_rec/{div}: {secs * 1e3:8.2f} ms  "
                           f"error {err:.2e}")
     best_ours = min((s for s in ours if s["error"] <= TARGET_ACCURACY), key=lambda s: s["seconds"])
-    ratio = best_os["seconds"] / best_ours["seconds"]
+    scan_ratio = best_os["seconds"] / best_ours["seconds"]
     ours_kw = {k: best_ours[k] for k in ("sample", "rtol", "method", "integrator")}
     os_kw = {k: best_os[k] for k in ("system", "algorithm", "tol", "integrator")}
     fast = peaks_of_ours(vi.pounding(text, record, scale=scale, free=False, **ours_kw), building)
@@ -300,10 +304,11 @@ def study(name, record, quick, waits, timing=True):
     )
     print(f"best OpenSees {best_os['seconds'] * 1e3:.2f} ms ({ {**os_kw, 'm': best_os['m']} }, "
           f"error {best_os['error']:.1e}); best vibroimpact {best_ours['seconds'] * 1e3:.2f} ms "
-          f"({ours_kw}, error {best_ours['error']:.1e}): ratio {ratio:.1f} (target >= {TARGET_RATIO:g})")
+          f"({ours_kw}, error {best_ours['error']:.1e}): the scan's ratio {scan_ratio:.1f}")
+    ratio = speed["ratio_idle"] or speed["ratio_all"]
     print(f"the two retimed in {len(speed['rounds'])} rounds, {speed['idle_rounds']} idle: ratio "
           f"{speed['ratio_idle'] if speed['ratio_idle'] is None else round(speed['ratio_idle'], 1)} (idle rounds), "
-          f"{speed['ratio_all']:.1f} (all)")
+          f"{speed['ratio_all']:.1f} (all): ratio {ratio:.1f} (target >= {TARGET_RATIO:g})")
     for k, e in fast_vs.items():
         print(f"our best against OpenSees at {k}: {e['error']:.2e} ({shown(e)})")
     return {
@@ -314,6 +319,7 @@ def study(name, record, quick, waits, timing=True):
         "best_vibroimpact": best_ours,
         "best_vibroimpact_vs_opensees": fast_vs,
         "ratio": ratio,
+        "scan_ratio": scan_ratio,
         "retimed": speed,
         # The speed target is the IMK frame's (the issue's); every case
         # must agree.
@@ -349,7 +355,7 @@ def table(results):
                         f"({e['residual_self']:.1e}){'' if r['residuals_judged'] else ', not judged'} |")
         return "\n".join(rows)
     rows = ["| case | OpenSees converged step | peak drift ratios | residual drift ratios / u_y/h (/ themselves) "
-            "| OpenSees best | ours best | ratio (retimed) |",
+            "| OpenSees best | ours best | ratio retimed (the scan's) |",
             "| --- | --- | --- | --- | --- | --- | --- |"]
     for name, r in results.items():
         c = r["opensees_converged_step"]
@@ -359,10 +365,9 @@ def table(results):
                   f"tol {b['tol']:.0e}, dt_rec/{b['m']} ({b['error']:.1e})")
         our_set = (f"{o['seconds'] * 1e3:.1f} ms: {o['integrator']}, {o['method']}, rtol {o['rtol']:.0e}, "
                    f"sample dt_rec/{round(0.01 / o['sample'])} ({o['error']:.1e})")
-        re_ = r["retimed"]["ratio_idle"] or r["retimed"]["ratio_all"]
         rows.append(f"| {name} x {r['scale']} | dt_rec/{c['m']} | {e['drift']:.1e} | {e['residual']:.1e} "
                     f"({e['residual_self']:.1e}){'' if r['residuals_judged'] else ', not judged'} | {os_set} | "
-                    f"{our_set} | {r['ratio']:.0f} ({re_:.0f}) |")
+                    f"{our_set} | {r['ratio']:.1f} ({r['scan_ratio']:.1f}) |")
     return "\n".join(rows)
 
 
