@@ -167,11 +167,16 @@ impl GaugeScan {
         }
     }
 
-    /// Notes a value.
+    /// Notes a value (a NaN passed over, as by `f64::min` and `max`; plain
+    /// comparisons, which cost less than their NaN-aware forms).
     #[inline]
     pub(super) fn note(&mut self, x: f64) {
-        self.min = self.min.min(x);
-        self.max = self.max.max(x);
+        if x < self.min {
+            self.min = x;
+        }
+        if x > self.max {
+            self.max = x;
+        }
     }
 
     /// The reading (min = max = 0 where nothing was scanned).

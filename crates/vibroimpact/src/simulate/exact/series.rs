@@ -140,7 +140,7 @@ impl Series {
             .zip(self.end.iter_mut())
         {
             (*c0, *c1, *v0) = (*u, v * h, *v);
-            largest = largest.max(u.abs()).max(c1.abs());
+            largest = larger(larger(largest, u.abs()), c1.abs());
             *e = [*c0 + *c1, *c1, 0.0, 0.0];
         }
         self.tails = (0.0, 0.0);
@@ -159,7 +159,7 @@ impl Series {
         if !(last.is_finite() && top.is_finite()) {
             return Built::NonFinite;
         }
-        largest = largest.max(2.0 * last).max(3.0 * top);
+        largest = larger(larger(largest, 2.0 * last), 3.0 * top);
         for j in 2..MAX_TERMS - 2 {
             let (wx, wz) = weights(STEPS[j]);
             (last, top) = (top, self.term(form, j, (wx, wz), Added::Nothing));
@@ -167,7 +167,7 @@ impl Series {
                 return Built::NonFinite;
             }
             let [k, k2, _] = AT_END[j + 2];
-            largest = largest.max(k * top);
+            largest = larger(largest, k * top);
             self.tails.0 += k * top;
             self.tails.1 += k2 * top;
             // (The tail past term k: every two terms at most ρ times the
@@ -175,7 +175,7 @@ impl Series {
             // `CUT`).)
             let (wx, wz) = weights(STEPS[j + 1]);
             let rho = norms.0 * wx + norms.1 * wz;
-            let e = top.max(last);
+            let e = larger(top, last);
             if e == 0.0
                 || rho < 0.5
                     && 2.0 * e * rho * (k + 2.0) <= CUT * largest * (1.0 - rho) * (1.0 - rho)
@@ -290,8 +290,8 @@ impl Series {
         let n = self.n;
         let theta = tau / self.h;
         let mut e = [0.0; 4];
-        for j in (0..self.terms).rev() {
-            let c = self.c[j * n + b];
+        for row in self.c[..self.terms * n].chunks_exact(n).rev() {
+            let c = row[b];
             e[3] = e[3] * theta + 3.0 * e[2];
             e[2] = e[2] * theta + 2.0 * e[1];
             e[1] = e[1] * theta + e[0];
@@ -326,13 +326,16 @@ impl Series {
     /// Horner on the difference's coefficients.
     #[inline(never)]
     fn value_rate_inside(&self, a: usize, b: Option<usize>, tau: f64) -> (f64, f64) {
-        let n = self.n;
         let theta = tau / self.h;
         let (mut x, mut dx) = (0.0, 0.0);
-        for k in (0..self.terms).rev() {
-            let c = self.c[k * n + a] - b.map_or(0.0, |b| self.c[k * n + b]);
+        let mut horner = |c: f64| {
             dx = dx * theta + x;
             x = x * theta + c;
+        };
+        let rows = self.c[..self.terms * self.n].chunks_exact(self.n).rev();
+        match b {
+            Some(b) => rows.for_each(|row| horner(row[a] - row[b])),
+            None => rows.for_each(|row| horner(row[a])),
         }
         (x, dx * self.inv[1])
     }
@@ -375,4 +378,15 @@ fn shifted(e: &[f64; 4], dt: f64) -> [f64; 3] {
         e[1] + dt * (e[2] + half * e[3]),
         e[2] + dt * e[3],
     ]
+}
+
+/// The larger of two values (a NaN in `b` passed over, as by `f64::max`;
+/// a plain comparison, which costs less than its NaN-aware form).
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
 }
