@@ -143,7 +143,7 @@ impl PiecewiseForm {
             return self.chain_term(chain, (x, wx), (z, wz), out, added, (sums, w));
         }
         let n = self.ground.len();
-        let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
+        let (x, z, out, sums) = (&x[..n], &z[..n], &mut out[..n], &mut sums[..n]);
         for ((o, g), (x, z)) in out.iter_mut().zip(&self.ground).zip(x.iter().zip(z)) {
             *o = (-g[0] * x) * wx + (-g[1] * z) * wz;
         }
@@ -186,7 +186,7 @@ impl PiecewiseForm {
     ) -> f64 {
         let mut top = 0.0f64;
         let n = self.ground.len();
-        let (x, z, out) = (&x[..n], &z[..n], &mut out[..n]);
+        let (x, z, out, sums) = (&x[..n], &z[..n], &mut out[..n], &mut sums[..n]);
         let mut rows = out
             .iter_mut()
             .zip(sums)
