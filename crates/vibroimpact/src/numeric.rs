@@ -34,6 +34,18 @@ pub enum RootError {
     },
 }
 
+/// The larger of two values, a NaN in `b` passed over as by `f64::max`:
+/// a plain comparison, which costs less than the NaN-aware form on the
+/// exact run's hot paths.
+#[inline(always)]
+pub(crate) fn larger(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// `(-1)^j / (j + 2)!` for j = 0..=18: the Taylor coefficients of
 /// `(e^{-p} - 1 + p) / p²`.
 const EXP_SERIES: [f64; 19] = {

@@ -10,6 +10,7 @@ use nalgebra::DMatrix;
 use super::{ChainDynamics, Screen};
 use crate::integrate::{Harmonic, LinearForm};
 use crate::model::BaseExcitation;
+use crate::numeric::larger;
 
 impl ChainDynamics {
     /// The chain as `A y + b(t)` (one block), or None where it is not
@@ -155,7 +156,7 @@ impl PiecewiseForm {
         let mut top = 0.0f64;
         for (i, ((o, m), e)) in out.iter_mut().zip(&self.inv_mass).zip(sums).enumerate() {
             *o = *o * m + self.added(i, added);
-            top = larger(*o, top);
+            top = larger(top, o.abs());
             add_weighted(e, *o, w);
         }
         top
@@ -209,7 +210,7 @@ impl PiecewiseForm {
                 Added::ConstantLess(a0, w) => a + (g[2] * m - a0) * w,
                 Added::Less(x) => a - x,
             };
-            top = larger(*o, top);
+            top = larger(top, o.abs());
             add_weighted(e, *o, w);
             below = above;
         };
@@ -307,17 +308,6 @@ impl PiecewiseForm {
 #[inline(always)]
 fn add_weighted(e: &mut [f64; 4], c: f64, w: [f64; 3]) {
     *e = [e[0] + c, e[1] + c * w[0], e[2] + c * w[1], e[3] + c * w[2]];
-}
-
-/// The larger of |x| and `top` (a plain comparison: a NaN passed over).
-#[inline(always)]
-fn larger(x: f64, top: f64) -> f64 {
-    let a = x.abs();
-    if a > top {
-        a
-    } else {
-        top
-    }
 }
 
 impl ChainDynamics {

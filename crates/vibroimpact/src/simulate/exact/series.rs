@@ -15,6 +15,7 @@
 //! one row per body.
 
 use crate::dynamics::{Added, PiecewiseForm};
+use crate::numeric::larger;
 
 /// Most terms of a series; an interval whose terms have not fallen by
 /// then is too long for it ([`Built::TooLong`]).
@@ -378,15 +379,4 @@ fn shifted(e: &[f64; 4], dt: f64) -> [f64; 3] {
         e[1] + dt * (e[2] + half * e[3]),
         e[2] + dt * e[3],
     ]
-}
-
-/// The larger of two values (a NaN in `b` passed over, as by `f64::max`;
-/// a plain comparison, which costs less than its NaN-aware form).
-#[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
-    if b > a {
-        b
-    } else {
-        a
-    }
 }
