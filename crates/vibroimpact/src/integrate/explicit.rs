@@ -26,20 +26,46 @@ pub(super) fn combine(y: &[f64], k: &[f64], row: &[f64], h: f64, out: &mut [f64]
         }
         i += B;
     }
-    let rest = n - i;
-    if rest > 0 {
-        let mut acc = [0.0; B];
-        for (j, &a) in row[..stages].iter().enumerate() {
-            if a != 0.0 {
-                let kj = &k[j * n + i..j * n + n];
-                for l in 0..rest {
-                    acc[l] += a * kj[l];
-                }
+    // The last n mod 8 components (all of a small system's state), with
+    // their count a constant: the loops unroll without bounds checks (R2
+    // N = 3, global, 5 periods: 40.1M → 37.4M instructions; the same sums
+    // in the same order, the same bits).
+    let (y, k, row, out) = (&y[i..], &k[i..], &row[..stages], &mut out[i..]);
+    match n - i {
+        0 => {}
+        1 => combine_tail::<1>(y, k, row, n, h, out),
+        2 => combine_tail::<2>(y, k, row, n, h, out),
+        3 => combine_tail::<3>(y, k, row, n, h, out),
+        4 => combine_tail::<4>(y, k, row, n, h, out),
+        5 => combine_tail::<5>(y, k, row, n, h, out),
+        6 => combine_tail::<6>(y, k, row, n, h, out),
+        _ => combine_tail::<7>(y, k, row, n, h, out),
+    }
+}
+
+/// [`combine`] on `R` components: `y` and `out` from the first, `k`'s
+/// stages `n` apart from it.
+#[inline(always)]
+fn combine_tail<const R: usize>(
+    y: &[f64],
+    k: &[f64],
+    row: &[f64],
+    n: usize,
+    h: f64,
+    out: &mut [f64],
+) {
+    let mut acc = [0.0; R];
+    for (j, &a) in row.iter().enumerate() {
+        if a != 0.0 {
+            let kj = &k[j * n..j * n + R];
+            for l in 0..R {
+                acc[l] += a * kj[l];
             }
         }
-        for l in 0..rest {
-            out[i + l] = y[i + l] + h * acc[l];
-        }
+    }
+    let (y, out) = (&y[..R], &mut out[..R]);
+    for l in 0..R {
+        out[l] = y[l] + h * acc[l];
     }
 }
 
