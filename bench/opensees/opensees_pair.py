@@ -212,19 +212,21 @@ def add_storey(ops, new, below: int, node: int, k: float, law: Dict[str, Any], b
 
 def transient(ops, system: str, algorithm: str, tol: float, integrator: str, constraints: str = "Plain") -> None:
     """The transient analysis of a model: the equation ``system``; Newmark's
-    average acceleration with a Newton ``algorithm`` and a displacement test
-    at ``tol``, or the explicit ``CentralDifference`` (linear algorithm);
-    ``constraints`` the constraint handler (``Transformation`` for a model
-    with ``equalDOF``)."""
+    average acceleration with a Newton ``algorithm`` (its flags after a
+    space: ``"ModifiedNewton -factoronce"``) and a displacement test at
+    ``tol``, or an explicit rule (``CentralDifference``,
+    ``ExplicitDifference``) with the linear algorithm (``"Linear
+    -factorOnce"`` where given so, else ``Linear``); ``constraints`` the
+    constraint handler (``Transformation`` for a model with ``equalDOF``)."""
     ops.constraints(constraints)
     ops.numberer("Plain")
     ops.system(system)
-    if integrator == "CentralDifference":
-        ops.algorithm("Linear")
-        ops.integrator("CentralDifference")
+    if integrator in ("CentralDifference", "ExplicitDifference"):
+        ops.algorithm(*(algorithm.split() if algorithm.startswith("Linear") else ["Linear"]))
+        ops.integrator(integrator)
     else:
         ops.test("NormDispIncr", tol, 50)
-        ops.algorithm(algorithm)
+        ops.algorithm(*algorithm.split())
         ops.integrator("Newmark", 0.5, 0.25)
     ops.analysis("Transient")
 
