@@ -210,7 +210,7 @@ impl GaugeScan {
         self.note(xb);
         if ra * rb < 0.0 {
             self.turning((a, b), ((xa, ra), (xb, rb)), at);
-        } else if self.gauge.mean_from().is_some() {
+        } else if self.gauge.mean_from().is_some_and(|from| from < b) {
             self.mean_part((a, b), at);
         }
     }

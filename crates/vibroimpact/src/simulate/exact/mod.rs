@@ -454,6 +454,26 @@ fn largest(at: impl Fn(f64) -> (f64, f64, f64), (a, b): (f64, f64)) -> f64 {
     x
 }
 
+/// A gauge and its rate at τ on the series, whose base acceleration is
+/// `a0 + s τ` (inlined always: at a piece's ends, the usual reading, it
+/// is a few of the end's sums).
+#[inline(always)]
+fn gauge_at(series: &Series, kind: Gauge, tau: f64, (a0, s): (f64, f64)) -> (f64, f64) {
+    match kind {
+        Gauge::Separation { left, right, .. } => match left {
+            Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), tau),
+            None => {
+                let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, tau);
+                (-x, -r)
+            }
+        },
+        Gauge::AbsoluteAcceleration { body } => {
+            let (_, a, jerk) = series.component(2 * body + 1, tau);
+            (a + a0 + s * tau, jerk + s)
+        }
+    }
+}
+
 impl Reader {
     /// The extrema and gauges over the piece `(ta, tb)` of the series
     /// (from `ta`; `tb` at its τ = `tau`), whose base acceleration is `a0 +
@@ -480,19 +500,7 @@ impl Reader {
         let end_tau = if b == tb { tau } else { b - ta };
         for (gauge, end) in self.gauges.iter_mut().zip(self.ends.iter_mut()) {
             let kind = gauge.gauge;
-            let at_tau = |tau: f64| match kind {
-                Gauge::Separation { left, right, .. } => match left {
-                    Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), tau),
-                    None => {
-                        let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, tau);
-                        (-x, -r)
-                    }
-                },
-                Gauge::AbsoluteAcceleration { body } => {
-                    let (_, a, jerk) = series.component(2 * body + 1, tau);
-                    (a + a0 + s * tau, jerk + s)
-                }
-            };
+            let at_tau = |tau: f64| gauge_at(series, kind, tau, (a0, s));
             let at = |t: f64| at_tau(t - ta);
             let start = match (kind, *end) {
                 (Gauge::Separation { .. }, (t, x)) if t == a => x,
