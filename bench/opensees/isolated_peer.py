@@ -25,8 +25,9 @@ bench/opensees/ISOLATED.md):
 * OpenSees at its best: at the coarsest step within 1 % of the reference,
   its solver settings scanned (timing.OPENSEES_VARIANTS: equation
   solver, Newton variant with or without ``-factoronce``, test
-  tolerance; the explicit ``CentralDifference`` and
-  ``ExplicitDifference``, with ``-factorOnce``, at dt_rec / m,
+  tolerance; the explicit ``CentralDifference`` (``Linear``, and
+  ``Linear -factorOnce``) and ``ExplicitDifference`` (``Linear
+  -factorOnce``) at dt_rec / m,
   m = 1 ... 16); ours scanned (integrator global or local; method DOP853
   or DOPRI5; rtol 1e-3 ... 1e-8; drift
   sampling dt_rec, dt_rec / 2, dt_rec / 4); each side's fastest within

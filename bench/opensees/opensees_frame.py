@@ -40,8 +40,8 @@ opensees_isolated.py build theirs:
   sample ramped to zero over one record step (a 0 appended to the Path);
   an elastic building runs the record alone (vibroimpact's row has no tail
   then);
-* Newmark's average acceleration with Newton iterations (or the explicit
-  ``CentralDifference``), a constant step ``dt``: one ``analyze`` call up
+* Newmark's average acceleration with Newton iterations (or an explicit
+  rule, ``CentralDifference`` or ``ExplicitDifference``), a constant step ``dt``: one ``analyze`` call up
   to one step before the residual window, one through it.
 
 Outputs, as vibroimpact's ``runs[0].pounding`` of the building: the peak
@@ -269,8 +269,9 @@ def run(
     ``scale``, constant step ``dt``, through the free-vibration tail if a
     storey yields; the equation solver, Newton variant, displacement-
     increment tolerance (m) and integrator (``Newmark``: average
-    acceleration; ``CentralDifference``: explicit, ``algorithm Linear``) as
-    given; P-Δ as ``p_delta`` (``spring`` or ``leaning-column``). Returns
+    acceleration; ``CentralDifference`` or ``ExplicitDifference``:
+    explicit, ``algorithm Linear``, with ``-factorOnce`` where given;
+    ``opensees_pair.transient``) as given; P-Δ as ``p_delta`` (``spring`` or ``leaning-column``). Returns
     the peak drifts and drift ratios, the residual drifts and ratios, the
     period, Rayleigh coefficients, duration, and the wall time of building
     and running the model."""

@@ -44,8 +44,8 @@ bench/opensees/opensees_pair.py builds the pounding pair:
   (:func:`period`: the slab and floors on the bearings' post-yield
   stiffness, vibroimpact's ``Building::period``), the record's last sample
   ramped to zero over one record step (a 0 appended to the ``Path``);
-* Newmark's average acceleration with Newton iterations (or the explicit
-  ``CentralDifference``), a constant step ``dt``, one ``analyze`` call up
+* Newmark's average acceleration with Newton iterations (or an explicit
+  rule, ``CentralDifference`` or ``ExplicitDifference``), a constant step ``dt``, one ``analyze`` call up
   to one step before the residual window and one through it.
 
 Outputs, as vibroimpact's ``runs[0].pounding`` of the building: the peak
@@ -132,8 +132,9 @@ def run(
     (``times``, ``acceleration`` in m/s^2, uniform from t = 0) times
     ``scale``, constant step ``dt``, through the free-vibration tail; the
     equation solver, Newton variant, displacement-increment tolerance (m)
-    and integrator (``Newmark``: average acceleration; ``CentralDifference``:
-    explicit, ``algorithm Linear``) as given. Returns the peak drifts, the
+    and integrator (``Newmark``: average acceleration; ``CentralDifference``
+    or ``ExplicitDifference``: explicit, ``algorithm Linear``, with
+    ``-factorOnce`` where given; ``opensees_pair.transient``) as given. Returns the peak drifts, the
     slab's peak displacement, the peak moat force (and per wall, ``left``
     and ``right``), the residual drifts and slab displacement, the wall time
     of building and running the model and, with ``impacts``, the moat

@@ -257,8 +257,9 @@ def run(
     """One OpenSees run of the pair (a parsed pair TOML) under the record,
     constant step ``dt``, with the given equation solver, Newton variant,
     displacement-increment tolerance (m) and integrator (``Newmark``: the
-    average acceleration rule; ``CentralDifference``: explicit, with
-    ``algorithm="Linear"``); returns the peaks and the wall time of
+    average acceleration rule; ``CentralDifference`` or
+    ``ExplicitDifference``: explicit, with ``algorithm="Linear"`` or
+    ``"Linear -factorOnce"``; :func:`transient`); returns the peaks and the wall time of
     building and running the model. A pair with yielding storeys runs
     through the free-vibration tail and returns ``residual_drift`` too."""
     ops = import_opensees()

@@ -169,7 +169,7 @@ def study(name, pair, text, record, quick):
     )
 
     repeats = 3 if quick else 7
-    print(f"OpenSees settings at dt = dt_rec/{m} (median of {repeats}); the explicit one at every step:")
+    print(f"OpenSees settings at dt = dt_rec/{m} (median of {repeats}); the explicit ones at every step:")
     settings = scan_opensees(
         lambda mm, v: run(pair, t, a, 1.0, rec_dt / mm, **v), judged, m, repeats, keep_errors=bool(uy)
     )
