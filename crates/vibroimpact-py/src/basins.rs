@@ -66,7 +66,7 @@ pub fn basins<'py>(
     let total = xs.len() * ys.len();
     let work = py.detach(|| map_work(&loaded, &options, total));
     crate::simulate::warn_if_long(py, work)?;
-    let out = monitor::run(py, progress, move |p: &Progress| {
+    let out = monitor::run(py, progress, None, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
             interrupt: Some(p.interrupt.clone()),

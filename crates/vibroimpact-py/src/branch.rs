@@ -147,7 +147,7 @@ pub fn continue_branch<'py>(
     }
     let work = py.detach(|| checked.branch.guess_work());
     crate::simulate::warn_if_long(py, work)?;
-    let out = monitor::run_keeping(py, progress, move |p: &Progress| {
+    let out = monitor::run_keeping(py, progress, None, move |p: &Progress| {
         p.set_total(max_points);
         checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());
         checked.run(|_| {
@@ -195,7 +195,7 @@ fn curves_from_document<'py>(
             .as_ref()
             .map(|(plane, _)| plane.q.name.clone()),
     );
-    let out = monitor::run(py, progress, move |p: &Progress| {
+    let out = monitor::run(py, progress, None, move |p: &Progress| {
         checked.branch.options.shooting.interrupt = Some(p.interrupt.clone());
         checked.curves_from(&read)
     })?;

@@ -63,7 +63,7 @@ pub fn chart<'py>(
         let work = py.detach(|| map_work(&base, &sweep, total * starts));
         crate::simulate::warn_if_long(py, work)?;
     }
-    let out = monitor::run(py, progress, move |p: &Progress| {
+    let out = monitor::run(py, progress, None, move |p: &Progress| {
         p.set_total(total);
         let options = ChartOptions {
             sweep: SweepOptions {

@@ -77,7 +77,7 @@ pub fn collapse_record<'py>(
     let record = record_of(&record)?;
     crate::simulate::warn_if_long(py, study.estimate(&row, &record).map_err(pounding_error)?)?;
     // Monitored: Ctrl-C stops the IDA at its next step (KeyboardInterrupt).
-    let part = monitor::run(py, None, move |p: &Progress| {
+    let part = monitor::run(py, None, None, move |p: &Progress| {
         study.run.interrupt = Some(p.interrupt.clone());
         study.record(&row, &record)
     })?

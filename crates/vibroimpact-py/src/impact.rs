@@ -74,7 +74,7 @@ pub fn impact<'py>(
     // Columns straight from the rows, chunk by chunk in parallel; the first
     // error in velocity order is reported; an interrupt stops at the next
     // chunk.
-    let chunks = monitor::run(py, progress, move |p: &Progress| {
+    let chunks = monitor::run(py, progress, None, move |p: &Progress| {
         let relations = ImpactRelations::new(&job_law, bodies, m, &opts)?;
         p.set_total(velocities.len().div_ceil(CHUNK));
         let chunks: Vec<Result<Vec<Vec<f64>>, ImpactError>> = velocities
@@ -185,7 +185,7 @@ pub fn identify<'py>(
             peak_acceleration: a,
         })
         .collect();
-    let r = monitor::run(py, None, move |_: &Progress| {
+    let r = monitor::run(py, None, None, move |_: &Progress| {
         vibroimpact::identify::identify(&rest, &acc, bodies, a_over_b, joint)
     })?
     .map_err(value_error)?;

@@ -6,6 +6,18 @@
 //! waited for, and the exception propagates. A panic in the worker becomes
 //! a `VibroimpactError`, never a crash of the interpreter.
 //!
+//! A simulation or a pounding study (whose estimates come from the
+//! simulation's own step count: a branch's or a map's are guesses, which
+//! a `ds_max` or a transient can exceed a hundredfold) that its estimate
+//! puts under [`INLINE`], with no callback, runs on the calling thread
+//! instead, the GIL released: a hand-over to a worker cost
+//! 0.1–0.6 ms a call on a 2-core virtual machine whose idle core had to
+//! be woken (the 4-storey IMK frame under record 1a through
+//! `vi.pounding`, medians of 12 rounds of 21 calls: 2.56–3.06 ms on a
+//! worker, 2.39–2.47 ms inline; docs/decisions.md D44). A signal that
+//! arrives meanwhile is met as the call returns, a few milliseconds
+//! later at most, as the worker's result would be.
+//!
 //! Worker threads are kept for the next call (one per call running at the
 //! same time): a fresh thread per call cost ~50 µs and a cold allocator
 //! arena, 5–10 % of a 2 ms simulation (bench/python). Both sides poll for
@@ -125,14 +137,26 @@ const POLL: Duration = Duration::from_millis(50);
 /// How long an interrupted call waits for its worker to stop.
 const ABANDON: Duration = Duration::from_secs(1);
 
+/// Work expected to take less than this (seconds, by its
+/// `WorkEstimate`; they run up to a few times longer) runs on the
+/// calling thread: a Ctrl-C waits for it to end.
+const INLINE: f64 = 0.02;
+
 /// Runs `work` on a worker thread, reporting to `callback(done, total)`
-/// when `done` changes and checking for signals.
-pub fn run<T, F>(py: Python<'_>, callback: Option<&Bound<'_, PyAny>>, work: F) -> PyResult<T>
+/// when `done` changes and checking for signals; on the calling thread
+/// where it is `expected` (seconds) to take less than [`INLINE`] and no
+/// callback waits for progress.
+pub fn run<T, F>(
+    py: Python<'_>,
+    callback: Option<&Bound<'_, PyAny>>,
+    expected: Option<f64>,
+    work: F,
+) -> PyResult<T>
 where
     T: Send + 'static,
     F: FnOnce(&Progress) -> T + Send + 'static,
 {
-    run_keeping(py, callback, work).map_err(|(e, _)| e)
+    run_keeping(py, callback, expected, work).map_err(|(e, _)| e)
 }
 
 /// [`run`], and on KeyboardInterrupt (or the callback's exception) what
@@ -142,12 +166,23 @@ where
 pub fn run_keeping<T, F>(
     py: Python<'_>,
     callback: Option<&Bound<'_, PyAny>>,
+    expected: Option<f64>,
     work: F,
 ) -> Result<T, (PyErr, Option<T>)>
 where
     T: Send + 'static,
     F: FnOnce(&Progress) -> T + Send + 'static,
 {
+    if callback.is_none() && expected.is_some_and(|s| s < INLINE) {
+        let progress = Progress::default();
+        let r = py
+            .detach(|| catch_unwind(AssertUnwindSafe(|| work(&progress))))
+            .map_err(|panic| (panicked(panic), None))?;
+        return match py.check_signals() {
+            Ok(()) => Ok(r),
+            Err(e) => Err((e, Some(r))),
+        };
+    }
     let progress = Arc::new(Progress::default());
     let (tx, rx) = mpsc::channel();
     let shared = progress.clone();
@@ -219,18 +254,18 @@ where
                 ))
             }
         };
-        return result.map_err(|panic| {
-            let msg = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown".into());
-            (
-                VibroimpactError::new_err(format!(
-                    "internal error (please report): the computation panicked: {msg}"
-                )),
-                None,
-            )
-        });
+        return result.map_err(|panic| (panicked(panic), None));
     }
+}
+
+/// The error a panic in the work becomes.
+fn panicked(panic: Box<dyn std::any::Any + Send>) -> PyErr {
+    let msg = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown".into());
+    VibroimpactError::new_err(format!(
+        "internal error (please report): the computation panicked: {msg}"
+    ))
 }

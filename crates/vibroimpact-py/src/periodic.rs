@@ -83,7 +83,7 @@ pub fn periodic<'py>(
     let work = py.detach(|| checked.work());
     crate::simulate::warn_if_long(py, work)?;
     let (m, krylov) = (checked.model.clone(), checked.krylov.is_some());
-    let out = monitor::run(py, progress, move |p: &Progress| {
+    let out = monitor::run(py, progress, None, move |p: &Progress| {
         let mut checked = checked;
         checked.study.options.interrupt = Some(p.interrupt.clone());
         checked.run().map_err(|e| (e, p.interrupt.requested()))

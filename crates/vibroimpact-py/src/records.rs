@@ -197,12 +197,12 @@ pub fn pounding<'py>(
         (_, _, Some(gaps)) => Study::Moat { gaps },
         _ => Study::Runs { free },
     };
-    crate::simulate::warn_if_long(
+    let expected = crate::simulate::warn_if_long(
         py,
         study.estimate(&row, &runs, &run).map_err(pounding_error)?,
     )?;
     // Monitored: Ctrl-C stops every run at its next step (KeyboardInterrupt).
-    let doc = monitor::run(py, None, move |p: &Progress| {
+    let doc = monitor::run(py, None, expected, move |p: &Progress| {
         let run = RunSettings {
             interrupt: Some(p.interrupt.clone()),
             ..run
@@ -264,7 +264,7 @@ pub fn pounding_history<'py>(
         (sample, rtol, method, integrator),
     )?;
     let shared = row.clone();
-    let h = monitor::run(py, None, move |p: &Progress| {
+    let h = monitor::run(py, None, None, move |p: &Progress| {
         let run = RunSettings {
             interrupt: Some(p.interrupt.clone()),
             ..run

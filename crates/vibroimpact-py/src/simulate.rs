@@ -64,10 +64,10 @@ pub fn simulate<'py>(
         ..SimulationOptions::default()
     };
     let work = py.detach(|| estimate_work(m, &opts));
-    warn_if_long(py, work)?;
+    let expected = warn_if_long(py, work)?;
     let provenance = Provenance::new(&model.document, &opts);
     let effective = job.model.clone();
-    let result = monitor::run_keeping(py, progress, move |p: &Progress| {
+    let result = monitor::run_keeping(py, progress, expected, move |p: &Progress| {
         p.track_time(duration);
         let opts = SimulationOptions {
             interrupt: Some(p.interrupt.clone()),
@@ -139,10 +139,12 @@ fn history<'py>(
     Ok(d)
 }
 
-/// A `LongRunWarning` with the estimate, if the run will take long.
-pub(crate) fn warn_if_long(py: Python<'_>, work: Option<WorkEstimate>) -> PyResult<()> {
+/// A `LongRunWarning` with the estimate, if the run will take long; the
+/// seconds it expects, for [`monitor::run`](crate::monitor::run).
+pub(crate) fn warn_if_long(py: Python<'_>, work: Option<WorkEstimate>) -> PyResult<Option<f64>> {
+    let expected = work.map(|w| w.seconds);
     let Some(work) = work.filter(|w| w.is_long()) else {
-        return Ok(());
+        return Ok(expected);
     };
     let text = format!(
         "{}; Ctrl-C stops it and keeps what is complete",
@@ -150,5 +152,6 @@ pub(crate) fn warn_if_long(py: Python<'_>, work: Option<WorkEstimate>) -> PyResu
     );
     let text = std::ffi::CString::new(text).map_err(crate::convert::value_error)?;
     // Level 2: the user's call of vi.simulate, not the package's.
-    PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 2)
+    PyErr::warn(py, &py.get_type::<crate::LongRunWarning>(), &text, 2)?;
+    Ok(expected)
 }

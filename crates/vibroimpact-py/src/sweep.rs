@@ -85,7 +85,7 @@ pub fn sweep<'py>(
         let work = py.detach(|| sweep_work(&base, &options, values.len()));
         crate::simulate::warn_if_long(py, work)?;
     }
-    let summary = monitor::run_keeping(py, progress, move |p: &Progress| {
+    let summary = monitor::run_keeping(py, progress, None, move |p: &Progress| {
         p.set_total(total);
         let options = SweepOptions {
             interrupt: Some(p.interrupt.clone()),

@@ -1,7 +1,8 @@
 //! One building row under a record, timed (for profiling the seismic
 //! runs): `cargo run --release -p vibroimpact --example frame_once --
-//! ROW.toml RECORD.txt SCALE METHOD RTOL REPEATS` (the record in m/s²;
-//! METHOD dopri5 or dop853). Prints the median time of `REPEATS` runs
+//! ROW.toml RECORD.txt SCALE METHOD RTOL REPEATS [INTEGRATOR]` (the
+//! record in m/s²; METHOD dopri5 or dop853; INTEGRATOR auto, global or
+//! local, default RunSettings::new's). Prints the median time of `REPEATS` runs
 //! without the contacts' twin, and the peak drifts.
 use std::time::Instant;
 use vibroimpact::integrate::Method;
@@ -20,6 +21,9 @@ fn main() {
     } else {
         Method::Dop853
     };
+    if let Some(name) = args.get(7) {
+        run.integrator = name.parse().expect("integrator");
+    }
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..num(6) as usize {
