@@ -201,7 +201,8 @@ pub fn pounding<'py>(
         py,
         study.estimate(&row, &runs, &run).map_err(pounding_error)?,
     )?;
-    // Monitored: Ctrl-C stops every run at its next step (KeyboardInterrupt).
+    // Monitored (unless it is short: D44): Ctrl-C stops every run at its
+    // next step (KeyboardInterrupt).
     let doc = monitor::run(py, None, expected, move |p: &Progress| {
         let run = RunSettings {
             interrupt: Some(p.interrupt.clone()),
