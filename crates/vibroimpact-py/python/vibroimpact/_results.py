@@ -15,11 +15,16 @@ def _number(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+# The types a document's plain numbers (and nulls) have: a list of these
+# alone is an array, decided without a call per item.
+_PLAIN = frozenset((int, float, type(None)))
+
+
 def _numeric(v: list) -> bool:
     """Whether a list holds only numbers (None, JSON's null, counting as
     NaN), or only equally long non-empty lists of numbers: then it is an
     array."""
-    if all(_number(x) or x is None for x in v):
+    if all(type(x) in _PLAIN for x in v) or all(_number(x) or x is None for x in v):
         return True
     return (
         all(isinstance(x, list) and x and all(_number(y) for y in x) for x in v)
@@ -34,7 +39,8 @@ def _convert(v: Any) -> Any:
         if v and all(isinstance(x, dict) for x in v):
             return [Result(x) for x in v]
         if _numeric(v):
-            return np.asarray([np.nan if x is None else x for x in v], dtype=float)
+            # (None, JSON's null, is NaN in a float array.)
+            return np.asarray(v, dtype=float)
         return [_convert(x) for x in v]
     return v
 

@@ -229,10 +229,12 @@ impl Record {
                 format!("{} samples; a record needs at least two", times.len()),
             ));
         }
-        let steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-        let (lo, hi) = steps
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(*s), b.max(*s)));
+        // (Plain comparisons: `f64::min` and `max` chain a NaN test a
+        // sample; a NaN step is ignored either way.)
+        let (lo, hi) = times.windows(2).fold((f64::INFINITY, 0.0f64), |(a, b), w| {
+            let s = w[1] - w[0];
+            (if s < a { s } else { a }, if s > b { s } else { b })
+        });
         let dt = (hi - lo <= 1e-9 * hi).then_some(times[1] - times[0]);
         let acceleration: Vec<f64> = values.iter().map(|v| v * units.to_si()).collect();
         // A finite value in g or gal can overflow in m/s² (1e308 g).

@@ -399,7 +399,10 @@ impl Row {
     /// of [`TAIL_PERIODS`] of the longest fundamental period at rest (the
     /// residual drifts are read in its last period).
     fn excitation(&self, record: &Record) -> (Vec<f64>, Vec<f64>) {
-        let (mut times, mut acceleration) = (record.times.clone(), record.acceleration.clone());
+        let n = record.times.len() + 2;
+        let (mut times, mut acceleration) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        times.extend_from_slice(&record.times);
+        acceleration.extend_from_slice(&record.acceleration);
         if let Some(tail) = self.tail() {
             let end = times.last().copied().unwrap_or(0.0);
             // One sample step down to rest (within the tail however coarse
