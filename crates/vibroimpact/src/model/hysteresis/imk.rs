@@ -590,16 +590,24 @@ impl Imk {
     /// Bounds on how fast the two [`Imk::switch_parts`] change while the
     /// drift moves no faster than `speed` and its rate changes no faster
     /// than `acceleration` (force units per second): each drift term is a
-    /// line in the drift of slope at most the steepest backbone or
-    /// unloading slope S (a bound less the piece's force: 2 S); the
-    /// reversal's is k × the rate.
+    /// line in the drift, the distances to the ultimate and residual
+    /// drifts and to the backbone's next corner of slope k, the piece's
+    /// force of the piece's slope p, and off the backbone the distance
+    /// from the piece's force to a bound of slope b − p, b a backbone
+    /// slope (k_p, k_pc, or 0 on a residual or a lost side); the
+    /// reversal's is k × the rate. (Twice the steepest slope of all
+    /// bounded every term before: up to twice as loose, and most of the
+    /// exact run's switch search went into halving what it did not
+    /// clear.)
     pub fn switch_rate_bounds(&self, s: &ImkState, speed: f64, acceleration: f64) -> (f64, f64) {
-        let steepest = [s.pos, s.neg]
-            .iter()
-            .fold(self.stiffness.max(s.kunload.abs()), |m, side| {
-                m.max(side.kp.abs()).max(side.kpc.abs())
-            });
-        (2.0 * steepest * speed, self.stiffness * acceleration)
+        let p = s.slope;
+        let mut steepest = self.stiffness.max(p.abs());
+        if !s.on_backbone {
+            for side in [&s.pos, &s.neg] {
+                steepest = steepest.max((side.kp - p).abs()).max((side.kpc - p).abs());
+            }
+        }
+        (steepest * speed, self.stiffness * acceleration)
     }
 
     /// Whether, while the drift moves one way, [`Imk::switch_parts`]' drift

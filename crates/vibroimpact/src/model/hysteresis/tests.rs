@@ -405,3 +405,50 @@ fn a_force_past_double_precision_is_refused() {
         vec![(2.5e10, 0.0)]
     );
 }
+
+/// An IMK storey's drift terms ([`imk::Imk::switch_parts`]' first, moving
+/// up and moving down) change with the drift no faster than the slope
+/// [`imk::Imk::switch_rate_bounds`] gives at unit speed, in every state a
+/// random drift history reaches (backbone, unloading, capping, residual,
+/// a side lost): difference quotients over steps of 1e-4 u_y, at drifts
+/// around each state's anchor, to 1e-9 of the bound.
+#[test]
+fn imk_drift_terms_stay_within_their_slope_bound() {
+    let law = imk(0.5);
+    let mut seed = 11u64;
+    let mut rand = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut state = law.rest();
+    let (mut checked, mut steepest_seen) = (0, 0.0f64);
+    for j in 0..2000 {
+        let reach = 12.0 * UY * j as f64 / 2000.0;
+        law.advance(&mut state, reach * (2.0 * rand() - 1.0));
+        let (slope, _) = law.switch_rate_bounds(&state, 1.0, 1.0);
+        for _ in 0..20 {
+            let d = state.u + UY * (2.0 * rand() - 1.0);
+            let step = 1e-4 * UY;
+            for rate in [1.0, -1.0] {
+                let (g0, _) = law.switch_parts(&state, d, rate);
+                let (g1, _) = law.switch_parts(&state, d + step, rate);
+                if !(g0.is_finite() && g1.is_finite()) {
+                    continue;
+                }
+                let quotient = ((g1 - g0) / step).abs();
+                assert!(
+                    quotient <= slope * (1.0 + 1e-9),
+                    "{state:?} at {d}: |dg/dd| {quotient} above {slope}"
+                );
+                checked += 1;
+                steepest_seen = steepest_seen.max(quotient / slope);
+            }
+        }
+    }
+    // Most cases are read, and some come near the bound (it is not loose
+    // everywhere).
+    assert!(checked > 50_000, "{checked}");
+    assert!(steepest_seen > 0.9, "{steepest_seen}");
+}
