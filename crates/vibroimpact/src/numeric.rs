@@ -392,6 +392,19 @@ where
     })
 }
 
+/// Uniform numbers in [0, 1) from a seed, the same on every machine (a
+/// 64-bit linear congruential generator, its top 53 bits): the tests'
+/// random cases.
+#[cfg(test)]
+pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -271,13 +271,7 @@ fn a_switch_part_the_screen_passes_over_stays_positive_in_the_step() {
         yield_drift: 0.02,
         post_yield_ratio: 0.05,
     };
-    let mut seed = 7u64;
-    let mut rand = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rand = crate::numeric::uniform(7);
     let (mut passed_over, mut cases) = (0, 0);
     let mut state = imk.rest();
     for j in 0..600 {

@@ -415,13 +415,7 @@ fn a_force_past_double_precision_is_refused() {
 #[test]
 fn imk_drift_terms_stay_within_their_slope_bound() {
     let law = imk(0.5);
-    let mut seed = 11u64;
-    let mut rand = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rand = crate::numeric::uniform(11);
     let mut state = law.rest();
     let (mut checked, mut steepest_seen) = (0, 0.0f64);
     for j in 0..2000 {

@@ -420,13 +420,7 @@ fn a_records_peak_over_a_stretch() {
         vec![],
     );
     let free = FreeMotion::new(&model).unwrap();
-    let mut seed = 7u64;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = crate::numeric::uniform(7);
     for k in 0..3000 {
         let a = -0.5 + 11.5 * next();
         let len = [0.003, 0.05, 0.4, 12.0][k % 4] * next();
