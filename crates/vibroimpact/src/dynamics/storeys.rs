@@ -65,6 +65,10 @@ struct Term {
 #[derive(Clone, Debug, Default)]
 pub struct StoreyTerms {
     terms: Vec<Term>,
+    /// The storeys that switch branches (bilinear and IMK), in order: the
+    /// exact run asks at every piece (a filter over the laws there cost
+    /// 0.45 % of the IMK frame's run).
+    switching: Vec<usize>,
     states: usize,
     /// Changes whenever a branch does (unique over the process: a copy
     /// has its original's, any change a new one), so that what was
@@ -115,9 +119,13 @@ impl StoreyTerms {
                     state,
                 }
             })
+            .collect::<Vec<Term>>();
+        let switching = (0..terms.len())
+            .filter(|&k| matches!(terms[k].law, StoreyLaw::Bilinear(_) | StoreyLaw::Imk(_)))
             .collect();
         Self {
             terms,
+            switching,
             states,
             stamp: new_stamp(),
         }
@@ -278,12 +286,7 @@ impl StoreyTerms {
 
     /// The storeys whose branch switches (bilinear and IMK).
     pub fn switching(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..self.terms.len()).filter(|&k| {
-            matches!(
-                self.terms[k].law,
-                StoreyLaw::Bilinear(_) | StoreyLaw::Imk(_)
-            )
-        })
+        self.switching.iter().copied()
     }
 
     /// Storey k's switch function in `y`: positive while its branch
