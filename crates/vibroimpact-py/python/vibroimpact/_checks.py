@@ -34,11 +34,19 @@ def _floats(x: Any, name: str, *, allow_scalar: bool = True) -> np.ndarray:
         and x.flags.c_contiguous
         and x.flags.aligned
     ):
-        # The usual case (a record's samples), checked in one pass.
-        if not np.isfinite(x).all():
-            bad = np.flatnonzero(~np.isfinite(x))
-            raise ValueError(f"{name}[{bad[0]}] = {x[bad[0]]}: must be finite")
-        return x
+        # The usual case (a record's samples): nothing to convert.
+        a = x
+    else:
+        a = _converted(x, name, allow_scalar)
+    if not np.isfinite(a).all():
+        bad = np.flatnonzero(~np.isfinite(a))
+        raise ValueError(f"{name}[{bad[0]}] = {a[bad[0]]}: must be finite")
+    return a
+
+
+def _converted(x: Any, name: str, allow_scalar: bool) -> np.ndarray:
+    """`x` as a contiguous, aligned float64 1-D array (not yet checked
+    for finiteness)."""
     if isinstance(x, (str, bytes)):
         raise TypeError(f"{name}: expected numbers, got {type(x).__name__}")
     try:
@@ -54,11 +62,7 @@ def _floats(x: Any, name: str, *, allow_scalar: bool = True) -> np.ndarray:
         a = a.reshape(1)
     if a.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {a.shape}")
-    a = np.require(a, np.float64, ["C", "A"])
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise ValueError(f"{name}[{bad[0]}] = {a[bad[0]]}: must be finite")
-    return a
+    return np.require(a, np.float64, ["C", "A"])
 
 
 def _real(x: Any, name: str, *, positive: bool = False, optional: bool = False):

@@ -80,7 +80,7 @@ impl Accelerogram {
                 "accelerogram: scale must be finite",
             ));
         }
-        // The median spacing (of at most 65 spread over the record: only
+        // The median spacing (of at most 64 spread over the record: only
         // the guess depends on it): a record with a tail sample appended (a
         // pounding run's ramp to rest) keeps its own rate, and the guess
         // stays exact; the average would send every guess to bisection.
