@@ -203,13 +203,7 @@ impl PiecewiseForm {
                        g: &[f64; 3],
                        m: f64,
                        above: (f64, f64)| {
-            let a =
-                ((-g[0] * u + above.0 - below.0) * wx + (-g[1] * v + above.1 - below.1) * wz) * m;
-            *o = match added {
-                Added::Nothing => a,
-                Added::ConstantLess(a0, w) => a + (g[2] * m - a0) * w,
-                Added::Less(x) => a - x,
-            };
+            *o = chain_row((g, m), (u, v), (above, below), (wx, wz), added);
             top = larger(top, o.abs());
             add_weighted(e, *o, w);
             below = above;
@@ -223,6 +217,26 @@ impl PiecewiseForm {
         }
         row(o, (u, v), g, *m, (0.0, 0.0));
         top
+    }
+
+    /// The chain of exactly `N` bodies as arrays (None: not a chain, or
+    /// not of N bodies), for [`FixedChain::term`].
+    #[inline(always)]
+    pub fn fixed<const N: usize>(&self) -> Option<FixedChain<N>> {
+        let chain = self.chain.as_ref()?;
+        let (ground, inv_mass) = (
+            self.ground.as_slice().try_into().ok()?,
+            self.inv_mass.as_slice().try_into().ok()?,
+        );
+        let mut above = [[0.0; 2]; N];
+        for (a, link) in above.iter_mut().zip(chain) {
+            *a = *link;
+        }
+        Some(FixedChain {
+            ground,
+            inv_mass,
+            above,
+        })
     }
 
     /// Whether its links are taken as a chain.
@@ -300,6 +314,70 @@ impl PiecewiseForm {
     #[inline]
     pub fn constant(&self, i: usize) -> f64 {
         self.ground[i][2] * self.inv_mass[i]
+    }
+}
+
+/// A chain of `N` bodies ([`PiecewiseForm::fixed`]): its product with
+/// rows of a known length, which the compiler unrolls, with no index to
+/// check (a building of up to eight storeys: the exact run's series).
+#[derive(Clone, Copy, Debug)]
+pub struct FixedChain<const N: usize> {
+    /// Per body: its spring and damper to the ground and its constant
+    /// force; its inverse mass; the link above it (k, c; zero above the
+    /// last).
+    ground: [[f64; 3]; N],
+    inv_mass: [f64; N],
+    above: [[f64; 2]; N],
+}
+
+impl<const N: usize> FixedChain<N> {
+    /// [`PiecewiseForm::displacement_term`] on rows of N: the same
+    /// arithmetic in the same order (each link's force once, a body's row
+    /// written when the link above it is known).
+    #[inline(always)]
+    pub fn term(
+        &self,
+        (x, wx): (&[f64; N], f64),
+        (z, wz): (&[f64; N], f64),
+        out: &mut [f64; N],
+        added: Added,
+        (sums, w): (&mut [[f64; 4]; N], [f64; 3]),
+    ) -> f64 {
+        let mut top = 0.0f64;
+        let mut below = (0.0, 0.0);
+        for i in 0..N {
+            let [k, c] = self.above[i];
+            let above = match i + 1 < N {
+                true => (k * (x[i + 1] - x[i]), c * (z[i + 1] - z[i])),
+                false => (0.0, 0.0),
+            };
+            let (g, m) = (&self.ground[i], self.inv_mass[i]);
+            out[i] = chain_row((g, m), (x[i], z[i]), (above, below), (wx, wz), added);
+            top = larger(top, out[i].abs());
+            add_weighted(&mut sums[i], out[i], w);
+            below = above;
+        }
+        top
+    }
+}
+
+/// A chain body's row of a term: from its ground (spring, damper,
+/// constant force) and inverse mass, its displacement and velocity terms
+/// `(u, v)`, and the forces of the links above and below it (each `(k
+/// Δu, c Δv)`), weighted by `(wx, wz)`, with what `added` adds.
+#[inline(always)]
+fn chain_row(
+    (g, m): (&[f64; 3], f64),
+    (u, v): (f64, f64),
+    (above, below): ((f64, f64), (f64, f64)),
+    (wx, wz): (f64, f64),
+    added: Added,
+) -> f64 {
+    let a = ((-g[0] * u + above.0 - below.0) * wx + (-g[1] * v + above.1 - below.1) * wz) * m;
+    match added {
+        Added::Nothing => a,
+        Added::ConstantLess(a0, w) => a + (g[2] * m - a0) * w,
+        Added::Less(x) => a - x,
     }
 }
 

@@ -57,7 +57,7 @@ pub mod saltation;
 mod state;
 mod storeys;
 pub mod variational;
-pub use linear::{Added, PiecewiseForm};
+pub use linear::{Added, FixedChain, PiecewiseForm};
 pub use state::{from_interleaved, interleaved_index, to_interleaved};
 pub use storeys::{Branch, StoreyTerms};
 

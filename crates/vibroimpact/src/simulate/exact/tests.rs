@@ -296,8 +296,10 @@ fn the_exact_run_is_for_linear_pieces_under_a_record() {
 /// A building's storeys are a chain: a term of its series (a product
 /// with `A` in one pass over the floors, with each kind of forcing) is the
 /// links' one by one (P-Δ, Rayleigh damping and IMK storeys of the
-/// 4-storey frame) to 1e-15 of its size, with its rows' sizes; a row of
-/// two buildings without their contacts is one too (no link between them).
+/// 4-storey frame) to 1e-15 of its size, with its rows' sizes, and its
+/// arrays' product ([`crate::dynamics::FixedChain`]) is its own bit for
+/// bit; a row of two buildings without their contacts is one too (no
+/// link between them).
 #[test]
 fn a_chain_multiplies_as_its_links() {
     for file in ["moment-frame-4.toml", "pounding-frames.toml"] {
@@ -347,8 +349,31 @@ fn a_chain_multiplies_as_its_links() {
             }
             let largest = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             assert_eq!(top, largest, "{file} {added:?}");
+            // (The chain's arrays: bit for bit the chain's product.)
+            let fixed = match n {
+                4 => fixed_term::<4>(&form, (&x, &z), added, w),
+                5 => fixed_term::<5>(&form, (&x, &z), added, w),
+                _ => panic!("{file}: {n} bodies"),
+            };
+            assert_eq!(fixed, (a, sums_a, top), "{file} {added:?}: by arrays");
         }
     }
+}
+
+/// [`FixedChain::term`] of `form`, a chain of N bodies, on `x` and `z` (as
+/// the test above gives them): the row, the sums and the largest.
+fn fixed_term<const N: usize>(
+    form: &PiecewiseForm,
+    (x, z): (&[f64], &[f64]),
+    added: Added,
+    w: [f64; 3],
+) -> (Vec<f64>, Vec<[f64; 4]>, f64) {
+    let chain = form.fixed::<N>().expect("a chain of N bodies");
+    let mut sums: [[f64; 4]; N] = std::array::from_fn(|i| [x[i], 0.0, -x[i], 1.0]);
+    let mut out = [0.0; N];
+    let (x, z): (&[f64; N], &[f64; N]) = (x.try_into().unwrap(), z.try_into().unwrap());
+    let top = chain.term((x, 0.3), (z, 0.6), &mut out, added, (&mut sums, w));
+    (out.to_vec(), sums.to_vec(), top)
 }
 
 /// A series is cut where the bound on its tail falls below rounding, not
