@@ -224,18 +224,21 @@ impl PiecewiseForm {
     #[inline(always)]
     pub fn fixed<const N: usize>(&self) -> Option<FixedChain<N>> {
         let chain = self.chain.as_ref()?;
-        let (ground, inv_mass) = (
+        let (ground, inv_mass): (&[[f64; 3]; N], [f64; N]) = (
             self.ground.as_slice().try_into().ok()?,
             self.inv_mass.as_slice().try_into().ok()?,
         );
-        let mut above = [[0.0; 2]; N];
-        for (a, link) in above.iter_mut().zip(chain) {
-            *a = *link;
+        let (mut link_k, mut link_c) = ([0.0; N], [0.0; N]);
+        for ((k, c), link) in link_k.iter_mut().zip(link_c.iter_mut()).zip(chain) {
+            (*k, *c) = (link[0], link[1]);
         }
         Some(FixedChain {
-            ground,
+            ground_k: ground.map(|g| g[0]),
+            ground_c: ground.map(|g| g[1]),
+            constant: ground.map(|g| g[2]),
             inv_mass,
-            above,
+            link_k,
+            link_c,
         })
     }
 
@@ -322,18 +325,22 @@ impl PiecewiseForm {
 /// check (a building of up to eight storeys: the exact run's series).
 #[derive(Clone, Copy, Debug)]
 pub struct FixedChain<const N: usize> {
-    /// Per body: its spring and damper to the ground and its constant
-    /// force; its inverse mass; the link above it (k, c; zero above the
-    /// last).
-    ground: [[f64; 3]; N],
+    /// Per body: its spring, damper and constant force to the ground, its
+    /// inverse mass, and the link above it (stiffness and damping; zero
+    /// above the last).
+    ground_k: [f64; N],
+    ground_c: [f64; N],
+    constant: [f64; N],
     inv_mass: [f64; N],
-    above: [[f64; 2]; N],
+    link_k: [f64; N],
+    link_c: [f64; N],
 }
 
 impl<const N: usize> FixedChain<N> {
-    /// [`PiecewiseForm::displacement_term`] on rows of N: the same
-    /// arithmetic in the same order (each link's force once, a body's row
-    /// written when the link above it is known).
+    /// [`PiecewiseForm::displacement_term`] on rows of N, without the
+    /// sums (a series of them sums its rows once it has them: see
+    /// `simulate::exact`): the same arithmetic in the same order, each
+    /// link's force once.
     #[inline(always)]
     pub fn term(
         &self,
@@ -341,23 +348,30 @@ impl<const N: usize> FixedChain<N> {
         (z, wz): (&[f64; N], f64),
         out: &mut [f64; N],
         added: Added,
-        (sums, w): (&mut [[f64; 4]; N], [f64; 3]),
     ) -> f64 {
-        let mut top = 0.0f64;
-        let mut below = (0.0, 0.0);
-        for i in 0..N {
-            let [k, c] = self.above[i];
-            let above = match i + 1 < N {
-                true => (k * (x[i + 1] - x[i]), c * (z[i + 1] - z[i])),
-                false => (0.0, 0.0),
-            };
-            let (g, m) = (&self.ground[i], self.inv_mass[i]);
-            out[i] = chain_row((g, m), (x[i], z[i]), (above, below), (wx, wz), added);
-            top = larger(top, out[i].abs());
-            add_weighted(&mut sums[i], out[i], w);
-            below = above;
+        // (Each link's force, link i between bodies i and i + 1; none
+        // above the last.)
+        let (mut fk, mut fc) = ([0.0; N], [0.0; N]);
+        for i in 1..N {
+            fk[i - 1] = self.link_k[i - 1] * (x[i] - x[i - 1]);
+            fc[i - 1] = self.link_c[i - 1] * (z[i] - z[i - 1]);
         }
-        top
+        for i in 0..N {
+            let below = match i {
+                0 => (0.0, 0.0),
+                _ => (fk[i - 1], fc[i - 1]),
+            };
+            let g = [self.ground_k[i], self.ground_c[i], self.constant[i]];
+            let m = self.inv_mass[i];
+            out[i] = chain_row(
+                (&g, m),
+                (x[i], z[i]),
+                ((fk[i], fc[i]), below),
+                (wx, wz),
+                added,
+            );
+        }
+        out.iter().fold(0.0f64, |top, o| larger(top, o.abs()))
     }
 }
 

@@ -223,6 +223,7 @@ impl Series {
                     && 2.0 * e * rho * (k + 2.0) <= CUT * largest * (1.0 - rho) * (1.0 - rho)
             {
                 self.terms = j + 3;
+                terms.sums(&self.c[..self.terms * n], &mut self.end);
                 self.ends();
                 return Built::Done;
             }
@@ -391,6 +392,7 @@ impl Series {
 /// `added` says, into its row and the end's sums, its largest coefficient
 /// returned (see [`PiecewiseForm::displacement_term`]).
 trait Terms {
+    /// Term j + 2 (see [`Terms`]).
     fn term(
         &self,
         rows: (&mut [f64], &[f64], &mut [[f64; 4]]),
@@ -398,6 +400,9 @@ trait Terms {
         w: (f64, f64),
         added: Added,
     ) -> f64;
+
+    /// The end's sums of `rows`, where the terms did not add them.
+    fn sums(&self, rows: &[f64], sums: &mut [[f64; 4]]);
 }
 
 /// Any form's terms, on rows of its bodies.
@@ -423,6 +428,10 @@ impl Terms for Rows<'_> {
         self.0
             .displacement_term((x, wx), (z, wz), out, added, (sums, AT_END[j + 2]))
     }
+
+    /// (Its terms added them.)
+    #[inline(always)]
+    fn sums(&self, _: &[f64], _: &mut [[f64; 4]]) {}
 }
 
 /// A chain of N bodies' terms, on rows of N.
@@ -430,7 +439,7 @@ impl<const N: usize> Terms for FixedChain<N> {
     #[inline(always)]
     fn term(
         &self,
-        (c, v0, sums): (&mut [f64], &[f64], &mut [[f64; 4]]),
+        (c, v0, _): (&mut [f64], &[f64], &mut [[f64; 4]]),
         j: usize,
         (wx, wz): (f64, f64),
         added: Added,
@@ -440,16 +449,40 @@ impl<const N: usize> Terms for FixedChain<N> {
             0 => v0,
             _ => &before[(j + 1) * N..],
         };
-        let (Some(x), Some(z), Ok(sums), Some(out)) = (
+        let (Some(x), Some(z), Some(out)) = (
             before[j * N..].first_chunk::<N>(),
             z.first_chunk::<N>(),
-            <&mut [[f64; 4]; N]>::try_from(sums),
             after.first_chunk_mut::<N>(),
         ) else {
             // (Rows of N bodies, a term within them: never.)
             return f64::NAN;
         };
-        FixedChain::term(self, (x, wx), (z, wz), out, added, (sums, AT_END[j + 2]))
+        FixedChain::term(self, (x, wx), (z, wz), out, added)
+    }
+
+    /// The sums term by term from the third, in the order the terms'
+    /// products would add them (the first two's are there), N bodies at a
+    /// time in registers.
+    #[inline(always)]
+    fn sums(&self, rows: &[f64], sums: &mut [[f64; 4]]) {
+        let mut e = [[0.0; N]; 4];
+        for (i, s) in sums.iter().take(N).enumerate() {
+            for (e, s) in e.iter_mut().zip(s) {
+                e[i] = *s;
+            }
+        }
+        for (row, w) in rows.chunks_exact(N).zip(AT_END.iter()).skip(2) {
+            // (A sum at a time over the bodies, which the compiler takes
+            // two bodies at a time.)
+            for (e, w) in e.iter_mut().zip([1.0, w[0], w[1], w[2]]) {
+                for (e, c) in e.iter_mut().zip(row) {
+                    *e += c * w;
+                }
+            }
+        }
+        for (i, s) in sums.iter_mut().take(N).enumerate() {
+            *s = [e[0][i], e[1][i], e[2][i], e[3][i]];
+        }
     }
 }
 
