@@ -188,7 +188,14 @@ pub(super) fn run(
         if let Some((_, k)) = switch {
             sys.storeys_mut().switch(k, &y);
             sys.piecewise_form(&mut form);
-            carried.fill(Known::Nothing);
+            // (The other storeys' bounds over the piece hold where it
+            // ended; their values at its planned end do not.)
+            for c in carried.iter_mut() {
+                if let Known::Exact(_) = c {
+                    *c = Known::Nothing;
+                }
+            }
+            carried[k] = Known::Nothing;
             slopes_of(sys.storeys(), &mut slopes);
         }
     }
@@ -295,7 +302,6 @@ fn first_switch(
                 || near(d, lines * speed) && near(t, turn * acceleration)
         });
         let bounds = Rates {
-            drift: lines * speed,
             lines,
             speed,
             least_at_ends,
@@ -305,15 +311,18 @@ fn first_switch(
         // Moving one way on one side of zero drift, and further from its
         // switches than its parts can move over the piece, a storey clears
         // on what it carries, its parts at the end not read: it carries
-        // their lower bounds on.
+        // their lower bounds on. (Its drift terms, each of slope at most
+        // `lines` in the drift, move at most `lines` times the drift's
+        // move, which is monotone there: tighter than the piece's speed
+        // bound times its length, which about doubled the parts read.)
         let (g, r) = start.lower();
         let drift = |tau: f64| series.value_rate(2 * above, below.map(|j| 2 * j), tau);
         let ((da, ra), (db, rb)) = (drift(0.0), drift(b));
         let one_way = ra.abs().max(rb.abs()) > acceleration * b && da * db > 0.0;
-        if one_way && g > bounds.drift * b && r > bounds.turn * b {
-            if b == h {
-                carried[k] = Known::Above(g - bounds.drift * h, r - bounds.turn * h);
-            }
+        let moved = lines * (db - da).abs();
+        if one_way && g > moved && r > bounds.turn * b {
+            // (Bounds over all of `[0, b]`, where the piece ends.)
+            carried[k] = Known::Above(g - moved, r - bounds.turn * b);
             continue;
         }
         let p0 = match start {
@@ -405,14 +414,13 @@ fn clear(bounds: Rates, (a, pa): (f64, Parts), (b, pb): (f64, Parts)) -> bool {
 }
 
 /// Bounds over a piece on how a storey's switch parts change: the drift
-/// terms' rate, whether they are least at the ends of an interval the
-/// drift moves over one way, the reversal's rate, and the drift's
-/// acceleration.
+/// terms' slope in the drift and the drift's speed, whether they are
+/// least at the ends of an interval the drift moves over one way, the
+/// reversal's rate, and the drift's acceleration.
 #[derive(Clone, Copy, Debug)]
 struct Rates {
-    drift: f64,
-    /// The drift terms' rate bound at unit drift speed, and the drift's
-    /// speed bound over the piece (`drift` their product).
+    /// The drift terms' rate bound at unit drift speed (their steepest
+    /// slope in the drift), and the drift's speed bound over the piece.
     lines: f64,
     speed: f64,
     least_at_ends: bool,
