@@ -31,6 +31,15 @@ pub(super) struct Peaks {
     loops: Vec<Tracked>,
 }
 
+/// A storey's drift limit ([`Peaks::limits`]): the bodies above and below
+/// it (None: the ground), its bound (m), and its building and storey.
+pub(super) struct Limit {
+    above: usize,
+    below: Option<usize>,
+    bound: f64,
+    at: (usize, usize),
+}
+
 /// A hysteretic storey's body below (None: the ground) and above, and its
 /// loop so far.
 type Tracked = (Option<usize>, usize, StoreyLoop);
@@ -139,26 +148,41 @@ impl Peaks {
         }
     }
 
-    /// The storey drifts of a sample against `bounds` (m, per building and
-    /// storey): the largest drift over its bound, with its building and
-    /// storey.
-    pub(super) fn check(&self, row: &[f64], bounds: &[Vec<f64>]) -> (f64, usize, usize) {
-        let u = &row[..(row.len() - self.loops.len()) / 2];
-        let mut worst = (0.0f64, 0, 0);
+    /// Each storey's drift against its bound in `bounds` (m, per building
+    /// and storey), for [`Peaks::check`].
+    pub(super) fn limits(&self, bounds: &[Vec<f64>]) -> Vec<Limit> {
+        let mut limits = Vec::new();
         for (k, (&(first, base, floors), bound)) in self.layout.iter().zip(bounds).enumerate() {
-            for i in 0..floors {
+            for (i, &bound) in bound.iter().enumerate().take(floors) {
                 let below = match (i, base) {
-                    (0, None) => 0.0,
-                    (0, Some(b)) => u[b],
-                    _ => u[first + i - 1],
+                    (0, b) => b,
+                    _ => Some(first + i - 1),
                 };
-                let r = (u[first + i] - below).abs() / bound[i];
-                if r > worst.0 {
-                    worst = (r, k, i);
-                }
+                limits.push(Limit {
+                    above: first + i,
+                    below,
+                    bound,
+                    at: (k, i),
+                });
             }
         }
-        worst
+        limits
+    }
+
+    /// The storey drifts of a sample against their `limits`: the building
+    /// and storey of the largest drift over its bound, where one exceeds
+    /// it. (A drift is divided by its bound only where it exceeds it: a
+    /// division per storey and sample was most of the check.)
+    pub(super) fn check(&self, row: &[f64], limits: &[Limit]) -> Option<(usize, usize)> {
+        let u = &row[..(row.len() - self.loops.len()) / 2];
+        let mut worst: Option<(f64, (usize, usize))> = None;
+        for l in limits {
+            let drift = (u[l.above] - l.below.map_or(0.0, |b| u[b])).abs();
+            if drift > l.bound && worst.is_none_or(|w| drift / l.bound > w.0) {
+                worst = Some((drift / l.bound, l.at));
+            }
+        }
+        worst.map(|w| w.1)
     }
 
     /// The response: these peaks with the run's impacts (between buildings

@@ -314,7 +314,7 @@ fn first_switch(
         // their lower bounds on. (Its drift terms, each of slope at most
         // `lines` in the drift, move at most `lines` times the drift's
         // move, which is monotone there: tighter than the piece's speed
-        // bound times its length, which about doubled the parts read.)
+        // bound times its length.)
         let (g, r) = start.lower();
         let drift = |tau: f64| series.value_rate(2 * above, below.map(|j| 2 * j), tau);
         let ((da, ra), (db, rb)) = (drift(0.0), drift(b));
