@@ -203,10 +203,22 @@ impl GaugeScan {
     pub(super) fn scan_ends(
         &mut self,
         (a, b): (f64, f64),
+        ends: ((f64, f64), (f64, f64)),
+        at: impl FnMut(f64) -> (f64, f64),
+    ) {
+        self.note(ends.0 .0);
+        self.scan_on((a, b), ends, at);
+    }
+
+    /// [`GaugeScan::scan_ends`] from the end of the last piece scanned,
+    /// noted then.
+    #[inline]
+    pub(super) fn scan_on(
+        &mut self,
+        (a, b): (f64, f64),
         ((xa, ra), (xb, rb)): ((f64, f64), (f64, f64)),
         at: impl FnMut(f64) -> (f64, f64),
     ) {
-        self.note(xa);
         self.note(xb);
         if ra * rb < 0.0 {
             self.turning((a, b), ((xa, ra), (xb, rb)), at);

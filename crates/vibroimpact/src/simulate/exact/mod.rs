@@ -49,6 +49,7 @@ struct Reader {
     bodies: bool,
     found: Extrema,
     gauges: Vec<GaugeScan>,
+    reads: Vec<Read>,
     /// Each gauge's time, value and rate where the last piece ended (NaN
     /// time: none): a separation's rate is continuous, so the next piece
     /// starts from them.
@@ -91,6 +92,7 @@ pub(super) fn run(
             gauges: Vec::new(),
         },
         gauges: opts.gauges.iter().copied().map(GaugeScan::new).collect(),
+        reads: opts.gauges.iter().copied().map(Read::of).collect(),
         ends: vec![(f64::NAN, (0.0, 0.0)); opts.gauges.len()],
     };
     if let Some((from, to)) = reader.window {
@@ -477,22 +479,58 @@ fn largest(at: impl Fn(f64) -> (f64, f64, f64), (a, b): (f64, f64)) -> f64 {
     x
 }
 
-/// A gauge and its rate at τ on the series, whose base acceleration is
-/// `a0 + s τ` (inlined always: at a piece's ends, the usual reading, it
-/// is a few of the end's sums).
-#[inline(always)]
-fn gauge_at(series: &Series, kind: Gauge, tau: f64, (a0, s): (f64, f64)) -> (f64, f64) {
-    match kind {
-        Gauge::Separation { left, right, .. } => match left {
-            Some(l) => series.value_rate(2 * l, right.map(|j| 2 * j), tau),
-            None => {
-                let (x, r) = series.value_rate(2 * right.unwrap_or(0), None, tau);
-                (-x, -r)
+/// How the run reads a gauge on the series: `sign (u_p − u_q)` (a
+/// separation; q None: the ground) or body p's absolute acceleration.
+#[derive(Clone, Copy, Debug)]
+enum Read {
+    Separation {
+        p: usize,
+        q: Option<usize>,
+        sign: f64,
+    },
+    Acceleration {
+        p: usize,
+    },
+}
+
+impl Read {
+    /// How `gauge` is read.
+    fn of(gauge: Gauge) -> Self {
+        match gauge {
+            Gauge::Separation {
+                left: Some(l),
+                right,
+                ..
+            } => Read::Separation {
+                p: l,
+                q: right,
+                sign: 1.0,
+            },
+            Gauge::Separation {
+                left: None, right, ..
+            } => Read::Separation {
+                p: right.unwrap_or(0),
+                q: None,
+                sign: -1.0,
+            },
+            Gauge::AbsoluteAcceleration { body } => Read::Acceleration { p: body },
+        }
+    }
+
+    /// The gauge and its rate at τ on the series, whose base acceleration
+    /// is `a0 + s τ` (inlined always: at a piece's ends, the usual reading,
+    /// it is a few of the end's sums).
+    #[inline(always)]
+    fn at(self, series: &Series, tau: f64, (a0, s): (f64, f64)) -> (f64, f64) {
+        match self {
+            Read::Separation { p, q, sign } => {
+                let (x, r) = series.value_rate(2 * p, q.map(|j| 2 * j), tau);
+                (sign * x, sign * r)
             }
-        },
-        Gauge::AbsoluteAcceleration { body } => {
-            let (_, a, jerk) = series.component(2 * body + 1, tau);
-            (a + a0 + s * tau, jerk + s)
+            Read::Acceleration { p } => {
+                let (_, a, jerk) = series.component(2 * p + 1, tau);
+                (a + a0 + s * tau, jerk + s)
+            }
         }
     }
 }
@@ -521,17 +559,19 @@ impl Reader {
         // (The piece's end read at its own τ: tb − ta may differ from it
         // in the last bit, and at the series' end that is its sums.)
         let end_tau = if b == tb { tau } else { b - ta };
-        for (gauge, end) in self.gauges.iter_mut().zip(self.ends.iter_mut()) {
-            let kind = gauge.gauge;
-            let at_tau = |tau: f64| gauge_at(series, kind, tau, (a0, s));
-            let at = |t: f64| at_tau(t - ta);
-            let start = match (kind, *end) {
-                (Gauge::Separation { .. }, (t, x)) if t == a => x,
-                _ => at(a),
-            };
-            let ends = (start, at_tau(end_tau));
-            *end = (b, ends.1);
-            gauge.scan_ends((a, b), ends, at);
+        let gauges = self.gauges.iter_mut().zip(&self.reads);
+        for ((gauge, &read), end) in gauges.zip(self.ends.iter_mut()) {
+            let at = |t: f64| read.at(series, t - ta, (a0, s));
+            let stop = read.at(series, end_tau, (a0, s));
+            match (read, *end) {
+                // (A separation goes on from the last piece's end, noted
+                // there.)
+                (Read::Separation { .. }, (t, x)) if t == a => {
+                    gauge.scan_on((a, b), (x, stop), at);
+                }
+                _ => gauge.scan_ends((a, b), (at(a), stop), at),
+            }
+            *end = (b, stop);
         }
     }
 
