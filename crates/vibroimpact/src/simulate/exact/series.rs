@@ -369,6 +369,7 @@ impl Series {
     /// |c_k| h^{k−2}` of the difference, rigorous for the series; beyond
     /// the third term by the largest displacement's coefficients, once for
     /// each side.
+    #[inline(always)]
     pub(super) fn rate_bounds(&self, i: usize, j: Option<usize>) -> (f64, f64) {
         debug_assert!(i % 2 == 0 && j.is_none_or(|j| j % 2 == 0));
         let n = self.n;
