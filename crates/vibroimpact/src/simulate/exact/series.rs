@@ -311,7 +311,7 @@ impl Series {
     #[inline(never)]
     fn derivatives_inside(&self, b: usize, tau: f64) -> [f64; 4] {
         let n = self.n;
-        let theta = tau / self.h;
+        let theta = tau * self.inv[1];
         let mut e = [0.0; 4];
         for row in self.c[..self.terms * n].chunks_exact(n).rev() {
             let c = row[b];
@@ -349,7 +349,7 @@ impl Series {
     /// Horner on the difference's coefficients.
     #[inline(never)]
     fn value_rate_inside(&self, a: usize, b: Option<usize>, tau: f64) -> (f64, f64) {
-        let theta = tau / self.h;
+        let theta = tau * self.inv[1];
         let (mut x, mut dx) = (0.0, 0.0);
         let mut horner = |c: f64| {
             dx = dx * theta + x;
