@@ -171,8 +171,8 @@ impl Peaks {
 
     /// The storey drifts of a sample against their `limits`: the building
     /// and storey of the largest drift over its bound, where one exceeds
-    /// it. (A drift is divided by its bound only where it exceeds it: a
-    /// division per storey and sample was most of the check.)
+    /// it. (A drift is divided by its bound only where it exceeds it, not
+    /// every storey at every sample.)
     pub(super) fn check(&self, row: &[f64], limits: &[Limit]) -> Option<(usize, usize)> {
         let u = &row[..(row.len() - self.loops.len()) / 2];
         let mut worst: Option<(f64, (usize, usize))> = None;

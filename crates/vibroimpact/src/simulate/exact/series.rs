@@ -462,8 +462,8 @@ impl<const N: usize> Terms for FixedChain<N> {
     }
 
     /// The sums term by term from the third, in the order the terms'
-    /// products would add them (the first two's are there), N bodies at a
-    /// time in registers.
+    /// products would add them (the first two's are there), kept in
+    /// registers while the rows are read.
     #[inline(always)]
     fn sums(&self, rows: &[f64], sums: &mut [[f64; 4]]) {
         let mut e = [[0.0; N]; 4];
@@ -473,8 +473,6 @@ impl<const N: usize> Terms for FixedChain<N> {
             }
         }
         for (row, w) in rows.chunks_exact(N).zip(AT_END.iter()).skip(2) {
-            // (A sum at a time over the bodies, which the compiler takes
-            // two bodies at a time.)
             for (e, w) in e.iter_mut().zip([1.0, w[0], w[1], w[2]]) {
                 for (e, c) in e.iter_mut().zip(row) {
                     *e += c * w;
