@@ -448,3 +448,38 @@ fn a_series_runs_past_terms_that_vanish() {
         }
     }
 }
+
+/// Inside an interval, the state of every body read in one pass
+/// ([`Series::state`]) is each body's own reading
+/// ([`Series::value_rate`]) bit for bit: the 4-storey frame and a row of
+/// two buildings, from a state away from rest over a record's step.
+#[test]
+fn a_state_inside_is_each_bodys_reading() {
+    for file in ["moment-frame-4.toml", "pounding-frames.toml"] {
+        let path = format!("{}/../../examples/{file}", env!("CARGO_MANIFEST_DIR"));
+        let row = parse_row(&std::fs::read_to_string(&path).unwrap(), file).unwrap();
+        let model = row.model(&record(), 1.0, false).unwrap().model;
+        let mut form = PiecewiseForm::default();
+        assert!(ChainDynamics::new(&model, false).piecewise_form(&mut form));
+        let n = model.bodies().len();
+        let y0: Vec<f64> = (0..2 * n)
+            .map(|i| ((i * 5 + 2) % 7) as f64 / 70.0 - 0.04)
+            .collect();
+        let mut series = Series::new(2 * n);
+        let h = 0.02;
+        assert_eq!(series.build(&form, &y0, (0.3, -2.0), h), Built::Done);
+        for tau in [0.1 * h, h / 3.0, 0.75 * h] {
+            let mut y = vec![0.0; 2 * n];
+            series.state(tau, &mut y);
+            for b in 0..n {
+                let (u, v) = series.value_rate(2 * b, None, tau);
+                assert_eq!(
+                    (y[2 * b], y[2 * b + 1]),
+                    (u, v),
+                    "{file}: body {b} at {tau}"
+                );
+            }
+            assert!(y.iter().zip(&y0).any(|(p, q)| p != q), "{file}: it moved");
+        }
+    }
+}
