@@ -281,10 +281,7 @@ fn first_switch(
     for k in storeys.switching() {
         let (below, above) = storeys.ends(k);
         let mut parts = |tau: f64| {
-            for i in [Some(above), below].into_iter().flatten() {
-                let (u, v) = series.value_rate(2 * i, None, tau);
-                (y[2 * i], y[2 * i + 1]) = (u, v);
-            }
+            series.two_states(above, below, tau, y);
             let (d, r) = storeys.switch_parts(k, y);
             let rate = y[2 * above + 1] - below.map_or(0.0, |j| y[2 * j + 1]);
             (d, r, rate)

@@ -387,6 +387,43 @@ impl Series {
         self.value_rate_inside(a, b, tau)
     }
 
+    /// The states (`[u, v]` per body) of bodies `a` and `b` (if any) at τ
+    /// into `y`, each exactly as [`Series::value_rate`] reads it alone;
+    /// inside the interval both in one pass over the terms (a storey's
+    /// two floors, read at every point the switch search looks at).
+    #[inline(always)]
+    pub(super) fn two_states(&self, a: usize, b: Option<usize>, tau: f64, y: &mut [f64]) {
+        match b {
+            Some(b) if tau != 0.0 && tau != self.h => {
+                let theta = tau * self.inv[1];
+                let [(ua, va), (ub, vb)] = self.two_inside(a, b, theta);
+                (y[2 * a], y[2 * a + 1]) = (ua, va);
+                (y[2 * b], y[2 * b + 1]) = (ub, vb);
+            }
+            _ => {
+                for i in [Some(a), b].into_iter().flatten() {
+                    (y[2 * i], y[2 * i + 1]) = self.value_rate(2 * i, None, tau);
+                }
+            }
+        }
+    }
+
+    /// Bodies a and b's displacements and velocities at θ = τ/h inside
+    /// the interval, by Horner side by side (each as
+    /// [`Series::value_rate_inside`] alone).
+    #[inline(never)]
+    fn two_inside(&self, a: usize, b: usize, theta: f64) -> [(f64, f64); 2] {
+        let (mut x, mut dx) = ([0.0; 2], [0.0; 2]);
+        for row in self.c[..self.terms * self.n].chunks_exact(self.n).rev() {
+            for (k, c) in [row[a], row[b]].into_iter().enumerate() {
+                dx[k] = dx[k] * theta + x[k];
+                x[k] = x[k] * theta + c;
+            }
+        }
+        let r = self.inv[1];
+        [(x[0], dx[0] * r), (x[1], dx[1] * r)]
+    }
+
     /// [`Series::value_rate`] inside the interval (bodies a and b), by
     /// Horner on the difference's coefficients.
     #[inline(never)]

@@ -451,8 +451,10 @@ fn a_series_runs_past_terms_that_vanish() {
 
 /// Inside an interval, the state of every body read in one pass
 /// ([`Series::state`]) is each body's own reading
-/// ([`Series::value_rate`]) bit for bit: the 4-storey frame and a row of
-/// two buildings, from a state away from rest over a record's step.
+/// ([`Series::value_rate`]) bit for bit, and so are a storey's two
+/// floors read side by side ([`Series::two_states`]): the 4-storey frame
+/// and a row of two buildings, from a state away from rest over a
+/// record's step.
 #[test]
 fn a_state_inside_is_each_bodys_reading() {
     for file in ["moment-frame-4.toml", "pounding-frames.toml"] {
@@ -478,6 +480,17 @@ fn a_state_inside_is_each_bodys_reading() {
                     (u, v),
                     "{file}: body {b} at {tau}"
                 );
+                // (A storey's two floors read side by side.)
+                let mut two = vec![f64::NAN; 2 * n];
+                let below = b.checked_sub(1);
+                series.two_states(b, below, tau, &mut two);
+                for i in [Some(b), below].into_iter().flatten() {
+                    assert_eq!(
+                        (two[2 * i], two[2 * i + 1]),
+                        (y[2 * i], y[2 * i + 1]),
+                        "{file}: storey {b}'s body {i} at {tau}"
+                    );
+                }
             }
             assert!(y.iter().zip(&y0).any(|(p, q)| p != q), "{file}: it moved");
         }
