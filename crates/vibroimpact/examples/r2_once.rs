@@ -24,8 +24,15 @@ fn main() {
         },
     )
     .expect("options");
+    // (The final state's bits folded into one number: a change that
+    // should keep the arithmetic keeps it.)
+    let bits = sim
+        .final_displacement
+        .iter()
+        .chain(&sim.final_velocity)
+        .fold(0u64, |h, x| h.rotate_left(5) ^ x.to_bits());
     println!(
-        "rhs {} steps {} rejected {} impacts {}",
+        "rhs {} steps {} rejected {} impacts {} final state {bits:016x}",
         sim.stats.rhs_evaluations,
         sim.stats.steps,
         sim.stats.rejected_steps,

@@ -700,11 +700,20 @@ impl ChainDynamics {
                     &sc.boa[chain_start..chain_end],
                     &sc.limit[chain_start..chain_end],
                 );
-                for i in 0..n - 1 {
-                    let w = &y[2 * i..2 * i + 4];
-                    let s = w[0] - w[2] - g[i];
-                    let sdot = w[1] - w[3];
-                    if al[i] * s + boa[i] * sdot.abs() < lim[i] {
+                // (Each pair's two states as one window of the state: no
+                // index to check.)
+                let pairs = y[..2 * n]
+                    .windows(4)
+                    .step_by(2)
+                    .zip(g)
+                    .zip(al)
+                    .zip(boa)
+                    .zip(lim);
+                for (i, ((((w, g), al), boa), lim)) in pairs.enumerate() {
+                    let &[ul, vl, ur, vr] = w else { continue };
+                    let s = ul - ur - g;
+                    let sdot = vl - vr;
+                    if al * s + boa * sdot.abs() < *lim {
                         continue;
                     }
                     let k = chain_start + i;
@@ -746,9 +755,13 @@ impl ChainDynamics {
             }
         }
         self.contact_evaluations += evaluations;
-        for i in 0..n {
-            dydt[2 * i] = y[2 * i + 1];
-            dydt[2 * i + 1] = self.force[i] * self.inv_mass[i];
+        let rows = dydt[..2 * n]
+            .chunks_exact_mut(2)
+            .zip(y[..2 * n].chunks_exact(2));
+        for ((d, w), (f, im)) in rows.zip(self.force.iter().zip(&self.inv_mass)) {
+            if let ([du, dv], [_, v]) = (d, w) {
+                (*du, *dv) = (*v, f * im);
+            }
         }
         if self.energy {
             for i in 0..n {
