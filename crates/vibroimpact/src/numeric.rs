@@ -264,7 +264,9 @@ where
 
 /// Golden-section search for the maximum of `f` on `[a, b]` (exact for a
 /// unimodal `f`, a local maximum otherwise), to a bracket of 8 ulps or 60
-/// iterations. Returns `(f(t*), t*)`.
+/// iterations: where the maximum's place matters, a corner's (a
+/// pushover's cap), which [`maximum`] finds only to √ε. Returns `(f(t*),
+/// t*)`.
 pub fn golden_max<F>(mut f: F, a: f64, b: f64) -> (f64, f64)
 where
     F: FnMut(f64) -> f64,
@@ -294,6 +296,87 @@ where
     }
     let t = 0.5 * (a + b);
     (f(t), t)
+}
+
+/// The maximum of `f` on `[a, b]` by Brent's search (parabolas through
+/// the three best points, golden sections where a parabola would not
+/// shrink the bracket): exact for a unimodal `f`, a local maximum
+/// otherwise. Stops where the bracket is within 2·tol of the best point,
+/// tol = √ε (b − a) + 4ε|t|: near a maximum `f` changes by the square of
+/// the distance, so its value there is the maximum's to rounding (a
+/// golden-section search to 8 ulps of t took 60 evaluations where this
+/// takes about 12). Returns `(f(t*), t*)`, the best point evaluated.
+pub fn maximum<F>(mut f: F, a: f64, b: f64) -> (f64, f64)
+where
+    F: FnMut(f64) -> f64,
+{
+    // (Brent 1973, ch. 5, on −f.)
+    const C: f64 = 0.381_966_011_250_105_1;
+    let (mut a, mut b) = (a.min(b), a.max(b));
+    let width = f64::EPSILON.sqrt() * (b - a);
+    let mut x = a + C * (b - a);
+    let (mut w, mut v) = (x, x);
+    let mut fx = -f(x);
+    let (mut fw, mut fv) = (fx, fx);
+    let (mut d, mut e) = (0.0f64, 0.0f64);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        let tol = width + 4.0 * f64::EPSILON * x.abs();
+        if (x - m).abs() <= 2.0 * tol - 0.5 * (b - a) {
+            break;
+        }
+        let mut parabola = false;
+        if e.abs() > tol {
+            let r = (x - w) * (fx - fv);
+            let mut q = (x - v) * (fx - fw);
+            let mut p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            } else {
+                q = -q;
+            }
+            if p.abs() < (0.5 * q * e).abs() && p > q * (a - x) && p < q * (b - x) {
+                e = d;
+                d = p / q;
+                let u = x + d;
+                if u - a < 2.0 * tol || b - u < 2.0 * tol {
+                    d = if x < m { tol } else { -tol };
+                }
+                parabola = true;
+            }
+        }
+        if !parabola {
+            e = if x < m { b - x } else { a - x };
+            d = C * e;
+        }
+        let u = if d.abs() >= tol {
+            x + d
+        } else {
+            x + tol.copysign(d)
+        };
+        let fu = -f(u);
+        if fu <= fx {
+            if u < x {
+                b = x;
+            } else {
+                a = x;
+            }
+            (v, fv, w, fw, x, fx) = (w, fw, x, fx, u, fu);
+        } else {
+            if u < x {
+                a = u;
+            } else {
+                b = u;
+            }
+            if fu <= fw || w == x {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == x || v == w {
+                (v, fv) = (u, fu);
+            }
+        }
+    }
+    (-fx, x)
 }
 
 /// Brent's method (inverse quadratic interpolation, secant and bisection) for
@@ -408,6 +491,44 @@ pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The maximum of smooth peaks is their value to rounding in about a
+    /// dozen evaluations, on any scale of t (a peak 1e-4 s wide at t =
+    /// 1000 s, as an impact's force late in a run); a monotone function's
+    /// search ends within a part in 1e7 of the bracket's upper end.
+    #[test]
+    fn a_maximum_is_found_to_rounding_in_few_evaluations() {
+        for (t0, w) in [(0.0, 1.0), (1000.0, 1e-4), (-3.0, 2.0)] {
+            for at in [0.3, 0.5, 0.93] {
+                let top = t0 + at * w;
+                // (An asymmetric peak: exponential sides, as a contact's force.)
+                let f = |t: f64| {
+                    let z = (t - top) / w;
+                    7.0 * (-(z * z) * (1.0 + 0.8 * z)).exp()
+                };
+                let mut n = 0;
+                let (v, t) = maximum(
+                    |t| {
+                        n += 1;
+                        f(t)
+                    },
+                    t0,
+                    t0 + w,
+                );
+                assert!(
+                    (v - 7.0).abs() <= 4.0 * f64::EPSILON * 7.0,
+                    "{t0} {at}: {v}"
+                );
+                assert!((t - top).abs() <= 1e-7 * w, "{t0} {at}: at {t}");
+                assert!(n <= 25, "{t0} {at}: {n} evaluations");
+            }
+        }
+        let (v, t) = maximum(|t: f64| t.ln(), 1.0, 2.0);
+        assert!(
+            2.0 - t <= 1e-7 && (v - 2f64.ln()).abs() <= 1e-7,
+            "{v} at {t}"
+        );
+    }
 
     #[test]
     fn exp_neg_minus_one_plus_matches_series_and_direct() {

@@ -85,7 +85,7 @@ impl StepScan {
 
     /// Largest force of contact k on [ta, tb]. `interior`: the force rate
     /// says the maximum may lie inside (rising at ta or unknown, falling at tb
-    /// or unknown), then a golden-section search on the dense output finds it.
+    /// or unknown), then a search on the dense output finds it ([`maximum`]).
     pub(super) fn peak<S: Chain>(
         st: &mut Stepper,
         sys: &mut S,
@@ -107,7 +107,7 @@ impl StepScan {
         };
         let mut best = if fa >= fb { (fa, ta) } else { (fb, tb) };
         if interior {
-            for cand in [golden_max(&mut force, ta, tb), (fm, tm)] {
+            for cand in [maximum(&mut force, ta, tb), (fm, tm)] {
                 if cand.0 > best.0 {
                     best = cand;
                 }

@@ -7,7 +7,7 @@ use super::*;
 /// Largest |u_i| and |v_i| of every body over a time window, located on the
 /// integrator's dense output rather than sampled: an interior maximum of
 /// |u_i| lies where v_i changes sign within a step (Brent on the dense
-/// v_i), one of |v_i| where the acceleration changes sign (golden section
+/// v_i), one of |v_i| where the acceleration changes sign (Brent's parabolic search
 /// on the dense v_i); otherwise the maximum is at a step end. Contact pulses
 /// shorter than any output interval (the deepest penetration, the fastest
 /// approach) are therefore caught to the integration tolerance.
@@ -300,7 +300,7 @@ impl ExtremaScan {
             }
             if self.dydt[iv] * st.dydt()[iv] < 0.0 {
                 let speed = |t| st.dense_component(sys, iv, t).abs();
-                max_v = max_v.max(golden_max(speed, a, b).0);
+                max_v = max_v.max(maximum(speed, a, b).0);
             }
             let f = &mut self.found;
             f.max_displacement[i] = f.max_displacement[i].max(max_u);

@@ -36,7 +36,7 @@
 //! located on the 7th-order dense output (Brent); a contact whose relative
 //! velocity turns from approach to separation inside the step is checked at
 //! its maximum of s, so an impact that starts and ends within one step is
-//! not missed. The peak force is located by golden-section search on the
+//! not missed. The peak force is located by Brent's parabolic search on the
 //! dense output in the step that contains it.
 //!
 //! Contacts are independent: impacts of different pairs that overlap in
@@ -54,7 +54,7 @@ use crate::impact::rigid::RigidImpact;
 use crate::integrate::events::EventLocator;
 use crate::integrate::{IntegrationError, IntegratorOptions, Interrupt, Method, Stats, Stepper};
 use crate::model::{BaseExcitation, Model};
-use crate::numeric::golden_max;
+use crate::numeric::maximum;
 
 /// Options of a simulation.
 #[derive(Clone, Debug, PartialEq)]

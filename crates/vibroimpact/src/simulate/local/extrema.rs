@@ -566,7 +566,7 @@ impl Run<'_> {
                     free.acceleration(g, tb, &xb, j),
                 );
                 if aa * ab < 0.0 {
-                    let v = golden_max(|t| at(t)[2 * j + 1].abs(), ta, tb).0;
+                    let v = maximum(|t| at(t)[2 * j + 1].abs(), ta, tb).0;
                     ex.note_body(i, 0.0, v);
                 }
             }
