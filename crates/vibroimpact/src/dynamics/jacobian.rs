@@ -95,7 +95,10 @@ impl RecordedJacobian for ChainDynamics {
         );
     }
 
-    fn record_jacobian_after_rhs(&self, _y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
+    fn record_jacobian_after_rhs(&self, y: &[f64], out: &mut Vec<(u32, f64, f64)>) {
+        if !self.partials {
+            return self.record_jacobian(y, out);
+        }
         out.extend(
             self.last_evaluated()
                 .map(|(k, c)| (k as u32, c.d_ds, c.d_dsdot)),

@@ -63,7 +63,9 @@ pub use storeys::{Branch, StoreyTerms};
 
 /// Evaluates a contact law at (s, ṡ) and adds its force to the bodies
 /// (`-ml F` on the left, `+mr F` on the right; masks 0 for a wall side).
-/// Returns the dissipated power `(F(s, ṡ) - F(s, 0)) ṡ` when `energy`.
+/// Returns the dissipated power `(F(s, ṡ) - F(s, 0)) ṡ` when `energy`,
+/// and the law's partial derivatives with the force when `partials` (else
+/// zeros: the force alone is the same number).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn apply_contact(
@@ -74,9 +76,16 @@ fn apply_contact(
     (ml, mr): (f64, f64),
     s: f64,
     sdot: f64,
-    energy: bool,
+    (energy, partials): (bool, bool),
 ) -> (ContactForce, f64) {
-    let c = law.eval(s, sdot, onset_velocity);
+    let c = if partials {
+        law.eval(s, sdot, onset_velocity)
+    } else {
+        ContactForce {
+            force: law.force(s, sdot, onset_velocity),
+            ..ContactForce::default()
+        }
+    };
     let f = c.force;
     force[l] -= ml * f;
     force[r] += mr * f;
@@ -151,6 +160,10 @@ pub struct ChainDynamics {
     /// The contacts the last right-hand side evaluated, in its order, with
     /// their forces and partial derivatives (`jacobian.rs`).
     evaluated: Vec<(usize, ContactForce)>,
+    /// Whether the right-hand side keeps `evaluated` (off where no
+    /// Jacobian, tape or replay reads it after the right-hand side; those
+    /// then evaluate the laws afresh).
+    partials: bool,
     bandwidth: (usize, usize),
     screen: ScreenSoA,
     storeys: StoreyTerms,
@@ -312,6 +325,7 @@ impl ChainDynamics {
             force: vec![0.0; n],
             contact_evaluations: 0,
             evaluated: Vec::new(),
+            partials: true,
             bandwidth,
             screen,
             storeys,
@@ -347,6 +361,17 @@ impl ChainDynamics {
     /// Lower and upper bandwidths of the mechanical Jacobian.
     pub fn bandwidth(&self) -> (usize, usize) {
         self.bandwidth
+    }
+
+    /// This system with a right-hand side that does not keep its
+    /// contacts' partial derivatives: for an integration that never asks
+    /// for a Jacobian after it (an explicit method, no tangent columns,
+    /// no tape). Results are unchanged; a Jacobian, tape record or replay
+    /// from it then evaluates the laws afresh.
+    pub fn without_partials(mut self) -> Self {
+        self.partials = false;
+        self.evaluated.clear();
+        self
     }
 
     /// Contact law evaluations so far (skipped contacts not counted).
@@ -596,13 +621,14 @@ impl OdeSystem for ChainDynamics {
     }
 
     fn rhs_reforced(&mut self, source: &Self, t: f64, y: &[f64], dydt: &mut [f64]) {
-        // The energy audit's contact term is not kept: evaluate.
-        let replay = (!self.energy).then_some(&source.evaluated[..]);
+        // The energy audit's contact term is not kept, nor are contacts a
+        // source without partials evaluated: evaluate.
+        let replay = (!self.energy && source.partials).then_some(&source.evaluated[..]);
         self.rhs_with(t, y, dydt, replay);
     }
 
     fn jacobian_after_rhs(&mut self, _t: f64, y: &[f64], jac: &mut BandMatrix) -> bool {
-        self.jacobian_from(y, jac, true)
+        self.jacobian_from(y, jac, self.partials)
     }
 
     /// A body's displacement and velocity: the error of the bodies that
@@ -679,7 +705,7 @@ impl ChainDynamics {
             &mut self.force,
             &mut self.evaluated,
         );
-        let energy = self.energy;
+        let (energy, partials) = (self.energy, self.partials);
         let mut evaluations = 0;
         if let Some(list) = replay {
             for &(k, c) in list {
@@ -726,9 +752,11 @@ impl ChainDynamics {
                         (1.0, 1.0),
                         s,
                         sdot,
-                        energy,
+                        (energy, partials),
                     );
-                    kept.push((k, c));
+                    if partials {
+                        kept.push((k, c));
+                    }
                     contact += dissipated;
                 }
             }
@@ -748,9 +776,11 @@ impl ChainDynamics {
                     (sc.ml[k], sc.mr[k]),
                     s,
                     sdot,
-                    energy,
+                    (energy, partials),
                 );
-                kept.push((k, c));
+                if partials {
+                    kept.push((k, c));
+                }
                 contact += dissipated;
             }
         }

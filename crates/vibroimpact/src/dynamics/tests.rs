@@ -1,7 +1,7 @@
 //! Tests of the equations of motion (`mod.rs`).
 
 use super::*;
-use crate::integrate::BandMatrix;
+use crate::integrate::{BandMatrix, RecordedJacobian};
 use crate::model::{Body, Contact, ContactPair, Coupling};
 
 use crate::model::reference::seed_law as law;
@@ -131,8 +131,8 @@ fn source_is_the_forced_minus_the_unforced_rhs() {
 
 /// The analytic banded Jacobian equals central differences of the
 /// right-hand side, with contacts engaged.
-#[test]
-fn jacobian_matches_finite_differences() {
+/// Three bodies between walls, coupled, their four contacts of two laws.
+fn three_bodies() -> Model {
     let bodies = vec![
         Body::from_frequency("a", 0.2, 7.0, 0.01),
         Body::from_frequency("b", 0.3, 5.0, 0.02),
@@ -166,7 +166,7 @@ fn jacobian_matches_finite_differences() {
             law: law(),
         },
     ];
-    let model = Model::new(
+    Model::new(
         bodies,
         couplings,
         contacts,
@@ -175,10 +175,17 @@ fn jacobian_matches_finite_differences() {
         vec![],
         vec![],
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// Their state with every contact near or in touch: u = (-1e-5, 5e-5, 3e-5).
+const IN_TOUCH: [f64; 6] = [-1.2e-5, 0.01, 6e-5, -0.02, 1e-5, 0.03];
+
+#[test]
+fn jacobian_matches_finite_differences() {
+    let model = three_bodies();
     let mut sys = ChainDynamics::new(&model, false);
-    // u = (-1e-5, 5e-5, 3e-5): every contact near or in touch.
-    let y = [-1.2e-5, 0.01, 6e-5, -0.02, 1e-5, 0.03];
+    let y = IN_TOUCH;
     let (kl, ku) = sys.jacobian_bandwidth().unwrap();
     let mut jac = BandMatrix::new(6, kl, ku);
     assert!(sys.jacobian(0.0, &y, &mut jac));
@@ -210,6 +217,40 @@ fn jacobian_matches_finite_differences() {
             );
         }
     }
+}
+
+/// A system without partials gives the same right-hand side, bit for bit,
+/// and a Jacobian after it (evaluated afresh) equal to the one that kept
+/// them; its recorded tangent entries too.
+#[test]
+fn a_system_without_partials_answers_as_one_with_them() {
+    let model = three_bodies();
+    let mut kept = ChainDynamics::new(&model, false);
+    let mut bare = ChainDynamics::new(&model, false).without_partials();
+    let (mut f_kept, mut f_bare) = ([0.0; 6], [0.0; 6]);
+    kept.rhs(0.1, &IN_TOUCH, &mut f_kept);
+    bare.rhs(0.1, &IN_TOUCH, &mut f_bare);
+    assert_eq!(f_kept.map(f64::to_bits), f_bare.map(f64::to_bits));
+    let (kl, ku) = kept.jacobian_bandwidth().unwrap();
+    let (mut j_kept, mut j_bare) = (BandMatrix::new(6, kl, ku), BandMatrix::new(6, kl, ku));
+    assert!(kept.jacobian_after_rhs(0.1, &IN_TOUCH, &mut j_kept));
+    assert!(bare.jacobian_after_rhs(0.1, &IN_TOUCH, &mut j_bare));
+    let mut in_touch = 0;
+    for i in 0..6 {
+        for j in (0..6).filter(|&j| j_kept.in_band(i, j)) {
+            assert_eq!(j_kept.get(i, j), j_bare.get(i, j), "J[{i}][{j}]");
+            in_touch += usize::from(i % 2 == 1 && j_kept.get(i, j) != 0.0);
+        }
+    }
+    // (Not only the springs: the contacts' terms are there.)
+    assert!(in_touch >= 8, "{in_touch} rate rows' entries");
+    let (mut r_kept, mut r_bare) = (Vec::new(), Vec::new());
+    kept.record_jacobian_after_rhs(&IN_TOUCH, &mut r_kept);
+    bare.record_jacobian_after_rhs(&IN_TOUCH, &mut r_bare);
+    r_kept.sort_by_key(|e| e.0);
+    r_bare.sort_by_key(|e| e.0);
+    assert_eq!(r_kept, r_bare);
+    assert_eq!(r_kept.len(), 4);
 }
 
 /// A skipped contact's force is below 1e-3 ε of the force scale.

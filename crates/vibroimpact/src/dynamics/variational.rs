@@ -47,33 +47,14 @@ impl<S: OdeSystem> Variational<S> {
     /// state and its parameter sensitivity alone; more than the dimension:
     /// tangent vectors of a larger system restricted to this one's rows).
     pub fn new(sys: S, columns: usize) -> Self {
-        let dim = sys.dim();
-        let jac = match sys.jacobian_bandwidth() {
-            Some((kl, ku)) => BandMatrix::new(dim, kl, ku),
-            None => BandMatrix::dense(dim),
-        };
-        Self {
-            sys,
-            dim,
-            columns,
-            jac,
-            f0: vec![0.0; dim],
-            f1: vec![0.0; dim],
-            yp: vec![0.0; dim],
-            fp: vec![0.0; dim],
-            parameter: None,
-            forcing_only: false,
-        }
+        Self::carrying(sys, columns, None, false)
     }
 
     /// Extends `sys` by `columns` columns of Φ and, after them, the
     /// sensitivity to a parameter p: `shifted` is the same system at
-    /// `p + dp` (`dp != 0`).
+    /// `p + δp` (`dp != 0`).
     pub fn with_parameter(sys: S, columns: usize, shifted: S, dp: f64) -> Self {
-        Self {
-            parameter: Some((shifted, dp)),
-            ..Self::new(sys, columns)
-        }
+        Self::carrying(sys, columns, Some((shifted, dp)), false)
     }
 
     /// [`with_parameter`](Self::with_parameter) for a parameter of the
@@ -81,9 +62,35 @@ impl<S: OdeSystem> Variational<S> {
     /// right-hand side takes the rest, contact forces included, from the
     /// system's ([`OdeSystem::rhs_reforced`]).
     pub fn with_forcing_parameter(sys: S, columns: usize, shifted: S, dp: f64) -> Self {
+        Self::carrying(sys, columns, Some((shifted, dp)), true)
+    }
+
+    /// The extension, with the Jacobian and its work rows sized for the
+    /// carried columns: none without any (a set of the local integrator
+    /// that carries no tangent is built at every impact, and these five
+    /// allocations were a quarter of building it).
+    fn carrying(sys: S, columns: usize, parameter: Option<(S, f64)>, forcing_only: bool) -> Self {
+        let dim = sys.dim();
+        let rows = if columns > 0 || parameter.is_some() {
+            dim
+        } else {
+            0
+        };
+        let jac = match sys.jacobian_bandwidth() {
+            Some((kl, ku)) => BandMatrix::new(rows, kl, ku),
+            None => BandMatrix::dense(rows),
+        };
         Self {
-            forcing_only: true,
-            ..Self::with_parameter(sys, columns, shifted, dp)
+            sys,
+            dim,
+            columns,
+            jac,
+            f0: vec![0.0; rows],
+            f1: vec![0.0; rows],
+            yp: vec![0.0; rows],
+            fp: vec![0.0; rows],
+            parameter,
+            forcing_only,
         }
     }
 

@@ -232,6 +232,34 @@ impl Model {
         (f > 0.0 && f.is_finite()).then_some(f)
     }
 
+    /// A model of parts taken from a validated model and renumbered (the
+    /// local integrator's set: its bodies, and the couplings, contacts,
+    /// forces and storeys among them), at rest, soft, without gravity, as
+    /// [`Model::new`] and [`Model::with_storeys`] would build it from these
+    /// parts; not validated again: each part passed with the whole (and a
+    /// state at rest says nothing of a set, which starts from the run's).
+    pub(crate) fn part(
+        bodies: Vec<Body>,
+        couplings: Vec<Coupling>,
+        contacts: Vec<Contact>,
+        base: BaseExcitation,
+        (forces, storeys): (Vec<HarmonicForce>, Vec<Storey>),
+    ) -> Self {
+        let n = bodies.len();
+        Self {
+            initial_displacement: vec![0.0; n],
+            initial_velocity: vec![0.0; n],
+            impacts: vec![Impacts::Soft; contacts.len()],
+            bodies,
+            couplings,
+            contacts,
+            base,
+            forces,
+            storeys,
+            gravity: 0.0,
+        }
+    }
+
     /// Builds and validates a model. Initial displacements and velocities
     /// default to rest when empty.
     pub fn new(

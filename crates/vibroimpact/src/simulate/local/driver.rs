@@ -140,7 +140,7 @@ impl Run<'_> {
                 *t0 = t;
                 x
             } else {
-                let mut y = x.clone();
+                let mut y = Rows::from_slice(x);
                 free.propagate(g, *t0, t, &mut y);
                 moved = y;
                 &moved

@@ -30,7 +30,7 @@ impl BoundaryEnds {
         } else if t == self.ta {
             (xa[2 * j], xa[2 * j + 1])
         } else {
-            let mut x = xa.clone();
+            let mut x = Rows::from_slice(xa);
             free.propagate(g, self.ta, t, &mut x);
             (x[2 * j], x[2 * j + 1])
         })
@@ -95,21 +95,25 @@ impl Run<'_> {
                 }
                 let (t0, x0) = &self.exact[g];
                 let xa = match carried.iter().find(|(h, t, _)| *h == g && *t == ta) {
-                    Some((_, _, x)) => x.clone(),
+                    Some((_, _, x)) => Rows::from_slice(x),
                     None => {
-                        let mut x = x0.clone();
+                        let mut x = Rows::from_slice(x0);
                         self.free.propagate(g, *t0, ta, &mut x);
                         x
                     }
                 };
-                let mut xb = xa.clone();
+                let mut xb = Rows::from_slice(&xa);
                 self.free.propagate(g, ta, tb, &mut xb);
                 ends.groups.push((g, xa, xb));
             }
         }
         // (The carried list's buffer is kept from step to step.)
         carried.clear();
-        carried.extend(ends.groups.iter().map(|(g, _, xb)| (*g, tb, xb.clone())));
+        carried.extend(
+            ends.groups
+                .iter()
+                .map(|(g, _, xb)| (*g, tb, Rows::from_slice(xb))),
+        );
         set.carried = carried;
         ends
     }
@@ -225,13 +229,15 @@ impl Run<'_> {
 
     /// The groups of check k's bodies (a contact's, or a storey's group).
     pub(super) fn groups_of(&self, k: usize) -> SmallVec<[usize; 2]> {
-        let mut groups: SmallVec<[usize; 2]> = self
-            .sides(k)
-            .into_iter()
-            .flatten()
-            .map(|i| self.free.place(i).0)
-            .collect();
-        groups.dedup();
+        // (Pushed, not collected: smallvec's collect costs several times
+        // these two lookups.)
+        let mut groups = SmallVec::new();
+        for i in self.sides(k).into_iter().flatten() {
+            let g = self.free.place(i).0;
+            if groups.last() != Some(&g) {
+                groups.push(g);
+            }
+        }
         groups
     }
 
@@ -321,11 +327,10 @@ impl Run<'_> {
         // A group that joined within the lookahead stays (no chatter); one
         // whose contacts are all rigid (a soft episode) leaves once they
         // have separated, as the global run's episode ends.
-        let mut engaged: SmallVec<[bool; 8]> = set
-            .groups
-            .iter()
-            .map(|&g| t - self.joined[g] < self.rigid_lookahead(g, lookahead))
-            .collect();
+        let mut engaged: SmallVec<[bool; 8]> = SmallVec::new();
+        for &g in &set.groups {
+            engaged.push(t - self.joined[g] < self.rigid_lookahead(g, lookahead));
+        }
         for (kl, &k) in set.scan.ids.iter().enumerate() {
             let ahead = if self.is_rigid(k) { 0.0 } else { lookahead };
             if Self::engaged(set, self.activation[k], kl, ahead) {

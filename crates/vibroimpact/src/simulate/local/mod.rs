@@ -345,7 +345,7 @@ impl Run<'_> {
     fn exact_body(&self, i: usize, t: f64) -> (f64, f64) {
         let (g, j) = self.free.place(i);
         let (t0, x) = &self.exact[g];
-        let mut x = x.clone();
+        let mut x = Rows::from_slice(x);
         self.free.propagate(g, *t0, t, &mut x);
         (x[2 * j], x[2 * j + 1])
     }
@@ -425,7 +425,7 @@ impl Run<'_> {
             .iter()
             .map(|&g| {
                 let (t0, x) = &self.exact[g];
-                let mut x = x.clone();
+                let mut x = Rows::from_slice(x);
                 self.free.propagate(g, *t0, t, &mut x);
                 (g, x)
             })

@@ -112,7 +112,15 @@ impl Run<'_> {
             storeys,
         } = self.sub_model(&groups, &bodies)?;
         let energy = self.energy.is_some();
-        let chain = Recorder::new(ChainDynamics::new(&sub, energy), self.tape.is_some());
+        // A set whose steps no tape or tangent column reads keeps no
+        // partial derivatives of its contacts.
+        let dynamics = ChainDynamics::new(&sub, energy);
+        let dynamics = if self.tape.is_none() && self.columns == 0 {
+            dynamics.without_partials()
+        } else {
+            dynamics
+        };
+        let chain = Recorder::new(dynamics, self.tape.is_some());
         let mut sys = Variational::new(chain, self.columns);
         // The storeys' Bouc–Wen states after the bodies', then the audit's
         // quadratures (from 0: the old set's are in the sums). (No tangent
@@ -474,17 +482,13 @@ impl Run<'_> {
                 })
             })
             .collect::<Result<Vec<_>, IntegrationError>>()?;
-        let sub = Model::new(
+        let sub = Model::part(
             sub_bodies,
             couplings,
             contacts,
             model.base().clone(),
-            forces,
-            Vec::new(),
-            Vec::new(),
-        )
-        .and_then(|m| m.with_storeys(storeys))
-        .map_err(|e| IntegrationError::InvalidOptions(e.to_string()))?;
+            (forces, storeys),
+        );
         Ok(SubModel {
             model: sub,
             contacts: ids,

@@ -172,7 +172,7 @@ impl Run<'_> {
                 let Some(i) = side else { continue };
                 let (g, jj) = self.free.place(i);
                 let (t0, x) = &self.exact[g];
-                let mut x = x.clone();
+                let mut x = Rows::from_slice(x);
                 self.free.propagate(g, *t0, t, &mut x);
                 s += sign * x[2 * jj];
                 sd += sign * x[2 * jj + 1];

@@ -85,7 +85,8 @@ enum Propagator {
 pub(crate) type Bodies = SmallVec<[usize; 2]>;
 /// A value per body of a group.
 type PerBody = SmallVec<[f64; 2]>;
-/// A group's state rows (u, v per body), or a value per row.
+/// A group's state rows (u, v per body), or a value per row. Copied by
+/// `Rows::from_slice`: smallvec's `clone` collects through an iterator.
 pub(crate) type Rows = SmallVec<[f64; 4]>;
 
 /// One spring-coupled group of bodies and its exact propagator.
