@@ -31,8 +31,23 @@ fn main() {
         .iter()
         .chain(&sim.final_velocity)
         .fold(0u64, |h, x| h.rotate_left(5) ^ x.to_bits());
+    // (And the impact log's times, velocities and peaks.)
+    let log = sim
+        .impacts
+        .iter()
+        .flat_map(|i| {
+            [
+                i.start_time,
+                i.end_time,
+                i.impact_velocity,
+                i.rebound_velocity,
+                i.peak_force,
+                i.peak_time,
+            ]
+        })
+        .fold(0u64, |h, x| h.rotate_left(5) ^ x.to_bits());
     println!(
-        "rhs {} steps {} rejected {} impacts {} final state {bits:016x}",
+        "rhs {} steps {} rejected {} impacts {} final state {bits:016x} log {log:016x}",
         sim.stats.rhs_evaluations,
         sim.stats.steps,
         sim.stats.rejected_steps,

@@ -52,10 +52,22 @@ pub(super) fn contact_end(
     y: &[f64],
     dydt: &[f64],
 ) -> (f64, f64, f64) {
+    contact_end_force(sys, k, y, dydt).0
+}
+
+/// [`contact_end`], and the force there (the number [`contact_at`] and
+/// the law give at the step's end, from the same evaluation).
+fn contact_end_force(
+    sys: &ChainDynamics,
+    k: usize,
+    y: &[f64],
+    dydt: &[f64],
+) -> ((f64, f64, f64), f64) {
     let (s, sd) = sys.approach(k, y);
     let idx = sys.contact_indices(k);
     let sdd = idx[1].map_or(0.0, |i| dydt[i]) - idx[3].map_or(0.0, |i| dydt[i]);
-    (s, sd, sys.contact_force_rate(k, s, sd, sdd))
+    let (f, rate) = sys.contact_force_and_rate(k, s, sd, sdd);
+    ((s, sd, rate), f)
 }
 
 /// Dense-output evaluation of contact k's (s, ṡ) at time t.
@@ -83,22 +95,24 @@ impl StepScan {
             .unwrap_or(0.5 * (ta + tb))
     }
 
-    /// Largest force of contact k on [ta, tb]. `interior`: the force rate
-    /// says the maximum may lie inside (rising at ta or unknown, falling at tb
-    /// or unknown), then a search on the dense output finds it ([`maximum`]).
+    /// Largest force of contact k on [ta, tb]; `fb`, the force at `tb`
+    /// where it is known. `interior`: the force rate says the maximum may
+    /// lie inside (rising at ta or unknown, falling at tb or unknown),
+    /// then a search on the dense output finds it ([`maximum`]).
     pub(super) fn peak<S: Chain>(
         st: &mut Stepper,
         sys: &mut S,
         k: usize,
         ta: f64,
-        tb: f64,
+        (tb, fb): (f64, Option<f64>),
         interior: bool,
     ) -> (f64, f64) {
         let mut force = |t: f64| {
             let (s, sd) = contact_at(st, sys, k, t);
             sys.chain().contact_force(k, s, sd)
         };
-        let (fa, fb) = (force(ta), force(tb));
+        let fa = force(ta);
+        let fb = fb.unwrap_or_else(|| force(tb));
         let tm = 0.5 * (ta + tb);
         let fm = if interior {
             force(tm)
@@ -114,6 +128,27 @@ impl StepScan {
             }
         }
         best
+    }
+
+    /// Raises the peak of contact k's impact under way to its largest
+    /// force on [ta, tb]: `rate_a`, `rate_b` the force's rate at an end
+    /// that is the step's (else None), `fb` the force at `tb` if known.
+    pub(super) fn update_peak<S: Chain>(
+        &mut self,
+        st: &mut Stepper,
+        sys: &mut S,
+        k: usize,
+        (ta, rate_a): (f64, Option<f64>),
+        (tb, rate_b, fb): (f64, Option<f64>, Option<f64>),
+    ) {
+        if let Some(i) = self.trackers[k].active {
+            let interior = rate_a.is_none_or(|r| r > 0.0) && rate_b.is_none_or(|r| r < 0.0);
+            let (f, t) = Self::peak(st, sys, k, ta, (tb, fb), interior);
+            if f > self.impacts[i].peak_force {
+                self.impacts[i].peak_force = f;
+                self.impacts[i].peak_time = t;
+            }
+        }
     }
 
     pub(super) fn start<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, k: usize, t: f64) {
@@ -137,26 +172,6 @@ impl StepScan {
     /// Updates the running peak of contact k's impact over [ta, tb] given
     /// the force rates at the ends (None where unknown).
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn update_peak<S: Chain>(
-        &mut self,
-        st: &mut Stepper,
-        sys: &mut S,
-        k: usize,
-        ta: f64,
-        tb: f64,
-        rate_a: Option<f64>,
-        rate_b: Option<f64>,
-    ) {
-        if let Some(i) = self.trackers[k].active {
-            let interior = rate_a.is_none_or(|r| r > 0.0) && rate_b.is_none_or(|r| r < 0.0);
-            let (f, t) = Self::peak(st, sys, k, ta, tb, interior);
-            if f > self.impacts[i].peak_force {
-                self.impacts[i].peak_force = f;
-                self.impacts[i].peak_time = t;
-            }
-        }
-    }
-
     pub(super) fn finish<S: Chain>(&mut self, st: &mut Stepper, sys: &mut S, k: usize, t: f64) {
         if let Some(i) = self.trackers[k].active.take() {
             let (_, sd) = contact_at(st, sys, k, t);
@@ -195,20 +210,21 @@ impl StepScan {
                 continue;
             }
             let (s0, sd0, r0) = self.previous[k];
-            let (s1, sd1, r1) = contact_end(sys.chain(), k, st.y(), st.dydt());
+            let ((s1, sd1, r1), f1) = contact_end_force(sys.chain(), k, st.y(), st.dydt());
             self.previous[k] = (s1, sd1, r1);
             let (g0, g1) = (s0 - s_on, s1 - s_on);
             let active = self.trackers[k].active.is_some();
             if !active && g1 > 0.0 && g0 <= 0.0 {
                 let ts = Self::locate(st, sys, k, s_on, (t0, g0), (t1, g1));
                 self.start(st, sys, k, ts);
-                self.update_peak(st, sys, k, ts, t1, None, Some(r1));
+                // (The onset velocity just set may change the force at t1.)
+                self.update_peak(st, sys, k, (ts, None), (t1, Some(r1), None));
             } else if active && g1 <= 0.0 {
                 let te = Self::locate(st, sys, k, s_on, (t0, g0), (t1, g1));
-                self.update_peak(st, sys, k, t0, te, Some(r0), None);
+                self.update_peak(st, sys, k, (t0, Some(r0)), (te, None, None));
                 self.finish(st, sys, k, te);
             } else if active {
-                self.update_peak(st, sys, k, t0, t1, Some(r0), Some(r1));
+                self.update_peak(st, sys, k, (t0, Some(r0)), (t1, Some(r1), Some(f1)));
             } else if g0 <= 0.0 && sd0 > 0.0 && sd1 < 0.0 {
                 // Approach turned to separation inside the step: was s_on
                 // exceeded in between?
@@ -220,7 +236,7 @@ impl StepScan {
                     let ts = Self::locate(st, sys, k, s_on, (t0, g0), (tm, gm));
                     let te = Self::locate(st, sys, k, s_on, (tm, gm), (t1, g1));
                     self.start(st, sys, k, ts);
-                    self.update_peak(st, sys, k, ts, te, None, None);
+                    self.update_peak(st, sys, k, (ts, None), (te, None, None));
                     self.finish(st, sys, k, te);
                 }
             }
