@@ -46,6 +46,12 @@ fn main() {
             ]
         })
         .fold(0u64, |h, x| h.rotate_left(5) ^ x.to_bits());
+    // (Bodies integrated, summed over the right-hand sides: the local
+    // integrator's work.)
+    if let Some(local) = &sim.local {
+        let bodies: u64 = local.body_evaluations.iter().sum();
+        print!("body evaluations {bodies} ");
+    }
     println!(
         "rhs {} steps {} rejected {} impacts {} final state {bits:016x} log {log:016x}",
         sim.stats.rhs_evaluations,

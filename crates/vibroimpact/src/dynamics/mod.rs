@@ -705,7 +705,11 @@ impl ChainDynamics {
             self.force[b] -= f;
             damper += c * dv * dv;
         }
-        self.storeys.apply(y, &mut self.force, dydt);
+        // (Not called without storeys: a call per right-hand side of a
+        // small set costs as much as a body's forces.)
+        if !self.storeys.is_empty() {
+            self.storeys.apply(y, &mut self.force, dydt);
+        }
         let (sc, contacts, onset, force, kept) = (
             &self.screen,
             &self.contacts,
