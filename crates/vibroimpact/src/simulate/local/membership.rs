@@ -37,6 +37,33 @@ impl BoundaryEnds {
     }
 }
 
+/// The groups of a check's bodies ([`Run::groups_of`]): one or two, in
+/// the check's order, without a repeat. (A plain pair, not a small
+/// vector: asked after nearly every step, whose growth checks cost more
+/// than the two lookups.)
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CheckGroups {
+    groups: [usize; 2],
+    len: usize,
+}
+
+impl std::ops::Deref for CheckGroups {
+    type Target = [usize];
+
+    fn deref(&self) -> &[usize] {
+        &self.groups[..self.len]
+    }
+}
+
+impl IntoIterator for CheckGroups {
+    type Item = usize;
+    type IntoIter = std::iter::Take<std::array::IntoIter<usize, 2>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.groups.into_iter().take(self.len)
+    }
+}
+
 impl Run<'_> {
     /// Contact k's (s, ṡ) at `t` within the set's last step, for a contact
     /// with one side in the set and the other moving exactly (or a wall).
@@ -228,14 +255,16 @@ impl Run<'_> {
     }
 
     /// The groups of check k's bodies (a contact's, or a storey's group).
-    pub(super) fn groups_of(&self, k: usize) -> SmallVec<[usize; 2]> {
-        // (Pushed, not collected: smallvec's collect costs several times
-        // these two lookups.)
-        let mut groups = SmallVec::new();
+    pub(super) fn groups_of(&self, k: usize) -> CheckGroups {
+        let mut groups = CheckGroups {
+            groups: [0; 2],
+            len: 0,
+        };
         for i in self.sides(k).into_iter().flatten() {
             let g = self.free.place(i).0;
             if groups.last() != Some(&g) {
-                groups.push(g);
+                groups.groups[groups.len] = g;
+                groups.len += 1;
             }
         }
         groups
