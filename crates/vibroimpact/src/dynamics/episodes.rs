@@ -36,9 +36,8 @@ impl ChainDynamics {
             (Screen::Never, f64::INFINITY)
         };
         let (alpha, boa, limit) = c.screen.parts();
-        self.screen.alpha[k] = alpha;
-        self.screen.boa[k] = boa;
-        self.screen.limit[k] = limit;
+        let test = &mut self.screen.test[k];
+        (test[1], test[2], test[3]) = (alpha, boa, limit);
     }
 
     /// Whether rigid contact k is in a soft episode.

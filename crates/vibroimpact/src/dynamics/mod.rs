@@ -186,10 +186,10 @@ struct ScreenSoA {
     r: Vec<usize>,
     ml: Vec<f64>,
     mr: Vec<f64>,
-    g: Vec<f64>,
-    alpha: Vec<f64>,
-    boa: Vec<f64>,
-    limit: Vec<f64>,
+    /// Per contact, the test's terms side by side, `[g, alpha, boa,
+    /// limit]`: the pair loop walks one array (four had held one register
+    /// too many in that loop: two reloads a pair).
+    test: Vec<[f64; 4]>,
 }
 
 impl ChainDynamics {
@@ -272,11 +272,8 @@ impl ChainDynamics {
             screen.r.push(c.right.unwrap_or(0));
             screen.ml.push(if c.left.is_some() { 1.0 } else { 0.0 });
             screen.mr.push(if c.right.is_some() { 1.0 } else { 0.0 });
-            screen.g.push(c.clearance);
             let (alpha, boa, limit) = c.screen.parts();
-            screen.alpha.push(alpha);
-            screen.boa.push(boa);
-            screen.limit.push(limit);
+            screen.test.push([c.clearance, alpha, boa, limit]);
         }
         screen.chain = (n >= 2)
             .then(|| {
@@ -338,8 +335,7 @@ impl ChainDynamics {
     /// right-hand side may replay this one's ([`OdeSystem::rhs_reforced`]).
     pub fn same_contact_terms(&self, other: &ChainDynamics) -> bool {
         let (a, b) = (&self.screen, &other.screen);
-        (a.chain, &a.l, &a.r, &a.ml, &a.mr, &a.g) == (b.chain, &b.l, &b.r, &b.ml, &b.mr, &b.g)
-            && (&a.alpha, &a.boa, &a.limit) == (&b.alpha, &b.boa, &b.limit)
+        (a.chain, &a.l, &a.r, &a.ml, &a.mr, &a.test) == (b.chain, &b.l, &b.r, &b.ml, &b.mr, &b.test)
             && self.contacts.len() == other.contacts.len()
             && self
                 .contacts
@@ -523,7 +519,8 @@ impl ChainDynamics {
         let sc = &self.screen;
         (0..sc.l.len()).filter_map(move |k| {
             let (s, sdot) = self.approach(k, y);
-            if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+            let [_, alpha, boa, limit] = sc.test[k];
+            if alpha * s + boa * sdot.abs() < limit {
                 None
             } else {
                 Some((
@@ -677,6 +674,24 @@ impl ChainDynamics {
         dydt: &mut [f64],
         replay: Option<&[(usize, ContactForce)]>,
     ) {
+        // (Whether the partials are kept is chosen once a call, not at
+        // every contact: the hot loop over a row's pairs stays as it was.)
+        if self.partials {
+            self.rhs_keeping::<true>(t, y, dydt, replay);
+        } else {
+            self.rhs_keeping::<false>(t, y, dydt, replay);
+        }
+    }
+
+    /// [`rhs_with`](Self::rhs_with), keeping the evaluated contacts'
+    /// partial derivatives if `PARTIALS`.
+    fn rhs_keeping<const PARTIALS: bool>(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        dydt: &mut [f64],
+        replay: Option<&[(usize, ContactForce)]>,
+    ) {
         let zdd = self.base.at_from(t, &mut self.segment);
         let n = self.n;
         for ((((f, uv), k), c), m) in self
@@ -717,7 +732,7 @@ impl ChainDynamics {
             &mut self.force,
             &mut self.evaluated,
         );
-        let (energy, partials) = (self.energy, self.partials);
+        let energy = self.energy;
         let mut evaluations = 0;
         if let Some(list) = replay {
             for &(k, c) in list {
@@ -732,26 +747,17 @@ impl ChainDynamics {
             let (chain_start, chain_end) = chain_range(sc, n);
             if chain_end > chain_start {
                 // Neighbour pairs of a chain: contiguous, no gathers.
-                let (g, al, boa, lim) = (
-                    &sc.g[chain_start..chain_end],
-                    &sc.alpha[chain_start..chain_end],
-                    &sc.boa[chain_start..chain_end],
-                    &sc.limit[chain_start..chain_end],
-                );
                 // (Each pair's two states as one window of the state: no
                 // index to check.)
                 let pairs = y[..2 * n]
                     .windows(4)
                     .step_by(2)
-                    .zip(g)
-                    .zip(al)
-                    .zip(boa)
-                    .zip(lim);
-                for (i, ((((w, g), al), boa), lim)) in pairs.enumerate() {
+                    .zip(&sc.test[chain_start..chain_end]);
+                for (i, (w, &[g, al, boa, lim])) in pairs.enumerate() {
                     let &[ul, vl, ur, vr] = w else { continue };
                     let s = ul - ur - g;
                     let sdot = vl - vr;
-                    if al * s + boa * sdot.abs() < *lim {
+                    if al * s + boa * sdot.abs() < lim {
                         continue;
                     }
                     let k = chain_start + i;
@@ -764,9 +770,9 @@ impl ChainDynamics {
                         (1.0, 1.0),
                         s,
                         sdot,
-                        (energy, partials),
+                        (energy, PARTIALS),
                     );
-                    if partials {
+                    if PARTIALS {
                         kept.push((k, c));
                     }
                     contact += dissipated;
@@ -774,9 +780,10 @@ impl ChainDynamics {
             }
             for k in (0..chain_start).chain(chain_end..nc) {
                 let (l, r) = (sc.l[k], sc.r[k]);
-                let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - sc.g[k];
+                let [g, alpha, boa, limit] = sc.test[k];
+                let s = sc.ml[k] * y[2 * l] - sc.mr[k] * y[2 * r] - g;
                 let sdot = sc.ml[k] * y[2 * l + 1] - sc.mr[k] * y[2 * r + 1];
-                if sc.alpha[k] * s + sc.boa[k] * sdot.abs() < sc.limit[k] {
+                if alpha * s + boa * sdot.abs() < limit {
                     continue;
                 }
                 evaluations += 1;
@@ -788,9 +795,9 @@ impl ChainDynamics {
                     (sc.ml[k], sc.mr[k]),
                     s,
                     sdot,
-                    (energy, partials),
+                    (energy, PARTIALS),
                 );
-                if partials {
+                if PARTIALS {
                     kept.push((k, c));
                 }
                 contact += dissipated;

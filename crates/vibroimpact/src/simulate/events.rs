@@ -57,6 +57,7 @@ pub(super) fn contact_end(
 
 /// [`contact_end`], and the force there (the number [`contact_at`] and
 /// the law give at the step's end, from the same evaluation).
+#[inline]
 fn contact_end_force(
     sys: &ChainDynamics,
     k: usize,
