@@ -179,7 +179,10 @@ fn interrupted_report_and_periodic_leave_no_partial_output() {
     assert_eq!(siblings, vec!["report".to_string()], "{siblings:?}");
 
     let mut cmd = bin();
-    cmd.args(["periodic", &repo_file("examples/fujita-row.toml"), "--out"])
+    // (A long transient: the whole default run takes 0.4 s, and the stop
+    // must land inside it.)
+    cmd.args(["periodic", &repo_file("examples/fujita-row.toml")])
+        .args(["--guess-periods", "500", "--out"])
         .arg(dir.join("orbit"));
     let out = interrupt_after(cmd, 300);
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -97,7 +97,7 @@ fn read_guess(spec: &str) -> Result<Guess, CliError> {
 /// A study error in the command line's words: the option first.
 fn study_error(e: StudyError, args: &PeriodicArgs, interrupt: &Interrupt) -> CliError {
     if interrupt.requested() {
-        return CliError::new("interrupted (Ctrl-C): no periodic solution was written");
+        return interrupted();
     }
     match e {
         StudyError::Invalid { field, message } => {
@@ -113,6 +113,11 @@ fn study_error(e: StudyError, args: &PeriodicArgs, interrupt: &Interrupt) -> Cli
         StudyError::Field(f) => crate::error::option_error(&f),
         other => CliError::new(other.to_string()),
     }
+}
+
+/// The error of a run stopped by Ctrl-C.
+fn interrupted() -> CliError {
+    CliError::new("interrupted (Ctrl-C): no periodic solution was written")
 }
 
 /// Runs `vibroimpact periodic`.
@@ -140,6 +145,11 @@ pub fn run_periodic(args: &PeriodicArgs) -> Result<(), CliError> {
     crate::progress::announce_long(checked.work());
     let (model, krylov) = (checked.model.clone(), checked.krylov.is_some());
     let out = checked.run().map_err(spell)?;
+    // A Ctrl-C after the last point the run checked (its summary, or a
+    // Newton that ended unconverged): still nothing is written.
+    if interrupt.requested() {
+        return Err(interrupted());
+    }
     let (sol, orbit) = (&out.solution, &out.orbit);
     let doc = periodic_document(&model, sol, orbit, args.subharmonic, out.symmetric, krylov);
     if let Some(dir) = &args.out {
