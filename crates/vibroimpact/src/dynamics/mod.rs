@@ -410,15 +410,8 @@ impl ChainDynamics {
         self.contacts[k].law.force(s, sdot, self.onset_velocity[k])
     }
 
-    /// Rate dF/dt of contact k's force at (s, ṡ) with s̈ (N/s).
-    #[inline]
-    pub fn contact_force_rate(&self, k: usize, s: f64, sdot: f64, sddot: f64) -> f64 {
-        self.contact_force_and_rate(k, s, sdot, sddot).1
-    }
-
-    /// Contact k's force ([`contact_force`](Self::contact_force)) and its
-    /// rate ([`contact_force_rate`](Self::contact_force_rate)) from one
-    /// evaluation of its law.
+    /// Contact k's force ([`contact_force`](Self::contact_force)) at (s, ṡ)
+    /// and its rate dF/dt with s̈ (N/s), from one evaluation of its law.
     #[inline]
     pub fn contact_force_and_rate(&self, k: usize, s: f64, sdot: f64, sddot: f64) -> (f64, f64) {
         let c = self.contacts[k].law.eval(s, sdot, self.onset_velocity[k]);
