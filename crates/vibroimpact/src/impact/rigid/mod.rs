@@ -28,7 +28,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::closed_form::{restitution, restitution_derivative, ExponentialImpact};
+use super::closed_form::{restitution_derivative, ExponentialImpact};
 use super::direct::{integrate_impact, DirectImpact, DirectOptions};
 use super::table::Table;
 use super::{positive, ImpactError, TwoBodies};
@@ -233,15 +233,16 @@ impl Shape {
                 alpha,
                 table,
             } => {
-                let v = u / a_over_b;
-                let e = restitution(v)?;
+                // (The closed form's e(V) is the same root: solved once.)
+                let closed = closed.impact(u)?;
+                let (v, e) = (closed.v, closed.restitution);
                 let duration = if table.contains(v.ln()) {
                     table.at(2, v.ln()).0.exp() / (alpha * a_over_b)
                 } else {
                     direct(law, mu, u)?.contact_duration
                 };
                 let slope = restitution_derivative(v, e) / a_over_b;
-                (e, slope, closed.impact(u)?.peak_force, duration)
+                (e, slope, closed.peak_force, duration)
             }
             Shape::Damped {
                 law,
