@@ -625,7 +625,7 @@ impl<'a> Run<'a> {
         run.alike = model
             .contacts()
             .iter()
-            .map(|c| alike(model, &run.free, c))
+            .map(|c| alike::alike(model, &run.free, c))
             .collect();
         if let Some(window) = opts.extrema_window {
             let s_on = model

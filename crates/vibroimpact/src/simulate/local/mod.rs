@@ -7,6 +7,7 @@
 //!   crawl;
 //! - `activation.rs`, `membership.rs`, `rebuild.rs` — when a contact
 //!   matters, the set's edge, rebuilding the set;
+//! - `alike.rs` — the check of a contact between bodies that move alike;
 //! - `clusters.rs` — a set and a stepper per cluster, earliest first;
 //! - `lists.rs` — lists per group in one flat array;
 //! - `free_motion/` — exact motion between contacts;
@@ -64,6 +65,7 @@ use crate::model::{Body, Contact, ContactPair, Coupling, HarmonicForce, Storey};
 use crate::simulate::local::free_motion::{FreeMotion, Rows};
 
 mod activation;
+mod alike;
 mod clusters;
 mod driver;
 mod energy;
@@ -249,9 +251,8 @@ struct Run<'a> {
     breakpoints: Vec<f64>,
     /// The record of the run's linearisation, when a tape is asked for.
     tape: Option<TapeRecord>,
-    /// Per contact between two bodies that move alike (see
-    /// [`alike`]): their ω² = k/m.
-    alike: Vec<Option<f64>>,
+    /// Per contact between two bodies that move alike (`alike.rs`).
+    alike: Vec<Option<alike::Alike>>,
     /// The energy audit's sums, when asked for.
     energy: Option<LocalEnergy>,
     /// Per contact: its rigid limit, for rigid impacts (`rigid.rs`).
@@ -265,28 +266,6 @@ struct Run<'a> {
     armed: Vec<bool>,
     /// The rigid contacts' soft episodes.
     episodes: Vec<super::SoftEpisode>,
-}
-
-/// ω² of the two bodies of contact `c` if they move alike: each a group
-/// of its own (no coupling), the same k/m > 0 and c/m, and no harmonic
-/// force or storey on either. Then the base drives both alike and their difference
-/// `Δ = u_l − u_r` is a free damped oscillator: its energy
-/// `Δ̇² + ω²Δ²` never grows, so `|Δ| <= sqrt(E)/ω` for all time.
-fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<f64> {
-    let (l, r) = (c.pair.left()?, c.pair.right()?);
-    let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
-    // (A body alone in its group: its group's forces and storeys are its.)
-    let forced = |i: usize| {
-        let g = free.place(i).0;
-        !free.forces_in(g).is_empty() || !free.storeys_in(g).is_empty()
-    };
-    if !single(l) || !single(r) || forced(l) || forced(r) {
-        return None;
-    }
-    let (a, b) = (&model.bodies()[l], &model.bodies()[r]);
-    let w2 = a.stiffness / a.mass;
-    (w2 > 0.0 && w2 == b.stiffness / b.mass && a.damping / a.mass == b.damping / b.mass)
-        .then_some(w2)
 }
 
 /// The first time a quantity that starts `d` below its limit, at rate `b`
@@ -482,7 +461,7 @@ impl Run<'_> {
         state: impl Fn(usize) -> &'s [f64],
     ) -> Option<f64> {
         if let Some(c) = self.model.contacts().get(k) {
-            if let Some(until) = self.alike_bound(c, k, &state) {
+            if let Some(until) = self.alike_bound(c, k, t, &state) {
                 return Some(until);
             }
         }
@@ -514,6 +493,11 @@ impl Run<'_> {
                 }
             };
             match tau {
+                Some(tau) if tau <= floor && self.is_rigid(k) => {
+                    // (A rigid contact's jump is taken where its gap is
+                    // reached, not within the floor of it.)
+                    break self.locate_gap(k, t, 2.0 * floor, &state);
+                }
                 Some(tau) if tau < horizon || horizon >= remaining => {
                     break (tau > floor && t + tau > t).then_some(t + tau);
                 }
@@ -537,34 +521,6 @@ impl Run<'_> {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
         }
-    }
-
-    /// For a contact between bodies that move alike: the run's end, if
-    /// their difference's energy keeps the gap below activation for all
-    /// time.
-    fn alike_bound<'s>(
-        &self,
-        c: &Contact,
-        k: usize,
-        state: &impl Fn(usize) -> &'s [f64],
-    ) -> Option<f64> {
-        if let (Some(w2), Some(l), Some(r)) = (self.alike[k], c.pair.left(), c.pair.right()) {
-            // Bodies that move alike: the gap's bound for all time.
-            let (xl, xr) = (state(self.free.place(l).0), state(self.free.place(r).0));
-            let (d, dv) = (xl[0] - xr[0], xl[1] - xr[1]);
-            let energy = dv * dv + w2 * d * d;
-            let reach = (energy / w2).sqrt();
-            let size = c.clearance + xl[0].abs() + xr[0].abs();
-            let gap = self.check_gap(k, energy.sqrt());
-            // Safe to the end while both move exactly: no check is queued,
-            // so every path that changes either body's motion must lapse
-            // or reschedule this contact (`join` does, and `release`
-            // schedules the contacts it frees).
-            if reach - c.clearance + 1e-12 * size < gap {
-                return Some(self.opts.t_end);
-            }
-        }
-        None
     }
 
     /// The time within `horizon` until which contact `c` (index `k`) stays

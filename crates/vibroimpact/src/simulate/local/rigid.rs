@@ -58,6 +58,50 @@ impl Run<'_> {
         }
     }
 
+    /// Rigid contact k's gap ([`Run::check_gap`]) where the bounds leave
+    /// it within their floor of `t` (the sides' states at `t`: `state`):
+    /// the time it is reached on the sides' exact motion, by Newton's
+    /// steps from `t`, to rounding. None: reached at `t` already, or not
+    /// within `limit` (then taken as reached at `t`, as before).
+    pub(super) fn locate_gap<'s>(
+        &self,
+        k: usize,
+        t: f64,
+        limit: f64,
+        state: &impl Fn(usize) -> &'s [f64],
+    ) -> Option<f64> {
+        let c = &self.model.contacts()[k];
+        let gap = self.check_gap(k, 0.0);
+        let at = |tau: f64| {
+            let (mut s, mut sd) = (-c.clearance - gap, 0.0);
+            for (side, sign) in [c.pair.left(), c.pair.right()].into_iter().zip([1.0, -1.0]) {
+                let Some(i) = side else { continue };
+                let (g, j) = self.free.place(i);
+                let mut x = Rows::from_slice(state(g));
+                self.free.propagate(g, t, t + tau, &mut x);
+                s += sign * x[2 * j];
+                sd += sign * x[2 * j + 1];
+            }
+            (s, sd)
+        };
+        let mut tau = 0.0;
+        for _ in 0..8 {
+            let (s, sd) = at(tau);
+            if s >= 0.0 {
+                break;
+            }
+            let next = tau - s / sd;
+            if !(sd > 0.0 && next <= limit) {
+                return None;
+            }
+            if next == tau {
+                break;
+            }
+            tau = next;
+        }
+        (t + tau > t).then_some(t + tau)
+    }
+
     /// Whether check `k` is a rigid contact.
     pub(super) fn is_rigid(&self, k: usize) -> bool {
         self.rigid.get(k).is_some()
