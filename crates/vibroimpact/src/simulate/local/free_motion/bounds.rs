@@ -160,7 +160,7 @@ impl FreeMotion {
     /// and no harmonic terms.
     pub fn has_envelopes(&self, g: usize) -> bool {
         let group = &self.groups[g];
-        group.modal.is_some() && group.harmonic.is_empty()
+        group.modal.is_some() && group.harmonic().is_empty()
     }
 
     /// The envelopes of `q = Σ c x_r` over each of `quantities` (rows r
@@ -176,10 +176,12 @@ impl FreeMotion {
     ) -> Option<[Envelope; Q]> {
         let group = &self.groups[g];
         let modal = group.modal.as_ref()?;
-        if !group.harmonic.is_empty() {
+        if !group.harmonic().is_empty() {
             return None;
         }
-        let about: Rows = x.iter().zip(&group.rest).map(|(a, r)| a - r).collect();
+        let about: Rows = (x.iter().enumerate())
+            .map(|(r, a)| a - group.rest(r))
+            .collect();
         let mut z = Vec::with_capacity(x.len());
         modal.to_modes(&about, &mut z);
         Some(quantities.map(|rows| {
@@ -193,19 +195,19 @@ impl FreeMotion {
 impl Group {
     /// Row r of the rest state (interleaved).
     pub fn rest(&self, r: usize) -> f64 {
-        self.rest[r]
+        self.terms.as_deref().map_or(0.0, |t| t.rest[r])
     }
 
     /// Mechanical energy (kinetic and springs, about the rest state) of the
     /// interleaved state `x`.
     pub fn energy(&self, x: &[f64]) -> f64 {
-        let u = |i: usize| x[2 * i] - self.rest[2 * i];
+        let u = |i: usize| x[2 * i] - self.rest(2 * i);
         let mut e = 0.0;
         for j in 0..self.mass.len() {
             let v = x[2 * j + 1];
             e += 0.5 * self.mass[j] * v * v + 0.5 * self.stiffness[j] * u(j) * u(j);
         }
-        for &(a, b, k, _) in &self.couplings {
+        for &(a, b, k, _) in self.couplings() {
             let du = u(b) - u(a);
             e += 0.5 * k * du * du;
         }
@@ -222,10 +224,8 @@ impl Group {
     /// `G` of the module notes while the base's |z̈| stays below `zdd`: `√E`
     /// grows at most this fast (√J/s).
     pub fn growth(&self, zdd: f64) -> f64 {
-        self.force_amplitude
-            .iter()
-            .zip(&self.mass)
-            .map(|(p, m)| 0.5 * (m * zdd + p) * (2.0 / m).sqrt())
+        (self.mass.iter().enumerate())
+            .map(|(j, m)| 0.5 * (m * zdd + self.force_amplitude(j)) * (2.0 / m).sqrt())
             .sum()
     }
 
@@ -237,8 +237,8 @@ impl Group {
         let mut f = (2.0 * self.stiffness[j] * e_max).sqrt()
             + self.damping[j] * speed(j)
             + self.mass[j] * zdd
-            + self.force_amplitude[j];
-        for &(a, b, k, c) in &self.couplings {
+            + self.force_amplitude(j);
+        for &(a, b, k, c) in self.couplings() {
             if a == j || b == j {
                 f += (2.0 * k * e_max).sqrt() + c * (speed(a) + speed(b));
             }

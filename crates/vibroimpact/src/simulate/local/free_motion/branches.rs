@@ -7,7 +7,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::{FreeMotion, FreeMotionError, Group, HoldStep, Modal, Propagator};
+use super::{Coupling, FreeMotion, FreeMotionError, Group, Harmonic, HoldStep, Modal, Propagator};
 
 /// Where a storey's stiffness sits in its group.
 #[derive(Clone, Copy, Debug)]
@@ -40,9 +40,9 @@ pub(super) struct Branching {
 #[derive(Clone, Debug)]
 pub(super) struct Variant {
     stiffness: super::PerBody,
-    couplings: Vec<(usize, usize, f64, f64)>,
+    couplings: Vec<Coupling>,
     propagator: Propagator,
-    harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
+    harmonic: Vec<Harmonic>,
     rate: f64,
     modal: Option<Box<Modal>>,
     hold_step: Option<Box<HoldStep>>,
@@ -54,7 +54,7 @@ pub(super) fn system_matrix(
     mass: &[f64],
     stiffness: &[f64],
     damping: &[f64],
-    couplings: &[(usize, usize, f64, f64)],
+    couplings: &[Coupling],
 ) -> DMatrix<f64> {
     let m = mass.len();
     let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
@@ -82,7 +82,7 @@ pub(super) fn steady_states(
     a: &DMatrix<f64>,
     terms: &[(f64, f64, Vec<f64>)],
     names: &str,
-) -> Result<(Vec<(f64, f64, Vec<f64>, Vec<f64>)>, f64), FreeMotionError> {
+) -> Result<(Vec<Harmonic>, f64), FreeMotionError> {
     let d = a.nrows();
     let mut harmonic = Vec::with_capacity(terms.len());
     let mut rate = 0.0f64;
@@ -129,15 +129,14 @@ pub(super) fn steady_states(
 /// terms' steady states and the fastest rate ([`steady_states`]). A
 /// single body without terms builds no matrix: a row of a thousand
 /// pendulums sets up a thousand of these.
-#[allow(clippy::type_complexity)]
 pub(super) fn motion(
     mass: &[f64],
     stiffness: &[f64],
     damping: &[f64],
-    couplings: &[(usize, usize, f64, f64)],
+    couplings: &[Coupling],
     terms: &[(f64, f64, Vec<f64>)],
     names: &str,
-) -> Result<(Propagator, Vec<(f64, f64, Vec<f64>, Vec<f64>)>, f64), FreeMotionError> {
+) -> Result<(Propagator, Vec<Harmonic>, f64), FreeMotionError> {
     if mass.len() == 1 && couplings.is_empty() && terms.is_empty() {
         let (w2, c2) = (stiffness[0] / mass[0], damping[0] / mass[0]);
         return Ok((
@@ -154,7 +153,7 @@ pub(super) fn motion(
             c2: -a[(1, 1)],
         }
     } else {
-        Propagator::Group(a)
+        Propagator::Group(Box::new(a))
     };
     Ok((propagator, harmonic, rate))
 }
@@ -165,23 +164,24 @@ impl Group {
     fn take_variant(&mut self) -> Variant {
         Variant {
             stiffness: self.stiffness.clone(),
-            couplings: self.couplings.clone(),
+            couplings: self.couplings().to_vec(),
             propagator: self.propagator.clone(),
-            harmonic: std::mem::take(&mut self.harmonic),
+            harmonic: std::mem::take(&mut self.terms_mut().harmonic),
             rate: self.rate,
             modal: self.modal.take(),
-            hold_step: self.hold_step.take(),
+            hold_step: self.terms_mut().hold_step.take(),
         }
     }
 
     fn put_variant(&mut self, v: Variant) {
         self.stiffness = v.stiffness;
-        self.couplings = v.couplings;
         self.propagator = v.propagator;
-        self.harmonic = v.harmonic;
         self.rate = v.rate;
         self.modal = v.modal;
-        self.hold_step = v.hold_step;
+        let t = self.terms_mut();
+        t.couplings = v.couplings;
+        t.harmonic = v.harmonic;
+        t.hold_step = v.hold_step;
     }
 
     /// Its storeys (model indices), in the order
@@ -213,7 +213,7 @@ impl FreeMotion {
         let key = std::mem::replace(&mut br.stiffness, k.to_vec());
         // The rest state belongs to the stiffness: set again even for the
         // same forces.
-        group.rest_forces.fill(f64::NAN);
+        group.terms_mut().rest_forces.fill(f64::NAN);
         br.cache.push((key, old));
         if let Some(i) = br.cache.iter().position(|(key, _)| key == k) {
             let (_, v) = br.cache.swap_remove(i);
@@ -225,20 +225,20 @@ impl FreeMotion {
         for (&(_, slot), &new) in br.storeys.iter().zip(k) {
             match slot {
                 Slot::Ground(j) => group.stiffness[j] += new,
-                Slot::Coupling(c) => group.couplings[c].2 = new,
+                Slot::Coupling(c) => group.terms_mut().couplings[c].2 = new,
             }
         }
         let found = motion(
             &group.mass,
             &group.stiffness,
             &group.damping,
-            &group.couplings,
+            group.couplings(),
             &br.terms,
             &br.names,
         );
         group.branching = Some(br);
         let (propagator, harmonic, rate) = found?;
-        group.harmonic = harmonic;
+        group.terms_mut().harmonic = harmonic;
         group.rate = rate;
         group.propagator = propagator;
         Self::dress(group, record_step);

@@ -7,7 +7,7 @@
 use smallvec::smallvec;
 
 use super::{bounds, branches, hold, Bodies, FreeMotion, FreeMotionError, Group, HoldStep, Modal};
-use super::{PerBody, Propagator, Rows, HOLD_ROWS};
+use super::{Coupling, PerBody, Propagator, Terms, HOLD_ROWS};
 use crate::model::{BaseExcitation, Body, Model};
 use crate::simulate::local::lists::Lists;
 
@@ -87,15 +87,28 @@ impl FreeMotion {
             BaseExcitation::Harmonic { amplitude, .. } => *amplitude == 0.0,
             _ => true,
         };
-        let mut groups = Vec::with_capacity(ng);
-        for (g, bodies) in members.into_iter().enumerate() {
-            if bodies.len() == 1 && unforced && parts.is_empty(g) {
-                let body = &model.bodies()[bodies[0]];
-                groups.push(Group::single(bodies, body));
-            } else {
-                groups.push(Self::group(model, &place, bodies, &parts, g)?);
+        let lone = |g: usize, bodies: &Bodies| bodies.len() == 1 && unforced && parts.is_empty(g);
+        let mut groups: Vec<Group> = if (members.iter().enumerate()).all(|(g, b)| lone(g, b)) {
+            // (A row of lone bodies: built in place, without a `Result`
+            // between, which costs a copy of each group.)
+            (members.into_iter())
+                .map(|bodies| {
+                    let body = &model.bodies()[bodies[0]];
+                    Group::single(bodies, body)
+                })
+                .collect()
+        } else {
+            let mut groups = Vec::with_capacity(ng);
+            for (g, bodies) in members.into_iter().enumerate() {
+                groups.push(if lone(g, &bodies) {
+                    let body = &model.bodies()[bodies[0]];
+                    Group::single(bodies, body)
+                } else {
+                    Self::group(model, &place, bodies, &parts, g)?
+                });
             }
-        }
+            groups
+        };
         let record_step = match model.base() {
             BaseExcitation::Record(rec) => Some(hold::typical_step(rec.times())),
             _ => None,
@@ -117,7 +130,9 @@ impl FreeMotion {
     /// a record sampled every `record_step` (Some(None): not uniformly).
     pub(super) fn dress(g: &mut Group, record_step: Option<Option<f64>>) {
         g.modal = None;
-        g.hold_step = None;
+        if let Some(t) = g.terms.as_deref_mut() {
+            t.hold_step = None;
+        }
         if record_step.is_some() || matches!(g.propagator, Propagator::Group(_)) {
             g.modal = Modal::new(&Self::matrix(g), record_step.flatten()).map(Box::new);
         }
@@ -134,7 +149,7 @@ impl FreeMotion {
         let small = 2 * g.bodies.len() <= HOLD_ROWS;
         if let (true, Some(Some(tau))) = (g.modal.is_none() || small, record_step) {
             let (phi, g0, g1) = hold::matrices(&Self::matrix(g), tau);
-            g.hold_step = Some(Box::new(HoldStep { tau, phi, g0, g1 }));
+            g.terms_mut().hold_step = Some(Box::new(HoldStep { tau, phi, g0, g1 }));
         }
     }
 
@@ -151,7 +166,7 @@ impl FreeMotion {
         let own_stiffness: PerBody = bodies.iter().map(|&i| all[i].stiffness).collect();
         let mut stiffness = own_stiffness.clone();
         let damping: PerBody = bodies.iter().map(|&i| all[i].damping).collect();
-        let mut couplings: Vec<(usize, usize, f64, f64)> = parts.couplings[here]
+        let mut couplings: Vec<Coupling> = parts.couplings[here]
             .iter()
             .map(|&i| &model.couplings()[i])
             .map(|c| (place[c.a].1, place[c.b].1, c.stiffness, c.damping))
@@ -220,21 +235,24 @@ impl FreeMotion {
         };
         let (propagator, harmonic, rate) =
             branches::motion(&mass, &stiffness, &damping, &couplings, &terms, &names)?;
-        Ok(Group {
-            bodies,
-            propagator,
+        let extra = Terms {
             harmonic,
-            mass,
-            stiffness,
-            damping,
             couplings,
             force_amplitude,
             forces,
+            ..Terms::none(m)
+        };
+        let none =
+            extra.harmonic.is_empty() && extra.couplings.is_empty() && extra.forces.is_empty();
+        Ok(Group {
+            bodies,
+            propagator,
+            mass,
+            stiffness,
+            damping,
             rate,
             modal: None,
-            hold_step: None,
-            rest: Rows::from_elem(0.0, 2 * m),
-            rest_forces: PerBody::from_elem(0.0, m),
+            terms: (!none).then(|| Box::new(extra)),
             branching: (!storeys.is_empty()).then(|| {
                 Box::new(branches::Branching {
                     storeys,
@@ -257,18 +275,12 @@ impl Group {
         Group {
             bodies,
             propagator: Propagator::Single { w2, c2 },
-            harmonic: Vec::new(),
             mass: smallvec![b.mass],
             stiffness: smallvec![b.stiffness],
             damping: smallvec![b.damping],
-            couplings: Vec::new(),
-            force_amplitude: smallvec![0.0],
-            forces: Vec::new(),
             rate: w2.max(0.0).sqrt(),
             modal: None,
-            hold_step: None,
-            rest: smallvec![0.0, 0.0],
-            rest_forces: smallvec![0.0],
+            terms: None,
             branching: None,
         }
     }

@@ -76,8 +76,9 @@ pub enum FreeMotionError {
 enum Propagator {
     /// One body: `ü = −w2 u − c2 u̇` in closed form.
     Single { w2: f64, c2: f64 },
-    /// A group: the matrix exponential of `A`.
-    Group(DMatrix<f64>),
+    /// A group: the matrix exponential of `A` (boxed: a group stays
+    /// small).
+    Group(Box<DMatrix<f64>>),
 }
 
 /// A group's bodies (most groups of a row are one or two bodies: kept
@@ -94,22 +95,39 @@ pub(crate) type Rows = SmallVec<[f64; 4]>;
 pub struct Group {
     bodies: Bodies,
     propagator: Propagator,
-    /// Steady states of the harmonic terms: (Ω, φ, Re X, Im X).
-    harmonic: Vec<(f64, f64, Vec<f64>, Vec<f64>)>,
     mass: PerBody,
     stiffness: PerBody,
     damping: PerBody,
-    /// Couplings inside the group: (local a, local b, k, c).
-    couplings: Vec<(usize, usize, f64, f64)>,
-    /// Sum of the harmonic forces' amplitudes on each body (N).
-    force_amplitude: PerBody,
-    /// Harmonic forces: (body in the group, P, Ω, φ).
-    forces: Vec<(usize, f64, f64, f64)>,
     /// Fastest natural or forcing rate (rad/s), for the bound's horizon.
     rate: f64,
     /// The complex modes, where they can be trusted (not for a single
     /// body under harmonic forcing: closed form).
     modal: Option<Box<Modal>>,
+    /// Its forcing, couplings, record step and rest state (None for a
+    /// lone body without any: most groups of a row; boxed, a group
+    /// stays small).
+    terms: Option<Box<Terms>>,
+    /// Its storeys and what a change of their branches needs (None
+    /// without storeys: most groups of a row; boxed, a group stays small).
+    branching: Option<Box<branches::Branching>>,
+}
+
+/// A harmonic term's steady state: (Ω, φ, Re X, Im X).
+type Harmonic = (f64, f64, Vec<f64>, Vec<f64>);
+/// A coupling inside a group: (local a, local b, k, c).
+type Coupling = (usize, usize, f64, f64);
+
+/// What a group has beyond its bodies' own springs and dampers.
+#[derive(Clone, Debug)]
+struct Terms {
+    /// Steady states of the harmonic terms.
+    harmonic: Vec<Harmonic>,
+    /// Couplings inside the group.
+    couplings: Vec<Coupling>,
+    /// Sum of the harmonic forces' amplitudes on each body (N).
+    force_amplitude: PerBody,
+    /// Harmonic forces: (body in the group, P, Ω, φ).
+    forces: Vec<(usize, f64, f64, f64)>,
     /// Without modes, under a record: the matrix form of a whole typical
     /// sample step, computed once.
     hold_step: Option<Box<HoldStep>>,
@@ -117,9 +135,21 @@ pub struct Group {
     /// (interleaved; zero without storeys), and those forces.
     rest: Rows,
     rest_forces: PerBody,
-    /// Its storeys and what a change of their branches needs (None
-    /// without storeys: most groups of a row; boxed, a group stays small).
-    branching: Option<Box<branches::Branching>>,
+}
+
+impl Terms {
+    /// None of them, for `m` bodies.
+    fn none(m: usize) -> Self {
+        Terms {
+            harmonic: Vec::new(),
+            couplings: Vec::new(),
+            force_amplitude: PerBody::from_elem(0.0, m),
+            forces: Vec::new(),
+            hold_step: None,
+            rest: Rows::from_elem(0.0, 2 * m),
+            rest_forces: PerBody::from_elem(0.0, m),
+        }
+    }
 }
 
 /// The exact free motion of every group of a model.
@@ -294,19 +324,23 @@ impl FreeMotion {
     pub fn set_rest(&mut self, g: usize, f: &[f64]) -> Result<(), f64> {
         let group = &mut self.groups[g];
         let m = group.bodies.len();
-        if f == group.rest_forces.as_slice() {
-            return Ok(());
-        }
-        if f.iter().all(|&x| x == 0.0) {
-            group.rest.fill(0.0);
-            group.rest_forces.fill(0.0);
-            return Ok(());
+        let zero = f.iter().all(|&x| x == 0.0);
+        match group.terms.as_deref_mut() {
+            // (Without terms the rest state is zero.)
+            None if zero => return Ok(()),
+            Some(t) if f == t.rest_forces.as_slice() => return Ok(()),
+            Some(t) if zero => {
+                t.rest.fill(0.0);
+                t.rest_forces.fill(0.0);
+                return Ok(());
+            }
+            _ => {}
         }
         let mut k = DMatrix::<f64>::zeros(m, m);
         for j in 0..m {
             k[(j, j)] = group.stiffness[j];
         }
-        for &(a, b, kc, _) in &group.couplings {
+        for &(a, b, kc, _) in group.couplings() {
             k[(a, a)] += kc;
             k[(b, b)] += kc;
             k[(a, b)] -= kc;
@@ -324,21 +358,25 @@ impl FreeMotion {
         if residual.is_nan() || residual > 1e-9 * scale {
             return Err(residual / scale);
         }
+        let t = group.terms_mut();
         for j in 0..m {
-            group.rest[2 * j] = u[j];
-            group.rest[2 * j + 1] = 0.0;
+            t.rest[2 * j] = u[j];
+            t.rest[2 * j + 1] = 0.0;
         }
-        group.rest_forces.copy_from_slice(f);
+        t.rest_forces.copy_from_slice(f);
         Ok(())
     }
 
     /// Adds the particular motion of group `g` at time `t` (its rest state
     /// and harmonic steady state), times `sign`, to `x`.
     fn add_particular(&self, g: &Group, t: f64, sign: f64, x: &mut [f64]) {
-        for (xi, r) in x.iter_mut().zip(&g.rest) {
+        let Some(terms) = g.terms.as_deref() else {
+            return;
+        };
+        for (xi, r) in x.iter_mut().zip(&terms.rest) {
             *xi += sign * r;
         }
-        for (w, phi, re, im) in &g.harmonic {
+        for (w, phi, re, im) in &terms.harmonic {
             let (s, c) = (w * t + phi).sin_cos();
             for (xi, (r, i)) in x.iter_mut().zip(re.iter().zip(im)) {
                 *xi += sign * (r * s + i * c);
@@ -356,7 +394,7 @@ impl FreeMotion {
                 x[1] = p[2] * u + p[3] * v;
             }
             Propagator::Group(a) => {
-                let phi = (a * tau).exp();
+                let phi = (&**a * tau).exp();
                 let y = &phi * DVector::from_column_slice(x);
                 x.copy_from_slice(y.as_slice());
             }
@@ -380,10 +418,7 @@ impl FreeMotion {
         // A short run under a record: whole steps in the state (d² products
         // each, where a pass through the modes costs about 7 d² and 14 d a
         // step), a partial one through the modes.
-        let short = group
-            .hold_step
-            .as_ref()
-            .filter(|h| t1 - t0 <= SHORT_RUN * h.tau);
+        let short = group.hold_step().filter(|h| t1 - t0 <= SHORT_RUN * h.tau);
         match (&self.base, &group.modal, short) {
             (BaseExcitation::Record(rec), Some(modal), Some(h)) => {
                 let (mut y, mut z) = (vec![0.0; x.len()], Vec::with_capacity(x.len()));
@@ -407,7 +442,7 @@ impl FreeMotion {
             }
             (BaseExcitation::Record(rec), None, _) => {
                 let mut y = vec![0.0; x.len()];
-                hold::intervals(rec, t0, t1, |tau, fa, slope| match &group.hold_step {
+                hold::intervals(rec, t0, t1, |tau, fa, slope| match group.hold_step() {
                     // A whole sample step (to rounding of the sample times:
                     // 1e-12 of a step moves the state by far less than any
                     // tolerance).
@@ -438,9 +473,9 @@ impl FreeMotion {
         let group = &self.groups[g];
         // Springs act on the displacement from rest (the storeys' constant
         // forces balance there).
-        let u = |i: usize| x[2 * i] - group.rest[2 * i];
+        let u = |i: usize| x[2 * i] - group.rest(2 * i);
         let mut f = -group.stiffness[j] * u(j) - group.damping[j] * x[2 * j + 1];
-        for &(a, b, k, c) in &group.couplings {
+        for &(a, b, k, c) in group.couplings() {
             let other = match (a == j, b == j) {
                 (true, _) => b,
                 (_, true) => a,
@@ -448,7 +483,7 @@ impl FreeMotion {
             };
             f += k * (u(other) - u(j)) + c * (x[2 * other + 1] - x[2 * j + 1]);
         }
-        for &(i, p, w, phi) in &group.forces {
+        for &(i, p, w, phi) in group.forces() {
             if i == j {
                 f += p * (w * t + phi).sin();
             }
@@ -465,7 +500,7 @@ impl FreeMotion {
         let group = &self.groups[g];
         let v = |i: usize| x[2 * i + 1];
         let mut f = -group.stiffness[j] * v(j) - group.damping[j] * acc[j];
-        for &(a, b, k, c) in &group.couplings {
+        for &(a, b, k, c) in group.couplings() {
             let other = match (a == j, b == j) {
                 (true, _) => b,
                 (_, true) => a,
@@ -473,7 +508,7 @@ impl FreeMotion {
             };
             f += k * (v(other) - v(j)) + c * (acc[other] - acc[j]);
         }
-        for &(i, p, w, phi) in &group.forces {
+        for &(i, p, w, phi) in group.forces() {
             if i == j {
                 f += p * w * (w * t + phi).cos();
             }
@@ -502,7 +537,7 @@ impl FreeMotion {
     /// The group's system matrix `A` (interleaved).
     fn matrix(g: &Group) -> DMatrix<f64> {
         match &g.propagator {
-            Propagator::Group(a) => a.clone(),
+            Propagator::Group(a) => (**a).clone(),
             Propagator::Single { w2, c2 } => DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w2, -c2]),
         }
     }
@@ -513,10 +548,41 @@ impl Group {
     /// without forcing (no harmonic term, no record, no constant force), as
     /// a row's bodies are before a pulse reaches them.
     fn at_rest(&self, base: &BaseExcitation, x: &[f64]) -> bool {
-        self.harmonic.is_empty()
+        (self.terms.as_deref())
+            .is_none_or(|t| t.harmonic.is_empty() && t.rest.iter().all(|&r| r == 0.0))
             && !matches!(base, BaseExcitation::Record(_))
-            && self.rest.iter().all(|&r| r == 0.0)
             && x.iter().all(|&v| v == 0.0)
+    }
+
+    /// Its harmonic terms' steady states.
+    fn harmonic(&self) -> &[Harmonic] {
+        self.terms.as_deref().map_or(&[], |t| &t.harmonic)
+    }
+
+    /// Its couplings.
+    fn couplings(&self) -> &[Coupling] {
+        self.terms.as_deref().map_or(&[], |t| &t.couplings)
+    }
+
+    /// Its harmonic forces.
+    fn forces(&self) -> &[(usize, f64, f64, f64)] {
+        self.terms.as_deref().map_or(&[], |t| &t.forces)
+    }
+
+    /// The sum of the harmonic forces' amplitudes on body `j` (N).
+    fn force_amplitude(&self, j: usize) -> f64 {
+        self.terms.as_deref().map_or(0.0, |t| t.force_amplitude[j])
+    }
+
+    /// A whole typical sample step's matrix form, if kept.
+    fn hold_step(&self) -> Option<&HoldStep> {
+        self.terms.as_deref().and_then(|t| t.hold_step.as_deref())
+    }
+
+    /// Its terms, given (none of them) where it had none.
+    fn terms_mut(&mut self) -> &mut Terms {
+        let m = self.bodies.len();
+        self.terms.get_or_insert_with(|| Box::new(Terms::none(m)))
     }
 
     /// The bodies, in order along the line.

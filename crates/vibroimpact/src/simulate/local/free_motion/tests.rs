@@ -252,7 +252,7 @@ fn a_record_with_a_tail_keeps_its_whole_steps() {
     let group = &free.groups()[0];
     let modal = group.modal.as_ref().expect("modes");
     assert!(near(modal.whole_step()));
-    assert!(near(group.hold_step.as_ref().map(|h| h.tau)));
+    assert!(near(group.hold_step().map(|h| h.tau)));
     let reference = integrated(&m, 2.2);
     for pieces in [2200 / 5, 2200 / 3, 2200 / 2, 2200] {
         assert_close(&exact(&m, 2.2, pieces), &reference, 1e-9);
