@@ -203,7 +203,8 @@ pub trait StepMethod: Clone + std::fmt::Debug {
         stats: &mut Stats,
     ) -> f64;
 
-    /// All components of the dense output at `s` (default: one at a time).
+    /// The first `out.len()` components of the dense output at `s`
+    /// (default: one at a time).
     fn dense_all<S: OdeSystem>(
         &mut self,
         sys: &mut S,
@@ -618,7 +619,9 @@ impl<M: StepMethod> Driver<M> {
     }
 
     /// Dense output of the last accepted step, valid for `t` in
-    /// `[t_prev, t]`; writes all components. Requests at exactly `t_prev()`
+    /// `[t_prev, t]`: the first `out.len()` components (all of them, or
+    /// a leading part: a system's own state ahead of its carried
+    /// columns, which is all an event needs). Requests at exactly `t_prev()`
     /// or `t()` return the stored states; outside `[t_prev, t]` the
     /// polynomial is extrapolated (not accurate); before the first step
     /// after a reset the output is the current state. A method may evaluate
@@ -626,17 +629,17 @@ impl<M: StepMethod> Driver<M> {
     /// system.
     ///
     /// # Panics
-    /// If `out.len()` differs from the dimension.
+    /// If `out.len()` exceeds the dimension.
     pub fn dense_output<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
-        assert_eq!(
-            out.len(),
-            self.at.dim(),
-            "dense_output: wrong output length"
+        let m = out.len();
+        assert!(
+            m <= self.at.dim(),
+            "dense_output: output longer than the state"
         );
         if !self.has_step || t == self.at.t {
-            out.copy_from_slice(&self.at.y);
+            out.copy_from_slice(&self.at.y[..m]);
         } else if t == self.at.t_prev {
-            out.copy_from_slice(&self.at.y_prev);
+            out.copy_from_slice(&self.at.y_prev[..m]);
         } else {
             let s = (t - self.at.t_prev) / self.at.h_last;
             self.method

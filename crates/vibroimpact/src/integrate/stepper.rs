@@ -355,10 +355,11 @@ impl Stepper {
     }
 
     /// Dense output of the last accepted step, valid in `[t_prev, t]`: 7th
-    /// order for DOP853, 4th for DOPRI5, 3rd for RODAS.
+    /// order for DOP853, 4th for DOPRI5, 3rd for RODAS; the first
+    /// `out.len()` components ([`Driver::dense_output`]).
     ///
     /// # Panics
-    /// If `out.len()` differs from the dimension.
+    /// If `out.len()` exceeds the dimension.
     pub fn dense_output<S: OdeSystem>(&mut self, sys: &mut S, t: f64, out: &mut [f64]) {
         active!(mut self, d => d.dense_output(sys, t, out))
     }

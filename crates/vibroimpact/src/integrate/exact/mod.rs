@@ -191,7 +191,7 @@ impl Linear {
     /// The steady state of every block at `t` into `out`.
     fn steady_into(&self, t: f64, out: &mut [f64]) {
         out.fill(0.0);
-        for (block, terms) in out.chunks_exact_mut(self.d).zip(&self.steady) {
+        for (block, terms) in out.chunks_mut(self.d).zip(&self.steady) {
             for (w, xr, xi) in terms {
                 let (s, c) = (w * t).sin_cos();
                 for ((o, r), i) in block.iter_mut().zip(xr).zip(xi) {
@@ -390,12 +390,13 @@ fn series_terms(form: &Linear, v: &[f64], h: f64, terms: &mut [f64]) -> Option<u
     None
 }
 
-/// `out = Σ_k τ^k terms_k` over the first `count` terms (Horner).
-fn sum_series(terms: &[f64], count: usize, tau: f64, out: &mut [f64]) {
-    let n = out.len();
-    out.copy_from_slice(&terms[(count - 1) * n..count * n]);
+/// `out = Σ_k τ^k terms_k` over the first `count` terms of `n`
+/// components each (Horner), for the first `out.len()` components.
+fn sum_series(terms: &[f64], (n, count): (usize, usize), tau: f64, out: &mut [f64]) {
+    let m = out.len();
+    out.copy_from_slice(&terms[(count - 1) * n..(count - 1) * n + m]);
     for k in (0..count - 1).rev() {
-        for (x, t) in out.iter_mut().zip(&terms[k * n..(k + 1) * n]) {
+        for (x, t) in out.iter_mut().zip(&terms[k * n..k * n + m]) {
             *x = *x * tau + t;
         }
     }
@@ -499,7 +500,7 @@ impl StepMethod for ExactMethod {
                     return Err(NON_FINITE);
                 };
                 self.count_try = count;
-                sum_series(&self.terms_try, count, h, y_new);
+                sum_series(&self.terms_try, (y_new.len(), count), h, y_new);
                 form.steady_into(trial.t_new, &mut self.steady);
                 for (y, p) in y_new.iter_mut().zip(&self.steady) {
                     *y += p;
@@ -584,10 +585,8 @@ impl StepMethod for ExactMethod {
         form.steady_into(at.t_prev + tau, out);
         if let (Some(j), Some(q)) = (quarter(s), self.quarters_acc) {
             let e = &self.sizes[q].e[j];
-            for (ob, vb) in out
-                .chunks_exact_mut(d)
-                .zip(self.deviation_acc.chunks_exact(d))
-            {
+            // (`chunks_mut`: a leading part may end inside a block.)
+            for (ob, vb) in out.chunks_mut(d).zip(self.deviation_acc.chunks_exact(d)) {
                 for (o, row) in ob.iter_mut().zip(e.chunks_exact(d)) {
                     *o += row.iter().zip(vb).map(|(a, b)| a * b).sum::<f64>();
                 }
@@ -598,8 +597,9 @@ impl StepMethod for ExactMethod {
             out.fill(f64::NAN);
             return;
         }
-        let series = &mut self.steady;
-        sum_series(&self.terms, self.count, tau, series);
+        let n = self.steady.len();
+        let series = &mut self.steady[..out.len()];
+        sum_series(&self.terms, (n, self.count), tau, series);
         for (o, x) in out.iter_mut().zip(series.iter()) {
             *o += x;
         }

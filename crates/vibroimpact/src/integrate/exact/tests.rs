@@ -1,5 +1,6 @@
 //! Tests of the exact flow: a forced oscillator against its closed form,
-//! a forced pair against DOP853, the dense output between quarters, a
+//! a forced pair against DOP853 (and a leading part of either's dense
+//! output against the whole), the dense output between quarters, a
 //! resonance refused, and a stepper that takes the exact flow where the
 //! form holds.
 
@@ -205,6 +206,21 @@ fn a_forced_coupled_row_moves_as_dop853_says() {
     let scale = y0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     for (a, b) in exact.y().iter().zip(reference.y()) {
         assert!((a - b).abs() < 1e-10 * scale, "{a} vs {b}");
+    }
+    // A leading part of the dense output (an event's state) is the whole
+    // one's, bit for bit: at a quarter of the step, between quarters,
+    // ending inside the block.
+    for mut st in [exact, reference] {
+        let (t0, h) = (st.t_prev(), st.h_last());
+        for s in [0.25, 0.37] {
+            let mut whole = [0.0; 6];
+            st.dense_output(&mut sys, t0 + s * h, &mut whole);
+            for m in [2, 3] {
+                let mut part = vec![0.0; m];
+                st.dense_output(&mut sys, t0 + s * h, &mut part);
+                assert_eq!(part, whole[..m], "{:?} s {s}: {m} of 6", st.active());
+            }
+        }
     }
 }
 

@@ -16,7 +16,7 @@
 use super::ChainDynamics;
 use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
-use crate::integrate::{IntegrationError, Stepper};
+use crate::integrate::{IntegrationError, OdeSystem, Stepper};
 use crate::numeric::brent;
 
 mod episodes;
@@ -89,8 +89,9 @@ pub(super) struct Switches {
     carried: Vec<(f64, f64)>,
     carried_y: Vec<f64>,
     carried_stamp: Option<u64>,
+    /// The chain's state on the dense output (a root's search).
     buf: Vec<f64>,
-    /// The states at the three inside points of the last step.
+    /// The chain's states at the three inside points of the last step.
     inside: [Vec<f64>; 3],
     /// The next event's time, once located.
     pending: Option<(f64, Event)>,
@@ -120,6 +121,10 @@ impl Switches {
         let approaches = (0..s_on.len())
             .filter(|&k| sys.rigid_law(k).is_some() && pre[k] < 0.0)
             .map(Event::Approach);
+        // (The events read the chain's own state alone: the dense output
+        // inside a step is taken of it, not of the columns a variational
+        // system carries after it.)
+        let own = OdeSystem::dim(sys).min(dim);
         let events: Vec<Event> = sys
             .storeys()
             .switching()
@@ -143,8 +148,8 @@ impl Switches {
             t_prev: 0.0,
             y_prev: vec![0.0; dim],
             f_prev: vec![0.0; dim],
-            buf: vec![0.0; dim],
-            inside: [vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]],
+            buf: vec![0.0; own],
+            inside: [vec![0.0; own], vec![0.0; own], vec![0.0; own]],
             pending: None,
             last_impact: vec![(f64::NEG_INFINITY, 0.0); sys.contacts()],
             episode: vec![false; sys.contacts()],
