@@ -252,7 +252,10 @@ fn applied(
             Err(e) => return Some(e),
         },
     };
-    if let Jump::Soft(_) = jump {
+    if let Jump::Soft(reason) = &jump {
+        if let Err(e) = sw.soft_impact(sys, k, (t, &y), reason) {
+            return Some(e);
+        }
         sys.set_soft_episode(k, true);
         sw.suspend(k, true);
     }

@@ -628,10 +628,13 @@ impl<'a> Run<'a> {
             .map(|c| alike::alike(model, &run.free, c))
             .collect();
         if let Some(window) = opts.extrema_window {
-            let s_on = model
-                .contacts()
-                .iter()
-                .map(|c| c.law.onset_approach(opts.impact_force_threshold))
+            // (A rigid contact's margin is its approach itself, as in the
+            // global run.)
+            let s_on = (model.contacts().iter().enumerate())
+                .map(|(k, c)| match run.is_rigid(k) {
+                    true => 0.0,
+                    false => c.law.onset_approach(opts.impact_force_threshold),
+                })
                 .collect();
             run.extrema = Some(LocalExtrema::new(
                 window,

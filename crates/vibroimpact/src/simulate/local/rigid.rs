@@ -146,6 +146,9 @@ impl Run<'_> {
             reason: e.to_string(),
         })?;
         if let Some(reason) = judged(&r, pressing, |d| self.neighbours(k, t, d)) {
+            // (Its duration kept for the neighbours' overlap, as a
+            // jump's: `Switches::soft_impact`.)
+            self.last_impact[k] = (t, r.duration);
             self.open_episode(k, t, reason);
             return Ok(false);
         }

@@ -285,6 +285,37 @@ impl Switches {
         Ok(Jump::Rigid(r))
     }
 
+    /// Rigid contact k's impact at `(t, y)`, taken by its law for
+    /// `reason`: its estimated duration kept for its neighbours' overlap
+    /// test, as a jump's is (a second impact on a body within it is soft
+    /// whether the first was a jump or an episode). None for a slow
+    /// impact or one joining a neighbour's episode: no impact estimated.
+    pub(in crate::simulate) fn soft_impact(
+        &mut self,
+        chain: &ChainDynamics,
+        k: usize,
+        (t, y): (f64, &[f64]),
+        reason: &EpisodeReason,
+    ) -> Result<(), IntegrationError> {
+        let (Some(law), false) = (
+            chain.rigid_law(k),
+            matches!(
+                reason,
+                EpisodeReason::Slow { .. } | EpisodeReason::Cluster { .. }
+            ),
+        ) else {
+            return Ok(());
+        };
+        let u = chain.approach(k, y).1;
+        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
+            t,
+            contact: k,
+            reason: e.to_string(),
+        })?;
+        self.last_impact[k] = (t, r.duration);
+        Ok(())
+    }
+
     /// Suspends (`on`) or resumes contact k's impact and approach events:
     /// in a soft episode its law is integrated, no jump. (A resumed
     /// approach is armed again once the contact is open.)

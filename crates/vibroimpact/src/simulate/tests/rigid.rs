@@ -2,7 +2,7 @@
 //! global run and between the local run's exact motions: the impact
 //! oscillator's period-1 orbit, a grazing touch, two free bodies, the
 //! energy audit, the soft law's limit, and the two runs against each
-//! other.
+//! other (an overlap after a soft impact among them).
 
 use super::*;
 use crate::contact::LawKind;
@@ -575,6 +575,53 @@ fn the_local_run_takes_rigid_impacts_as_the_global_one() {
         );
         assert!(audit.residual().abs() < bound, "{audit:?}");
     }
+}
+
+/// The example row of two (`examples/fujita-row-n2.toml`), rigid: its
+/// wall contact's slow impact at 1.0145 s (0.8 mm/s) is taken soft, its
+/// estimated duration 0.162 s; the bodies' contact touches 35 ms later,
+/// within it, on their shared body: soft in both runs, from the same
+/// time to the soft law's tail (2.8e-6 s apart: the local run's set
+/// still integrates the wall's law below its threshold). The global run
+/// had taken it as a jump (it kept the durations of jumps alone).
+#[test]
+fn an_impact_within_a_soft_neighbours_duration_is_soft() {
+    let model = crate::model::file::ModelDocument::from_toml(
+        include_str!("../../../../../examples/fujita-row-n2.toml"),
+        "fujita-row-n2.toml",
+    )
+    .unwrap()
+    .build()
+    .unwrap()
+    .model
+    .with_all_impacts(Impacts::Rigid { restitution: None })
+    .unwrap();
+    let run = |integrator| {
+        let opts = SimulationOptions {
+            t_end: 1.2,
+            rtol: 1e-10,
+            atol: 1e-13,
+            integrator,
+            ..Default::default()
+        };
+        simulate(&model, &opts).unwrap()
+    };
+    let (global, local) = (run(Integrator::Global), run(Integrator::Local));
+    assert!(global.error.is_none() && local.error.is_none());
+    let second = |sim: &Simulation| sim.soft_episodes.iter().find(|e| e.contact == 1).cloned();
+    let (Some(a), Some(b)) = (second(&global), second(&local)) else {
+        panic!("{:?}\n{:?}", global.soft_episodes, local.soft_episodes);
+    };
+    assert!(
+        matches!(a.reason, EpisodeReason::Overlap { other: 0, .. }),
+        "{a:?}"
+    );
+    assert!(
+        matches!(b.reason, EpisodeReason::Cluster { other: 0 }),
+        "{b:?}"
+    );
+    assert!((a.start_time - 1.0497).abs() < 1e-3, "{a:?}");
+    assert!((a.start_time - b.start_time).abs() < 1e-5, "{a:?} {b:?}");
 }
 
 /// A struck row of 40 of the seed's pendulums (1 mm gaps, no forcing, the

@@ -192,7 +192,13 @@ fn extrema_match_the_global_integrator() {
     // its extrema are scanned at the end of the run alone.
     let linear = crate::model::reference::r2(3, 1.0, 0.9 * W0).unwrap();
     let t_linear = 3.0 * 2.0 * std::f64::consts::PI / (0.9 * W0);
+    // Rigid, up to its first soft episode (1.0145 s): a margin is the
+    // approach itself.
+    let rigid = row
+        .clone()
+        .with_all_impacts(crate::model::Impacts::Rigid { restitution: None });
     for (model, t_end) in [
+        (rigid.unwrap(), 1.0),
         (row, 6.0 * t_row),
         (coupled, 6.0),
         (pair, 6.0),
