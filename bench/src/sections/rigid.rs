@@ -39,31 +39,43 @@ pub fn run(_peers: Option<&Peers>, quick: bool) -> Entries {
     vec![("rigid", Value::Object(out))]
 }
 
-/// Least total time of the runs behind one best time (s): a run of
-/// 0.2 ms timed 5 times measures its cold caches and the timer, not the
-/// run (the struck row's best of 5 scattered by 25 %).
+/// Least total time of the slowest side's runs behind one best time
+/// (s): a run of 0.2 ms timed 5 times measures its cold caches and the
+/// timer, not the run (the struck row's best of 5 scattered by 25 %).
 const BUDGET: f64 = 0.25;
 
-/// The best time of `run` (s) over at least `repeats` runs, and as many
-/// more as fit in [`BUDGET`] (at most 2000), with its last result.
-fn best_of<T>(repeats: usize, mut run: impl FnMut() -> T) -> (f64, T) {
-    let (mut best, mut total, mut count) = (f64::INFINITY, 0.0, 0);
-    loop {
+/// The best time of `run` (s) over `runs` runs, with its last result.
+fn best_of<T>(runs: usize, mut run: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..runs.max(1) {
         let start = Instant::now();
-        let out = run();
-        let dt = start.elapsed().as_secs_f64();
-        (best, total, count) = (best.min(dt), total + dt, count + 1);
-        if count >= repeats.max(1) && (total >= BUDGET || count >= 2000) {
-            return (best, out);
-        }
+        let o = run();
+        best = best.min(start.elapsed().as_secs_f64());
+        out = Some(o);
     }
+    (best, out.expect("one run"))
 }
 
-/// One timed simulation (best of at least `repeats`, [`best_of`]):
-/// seconds, impacts, soft episodes, right-hand sides.
-fn timed(model: &Model, opts: &SimulationOptions, repeats: usize) -> (f64, usize, usize, u64) {
-    let (best, sim) = best_of(repeats, || simulate(model, opts).expect("valid options"));
+/// The runs that time every side of a comparison: at least `repeats`,
+/// and as many as fill [`BUDGET`] at `once` s a run of its slowest (soft)
+/// side, at most 2000. Every side gets this count: a best of more tries
+/// is lower, and would favour the side that got them.
+fn runs(once: f64, repeats: usize) -> usize {
+    ((BUDGET / once).ceil() as usize).clamp(repeats.max(1), 2000)
+}
+
+/// One simulation that must succeed.
+fn checked(model: &Model, opts: &SimulationOptions) -> vibroimpact::simulate::Simulation {
+    let sim = simulate(model, opts).expect("valid options");
     assert!(sim.error.is_none(), "run failed: {:?}", sim.error);
+    sim
+}
+
+/// One timed simulation (best of `runs`): seconds, impacts, soft
+/// episodes, right-hand sides.
+fn timed(model: &Model, opts: &SimulationOptions, runs: usize) -> (f64, usize, usize, u64) {
+    let (best, sim) = best_of(runs, || checked(model, opts));
     (
         best,
         sim.impacts.len(),
@@ -87,8 +99,10 @@ pub fn r2_n3(repeats: usize) -> Value {
         integrator,
         ..SimulationOptions::default()
     };
-    let soft_run = timed(&soft, &opts(Integrator::Global), repeats);
-    compare(("soft, global", soft_run), &rigid, opts, repeats, 30.0)
+    let once = best_of(1, || checked(&soft, &opts(Integrator::Global))).0;
+    let runs = runs(once, repeats);
+    let soft_run = timed(&soft, &opts(Integrator::Global), runs);
+    compare(("soft, global", soft_run), &rigid, opts, runs, 30.0)
 }
 
 /// The rigid runs of `rigid` on both integrators against the soft one
@@ -97,7 +111,7 @@ fn compare(
     (soft_name, (ts, is, _, rs)): (&str, (f64, usize, usize, u64)),
     rigid: &Model,
     opts: impl Fn(Integrator) -> SimulationOptions,
-    repeats: usize,
+    runs: usize,
     asked: f64,
 ) -> Value {
     println!(
@@ -110,7 +124,7 @@ fn compare(
         json!({"run": soft_name, "seconds": ts, "impacts": is, "rhs_evaluations": rs}),
     );
     for (name, integrator) in [("global", Integrator::Global), ("local", Integrator::Local)] {
-        let (tr, ir, er, rr) = timed(rigid, &opts(integrator), repeats);
+        let (tr, ir, er, rr) = timed(rigid, &opts(integrator), runs);
         println!(
             "rigid, {name:<7} {:>9.2} ms  impacts {ir:>6}  rhs {rr}  soft episodes {er}  soft / rigid = {:.2}",
             tr * 1e3,
@@ -134,6 +148,8 @@ pub fn r2_n2_branch(repeats: usize) -> Value {
     let opts = ContinuationOptions::default();
     let mut rows = serde_json::Map::new();
     let mut seconds = [0.0; 2];
+    // (The soft branch first: its runs are the count for both.)
+    let mut count = None;
     for (i, impacts) in ["soft", "rigid"].into_iter().enumerate() {
         let doc = ModelDocument::from_toml(&text, "fujita-row-n2.toml")
             .and_then(|d| {
@@ -144,9 +160,9 @@ pub fn r2_n2_branch(repeats: usize) -> Value {
         let (amplitude, target) = ParameterizedModel::in_amplitude(doc.clone()).expect("family");
         let start = amplitude_homotopy(&amplitude, target, &opts).expect("homotopy");
         let family = ParameterizedModel::new(doc, "frequency").expect("family");
-        let (best, branch) = best_of(repeats, || {
-            continue_branch(&family, from, &start, to, &opts, |_| true).expect("branch")
-        });
+        let branch = || continue_branch(&family, from, &start, to, &opts, |_| true);
+        let count = *count.get_or_insert_with(|| runs(best_of(1, branch).0, repeats));
+        let (best, branch) = best_of(count, || branch().expect("branch"));
         let special: Vec<(String, f64)> = branch
             .special
             .iter()
@@ -195,6 +211,8 @@ pub fn struck_row(repeats: usize) -> Value {
         integrator,
         ..SimulationOptions::default()
     };
-    let soft_run = timed(&soft, &opts(Integrator::Local), repeats);
-    compare(("soft, local", soft_run), &rigid, opts, repeats, 10.0)
+    let once = best_of(1, || checked(&soft, &opts(Integrator::Local))).0;
+    let runs = runs(once, repeats);
+    let soft_run = timed(&soft, &opts(Integrator::Local), runs);
+    compare(("soft, local", soft_run), &rigid, opts, runs, 10.0)
 }

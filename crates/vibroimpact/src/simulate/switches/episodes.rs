@@ -288,8 +288,9 @@ impl Switches {
     /// Rigid contact k's impact at `(t, y)`, taken by its law for
     /// `reason`: its estimated duration kept for its neighbours' overlap
     /// test, as a jump's is (a second impact on a body within it is soft
-    /// whether the first was a jump or an episode). None for a slow
-    /// impact or one joining a neighbour's episode: no impact estimated.
+    /// whether the first was a jump or an episode). Nothing is kept for
+    /// a slow impact or one joining a neighbour's episode: no impact
+    /// estimated.
     pub(in crate::simulate) fn soft_impact(
         &mut self,
         chain: &ChainDynamics,
