@@ -26,21 +26,17 @@ pub(super) struct Alike {
 /// storey on either. Then the base drives both alike and their difference
 /// `Δ = u_l − u_r` is a free damped oscillator: its energy `Δ̇² + ω²Δ²`
 /// never grows, so `|Δ| <= sqrt(E)/ω` for all time.
-pub(super) fn alike(model: &Model, free: &FreeMotion, c: &Contact) -> Option<Alike> {
+pub(super) fn alike(free: &FreeMotion, c: &Contact) -> Option<Alike> {
     let (l, r) = (c.pair.left()?, c.pair.right()?);
-    let single = |i: usize| free.groups()[free.place(i).0].bodies().len() == 1;
-    // (A body alone in its group: its group's forces and storeys are its.)
+    // (Each alone in its group: its rates k/m and c/m are its closed
+    // form's, and its group's forces and storeys are its.)
+    let rates = |i: usize| free.groups()[free.place(i).0].lone_rates();
+    let ((w2, c2), other) = (rates(l)?, rates(r)?);
     let forced = |i: usize| {
         let g = free.place(i).0;
         !free.forces_in(g).is_empty() || !free.storeys_in(g).is_empty()
     };
-    if !single(l) || !single(r) || forced(l) || forced(r) {
-        return None;
-    }
-    let (a, b) = (&model.bodies()[l], &model.bodies()[r]);
-    let w2 = a.stiffness / a.mass;
-    let c2 = a.damping / a.mass;
-    (w2 > 0.0 && w2 == b.stiffness / b.mass && c2 == b.damping / b.mass).then_some(Alike { w2, c2 })
+    (w2 > 0.0 && (w2, c2) == other && !forced(l) && !forced(r)).then_some(Alike { w2, c2 })
 }
 
 /// The first `τ > 0` at which `Δ`, the free damped oscillation of `m`

@@ -625,7 +625,7 @@ impl<'a> Run<'a> {
         run.alike = model
             .contacts()
             .iter()
-            .map(|c| alike::alike(model, &run.free, c))
+            .map(|c| alike::alike(&run.free, c))
             .collect();
         if let Some(window) = opts.extrema_window {
             // (A rigid contact's margin is its approach itself, as in the

@@ -595,6 +595,15 @@ impl Group {
     pub fn rate(&self) -> f64 {
         self.rate
     }
+
+    /// `(k/m, c/m)` of a body alone in its group (the rates of its closed
+    /// form), else None.
+    pub fn lone_rates(&self) -> Option<(f64, f64)> {
+        match self.propagator {
+            Propagator::Single { w2, c2 } => Some((w2, c2)),
+            Propagator::Group(_) => None,
+        }
+    }
 }
 
 mod bounds;
