@@ -162,8 +162,6 @@ pub struct ContinuationOptions {
     pub step: StepControl,
     /// Location tolerance of special points in the parameter.
     pub locate_tol: f64,
-    /// Samples per period for amplitudes.
-    pub orbit_samples: usize,
     /// Largest change of the Floquet multipliers between consecutive points
     /// ([`spectral_distance`]); a larger change halves the step, so that two
     /// crossings of the unit circle do not hide in one step.
@@ -220,7 +218,6 @@ impl Default for ContinuationOptions {
             max_corrector: 8,
             step: StepControl::default(),
             locate_tol: 1e-8,
-            orbit_samples: 256,
             max_multiplier_change: 0.25,
             bounds: None,
             use_symmetry: true,
