@@ -537,8 +537,8 @@ impl<F: Family + Send> Iterator for Continuation<F> {
     type Item = BranchStep;
 
     /// The next point, finished: its orbit summary and the special points
-    /// before it. The points corrected so far are finished on one thread
-    /// while the next ones ([`AHEAD`] at most) are corrected on another.
+    /// before it. The points corrected so far are finished on this thread
+    /// while the next ones ([`AHEAD`] at most) are corrected in the pool.
     fn next(&mut self) -> Option<BranchStep> {
         if self.done {
             return None;
@@ -602,7 +602,15 @@ impl<F: Family + Send> Continuation<F> {
         let out = if rayon::current_num_threads() < 2 {
             finish()
         } else {
-            rayon::join(finish, || self.run_ahead(&done)).0
+            // The finishing on this thread, the corrector handed to the
+            // pool: `rayon::join` from outside the pool sent both there
+            // and put this thread to sleep and woke it, each batch (D38).
+            let this = &mut *self;
+            let done = &done;
+            rayon::in_place_scope(|s| {
+                s.spawn(move |_| this.run_ahead(done));
+                finish()
+            })
         };
         self.finisher = Some(finisher);
         self.finished.extend(out);
