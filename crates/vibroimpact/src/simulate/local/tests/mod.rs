@@ -4,7 +4,7 @@
 use super::*;
 use crate::contact::{ContactLaw, ForceForm};
 use crate::model::reference::NATURAL_FREQUENCY as W0;
-use crate::model::Accelerogram;
+use crate::model::{Accelerogram, Impacts};
 
 fn r2(n: usize, omega: f64) -> Model {
     crate::model::reference::r2(n, 1e-3, omega).unwrap()
@@ -137,10 +137,10 @@ fn local_matches_global_on_the_examples() {
 /// on its dense output, the exact motion on its own grid) equal the global
 /// integrator's at rtol 1e-10, every |u|, |v| to 1e-6 of the largest and
 /// every contact's impact margin to 1e-6 of its clearance: the example
-/// row, a spring-coupled pair beside a single body (harmonic base; one
-/// wall never reached), a pounding pair under a record, and R2 N = 3 with
-/// gaps never closed (scanned at the run's end alone); windows from the
-/// start and inside the run.
+/// row, soft and rigid (to its first episode, 1.0145 s), a spring-coupled
+/// pair beside a single body (harmonic base; one wall never reached), a
+/// pounding pair under a record, and R2 N = 3 with gaps never closed
+/// (scanned at the run's end alone); windows from the start and inside.
 #[test]
 fn extrema_match_the_global_integrator() {
     use crate::model::{Body, Contact, ContactPair, Coupling};
@@ -192,13 +192,9 @@ fn extrema_match_the_global_integrator() {
     // its extrema are scanned at the end of the run alone.
     let linear = crate::model::reference::r2(3, 1.0, 0.9 * W0).unwrap();
     let t_linear = 3.0 * 2.0 * std::f64::consts::PI / (0.9 * W0);
-    // Rigid, up to its first soft episode (1.0145 s): a margin is the
-    // approach itself.
-    let rigid = row
-        .clone()
-        .with_all_impacts(crate::model::Impacts::Rigid { restitution: None });
+    let rigid = Impacts::Rigid { restitution: None };
     for (model, t_end) in [
-        (rigid.unwrap(), 1.0),
+        (row.clone().with_all_impacts(rigid).unwrap(), 1.0),
         (row, 6.0 * t_row),
         (coupled, 6.0),
         (pair, 6.0),
