@@ -475,11 +475,10 @@ impl<F: Family> Problem<F> {
         let period =
             forcing_period(&model).ok()? * f64::from(self.opts.shooting.subharmonic.max(1));
         let span = if symmetric { 0.5 * period } else { period };
-        // (Amplitudes and impacts alone: the extrema are exact, no samples.)
         let orbit = orbit_summary_by(
             &model,
             &e.point.state,
-            (span, 0),
+            (span, 0), // (no samples: the extrema are exact)
             self.opts.shooting.rtol,
             self.opts.shooting.integrator,
         )
