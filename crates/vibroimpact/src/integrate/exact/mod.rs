@@ -29,11 +29,14 @@
 //!   its dense output then reads: a few products of `A` with a vector, not
 //!   an exponential of `A`. Its error is rounding, so the driver sees zero
 //!   and the step grows to `h_max`, kept below [`Linear::step_limit`]
-//!   (`‖A‖∞ h ≤ 2`).
+//!   (`‖A‖ h ≤ 2`, the norm balanced: `‖S A S⁻¹‖∞` with `S` diagonal
+//!   in powers of two, so that a chain's velocity rows, which carry ω²
+//!   against the displacement rows' 1, carry ω as they do; the series and
+//!   its products are the same, only measured balanced: `S` is exact).
 //! * **Dense output**: at a quarter of the step those matrices; elsewhere
 //!   (an event being located) the exponential's series on the deviation,
 //!   `Σ_k τ^k A^k v / k!` to the first term below 1e-17 of the sum, built
-//!   once a step and summed by Horner (at `‖A‖∞ τ ≤ 2` its terms never
+//!   once a step and summed by Horner (at `‖A‖ τ ≤ 2` its terms never
 //!   exceed the sum by more than a factor 3): exact to rounding, so events
 //!   are located on the motion itself.
 //! * `f(t + h, y_new)` is `A y_new + b(t + h)`: no evaluation of the
@@ -49,10 +52,10 @@ use nalgebra::{Complex, DMatrix, DVector};
 use super::driver::{all_finite, Attempt, Driver, Point, StepMethod, Trial, NON_FINITE};
 use super::{OdeSystem, RejectReason, Stats};
 
-/// Most terms of a step's series (at `‖A‖∞ h ≤ 2` it meets 1e-17 of the
+/// Most terms of a step's series (at `‖A‖ h ≤ 2` it meets 1e-17 of the
 /// sum by the 30th).
 const MAX_TERMS: usize = 40;
-/// Largest `‖A‖∞ h` of a step.
+/// Largest `‖A‖ h` of a step (‖A‖: balanced, [`Linear::norm`]).
 const NORM_STEP: f64 = 2.0;
 
 /// One harmonic of a block's forcing, `cos·cos(Ω t) + sin·sin(Ω t)` (Ω ≥
@@ -86,9 +89,21 @@ impl LinearForm {
         if self.a.ncols() != d || !self.a.iter().all(|x| x.is_finite()) {
             return None;
         }
-        let norm = (0..d)
-            .map(|i| (0..d).map(|j| self.a[(i, j)].abs()).sum::<f64>())
-            .fold(0.0, f64::max);
+        let rows: Vec<f64> = (0..d)
+            .flat_map(|i| (0..d).map(move |j| (i, j)))
+            .map(|(i, j)| self.a[(i, j)])
+            .collect();
+        let scale = balancing(&rows, d);
+        let norm_of = |s: &[f64]| {
+            (0..d)
+                .map(|i| {
+                    (0..d)
+                        .map(|j| (rows[i * d + j] * s[i] / s[j]).abs())
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max)
+        };
+        let raw_norm = norm_of(&vec![1.0; d]);
         let mut steady = Vec::with_capacity(self.blocks.len());
         for block in &self.blocks {
             let mut terms = Vec::with_capacity(block.len());
@@ -96,18 +111,19 @@ impl LinearForm {
                 if h.cos.len() != d || h.sin.len() != d {
                     return None;
                 }
-                terms.push(steady_state(&self.a, norm, h)?);
+                terms.push(steady_state(&self.a, raw_norm, h)?);
             }
             steady.push(terms);
         }
-        let rows = (0..d)
-            .flat_map(|i| (0..d).map(move |j| (i, j)))
-            .map(|(i, j)| self.a[(i, j)])
+        let balanced = (0..d * d)
+            .map(|ij| rows[ij] * scale[ij / d] / scale[ij % d])
             .collect();
         Some(Linear {
+            norm: norm_of(&scale),
+            balanced,
             rows,
             d,
-            norm,
+            scale,
             steady,
             forcing: self.blocks,
         })
@@ -144,6 +160,47 @@ fn steady_state(a: &DMatrix<f64>, norm: f64, h: &Harmonic) -> Option<Steady> {
     })
 }
 
+/// The diagonal balancing `S` of `A` (d × d, by rows) in powers of two
+/// (Osborne's iteration, as LAPACK's `gebal` scales): `S A S⁻¹` has row
+/// and column sums of its off-diagonal moduli within a factor 2 where
+/// both are nonzero. Powers of two keep `S A S⁻¹` and every product with
+/// it exact: the balanced series is the series itself, only measured in
+/// the balanced norm (a chain's velocity rows carry ω² against the
+/// displacement rows' 1; balanced, both carry ω, and the step grows by ω).
+fn balancing(rows: &[f64], d: usize) -> Vec<f64> {
+    // (LAPACK's D, B = D⁻¹ A D; S = D⁻¹.)
+    let mut dd = vec![1.0f64; d];
+    for _sweep in 0..64 {
+        let mut changed = false;
+        for i in 0..d {
+            let (mut c, mut r) = (0.0, 0.0);
+            for j in (0..d).filter(|&j| j != i) {
+                c += (rows[j * d + i] * dd[i] / dd[j]).abs();
+                r += (rows[i * d + j] * dd[j] / dd[i]).abs();
+            }
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let sum = c + r;
+            let mut f = 1.0;
+            while c < 0.5 * r {
+                (f, c, r) = (2.0 * f, 2.0 * c, 0.5 * r);
+            }
+            while 0.5 * c >= r {
+                (f, c, r) = (0.5 * f, 0.5 * c, 2.0 * r);
+            }
+            if c + r < 0.95 * sum {
+                dd[i] *= f;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    dd.iter().map(|x| 1.0 / x).collect()
+}
+
 /// A harmonic's steady state `(Ω, Re X, Im X)`: `Re X cos Ωt − Im X sin Ωt`.
 type Steady = (f64, Vec<f64>, Vec<f64>);
 
@@ -153,7 +210,11 @@ pub struct Linear {
     /// `A` by rows, d × d.
     rows: Vec<f64>,
     d: usize,
-    /// `‖A‖∞`.
+    /// The balancing `S` (powers of two, [`balancing`]) and `S A S⁻¹` by
+    /// rows.
+    scale: Vec<f64>,
+    balanced: Vec<f64>,
+    /// `‖S A S⁻¹‖∞`.
     norm: f64,
     /// Per block, per harmonic: (Ω, Re X, Im X).
     steady: Vec<Vec<Steady>>,
@@ -162,7 +223,7 @@ pub struct Linear {
 }
 
 impl Linear {
-    /// The longest step the method takes (`‖A‖∞ h ≤ 2`; unbounded for
+    /// The longest step the method takes (`‖A‖ h ≤ 2`; unbounded for
     /// `A = 0`).
     pub fn step_limit(&self) -> f64 {
         if self.norm > 0.0 {
@@ -219,35 +280,41 @@ impl Linear {
         }
     }
 
-    /// `e^{Aτ}` by rows, for `‖A‖∞ τ ≤ 0.55` (a quarter step): its
-    /// series to the first term below 1e-17 (at most 20 terms).
-    fn exponential(&self, tau: f64) -> Vec<f64> {
-        let d = self.d;
-        let mut e = vec![0.0; d * d];
-        let mut term = vec![0.0; d * d];
-        let mut next = vec![0.0; d * d];
+    /// `e^{Aτ}` by rows into `e`, for `‖A‖ τ ≤ 0.55` (balanced; a quarter
+    /// step): the series of `S A S⁻¹` to the first term below 1e-17 (at
+    /// most 20 terms), unbalanced (exactly: `S` is powers of two).
+    /// `term` and `next` are scratch of d² each.
+    fn exponential_into(&self, tau: f64, e: &mut [f64], [term, next]: [&mut [f64]; 2]) {
+        let (d, b) = (self.d, &self.balanced);
+        e.fill(0.0);
+        term.fill(0.0);
         for i in 0..d {
             e[i * d + i] = 1.0;
             term[i * d + i] = 1.0;
         }
+        let (mut term, mut next) = (term, next);
         for k in 1..=MAX_TERMS {
             let c = tau / k as f64;
-            for i in 0..d {
-                for j in 0..d {
-                    next[i * d + j] = c
-                        * (0..d)
-                            .map(|l| term[i * d + l] * self.rows[l * d + j])
-                            .sum::<f64>();
+            for (ti, ni) in term.chunks_exact(d).zip(next.chunks_exact_mut(d)) {
+                ni.fill(0.0);
+                for (t, bl) in ti.iter().zip(b.chunks_exact(d)) {
+                    for (n, x) in ni.iter_mut().zip(bl) {
+                        *n += t * x;
+                    }
                 }
+                ni.iter_mut().for_each(|n| *n *= c);
             }
             std::mem::swap(&mut term, &mut next);
             let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            e.iter_mut().zip(&term).for_each(|(e, t)| *e += t);
+            e.iter_mut().zip(term.iter()).for_each(|(e, t)| *e += t);
             if largest <= 1e-17 {
                 break;
             }
         }
-        e
+        // e^{Aτ} = S⁻¹ e^{Bτ} S.
+        for (ij, x) in e.iter_mut().enumerate() {
+            *x *= self.scale[ij % d] / self.scale[ij / d];
+        }
     }
 }
 
@@ -266,22 +333,35 @@ struct Quarters {
 }
 
 impl Quarters {
-    /// The four from one exponential and three products.
-    fn new(form: &Linear, h: f64) -> Self {
-        let d = form.d;
-        let product = |p: &[f64], q: &[f64]| -> Vec<f64> {
-            (0..d * d)
-                .map(|ij| (0..d).map(|k| p[ij / d * d + k] * q[k * d + ij % d]).sum())
-                .collect()
-        };
-        let e1 = form.exponential(0.25 * h);
-        let e2 = product(&e1, &e1);
-        let e3 = product(&e2, &e1);
-        let e4 = product(&e2, &e2);
+    /// Room for the four of a d × d matrix.
+    fn new(d: usize) -> Self {
         Self {
-            h,
-            e: [e1, e2, e3, e4],
+            h: f64::NAN,
+            e: std::array::from_fn(|_| vec![0.0; d * d]),
         }
+    }
+
+    /// The four of step size h, from one exponential and three products
+    /// (`scratch`: two d² buffers).
+    fn fill(&mut self, form: &Linear, h: f64, scratch: &mut [Vec<f64>; 2]) {
+        let d = form.d;
+        let product = |p: &[f64], q: &[f64], out: &mut [f64]| {
+            for (pi, oi) in p.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
+                oi.fill(0.0);
+                for (x, ql) in pi.iter().zip(q.chunks_exact(d)) {
+                    for (o, y) in oi.iter_mut().zip(ql) {
+                        *o += x * y;
+                    }
+                }
+            }
+        };
+        let [e1, e2, e3, e4] = &mut self.e;
+        let [t, n] = scratch;
+        form.exponential_into(0.25 * h, e1, [t, n]);
+        product(e1, e1, e2);
+        product(e2, e1, e3);
+        product(e2, e2, e4);
+        self.h = h;
     }
 }
 
@@ -320,14 +400,17 @@ pub struct ExactMethod {
     deviation_acc: Vec<f64>,
     quarters_acc: Option<usize>,
     /// The accepted step's series terms `A^k v / k!`, term k at
-    /// `[k·n..(k+1)·n]`, and how many (0: not built yet); the attempt's,
-    /// where it was taken by the series.
+    /// `[k·n..(k+1)·n]`, how many (0: not built yet) and of how many
+    /// leading components (a dense output of a leading part builds its
+    /// blocks alone); the attempt's, where it was taken by the series.
     terms: Vec<f64>,
     count: usize,
+    built: usize,
     terms_try: Vec<f64>,
     count_try: usize,
-    /// Scratch: a steady state.
+    /// Scratch: a steady state; two d × d matrices.
     steady: Vec<f64>,
+    scratch: [Vec<f64>; 2],
     /// `f(t + h, y_new)`.
     end: Vec<f64>,
 }
@@ -337,24 +420,28 @@ impl ExactMethod {
     /// solved (a [`crate::integrate::Stepper`] that read it to choose the
     /// method).
     pub(crate) fn with_form(form: Linear, dim: usize) -> Self {
+        let d2 = form.d * form.d;
         Self {
             form: Some(form),
+            scratch: [vec![0.0; d2], vec![0.0; d2]],
             ..<Self as StepMethod>::new(dim)
         }
     }
 
-    /// The accepted step's series, built on first use (see the module
-    /// documentation); false where it does not converge.
-    fn series(&mut self, h: f64) -> bool {
-        if self.count > 0 {
+    /// The accepted step's series of (at least) the first `m` components,
+    /// built on first use (see the module documentation) for the blocks
+    /// they lie in; false where it does not converge.
+    fn series(&mut self, h: f64, m: usize) -> bool {
+        if self.count > 0 && self.built >= m {
             return true;
         }
         let Some(form) = self.form.as_ref() else {
             return false;
         };
-        match series_terms(form, &self.deviation_acc, h, &mut self.terms) {
+        let (n, m) = (self.deviation_acc.len(), m.div_ceil(form.d) * form.d);
+        match series_terms(form, (&self.deviation_acc[..m], n), h, &mut self.terms) {
             Some(count) => {
-                self.count = count;
+                (self.count, self.built) = (count, m);
                 true
             }
             None => false,
@@ -362,18 +449,34 @@ impl ExactMethod {
     }
 }
 
-/// The series terms `A^k v / k!` of the deviation `v` into `terms` (term k
-/// at `[k·n..(k+1)·n]`), as many as reach 1e-17 of the largest entry of
-/// `v` over a step `h`: how many, or None where `MAX_TERMS` do not.
-fn series_terms(form: &Linear, v: &[f64], h: f64, terms: &mut [f64]) -> Option<usize> {
-    let (n, d) = (v.len(), form.d);
+/// The series terms `A^k v / k!` of the deviation `v` (whole blocks) into
+/// `terms` (term k at `[k·n..k·n + v.len()]`), as many as reach 1e-17 of
+/// the largest entry of `v` over a step `h`: how many, or None where
+/// `MAX_TERMS` do not.
+fn series_terms(
+    form: &Linear,
+    (v, n): (&[f64], usize),
+    h: f64,
+    terms: &mut [f64],
+) -> Option<usize> {
+    let (m, d) = (v.len(), form.d);
     let (first, rest) = terms.split_at_mut(n);
+    let first = &mut first[..m];
     first.copy_from_slice(v);
-    let size = first.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // (Entries measured balanced, `S v`.)
+    let balanced = |x: &[f64]| {
+        x.chunks_exact(d).fold(0.0f64, |m, b| {
+            b.iter()
+                .zip(&form.scale)
+                .fold(m, |m, (x, s)| m.max((x * s).abs()))
+        })
+    };
+    let size = balanced(first);
     let mut count = 1;
     let mut previous: &[f64] = first;
     let mut scale = 1.0;
     for (k, term) in rest.chunks_exact_mut(n).enumerate() {
+        let term = &mut term[..m];
         let inv = 1.0 / (k + 1) as f64;
         for (p, t) in previous.chunks_exact(d).zip(term.chunks_exact_mut(d)) {
             times(&form.rows, p, t);
@@ -381,7 +484,7 @@ fn series_terms(form: &Linear, v: &[f64], h: f64, terms: &mut [f64]) -> Option<u
         }
         count += 1;
         scale *= h;
-        let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs())) * scale;
+        let largest = balanced(term) * scale;
         if largest <= 1e-17 * size {
             return Some(count);
         }
@@ -422,7 +525,9 @@ impl StepMethod for ExactMethod {
             count: 0,
             terms_try: vec![0.0; (MAX_TERMS + 1) * dim],
             count_try: 0,
+            built: 0,
             steady: vec![0.0; dim],
+            scratch: [Vec::new(), Vec::new()],
             end: vec![0.0; dim],
         }
     }
@@ -433,6 +538,9 @@ impl StepMethod for ExactMethod {
                 .linear_form()
                 .and_then(LinearForm::solve)
                 .filter(|f| f.d * f.steady.len() == dim);
+            self.scratch = self.form.as_ref().map_or_else(Default::default, |f| {
+                [vec![0.0; f.d * f.d], vec![0.0; f.d * f.d]]
+            });
         }
     }
 
@@ -457,7 +565,9 @@ impl StepMethod for ExactMethod {
                 None
             }
             None if self.sizes.len() < KEPT_SIZES => {
-                self.sizes.push(Quarters::new(form, h));
+                let mut q = Quarters::new(d);
+                q.fill(form, h, &mut self.scratch);
+                self.sizes.push(q);
                 Some(self.sizes.len() - 1)
             }
             None => {
@@ -467,7 +577,7 @@ impl StepMethod for ExactMethod {
                     q = (q + 1) % KEPT_SIZES;
                 }
                 self.next = (q + 1) % KEPT_SIZES;
-                self.sizes[q] = Quarters::new(form, h);
+                self.sizes[q].fill(form, h, &mut self.scratch);
                 Some(q)
             }
         };
@@ -495,7 +605,8 @@ impl StepMethod for ExactMethod {
             // A size met once: the series on the deviation, kept for the
             // step's dense output.
             None => {
-                let Some(count) = series_terms(form, &self.deviation, h, &mut self.terms_try)
+                let n = self.deviation.len();
+                let Some(count) = series_terms(form, (&self.deviation, n), h, &mut self.terms_try)
                 else {
                     return Err(NON_FINITE);
                 };
@@ -528,7 +639,7 @@ impl StepMethod for ExactMethod {
         self.count = 0;
         if self.quarters.is_none() {
             std::mem::swap(&mut self.terms, &mut self.terms_try);
-            self.count = self.count_try;
+            (self.count, self.built) = (self.count_try, self.terms.len() / (MAX_TERMS + 1));
         }
     }
 
@@ -557,7 +668,7 @@ impl StepMethod for ExactMethod {
             let v = &self.deviation_acc[b * d..(b + 1) * d];
             return steady + row.iter().zip(v).map(|(a, x)| a * x).sum::<f64>();
         }
-        if !self.series(h) {
+        if !self.series(h, i + 1) {
             return f64::NAN;
         }
         let series = (0..self.count)
@@ -593,7 +704,7 @@ impl StepMethod for ExactMethod {
             }
             return;
         }
-        if !self.series(h) {
+        if !self.series(h, out.len()) {
             out.fill(f64::NAN);
             return;
         }

@@ -185,6 +185,46 @@ fn a_forced_oscillator_moves_as_its_closed_form() {
     }
 }
 
+/// A stiff oscillator (ω = 300 rad/s, ω² = 9e4 in its velocity row):
+/// the step is limited by the balanced norm, about ω, not by ‖A‖∞ ≈ ω²
+/// (300 times longer), and 40 periods still equal the closed form to
+/// 1e-12 of the amplitude, in about 4 steps a period.
+#[test]
+fn a_stiff_oscillator_steps_by_its_balanced_norm() {
+    let (w, zeta, f, omega) = (300.0, 0.02, 3.0e3, 250.0);
+    let mut sys = Forced {
+        w2: vec![w * w],
+        c: vec![2.0 * zeta * w],
+        k12: 0.0,
+        omega,
+        f,
+        g: 0.0,
+        p: 0.0,
+    };
+    let limit = sys.linear_form().unwrap().solve().unwrap().step_limit();
+    let balanced = 2.0 / (w + 2.0 * zeta * w);
+    assert!(
+        (0.5 * balanced..=balanced * 1.0001).contains(&limit),
+        "{limit} vs {balanced}"
+    );
+    let y0 = [0.01, -2.0];
+    let t_end = 40.0 * 2.0 * std::f64::consts::PI / w;
+    let st = run(&mut sys, &y0, t_end, Method::Exact, 1e-6);
+    let (x, v) = oscillator(t_end, (w, zeta, f, omega), (y0[0], y0[1]));
+    let scale = 0.1;
+    assert!(
+        (st.y()[0] - x).abs() < 1e-12 * scale,
+        "{} vs {x}",
+        st.y()[0]
+    );
+    assert!(
+        (st.y()[1] - v).abs() < 1e-12 * scale * w,
+        "{} vs {v}",
+        st.y()[1]
+    );
+    assert!(st.stats().steps <= 8 * 40, "{} steps", st.stats().steps);
+}
+
 /// Three bodies, two of them joined, under a harmonic force and a
 /// constant one: the exact flow equals DOP853 at rtol 1e-13 to 1e-10 of
 /// the motion.
