@@ -4,8 +4,8 @@
 //! system has a linear form ([`Stepper::exact_where_linear`]).
 
 use super::{
-    Dop853, Dopri5, Exact, ExactMethod, IntegrationError, IntegratorOptions, LinearForm, OdeSystem,
-    Rodas, Stats,
+    Dop853, Dopri5, Exact, ExactMethod, IntegrationError, IntegratorOptions, Linear, LinearForm,
+    OdeSystem, Rodas, Stats,
 };
 
 /// Integration method of a [`Stepper`].
@@ -181,6 +181,26 @@ impl Stepper {
         })
     }
 
+    /// A stepper on the exact flow of `linear` (of dimension `dim`), its
+    /// steps up to the form's [`step_limit`](super::Linear::step_limit)
+    /// (and `opts.h_max`); None where the options refuse it (e.g. an
+    /// `h_min` above that limit).
+    pub(crate) fn exact(linear: Linear, dim: usize, opts: &IntegratorOptions) -> Option<Self> {
+        let h = opts.h_max.min(linear.step_limit());
+        let opts = IntegratorOptions {
+            h_max: h,
+            h_init: Some(h),
+            ..opts.clone()
+        };
+        let engine = Exact::with_method(dim, opts.clone(), ExactMethod::with_form(linear, dim));
+        Some(Self {
+            method: Method::Exact,
+            opts,
+            engines: Engines::Exact(engine.ok()?),
+            exact: None,
+        })
+    }
+
     /// From every [`reset`](Self::reset) at which the system has a
     /// [`linear_form`](OdeSystem::linear_form) that solves, moves it
     /// exactly ([`Method::Exact`], steps up to its
@@ -221,15 +241,7 @@ impl Stepper {
         // step limit, leave the method of construction in place.)
         let exact = match form.clone().and_then(LinearForm::solve) {
             Some(linear) if linear.dim() == dim => {
-                let h = self.opts.h_max.min(linear.step_limit());
-                let opts = IntegratorOptions {
-                    h_max: h,
-                    h_init: Some(h),
-                    ..self.opts.clone()
-                };
-                Exact::with_method(dim, opts, ExactMethod::with_form(linear, dim))
-                    .ok()
-                    .map(Engines::Exact)
+                Self::exact(linear, dim, &self.opts).map(|st| st.engines)
             }
             _ => None,
         };

@@ -42,20 +42,13 @@ pub(crate) fn flow_through_events<S: Chain>(
     // A chain whose every contact is rigid moves exactly between impacts
     // (its linear form), in steps the exact series takes to rounding;
     // another by DOP853.
-    let (method, opts) = match sys.linear_form().and_then(LinearForm::solve) {
-        Some(form) => {
-            let h = opts.h_max.min(form.step_limit());
-            let exact = IntegratorOptions {
-                h_max: h,
-                h_init: Some(h),
-                ..opts.clone()
-            };
-            (Method::Exact, exact)
-        }
-        None => (Method::Dop853, opts.clone()),
+    let exact = (sys.linear_form().and_then(LinearForm::solve))
+        .filter(|form| form.dim() == dim)
+        .and_then(|form| Stepper::exact(form, dim, opts));
+    let mut st = match exact {
+        Some(st) => st,
+        None => Stepper::new(Method::Dop853, dim, opts.clone())?,
     };
-    let opts = &opts;
-    let mut st = Stepper::new(method, dim, opts.clone())?;
     st.reset(sys, 0.0, z0)?;
     let contacts = sys.chain().contacts();
     // (Rigid impacts judged where a simulation judges them, at the default
