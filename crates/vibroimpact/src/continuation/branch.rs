@@ -538,7 +538,7 @@ impl<F: Family + Send> Iterator for Continuation<F> {
 
     /// The next point, finished: its orbit summary and the special points
     /// before it. The points corrected so far are finished on this thread
-    /// while the next ones ([`AHEAD`] at most) are corrected in the pool.
+    /// while the next ones (`AHEAD` at most) are corrected in the pool.
     fn next(&mut self) -> Option<BranchStep> {
         if self.done {
             return None;

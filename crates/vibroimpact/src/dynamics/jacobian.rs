@@ -84,7 +84,7 @@ impl ChainDynamics {
 /// The Jacobian recorded for tangent replay: springs, dampers and
 /// couplings are the model's (constant); each contact not screened out
 /// contributes its index and its force's partial derivatives
-/// `(∂F/∂s, ∂F/∂ṡ)`, as in [`OdeSystem::jacobian`].
+/// `(∂F/∂s, ∂F/∂ṡ)`, as in [`crate::integrate::OdeSystem::jacobian`].
 impl RecordedJacobian for ChainDynamics {
     type Entry = (u32, f64, f64);
 

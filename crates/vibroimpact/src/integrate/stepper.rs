@@ -368,7 +368,7 @@ impl Stepper {
 
     /// Dense output of the last accepted step, valid in `[t_prev, t]`: 7th
     /// order for DOP853, 4th for DOPRI5, 3rd for RODAS; the first
-    /// `out.len()` components ([`Driver::dense_output`]).
+    /// `out.len()` components ([`super::Driver::dense_output`]).
     ///
     /// # Panics
     /// If `out.len()` exceeds the dimension.

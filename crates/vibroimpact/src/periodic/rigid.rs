@@ -2,14 +2,18 @@
 //! the state and Φ's columns integrated between impacts by the global
 //! integrator, the velocities' jump applied at each impact and the
 //! columns multiplied by its saltation matrix (including de/dU of a
-//! velocity-dependent law, seed eq. (10)). Φ is always dense here: the
-//! matrix-free products are products with it.
+//! velocity-dependent law, seed eq. (10)). Where the chain is linear
+//! between impacts the state alone goes through the events and the
+//! columns follow it exactly from impact to impact ([`replayed`]). Φ is
+//! always dense here: the matrix-free products are products with it.
 
 use super::map::{
     parameter_column, shooting_map, variational_map, MapDerivatives, MapTangent, Tape,
 };
 use super::*;
 use crate::dynamics::saltation::Saltation;
+use crate::impact::rigid::RigidImpact;
+use crate::integrate::LinearForm;
 use crate::simulate::{flow_through_events, ImpactJump};
 
 /// [`period_map_with`](super::period_map_with) for a model with rigid
@@ -41,7 +45,13 @@ pub(super) fn rigid_map(
     )?;
     let z0 = var.initial_state(&to_interleaved(x));
     let int_opts = opts.integrator_options(max_steps, Some(d));
-    let (z, steps, _) = flow_through_events(&mut var, &z0, t, &int_opts, saltation)?;
+    let (z, steps) = match replayed(&mut var, &z0, t, &int_opts)? {
+        Some(replayed) => replayed,
+        None => {
+            let (z, steps, _) = flow_through_events(&mut var, &z0, t, &int_opts, saltation)?;
+            (z, steps)
+        }
+    };
     let image = from_interleaved(&z[..d], n);
     let phi = var.sensitivity(&z).to_vec();
     let dp_column = var.parameter_sensitivity(&z).map(|s| {
@@ -62,6 +72,64 @@ pub(super) fn rigid_map(
         steps,
         tangent,
     })
+}
+
+/// An impact of the state's run: contact, time, the state just before
+/// and just after, the impact.
+type Recorded = (usize, f64, Vec<f64>, Vec<f64>, RigidImpact);
+
+/// Where the chain moves exactly between impacts (its linear form), its
+/// columns need not ride through the events: the state alone is flowed
+/// through them (its impacts recorded), and then the columns (Φ's and
+/// the parameter's, which the state does not steer) are moved exactly
+/// from impact to impact, each impact's saltation applied there with the
+/// state just before and after it. The extended state at `t` and the
+/// steps of both runs; None where the chain has no linear form.
+fn replayed(
+    var: &mut Variational<ChainDynamics>,
+    z0: &[f64],
+    t: f64,
+    int_opts: &IntegratorOptions,
+) -> Result<Option<(Vec<f64>, u64)>, IntegrationError> {
+    let dim = var.dim();
+    let Some(form) = (var.linear_form().and_then(LinearForm::solve)).filter(|f| f.dim() == dim)
+    else {
+        return Ok(None);
+    };
+    let d = var.state_dim();
+    let mut jumps: Vec<Recorded> = Vec::new();
+    let (y, steps, _) = flow_through_events(var.system_mut(), &z0[..d], t, int_opts, |_, j| {
+        jumps.push((
+            j.contact,
+            j.t,
+            j.before.to_vec(),
+            j.after.to_vec(),
+            *j.impact,
+        ));
+        Ok(())
+    })?;
+    let (mut z, mut t_last) = (z0.to_vec(), 0.0);
+    for (contact, t_k, state_before, state_after, impact) in &jumps {
+        form.flow((t_last, *t_k), &mut z);
+        let mut before = z;
+        before[..d].copy_from_slice(state_before);
+        let mut after = before.clone();
+        after[..d].copy_from_slice(state_after);
+        saltation(
+            var,
+            ImpactJump {
+                contact: *contact,
+                t: *t_k,
+                before: &before,
+                after: &mut after,
+                impact,
+            },
+        )?;
+        (z, t_last) = (after, *t_k);
+    }
+    form.flow((t_last, t), &mut z);
+    z[..d].copy_from_slice(&y);
+    Ok(Some((z, steps)))
 }
 
 /// The shooting map's image alone through rigid impacts (interleaved),
