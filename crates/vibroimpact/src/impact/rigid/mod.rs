@@ -28,7 +28,9 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::closed_form::{restitution_derivative, ExponentialImpact};
+use super::closed_form::{
+    dimensionless_velocity, restitution, restitution_derivative, ExponentialImpact,
+};
 use super::direct::{integrate_impact, DirectImpact, DirectOptions};
 use super::table::Table;
 use super::{positive, ImpactError, TwoBodies};
@@ -205,6 +207,16 @@ impl RigidLaw {
         self.mu
     }
 
+    /// What judging an impact at approach velocity `u > 0` (m/s) reads:
+    /// its estimated duration (s) and rebound velocity (m/s), as
+    /// [`RigidLaw::impact`] has them (for the seed's law without solving
+    /// for the peak force).
+    pub fn judging(&self, u: f64) -> Result<(f64, f64), ImpactError> {
+        positive("impact velocity", u)?;
+        let (e, duration) = self.shape.judging(self.mu, u)?;
+        Ok((duration, e * u))
+    }
+
     /// The impact at approach velocity `u > 0` (m/s).
     pub fn impact(&self, u: f64) -> Result<RigidImpact, ImpactError> {
         positive("impact velocity", u)?;
@@ -236,11 +248,7 @@ impl Shape {
                 // (The closed form's e(V) is the same root: solved once.)
                 let closed = closed.impact(u)?;
                 let (v, e) = (closed.v, closed.restitution);
-                let duration = if table.contains(v.ln()) {
-                    table.at(2, v.ln()).0.exp() / (alpha * a_over_b)
-                } else {
-                    direct(law, mu, u)?.contact_duration
-                };
+                let duration = seed_duration((law, table), (*a_over_b, *alpha), mu, (u, v))?;
                 let slope = restitution_derivative(v, e) / a_over_b;
                 (e, slope, closed.peak_force, duration)
             }
@@ -292,6 +300,44 @@ impl Shape {
             }
         })
     }
+
+    /// (e, duration) at U, as [`Shape::at`] has them: for the seed's law
+    /// without the peak force's root.
+    fn judging(&self, mu: f64, u: f64) -> Result<(f64, f64), ImpactError> {
+        match self {
+            Shape::Seed {
+                law,
+                closed,
+                a_over_b,
+                alpha,
+                table,
+            } => {
+                let v = dimensionless_velocity(u, closed.a_over_b());
+                let duration = seed_duration((law, table), (*a_over_b, *alpha), mu, (u, v))?;
+                Ok((restitution(v)?, duration))
+            }
+            Shape::Newton { e, soft } => Ok((*e, soft.judging(mu, u)?.1)),
+            _ => {
+                let (e, _, _, duration) = self.at(mu, u)?;
+                Ok((e, duration))
+            }
+        }
+    }
+}
+
+/// The seed's law's duration at U (V = U/(a/b)): its table's, or the
+/// law's integrated beyond the table.
+fn seed_duration(
+    (law, table): (&ContactLaw, &Table<3>),
+    (a_over_b, alpha): (f64, f64),
+    mu: f64,
+    (u, v): (f64, f64),
+) -> Result<f64, ImpactError> {
+    Ok(if table.contains(v.ln()) {
+        table.at(2, v.ln()).0.exp() / (alpha * a_over_b)
+    } else {
+        direct(law, mu, u)?.contact_duration
+    })
 }
 
 fn unsupported(e: impl std::fmt::Display) -> ImpactError {

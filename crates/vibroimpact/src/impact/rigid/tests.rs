@@ -188,3 +188,45 @@ fn a_newton_coefficient_replaces_the_laws() {
     }
     assert!(RigidLaw::new(&law, 1.0, None).unwrap().impact(0.0).is_err());
 }
+
+/// What the judging reads ([`RigidLaw::judging`]) is the impact's own
+/// duration and rebound, bit for bit, for every kind of law (the seed's
+/// inside its table and beyond it, Hunt–Crossley, Kelvin–Voigt, Hertz, a
+/// Newton coefficient); a velocity of 0 is refused as by the impact.
+#[test]
+fn the_judging_reads_the_impacts_own_values() {
+    let laws = [
+        (
+            ContactLaw::exponential(2.0, 0.5, 1e5, ForceForm::Published).unwrap(),
+            None,
+        ),
+        (
+            ContactLaw::hunt_crossley(3e9, 1.5, 0.4, ForceForm::Published).unwrap(),
+            None,
+        ),
+        (
+            ContactLaw::kelvin_voigt(4e6, 1.0e3, ForceForm::Published).unwrap(),
+            None,
+        ),
+        (ContactLaw::hertz(7e9, 1.5).unwrap(), None),
+        (ContactLaw::hertz(7e9, 1.5).unwrap(), Some(0.8)),
+        (
+            ContactLaw::exponential(2.0, 0.5, 1e5, ForceForm::Published).unwrap(),
+            Some(0.6),
+        ),
+    ];
+    for (law, e) in laws {
+        let rigid = RigidLaw::new(&law, 0.3, e).unwrap();
+        for u in [1e-9, 3e-4, 0.02, 1.7, 400.0] {
+            let r = rigid.impact(u).unwrap();
+            let (duration, rebound) = rigid.judging(u).unwrap();
+            assert_eq!(duration.to_bits(), r.duration.to_bits(), "{law:?} {u}");
+            assert_eq!(
+                rebound.to_bits(),
+                r.rebound_velocity.to_bits(),
+                "{law:?} {u}"
+            );
+        }
+        assert!(rigid.judging(0.0).is_err());
+    }
+}

@@ -16,6 +16,7 @@
 //! episode.
 
 use super::*;
+use crate::impact::ImpactError;
 use crate::model::RigidLimits;
 use crate::simulate::switches::{judged, reaches_within, EpisodeReason, SoftEpisode};
 
@@ -139,20 +140,28 @@ impl Run<'_> {
             self.open_episode(k, t, EpisodeReason::Slow { velocity: u });
             return Ok(false);
         }
-        // (The impact at u serves the judging and, at the touch, the jump.)
-        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
+        // (At the touch the impact at u serves the judging and the jump;
+        // at the law's onset the judging's part of it alone.)
+        let onset = !self.armed[k] && self.pre[k] < 0.0;
+        let failed = |e: ImpactError| IntegrationError::RigidImpact {
             t,
             contact: k,
             reason: e.to_string(),
-        })?;
-        if let Some(reason) = judged(&r, pressing, |d| self.neighbours(k, t, d)) {
+        };
+        let (r, judging) = if onset {
+            (None, law.judging(u).map_err(failed)?)
+        } else {
+            let r = law.impact(u).map_err(failed)?;
+            (Some(r), (r.duration, r.rebound_velocity))
+        };
+        if let Some(reason) = judged(judging, pressing, |d| self.neighbours(k, t, d)) {
             // (Its duration kept for the neighbours' overlap, as a
             // jump's: `Switches::soft_impact`.)
-            self.last_impact[k] = (t, r.duration);
+            self.last_impact[k] = (t, judging.0);
             self.open_episode(k, t, reason);
             return Ok(false);
         }
-        if !self.armed[k] && self.pre[k] < 0.0 {
+        let Some(r) = r else {
             // Rigid: on to the touch.
             self.armed[k] = true;
             self.generation[k] += 1;
@@ -160,7 +169,7 @@ impl Run<'_> {
                 return self.rigid_touch(k, t);
             }
             return Ok(true);
-        }
+        };
         // The jump: left side −P/m, right side +P/m.
         for (i, sign) in sides.iter().filter_map(|&(i, s)| Some((i?, s))) {
             let (g, j) = self.free.place(i);

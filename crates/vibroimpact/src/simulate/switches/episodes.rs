@@ -154,26 +154,27 @@ pub(in crate::simulate) fn soft_reason(
     if u <= floor {
         return Ok(Some(EpisodeReason::Slow { velocity: u }));
     }
-    Ok(judged(&law.impact(u)?, pressing, neighbour))
+    Ok(judged(law.judging(u)?, pressing, neighbour))
 }
 
-/// [`soft_reason`] of an impact `r` above the floor, found while its
-/// bodies press together at `pressing` (m/s²).
+/// [`soft_reason`] of an impact above the floor of estimated `duration`
+/// and `rebound` velocity ([`RigidLaw::judging`]), found while its bodies
+/// press together at `pressing` (m/s²).
 pub(in crate::simulate) fn judged(
-    r: &RigidImpact,
+    (duration, rebound): (f64, f64),
     pressing: f64,
     neighbour: impl FnOnce(f64) -> Option<EpisodeReason>,
 ) -> Option<EpisodeReason> {
-    if let Some(reason) = neighbour(r.duration) {
+    if let Some(reason) = neighbour(duration) {
         return Some(reason);
     }
     if pressing > 0.0 {
-        let back = 2.0 * r.rebound_velocity / pressing;
-        if back < r.duration {
+        let back = 2.0 * rebound / pressing;
+        if back < duration {
             return Some(EpisodeReason::Resting {
-                rebound: r.rebound_velocity,
+                rebound,
                 back,
-                duration: r.duration,
+                duration,
             });
         }
     }
