@@ -330,15 +330,8 @@ impl Linear {
         let (mut term, mut next) = (term, next);
         for k in 1..=MAX_TERMS {
             let c = tau / k as f64;
-            for (ti, ni) in term.chunks_exact(d).zip(next.chunks_exact_mut(d)) {
-                ni.fill(0.0);
-                for (t, bl) in ti.iter().zip(b.chunks_exact(d)) {
-                    for (n, x) in ni.iter_mut().zip(bl) {
-                        *n += t * x;
-                    }
-                }
-                ni.iter_mut().for_each(|n| *n *= c);
-            }
+            product(term, b, next);
+            next.iter_mut().for_each(|n| *n *= c);
             std::mem::swap(&mut term, &mut next);
             let largest = term.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             e.iter_mut().zip(term.iter()).for_each(|(e, t)| *e += t);
@@ -353,23 +346,63 @@ impl Linear {
     }
 }
 
-/// `out = M x`, M by rows (square, of x's length).
+/// `out = M x`, M by rows (square, of x's length); the small chains'
+/// sizes (up to 8 rows, a global run's exact limit) unrolled, the same
+/// sums in the same order.
 fn times(m: &[f64], x: &[f64], out: &mut [f64]) {
-    for (o, row) in out.iter_mut().zip(m.chunks_exact(x.len())) {
+    match x.len() {
+        2 => times_of::<2>(m, x, out),
+        4 => times_of::<4>(m, x, out),
+        6 => times_of::<6>(m, x, out),
+        8 => times_of::<8>(m, x, out),
+        d => {
+            for (o, row) in out.iter_mut().zip(m.chunks_exact(d)) {
+                *o = row.iter().zip(x).map(|(a, b)| a * b).sum();
+            }
+        }
+    }
+}
+
+/// [`times`] of D rows.
+fn times_of<const D: usize>(m: &[f64], x: &[f64], out: &mut [f64]) {
+    for (o, row) in out.iter_mut().zip(m.as_chunks::<D>().0) {
         *o = row.iter().zip(x).map(|(a, b)| a * b).sum();
     }
 }
 
-/// `out = P Q`, all square by rows.
+/// `out = P Q`, all square by rows; the small sizes unrolled as in
+/// [`times`].
 fn product(p: &[f64], q: &[f64], out: &mut [f64]) {
-    let d = (out.len() as f64).sqrt() as usize;
-    for (pi, oi) in p.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
-        oi.fill(0.0);
-        for (x, ql) in pi.iter().zip(q.chunks_exact(d)) {
-            for (o, y) in oi.iter_mut().zip(ql) {
+    match out.len() {
+        4 => product_of::<2>(p, q, out),
+        16 => product_of::<4>(p, q, out),
+        36 => product_of::<6>(p, q, out),
+        64 => product_of::<8>(p, q, out),
+        len => {
+            let d = (len as f64).sqrt() as usize;
+            for (pi, oi) in p.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
+                oi.fill(0.0);
+                for (x, ql) in pi.iter().zip(q.chunks_exact(d)) {
+                    for (o, y) in oi.iter_mut().zip(ql) {
+                        *o += x * y;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`product`] of D × D.
+fn product_of<const D: usize>(p: &[f64], q: &[f64], out: &mut [f64]) {
+    let q = q.as_chunks::<D>().0;
+    for (pi, oi) in p.as_chunks::<D>().0.iter().zip(out.as_chunks_mut::<D>().0) {
+        let mut row = [0.0; D];
+        for (x, ql) in pi.iter().zip(q) {
+            for (o, y) in row.iter_mut().zip(ql) {
                 *o += x * y;
             }
         }
+        *oi = row;
     }
 }
 
