@@ -365,8 +365,9 @@ fn times(m: &[f64], x: &[f64], out: &mut [f64]) {
 
 /// [`times`] of D rows.
 fn times_of<const D: usize>(m: &[f64], x: &[f64], out: &mut [f64]) {
-    for (o, row) in out.iter_mut().zip(m.as_chunks::<D>().0) {
-        *o = row.iter().zip(x).map(|(a, b)| a * b).sum();
+    let x = &x[..D];
+    for (o, row) in out.iter_mut().zip(m.chunks_exact(D)) {
+        *o = row[..D].iter().zip(x).map(|(a, b)| a * b).sum();
     }
 }
 
@@ -394,15 +395,14 @@ fn product(p: &[f64], q: &[f64], out: &mut [f64]) {
 
 /// [`product`] of D × D.
 fn product_of<const D: usize>(p: &[f64], q: &[f64], out: &mut [f64]) {
-    let q = q.as_chunks::<D>().0;
-    for (pi, oi) in p.as_chunks::<D>().0.iter().zip(out.as_chunks_mut::<D>().0) {
+    for (pi, oi) in p.chunks_exact(D).zip(out.chunks_exact_mut(D)) {
         let mut row = [0.0; D];
-        for (x, ql) in pi.iter().zip(q) {
-            for (o, y) in row.iter_mut().zip(ql) {
+        for (x, ql) in pi[..D].iter().zip(q.chunks_exact(D)) {
+            for (o, y) in row.iter_mut().zip(&ql[..D]) {
                 *o += x * y;
             }
         }
-        *oi = row;
+        oi[..D].copy_from_slice(&row);
     }
 }
 
