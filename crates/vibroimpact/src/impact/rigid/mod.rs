@@ -54,13 +54,7 @@ pub struct RigidLaw {
 enum Shape {
     /// Seed eq. (10) and the closed-form peak force; the duration tabulated
     /// in V (its unit `1/(α a/b)`: μ only shifts the impact in s).
-    Seed {
-        law: ContactLaw,
-        closed: ExponentialImpact,
-        a_over_b: f64,
-        alpha: f64,
-        table: Arc<Table<3>>,
-    },
+    Seed(Seed),
     /// Hunt–Crossley and Lankarani–Nikravesh: functions of x = χ(U) U.
     Damped {
         law: ContactLaw,
@@ -126,13 +120,13 @@ impl RigidLaw {
     pub fn new(law: &ContactLaw, mu: f64, restitution: Option<f64>) -> Result<Self, ImpactError> {
         positive("reduced mass", mu)?;
         let soft = match *law.kind() {
-            LawKind::Exponential { a, b, alpha } => Shape::Seed {
+            LawKind::Exponential { a, b, alpha } => Shape::Seed(Seed {
                 law: *law,
                 closed: ExponentialImpact::new(law, TwoBodies::against_wall(mu)?)?,
                 a_over_b: a / b,
                 alpha,
                 table: table(Tabled::Exponential)?,
-            },
+            }),
             LawKind::HuntCrossley { k, n, chi } if chi > 0.0 => Shape::Damped {
                 law: *law,
                 k,
@@ -238,18 +232,12 @@ impl Shape {
     /// (e, de/dU, peak force, duration) at U.
     fn at(&self, mu: f64, u: f64) -> Result<(f64, f64, f64, f64), ImpactError> {
         Ok(match self {
-            Shape::Seed {
-                law,
-                closed,
-                a_over_b,
-                alpha,
-                table,
-            } => {
+            Shape::Seed(seed) => {
                 // (The closed form's e(V) is the same root: solved once.)
-                let closed = closed.impact(u)?;
+                let closed = seed.closed.impact(u)?;
                 let (v, e) = (closed.v, closed.restitution);
-                let duration = seed_duration((law, table), (*a_over_b, *alpha), mu, (u, v))?;
-                let slope = restitution_derivative(v, e) / a_over_b;
+                let duration = seed.duration(mu, (u, v))?;
+                let slope = restitution_derivative(v, e) / seed.a_over_b;
                 (e, slope, closed.peak_force, duration)
             }
             Shape::Damped {
@@ -305,16 +293,9 @@ impl Shape {
     /// without the peak force's root.
     fn judging(&self, mu: f64, u: f64) -> Result<(f64, f64), ImpactError> {
         match self {
-            Shape::Seed {
-                law,
-                closed,
-                a_over_b,
-                alpha,
-                table,
-            } => {
-                let v = dimensionless_velocity(u, closed.a_over_b());
-                let duration = seed_duration((law, table), (*a_over_b, *alpha), mu, (u, v))?;
-                Ok((restitution(v)?, duration))
+            Shape::Seed(seed) => {
+                let v = dimensionless_velocity(u, seed.closed.a_over_b());
+                Ok((restitution(v)?, seed.duration(mu, (u, v))?))
             }
             Shape::Newton { e, soft } => Ok((*e, soft.judging(mu, u)?.1)),
             _ => {
@@ -325,19 +306,26 @@ impl Shape {
     }
 }
 
-/// The seed's law's duration at U (V = U/(a/b)): its table's, or the
-/// law's integrated beyond the table.
-fn seed_duration(
-    (law, table): (&ContactLaw, &Table<3>),
-    (a_over_b, alpha): (f64, f64),
-    mu: f64,
-    (u, v): (f64, f64),
-) -> Result<f64, ImpactError> {
-    Ok(if table.contains(v.ln()) {
-        table.at(2, v.ln()).0.exp() / (alpha * a_over_b)
-    } else {
-        direct(law, mu, u)?.contact_duration
-    })
+/// The seed's law in its rigid limit ([`Shape::Seed`]).
+#[derive(Clone, Debug)]
+struct Seed {
+    law: ContactLaw,
+    closed: ExponentialImpact,
+    a_over_b: f64,
+    alpha: f64,
+    table: Arc<Table<3>>,
+}
+
+impl Seed {
+    /// The duration at U (V = U/(a/b)): its table's, or the law's
+    /// integrated beyond the table.
+    fn duration(&self, mu: f64, (u, v): (f64, f64)) -> Result<f64, ImpactError> {
+        Ok(if self.table.contains(v.ln()) {
+            self.table.at(2, v.ln()).0.exp() / (self.alpha * self.a_over_b)
+        } else {
+            direct(&self.law, mu, u)?.contact_duration
+        })
+    }
 }
 
 fn unsupported(e: impl std::fmt::Display) -> ImpactError {

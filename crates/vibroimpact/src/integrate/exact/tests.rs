@@ -137,6 +137,14 @@ fn oscillator(
     (p + xh, q + vh)
 }
 
+/// `y` is the closed form's `(x, v)` to 1e-12 of an amplitude of 0.1 (and
+/// ω times it for the velocity).
+fn assert_on(y: &[f64], (x, v): (f64, f64), w: f64) {
+    let scale = 0.1;
+    assert!((y[0] - x).abs() < 1e-12 * scale, "{} vs {x}", y[0]);
+    assert!((y[1] - v).abs() < 1e-12 * scale * w, "{} vs {v}", y[1]);
+}
+
 /// A lightly damped oscillator under F cos Ω t, 40 periods: the state at
 /// the end and the dense output inside the last step (at a quarter and
 /// between quarters) equal the closed form to 1e-12 of the amplitude.
@@ -148,18 +156,9 @@ fn a_forced_oscillator_moves_as_its_closed_form() {
     let t_end = 40.0 * 2.0 * std::f64::consts::PI / omega;
     let mut st = run(&mut sys, &y0, t_end, Method::Exact, 1e-6);
     assert_eq!(st.active(), Method::Exact);
-    let (x, v) = oscillator(t_end, (w, zeta, f, omega), (y0[0], y0[1]));
+    let exact = oscillator(t_end, (w, zeta, f, omega), (y0[0], y0[1]));
+    assert_on(st.y(), exact, w);
     let scale = 0.1;
-    assert!(
-        (st.y()[0] - x).abs() < 1e-12 * scale,
-        "{} vs {x}",
-        st.y()[0]
-    );
-    assert!(
-        (st.y()[1] - v).abs() < 1e-12 * scale * w,
-        "{} vs {v}",
-        st.y()[1]
-    );
     let (t0, h) = (st.t_prev(), st.h_last());
     let mut out = [0.0; 2];
     for s in [0.25, 0.5, 0.37, 0.913] {
@@ -199,10 +198,7 @@ fn a_span_moves_at_once_as_the_closed_form() {
     let start = oscillator(t0, (w, zeta, f, omega), (y0[0], y0[1]));
     let mut y = [start.0, start.1];
     linear.flow((t0, t1), &mut y);
-    let (x, v) = oscillator(t1, (w, zeta, f, omega), (y0[0], y0[1]));
-    let scale = 0.1;
-    assert!((y[0] - x).abs() < 1e-12 * scale, "{} vs {x}", y[0]);
-    assert!((y[1] - v).abs() < 1e-12 * scale * w, "{} vs {v}", y[1]);
+    assert_on(&y, oscillator(t1, (w, zeta, f, omega), (y0[0], y0[1])), w);
     let mut same = [start.0, start.1];
     linear.flow((t0, t0), &mut same);
     assert!((same[0] - start.0).abs() < 1e-17 && (same[1] - start.1).abs() < 1e-16);
@@ -233,17 +229,10 @@ fn a_stiff_oscillator_steps_by_its_balanced_norm() {
     let y0 = [0.01, -2.0];
     let t_end = 40.0 * 2.0 * std::f64::consts::PI / w;
     let st = run(&mut sys, &y0, t_end, Method::Exact, 1e-6);
-    let (x, v) = oscillator(t_end, (w, zeta, f, omega), (y0[0], y0[1]));
-    let scale = 0.1;
-    assert!(
-        (st.y()[0] - x).abs() < 1e-12 * scale,
-        "{} vs {x}",
-        st.y()[0]
-    );
-    assert!(
-        (st.y()[1] - v).abs() < 1e-12 * scale * w,
-        "{} vs {v}",
-        st.y()[1]
+    assert_on(
+        st.y(),
+        oscillator(t_end, (w, zeta, f, omega), (y0[0], y0[1])),
+        w,
     );
     assert!(st.stats().steps <= 8 * 40, "{} steps", st.stats().steps);
 }
