@@ -27,7 +27,11 @@ const OSCILLATOR: (f64, f64, f64, f64) = (7.4, 0.02, 3.0, 6.1);
 impl Forced {
     /// One body: [`OSCILLATOR`] under F cos Ω t.
     fn oscillator() -> Self {
-        let (w, zeta, f, omega) = OSCILLATOR;
+        Self::lone(OSCILLATOR)
+    }
+
+    /// One body of (ω, ζ) under F cos Ω t.
+    fn lone((w, zeta, f, omega): (f64, f64, f64, f64)) -> Self {
         Self {
             w2: vec![w * w],
             c: vec![2.0 * zeta * w],
@@ -211,15 +215,7 @@ fn a_span_moves_at_once_as_the_closed_form() {
 #[test]
 fn a_stiff_oscillator_steps_by_its_balanced_norm() {
     let (w, zeta, f, omega) = (300.0, 0.02, 3.0e3, 250.0);
-    let mut sys = Forced {
-        w2: vec![w * w],
-        c: vec![2.0 * zeta * w],
-        k12: 0.0,
-        omega,
-        f,
-        g: 0.0,
-        p: 0.0,
-    };
+    let mut sys = Forced::lone((w, zeta, f, omega));
     let limit = sys.linear_form().unwrap().solve().unwrap().step_limit();
     let balanced = 2.0 / (w + 2.0 * zeta * w);
     assert!(
