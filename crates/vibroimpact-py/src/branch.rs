@@ -186,10 +186,10 @@ fn curves_from_document<'py>(
     let doc: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| value_error(format!("special_points: not a branch document: {e}")))?;
     let family = &checked.branch.family;
-    let read = branch_special_points(&doc, &family.document, &family.parameter)
+    let read = branch_special_points(&doc, family.document(), family.parameter())
         .map_err(|e| value_error(format!("special_points: {e}")))?;
     let names = (
-        family.parameter.name.clone(),
+        family.parameter().name.clone(),
         checked
             .plane
             .as_ref()

@@ -273,7 +273,7 @@ fn curves_from_file(
     interrupt: &Interrupt,
 ) -> Result<(), CliError> {
     let family = &checked.branch.family;
-    let read = curves::read_special_points(path, &family.document, &family.parameter)?;
+    let read = curves::read_special_points(path, family.document(), family.parameter())?;
     let q = checked
         .plane
         .as_ref()

@@ -187,7 +187,7 @@ fn brute_force(stop: &Interrupt) -> Result<(SweepSummary, Basins), CliError> {
         &|| {},
     )
     .map_err(|e| CliError::new(e.to_string()))?;
-    let loaded = doc.with_parameter(&family.parameter, 1.1 * W0)?;
+    let loaded = doc.with_parameter(family.parameter(), 1.1 * W0)?;
     let clearance = 1e-3;
     let u = grid((-0.9 * clearance, 0.9 * clearance), 20);
     let v = grid((-7.0 * clearance, 7.0 * clearance), 20);

@@ -72,20 +72,20 @@ impl ContinueStudy {
         let plane = match self.curves {
             None => None,
             Some(request) => {
-                let q = family.document.parameter(&request.parameter2)?;
-                if q.key == family.parameter.key {
+                let q = family.document().parameter(&request.parameter2)?;
+                if q.key == family.parameter().key {
                     return Err(StudyError::Invalid {
                         field: StudyField::Parameter2,
                         message: format!(
                             "the same key as the parameter {}; give another",
-                            family.parameter.name
+                            family.parameter().name
                         ),
                     });
                 }
                 request.selection.check().map_err(StudyError::Field)?;
                 let plane = ParameterizedModel2 {
-                    document: family.document.clone(),
-                    p: family.parameter.clone(),
+                    document: family.document().clone(),
+                    p: family.parameter().clone(),
                     q,
                 };
                 Some((plane, request.selection))
@@ -111,7 +111,7 @@ impl CheckedContinue {
         on_point: impl FnMut(&BranchPoint) -> bool,
     ) -> Result<ContinueOutcome, StudyError> {
         let range = self.range();
-        let parameter = self.branch.family.parameter.name.clone();
+        let parameter = self.branch.family.parameter().name.clone();
         let branch = self.branch.run(on_point)?;
         let curves = match self.plane {
             None => None,

@@ -128,26 +128,26 @@ impl<T: Family2 + ?Sized> Family2 for &mut T {
 
 impl Family for &ParameterizedModel {
     fn name(&self) -> &str {
-        &self.parameter.name
+        &self.parameter().name
     }
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
         ParameterizedModel::model_at(self, p)
-            .map_err(|e| FamilyError::new(&self.parameter.name, p, e))
+            .map_err(|e| FamilyError::new(&self.parameter().name, p, e))
     }
     fn whole_numbers(&self) -> bool {
-        self.parameter.integer
+        self.parameter().integer
     }
     fn simulation(&self) -> SimulationSpec {
-        self.document.simulation()
+        self.document().simulation()
     }
     fn amplitude_family(
         &self,
         p: f64,
     ) -> Option<Result<(ParameterizedModel, f64), ModelFileError>> {
-        let mut document = self.document.clone();
+        let mut document = self.document().clone();
         Some(
             document
-                .set(&self.parameter, p)
+                .set(self.parameter(), p)
                 .and_then(|()| ParameterizedModel::in_amplitude(document)),
         )
     }
@@ -156,7 +156,7 @@ impl Family for &ParameterizedModel {
 /// The owned family is the borrowed one.
 impl Family for ParameterizedModel {
     fn name(&self) -> &str {
-        &self.parameter.name
+        &self.parameter().name
     }
     fn model_at(&mut self, p: f64) -> Result<Model, FamilyError> {
         Family::model_at(&mut &*self, p)

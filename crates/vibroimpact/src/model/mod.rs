@@ -345,6 +345,16 @@ impl Model {
         Some(m)
     }
 
+    /// The model with its base excitation replaced by `base`, validated as
+    /// [`Model::new`] validates it (its values, and the rounding of the
+    /// contacts' scales that the base's peak enters).
+    pub fn reforced(&self, base: BaseExcitation) -> Result<Self, ModelError> {
+        check_base(&base)?;
+        let model = self.clone().with_base(base);
+        scales::check_rounding(&model)?;
+        Ok(model)
+    }
+
     /// Replaces the base excitation.
     pub fn with_base(mut self, base: BaseExcitation) -> Self {
         self.base = base;
