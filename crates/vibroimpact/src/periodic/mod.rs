@@ -329,6 +329,7 @@ pub use orbit::{
 };
 pub(crate) use rigid::{rigid_impacts_over, saltation};
 
+pub(crate) use shooting::shoot_orbit;
 pub use shooting::{shoot, shoot_krylov};
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use super::{
 };
 use crate::linalg::{arnoldi_matrix, gmres};
 use crate::model::Model;
-use crate::newton::{damped_newton, NewtonOptions, NewtonStop, NewtonSystem};
+use crate::newton::{damped_newton, NewtonOptions, NewtonOutcome, NewtonStop, NewtonSystem};
 
 fn scaled_norm(r: &[f64], scale: &[f64]) -> f64 {
     r.iter()
@@ -44,9 +44,11 @@ struct DenseShooting<'a> {
     iteration: usize,
 }
 
+/// The period map and the residual `P(x) − x` (unscaled).
+pub(crate) type DensePoint = (PeriodMap, Vec<f64>);
+
 impl NewtonSystem for DenseShooting<'_> {
-    /// The period map and the residual `P(x) − x` (unscaled).
-    type Point = (PeriodMap, Vec<f64>);
+    type Point = DensePoint;
     type Error = PeriodicError;
 
     fn evaluate(&mut self, x: &[f64]) -> Result<Self::Point, PeriodicError> {
@@ -191,14 +193,7 @@ pub fn shoot(
     guess: &[f64],
     opts: &ShootingOptions,
 ) -> Result<PeriodicSolution, PeriodicError> {
-    let (period, _) = shooting_checks(model, guess, opts)?;
-    let mut sys = DenseShooting {
-        model,
-        opts,
-        scale: scales(model, opts),
-        iteration: 0,
-    };
-    let out = damped_newton(&mut sys, guess, &newton_options(opts))?;
+    let (period, out) = shoot_orbit(model, guess, opts)?;
     let (mut map, _) = out.point;
     // The monodromy of a converged orbit once more at a 100× tighter
     // tolerance (down to 1e-13): the Newton iterations need it to the
@@ -229,6 +224,29 @@ pub fn shoot(
         monodromy,
         multipliers,
     })
+}
+
+/// The Newton iteration of [`shoot`] alone: the period nT and Newton's
+/// outcome (the state, the map there, the stop and the residual history),
+/// without the multipliers' finer monodromy. A branch's start, which
+/// corrects and evaluates its point in full itself, takes this (a soft
+/// R2 N = 2 start spent 1.4 ms of its 1.6 ms on that finer map).
+pub(crate) fn shoot_orbit(
+    model: &Model,
+    guess: &[f64],
+    opts: &ShootingOptions,
+) -> Result<(f64, NewtonOutcome<DensePoint>), PeriodicError> {
+    let (period, _) = shooting_checks(model, guess, opts)?;
+    let mut sys = DenseShooting {
+        model,
+        opts,
+        scale: scales(model, opts),
+        iteration: 0,
+    };
+    Ok((
+        period,
+        damped_newton(&mut sys, guess, &newton_options(opts))?,
+    ))
 }
 
 /// Newton–Krylov shooting for large systems (matrix-free: products with
