@@ -40,6 +40,11 @@
 //! It builds the peers itself (`bench/peers/build.sh`, which installs
 //! libsundials-dev and a Python venv with NumPy and SciPy if missing).
 
+/// The allocator: the rigid period maps build and drop a run's small
+/// buffers per evaluation (docs/decisions.md D45).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use std::path::{Path, PathBuf};
 
 use clap::Parser;

@@ -6,6 +6,11 @@
 //! prints one JSON line: the median and best wall time of the repeats (s)
 //! and the final displacement (to check that both sides computed the same).
 
+/// The allocator: the rigid period maps build and drop a run's small
+/// buffers per evaluation (docs/decisions.md D45).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use std::time::Instant;
 
 use vibroimpact::model::file::ModelDocument;

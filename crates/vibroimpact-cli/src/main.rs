@@ -3,6 +3,11 @@
 //! Without arguments it runs the built-in default study and writes its
 //! report (see [`report`]); subcommands expose the library's computations.
 
+/// The allocator: the rigid period maps build and drop a run's small
+/// buffers per evaluation (docs/decisions.md D45).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod args;
 mod commands;
 mod curves;

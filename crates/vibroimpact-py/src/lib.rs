@@ -15,6 +15,11 @@
 //! study its estimate puts under 20 ms runs on the calling thread, the
 //! GIL released.
 
+/// The allocator: the rigid period maps build and drop a run's small
+/// buffers per evaluation (docs/decisions.md D45).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod basins;
 mod branch;
 mod chart;
