@@ -5,7 +5,8 @@
 //! ## Files
 //! - `problem.rs` — the extended system in scaled variables, corrector, tangent;
 //! - `events.rs` — special points as events: test values, location;
-//! - `branch.rs` — the [`Continuation`] iterator over a branch's steps;
+//! - `branch/` — the [`Continuation`] iterator over a branch's steps, and
+//!   the hand-over of its points from the corrector to the finisher;
 //! - `finish.rs` — each point's orbit summary and the special points before
 //!   it, beside the corrector;
 //! - `switching.rs` — starts on crossing and period-doubled branches;

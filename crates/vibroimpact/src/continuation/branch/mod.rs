@@ -1,6 +1,10 @@
 //! The [`Continuation`] iterator: one accepted point of the branch per
 //! step (predictor, corrector, step control, special points between the
 //! points), ending with the reason it stopped.
+//!
+//! - `mod.rs` — the start, the corrector's steps and the branch's checks;
+//! - `handover.rs` — the points handed from the corrector to the finisher,
+//!   and the iterator of finished points.
 
 use std::collections::VecDeque;
 
