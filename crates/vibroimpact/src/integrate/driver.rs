@@ -203,6 +203,17 @@ pub trait StepMethod: Clone + std::fmt::Debug {
         stats: &mut Stats,
     ) -> f64;
 
+    /// Whether the dense output is the flow itself to rounding (the exact
+    /// method), so that a step can be shortened to end where an event lies
+    /// ([`Driver::end_step_at`]) instead of being taken again up to it; an
+    /// interpolant's is not (the step's end is the method's own).
+    const DENSE_IS_FLOW: bool = false;
+
+    /// For a method whose dense output is the flow: the last accepted step
+    /// now ends at `(t, y)`, its dense output still reading its first part;
+    /// [`end_derivative`](Self::end_derivative) then reads `f(t, y)`.
+    fn shorten(&mut self, _t: f64, _y: &[f64]) {}
+
     /// The first `out.len()` components of the dense output at `s`
     /// (default: one at a time).
     fn dense_all<S: OdeSystem>(
@@ -616,6 +627,28 @@ impl<M: StepMethod> Driver<M> {
     /// `t_bound` of the next [`step`](Self::step) call).
     pub fn h_next(&self) -> f64 {
         self.h_next
+    }
+
+    /// Shortens the last accepted step to end at `t` inside it, where the
+    /// method's dense output is the flow itself ([`StepMethod::DENSE_IS_FLOW`]):
+    /// the point becomes `(t, y(t))` from the dense output, which keeps
+    /// reading the step's first part. An event located inside a step then
+    /// ends it there, without the step being taken again up to it. False
+    /// (nothing changed) for another method or a `t` not inside the step.
+    pub fn end_step_at<S: OdeSystem>(&mut self, sys: &mut S, t: f64) -> bool {
+        if !(M::DENSE_IS_FLOW && self.has_step && t > self.at.t_prev && t < self.at.t) {
+            return false;
+        }
+        let mut y = std::mem::take(&mut self.y_new);
+        self.dense_output(sys, t, &mut y);
+        self.method.shorten(t, &y);
+        let at = &mut self.at;
+        std::mem::swap(&mut at.y, &mut y);
+        at.dydt.copy_from_slice(self.method.end_derivative());
+        at.t = t;
+        at.h_last = t - at.t_prev;
+        self.y_new = y;
+        true
     }
 
     /// Dense output of the last accepted step, valid for `t` in

@@ -376,6 +376,14 @@ impl Stepper {
         active!(mut self, d => d.dense_output(sys, t, out))
     }
 
+    /// Shortens the last step to end at `t` inside it where the active
+    /// method's dense output is the flow itself (the exact method;
+    /// [`Driver::end_step_at`](super::Driver::end_step_at)); false for
+    /// another method.
+    pub fn end_step_at<S: OdeSystem>(&mut self, sys: &mut S, t: f64) -> bool {
+        active!(mut self, d => d.end_step_at(sys, t))
+    }
+
     /// Single component of the dense output.
     ///
     /// # Panics

@@ -717,6 +717,19 @@ impl StepMethod for ExactMethod {
         &self.end
     }
 
+    // The dense output is the exponential's series on the deviation: the
+    // flow to rounding.
+    const DENSE_IS_FLOW: bool = true;
+
+    /// The step's first part keeps its series (its quarters are the whole
+    /// step's: no longer read); `f(t, y)` as at a step's end.
+    fn shorten(&mut self, t: f64, y: &[f64]) {
+        self.quarters_acc = None;
+        if let Some(form) = self.form.as_ref() {
+            form.rate(t, y, &mut self.end);
+        }
+    }
+
     /// Component i as [`ExactMethod::dense_all`] has it.
     fn dense<S: OdeSystem>(
         &mut self,

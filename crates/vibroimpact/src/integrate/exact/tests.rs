@@ -1,7 +1,7 @@
 //! Tests of the exact flow: a forced oscillator against its closed form,
 //! a forced pair against DOP853 (and a leading part of either's dense
-//! output against the whole), the dense output between quarters, a
-//! resonance refused, and a stepper that takes the exact flow where the
+//! output against the whole), the dense output between quarters, a step
+//! ended at an event inside it, a resonance refused, and a stepper that takes the exact flow where the
 //! form holds.
 
 use super::*;
@@ -186,6 +186,47 @@ fn a_forced_oscillator_moves_as_its_closed_form() {
             out[0]
         );
     }
+}
+
+/// A step ended at an event inside it (`end_step_at`, 0.37 of the last
+/// step of 40 periods): the point is the closed form's there to 1e-12 of
+/// the amplitude, its derivative the system's own, the dense output of
+/// the first part (a former quarter included) the closed form's, and the
+/// next step goes on exactly from there; DOP853 refuses (its dense output
+/// interpolates), and so does a time outside the step.
+#[test]
+fn a_step_ends_where_an_event_lies_inside_it() {
+    let (w, zeta, f, omega) = OSCILLATOR;
+    let forced = (w, zeta, f, omega);
+    let mut sys = Forced::oscillator();
+    let y0 = [0.01, -0.2];
+    let t_end = 40.0 * 2.0 * std::f64::consts::PI / omega;
+    let mut st = run(&mut sys, &y0, t_end, Method::Exact, 1e-6);
+    let (t0, h) = (st.t_prev(), st.h_last());
+    assert!(!st.end_step_at(&mut sys, t0 - 0.1 * h));
+    assert!(!st.end_step_at(&mut sys, t_end + 0.1 * h));
+    let t = t0 + 0.37 * h;
+    assert!(st.end_step_at(&mut sys, t));
+    assert_eq!((st.t(), st.t_prev()), (t, t0));
+    assert_on(st.y(), oscillator(t, forced, (y0[0], y0[1])), w);
+    let mut rate = [0.0; 2];
+    sys.rhs(t, st.y(), &mut rate);
+    for (a, b) in st.dydt().iter().zip(&rate) {
+        assert!((a - b).abs() < 1e-12 * w * w * 0.1, "{a} vs {b}");
+    }
+    let mut out = [0.0; 2];
+    for s in [0.25, 0.5, 0.9] {
+        let ts = t0 + s * (t - t0);
+        st.dense_output(&mut sys, ts, &mut out);
+        assert_on(&out, oscillator(ts, forced, (y0[0], y0[1])), w);
+    }
+    st.step(&mut sys, t_end).unwrap();
+    assert_eq!(st.t(), t_end);
+    assert_on(st.y(), oscillator(t_end, forced, (y0[0], y0[1])), w);
+    let mut st = run(&mut sys, &y0, 1.0, Method::Dop853, 1e-10);
+    let t = st.t_prev() + 0.37 * st.h_last();
+    assert!(!st.end_step_at(&mut sys, t));
+    assert_eq!(st.t(), 1.0);
 }
 
 /// A span taken at once ([`Linear::flow`], the exponential squared up to

@@ -420,6 +420,12 @@ impl Switches {
                 self.disarm(e);
                 Ok(Verdict::Switch(e))
             }
+            // The exact flow's step ends at the event itself (its dense
+            // output is the flow): not taken again up to it.
+            Some((t, e)) if st.end_step_at(sys, t) => {
+                self.disarm(e);
+                Ok(Verdict::Switch(e))
+            }
             Some(found) => {
                 self.pending = Some(found);
                 st.reset(sys, t0, &self.y_prev)?;
