@@ -53,8 +53,8 @@ pub(super) struct Finisher<F> {
 }
 
 impl<F: Family> Finisher<F> {
-    /// Finishes the points after `first` (already finished) with
-    /// `problem`, a copy of the corrector's.
+    /// Finishes `first` ([`start`](Self::start)) and the points after it
+    /// with `problem`, a copy of the corrector's.
     pub fn new(
         problem: Problem<F>,
         events: Vec<Box<dyn BranchEvent>>,
@@ -68,6 +68,15 @@ impl<F: Family> Finisher<F> {
             bounds,
             previous: first,
         }
+    }
+
+    /// The start (the point the finisher was made with), with its orbit
+    /// summary (the first and last points carry theirs even without
+    /// special points): added here, beside the corrector's first step,
+    /// not before the branch's threads start.
+    pub fn start(&mut self) -> Result<Evaluated, StopReason> {
+        self.previous = self.orbit_of(self.previous.clone())?;
+        Ok(self.previous.clone())
     }
 
     /// Whether the points need their orbit summaries (special points, or

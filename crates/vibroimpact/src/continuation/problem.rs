@@ -390,20 +390,11 @@ impl Evaluated {
 
 impl<F: Family> Problem<F> {
     /// The point `solved` in full detail: tangent (oriented along
-    /// `previous_tangent`), orbit summary, multipliers and test values.
-    pub(super) fn evaluate(
-        &mut self,
-        solved: Solved,
-        previous_tangent: &[f64],
-    ) -> Option<Evaluated> {
-        self.evaluate_with(solved, previous_tangent, true)
-    }
-
-    /// [`evaluate`](Self::evaluate), without the orbit summary (one more
-    /// integration of the period with its extrema and impacts) when
-    /// `with_orbit` is false: then the amplitudes are empty and the impacts
-    /// per period 0, which the tests of folds, branch points, period
-    /// doublings and Neimark–Sacker points do not read.
+    /// `previous_tangent`), multipliers and test values, and with
+    /// `with_orbit` its orbit summary (one more integration of the period
+    /// with its extrema and impacts; without it the amplitudes are empty
+    /// and the impacts per period 0, which the tests of folds, branch
+    /// points, period doublings and Neimark–Sacker points do not read).
     pub(super) fn evaluate_with(
         &mut self,
         solved: Solved,

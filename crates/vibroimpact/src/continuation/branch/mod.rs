@@ -4,7 +4,8 @@
 //!
 //! - `mod.rs` — the start, the corrector's steps and the branch's checks;
 //! - `handover.rs` — the points handed from the corrector to the finisher,
-//!   and the iterator of finished points.
+//!   and the iterator of finished points;
+//! - `tests.rs` — the start.
 
 use std::collections::VecDeque;
 
@@ -71,8 +72,9 @@ pub struct Continuation<F> {
     start_bound: Option<f64>,
     /// The last point corrected.
     current: Evaluated,
-    /// The start, not yet yielded.
-    start: Option<BranchPoint>,
+    /// Whether the start is not yet yielded (the finisher adds its orbit
+    /// summary beside the corrector's first step).
+    start: bool,
     ds: f64,
     /// Points corrected so far (the start included).
     points: usize,
@@ -127,8 +129,19 @@ impl<F: Family + Send> Continuation<F> {
             },
             ..opts.clone()
         };
+        let odd = opts.shooting.subharmonic.max(1) % 2 == 1;
+        let halves = opts.use_symmetry && odd && model.is_mirror_symmetric();
+        // A guess that is a symmetric orbit already (to 100 tol,
+        // `is_symmetric_orbit`) is corrected on the half map below at
+        // once: shooting the whole period would only confirm it (the
+        // start of R2 N = 2 from its orbit: one map of the period saved).
+        let on_half = opts.krylov.is_none()
+            && !opts.shooting.symmetric
+            && halves
+            && is_symmetric_orbit(&model, x0, &opts.shooting);
         // (The start's multipliers are the point's own, evaluated below.)
         let (start, converged, history) = match opts.krylov {
+            None if on_half => (x0.to_vec(), true, Vec::new()),
             None => {
                 let (_, out) = shoot_orbit(&model, x0, &opts.shooting)?;
                 (out.x, out.stop == NewtonStop::Converged, out.history)
@@ -144,12 +157,9 @@ impl<F: Family + Send> Continuation<F> {
             ));
         }
         let d = x0.len();
-        let odd = opts.shooting.subharmonic.max(1) % 2 == 1;
         let symmetric = opts.shooting.symmetric
-            || (opts.use_symmetry
-                && odd
-                && model.is_mirror_symmetric()
-                && is_symmetric_orbit(&model, &start, &opts.shooting));
+            || on_half
+            || (halves && is_symmetric_orbit(&model, &start, &opts.shooting));
         let local = ContinuationOptions {
             shooting: ShootingOptions {
                 symmetric,
@@ -172,8 +182,9 @@ impl<F: Family + Send> Continuation<F> {
             .correct(&z0, &dir, None)
             .ok_or(ContinuationError::StartNotConverged(f64::NAN))?;
         dir[d] = (p_end - p0).signum();
+        // (Its orbit summary is the finisher's, beside the first step.)
         let first = problem
-            .evaluate(solved0, &dir)
+            .evaluate_with(solved0, &dir, false)
             .ok_or_else(|| ContinuationError::Invalid("cannot evaluate the start point".into()))?;
         // Closing the loop: the branch is back at its first point, or (for
         // an asymmetric branch of a mirror-symmetric row) at the mirror
@@ -207,10 +218,10 @@ impl<F: Family + Send> Continuation<F> {
                 .into_iter()
                 .find(|&b| b == p0 && b != if p_end >= p0 { bounds.1 } else { bounds.0 }),
             origin: (first.solved.z.clone(), first.tangent.clone()),
-            start: Some(first.point.clone()),
+            start: true,
             current: first,
             ds: opts.ds,
-            points: 0,
+            points: 1,
             mirrors,
             symmetric,
             pending: None,
@@ -709,3 +720,6 @@ pub fn spectral_distance(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
 /// Modulus beyond which [`spectral_distance`] sees no change of a
 /// multiplier's size.
 pub const FAR_MULTIPLIER: f64 = 2.0;
+
+#[cfg(test)]
+mod tests;
