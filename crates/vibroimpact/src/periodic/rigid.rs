@@ -206,7 +206,7 @@ pub(crate) fn saltation(
     let u = jump.impact.impact_velocity;
     let impulse_p = match shifted.rigid_law(k) {
         Some(law) => {
-            law.impact(u)
+            law.jump(u)
                 .map_err(|e| IntegrationError::RigidImpact {
                     t: jump.t,
                     contact: k,

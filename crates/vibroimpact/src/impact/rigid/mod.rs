@@ -213,8 +213,22 @@ impl RigidLaw {
 
     /// The impact at approach velocity `u > 0` (m/s).
     pub fn impact(&self, u: f64) -> Result<RigidImpact, ImpactError> {
+        self.impact_with(u, true)
+    }
+
+    /// The impact at `u > 0` as a period map takes it: the jump, de/dU and
+    /// the estimated duration, the same bits as [`impact`](Self::impact)'s;
+    /// the peak force, which only an impact log reads, left NaN where it
+    /// is a root of its own (the seed's law, also under a Newton
+    /// coefficient).
+    pub fn jump(&self, u: f64) -> Result<RigidImpact, ImpactError> {
+        self.impact_with(u, false)
+    }
+
+    /// [`impact`](Self::impact), its peak force solved or not (`peak`).
+    fn impact_with(&self, u: f64, peak: bool) -> Result<RigidImpact, ImpactError> {
         positive("impact velocity", u)?;
-        let (e, slope, peak_force, duration) = self.shape.at(self.mu, u)?;
+        let (e, slope, peak_force, duration) = self.shape.at(self.mu, u, peak)?;
         Ok(RigidImpact {
             impact_velocity: u,
             restitution: e,
@@ -229,9 +243,17 @@ impl RigidLaw {
 }
 
 impl Shape {
-    /// (e, de/dU, peak force, duration) at U.
-    fn at(&self, mu: f64, u: f64) -> Result<(f64, f64, f64, f64), ImpactError> {
+    /// (e, de/dU, peak force, duration) at U; without `peak`, the seed's
+    /// law's peak force not solved (NaN).
+    fn at(&self, mu: f64, u: f64, peak: bool) -> Result<(f64, f64, f64, f64), ImpactError> {
         Ok(match self {
+            Shape::Seed(seed) if !peak => {
+                let v = dimensionless_velocity(u, seed.closed.a_over_b());
+                let e = restitution(v)?;
+                let duration = seed.duration(mu, (u, v))?;
+                let slope = restitution_derivative(v, e) / seed.a_over_b;
+                (e, slope, f64::NAN, duration)
+            }
             Shape::Seed(seed) => {
                 // (The closed form's e(V) is the same root: solved once.)
                 let closed = seed.closed.impact(u)?;
@@ -283,7 +305,7 @@ impl Shape {
                 (1.0, 0.0, k * l.powf(*n), tau * l / u)
             }
             Shape::Newton { e, soft } => {
-                let (_, _, peak, tau) = soft.at(mu, u)?;
+                let (_, _, peak, tau) = soft.at(mu, u, peak)?;
                 (*e, 0.0, peak, tau)
             }
         })
@@ -299,7 +321,7 @@ impl Shape {
             }
             Shape::Newton { e, soft } => Ok((*e, soft.judging(mu, u)?.1)),
             _ => {
-                let (e, _, _, duration) = self.at(mu, u)?;
+                let (e, _, _, duration) = self.at(mu, u, true)?;
                 Ok((e, duration))
             }
         }

@@ -192,7 +192,10 @@ fn a_newton_coefficient_replaces_the_laws() {
 /// What the judging reads ([`RigidLaw::judging`]) is the impact's own
 /// duration and rebound, bit for bit, for every kind of law (the seed's
 /// inside its table and beyond it, Hunt–Crossley, Kelvin–Voigt, Hertz, a
-/// Newton coefficient); a velocity of 0 is refused as by the impact.
+/// Newton coefficient), and so is a period map's jump ([`RigidLaw::jump`]:
+/// all but the peak force, which the seed's law leaves unsolved, also
+/// under a Newton coefficient); a velocity of 0 is refused as by the
+/// impact.
 #[test]
 fn the_judging_reads_the_impacts_own_values() {
     let laws = [
@@ -226,7 +229,20 @@ fn the_judging_reads_the_impacts_own_values() {
                 r.rebound_velocity.to_bits(),
                 "{law:?} {u}"
             );
+            let jump = rigid.jump(u).unwrap();
+            let seed = matches!(law.kind(), LawKind::Exponential { .. });
+            assert_eq!(jump.peak_force.is_nan(), seed, "{law:?} {u}");
+            let peak = if seed { r.peak_force } else { jump.peak_force };
+            assert_eq!(
+                RigidImpact {
+                    peak_force: peak,
+                    ..jump
+                },
+                r,
+                "{law:?} {u}"
+            );
         }
         assert!(rigid.judging(0.0).is_err());
+        assert!(rigid.jump(0.0).is_err());
     }
 }

@@ -279,7 +279,7 @@ impl Switches {
         if let Some(reason) = self.judge(chain, k, (t, y, dydt), floor)? {
             return Ok(Jump::Soft(reason));
         }
-        let Some((_, r)) = rigid_jump(chain, k, (t, y), floor)? else {
+        let Some((_, r)) = rigid_jump(chain, k, (t, y), (floor, self.peak_forces))? else {
             return Ok(Jump::Touch);
         };
         self.last_impact[k] = (t, r.duration);

@@ -55,7 +55,8 @@ pub(crate) fn flow_through_events<S: Chain>(
     // impact force threshold.)
     let threshold = crate::simulate::SimulationOptions::default().impact_force_threshold;
     let pre = super::episodes::judging_gaps(sys.chain(), threshold);
-    let mut switches = Switches::new(sys.chain(), dim, vec![0.0; contacts], pre);
+    let mut switches = Switches::new(sys.chain(), dim, vec![0.0; contacts], pre)
+        .map(Switches::without_peak_forces);
     let (mut steps, mut impacts) = (0_u64, 0_usize);
     while st.t() < t_end {
         steps += 1;
