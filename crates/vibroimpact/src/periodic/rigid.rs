@@ -14,7 +14,7 @@ use super::*;
 use crate::dynamics::saltation::Saltation;
 use crate::impact::rigid::RigidImpact;
 use crate::integrate::LinearForm;
-use crate::simulate::{flow_through_events, ImpactJump};
+use crate::simulate::{flow_through_events, flow_through_events_with, ImpactJump};
 
 /// [`period_map_with`](super::period_map_with) for a model with rigid
 /// impacts: the map, its dense Jacobian (also behind the tangent without
@@ -98,7 +98,11 @@ fn replayed(
     };
     let d = var.state_dim();
     let mut jumps: Vec<Recorded> = Vec::new();
-    let (y, steps, _) = flow_through_events(var.system_mut(), &z0[..d], t, int_opts, |_, j| {
+    // (The state's own form is the first block of the columns': not
+    // solved again.)
+    let own = Some(form.leading(1));
+    let state = var.system_mut();
+    let (y, steps, _) = flow_through_events_with(state, own, &z0[..d], t, int_opts, |_, j| {
         jumps.push((
             j.contact,
             j.t,

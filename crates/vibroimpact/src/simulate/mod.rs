@@ -652,7 +652,7 @@ use extrema::ExtremaScan;
 pub use gauges::{Gauge, GaugeReading};
 pub use global::simulate_streaming;
 pub use integrator::{Integrator, AUTO_LOCAL_GROUPS};
-pub(crate) use switches::{flow_through_events, ImpactJump};
+pub(crate) use switches::{flow_through_events, flow_through_events_with, ImpactJump};
 pub use switches::{EpisodeReason, SoftEpisode};
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! Tests of the exact flow: a forced oscillator against its closed form,
 //! a forced pair against DOP853 (and a leading part of either's dense
 //! output against the whole), the dense output between quarters, a step
-//! ended at an event inside it, a resonance refused, and a stepper that takes the exact flow where the
+//! ended at an event inside it, a leading block alone, a resonance
+//! refused, and a stepper that takes the exact flow where the
 //! form holds.
 
 use super::*;
@@ -227,6 +228,32 @@ fn a_step_ends_where_an_event_lies_inside_it() {
     let t = st.t_prev() + 0.37 * st.h_last();
     assert!(!st.end_step_at(&mut sys, t));
     assert_eq!(st.t(), 1.0);
+}
+
+/// The leading block of a two-block form ([`Linear::leading`], a
+/// variational system's state) moves as the one-block form solved alone,
+/// bit for bit (the same balancing, norm and steady states), over a span
+/// of 1.3 s; the second block, under a harmonic of its own, is dropped.
+#[test]
+fn a_leading_block_moves_as_its_own_form() {
+    let own = Forced::oscillator();
+    let mut pair = own.linear_form().unwrap();
+    let column = Harmonic {
+        omega: 6.3,
+        cos: vec![0.5, 0.1],
+        sin: vec![-0.2, 0.7],
+    };
+    let alone = pair.clone().solve().unwrap();
+    pair.blocks.push(vec![column]);
+    let both = pair.solve().unwrap();
+    let leading = both.leading(1);
+    assert_eq!(leading.dim(), alone.dim());
+    assert_eq!(both.dim(), 2 * alone.dim());
+    let (mut a, mut b) = ([0.01, -0.2], [0.01, -0.2]);
+    alone.flow((0.4, 1.7), &mut a);
+    leading.flow((0.4, 1.7), &mut b);
+    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+    assert!(a.iter().all(|x| x.is_finite()));
 }
 
 /// A span taken at once ([`Linear::flow`], the exponential squared up to

@@ -8,7 +8,7 @@
 use super::{apply_event, EpisodeReason, Event, Jump, Switches, Verdict};
 use crate::dynamics::Chain;
 use crate::impact::rigid::RigidImpact;
-use crate::integrate::{IntegrationError, IntegratorOptions, LinearForm, Method, Stepper};
+use crate::integrate::{IntegrationError, IntegratorOptions, Linear, LinearForm, Method, Stepper};
 
 /// What a rigid impact hands the hook: the contact, the time, the
 /// extended state just before the jump, and the state just after it (the
@@ -36,13 +36,28 @@ pub(crate) fn flow_through_events<S: Chain>(
     z0: &[f64],
     t_end: f64,
     opts: &IntegratorOptions,
+    at_impact: impl FnMut(&mut S, ImpactJump) -> Result<(), IntegrationError>,
+) -> Result<(Vec<f64>, u64, usize), IntegrationError> {
+    let form = sys.linear_form().and_then(LinearForm::solve);
+    flow_through_events_with(sys, form, z0, t_end, opts, at_impact)
+}
+
+/// [`flow_through_events`] with the system's linear form solved already
+/// (None: it has none), as a caller that solved a larger one has it
+/// ([`Linear::leading`]).
+pub(crate) fn flow_through_events_with<S: Chain>(
+    sys: &mut S,
+    form: Option<Linear>,
+    z0: &[f64],
+    t_end: f64,
+    opts: &IntegratorOptions,
     mut at_impact: impl FnMut(&mut S, ImpactJump) -> Result<(), IntegrationError>,
 ) -> Result<(Vec<f64>, u64, usize), IntegrationError> {
     let dim = sys.dim();
     // A chain whose every contact is rigid moves exactly between impacts
     // (its linear form), in steps the exact series takes to rounding;
     // another by DOP853.
-    let exact = (sys.linear_form().and_then(LinearForm::solve))
+    let exact = form
         .filter(|form| form.dim() == dim)
         .and_then(|form| Stepper::exact(form, dim, opts));
     let mut st = match exact {

@@ -24,7 +24,7 @@ mod flow;
 pub(super) use episodes::{judged, judging_gaps, reaches_within, Jump};
 
 pub use episodes::{EpisodeReason, SoftEpisode};
-pub(crate) use flow::{flow_through_events, ImpactJump};
+pub(crate) use flow::{flow_through_events, flow_through_events_with, ImpactJump};
 
 /// An event that changes the right-hand side.
 #[derive(Clone, Copy, Debug, PartialEq)]
