@@ -68,8 +68,8 @@ impl<F: Family + Send> Iterator for Continuation<F> {
 impl<F: Family + Send> Continuation<F> {
     /// Finishes the start first while it is not yielded (its orbit
     /// summary), then every point corrected so far (correcting one first
-    /// if there is neither), and then each point the corrector hands over as it runs
-    /// ahead on another thread, until it stops (the branch's end, or
+    /// if there is neither), and then each point the corrector hands over
+    /// as it runs ahead on another thread, until it stops (the branch's end, or
     /// [`AHEAD`] points in this batch) or a point ends the branch. (A
     /// finisher faster than the corrector had stopped it after each batch
     /// of one point and corrected the next point itself: R2 N = 2 rigid,

@@ -247,20 +247,19 @@ impl Shape {
     /// law's peak force not solved (NaN).
     fn at(&self, mu: f64, u: f64, peak: bool) -> Result<(f64, f64, f64, f64), ImpactError> {
         Ok(match self {
-            Shape::Seed(seed) if !peak => {
-                let v = dimensionless_velocity(u, seed.closed.a_over_b());
-                let e = restitution(v)?;
-                let duration = seed.duration(mu, (u, v))?;
-                let slope = restitution_derivative(v, e) / seed.a_over_b;
-                (e, slope, f64::NAN, duration)
-            }
             Shape::Seed(seed) => {
-                // (The closed form's e(V) is the same root: solved once.)
-                let closed = seed.closed.impact(u)?;
-                let (v, e) = (closed.v, closed.restitution);
+                // (The closed form's e(V) is the same root: solved once;
+                // without the peak, e(V) alone.)
+                let (v, e, peak_force) = if peak {
+                    let closed = seed.closed.impact(u)?;
+                    (closed.v, closed.restitution, closed.peak_force)
+                } else {
+                    let v = dimensionless_velocity(u, seed.closed.a_over_b());
+                    (v, restitution(v)?, f64::NAN)
+                };
                 let duration = seed.duration(mu, (u, v))?;
                 let slope = restitution_derivative(v, e) / seed.a_over_b;
-                (e, slope, closed.peak_force, duration)
+                (e, slope, peak_force, duration)
             }
             Shape::Damped {
                 law,
