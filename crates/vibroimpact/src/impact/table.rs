@@ -74,12 +74,27 @@ impl<const C: usize> Table<C> {
     /// Function `c`'s value and derivative at `x`, which the caller keeps
     /// within the table ([`Table::contains`]; outside, the nearest end's).
     pub fn at(&self, c: usize, x: f64) -> (f64, f64) {
+        let (p, t) = self.piece(x);
+        let (value, slope) = &self.pieces[p][c];
+        (clenshaw(value, t), clenshaw(slope, t))
+    }
+
+    /// Function `c`'s value at `x` alone, as [`Table::at`] has it.
+    pub fn value(&self, c: usize, x: f64) -> f64 {
+        let (p, t) = self.piece(x);
+        clenshaw(&self.pieces[p][c].0, t)
+    }
+
+    /// The piece `x` lies in (the nearest end's outside) and `x` on it,
+    /// in [-1, 1].
+    fn piece(&self, x: f64) -> (usize, f64) {
         let (lo, hi) = self.range();
         let x = x.clamp(lo, hi);
         let p = (((x - lo) / self.width) as usize).min(self.pieces.len() - 1);
-        let t = 2.0 * (x - lo - (p as f64 + 0.5) * self.width) / self.width;
-        let (value, slope) = &self.pieces[p][c];
-        (clenshaw(value, t), clenshaw(slope, t))
+        (
+            p,
+            2.0 * (x - lo - (p as f64 + 0.5) * self.width) / self.width,
+        )
     }
 }
 
@@ -150,6 +165,7 @@ mod tests {
             worst = worst.max((f - (3.0 * x).sin()).abs());
             worst = worst.max((df - 3.0 * (3.0 * x).cos()).abs() / 100.0);
             let (g, dg) = table.at(1, x);
+            assert_eq!(table.value(1, x).to_bits(), g.to_bits());
             let exact = (0.5 * x).exp();
             worst = worst.max((g / exact - 1.0).abs());
             worst = worst.max((dg / (0.5 * exact) - 1.0).abs() / 100.0);

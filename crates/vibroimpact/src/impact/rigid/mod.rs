@@ -275,7 +275,7 @@ impl Shape {
                 let (e, de) = if x < lo {
                     // Second order matched to the table's end (its value
                     // there carries the integration's 1e-13).
-                    let c = (table.at(0, lo.ln()).0 - 1.0 + 2.0 / 3.0 * lo) / (lo * lo);
+                    let c = (table.value(0, lo.ln()) - 1.0 + 2.0 / 3.0 * lo) / (lo * lo);
                     (1.0 - 2.0 / 3.0 * x + c * x * x, -2.0 / 3.0 + 2.0 * c * x)
                 } else if x > hi {
                     (1.0 / x, -1.0 / (x * x))
@@ -288,8 +288,8 @@ impl Shape {
                     let r = direct(law, mu, u)?;
                     (r.peak_force, r.contact_duration)
                 } else {
-                    let peak = table.at(1, q).0.exp();
-                    let tau = table.at(2, q).0.exp();
+                    let peak = table.value(1, q).exp();
+                    let tau = table.value(2, q).exp();
                     (peak * scale.0, tau * scale.1)
                 };
                 (e, de * dx, peak, tau)
@@ -342,7 +342,7 @@ impl Seed {
     /// integrated beyond the table.
     fn duration(&self, mu: f64, (u, v): (f64, f64)) -> Result<f64, ImpactError> {
         Ok(if self.table.contains(v.ln()) {
-            self.table.at(2, v.ln()).0.exp() / (self.alpha * self.a_over_b)
+            self.table.value(2, v.ln()).exp() / (self.alpha * self.a_over_b)
         } else {
             direct(&self.law, mu, u)?.contact_duration
         })

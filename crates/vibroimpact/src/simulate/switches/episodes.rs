@@ -7,9 +7,9 @@
 //! absolute tolerance, is taken by the contact's own law, integrated, in
 //! a soft episode that ends once the bodies separate.
 
-use super::{rigid_jump, Event, Switches};
+use super::{apply_jump, Event, Switches};
 use crate::dynamics::ChainDynamics;
-use crate::impact::rigid::{RigidImpact, RigidLaw};
+use crate::impact::rigid::RigidImpact;
 use crate::impact::ImpactError;
 use crate::integrate::IntegrationError;
 use crate::model::Model;
@@ -140,26 +140,12 @@ pub(in crate::simulate) fn judging_gaps(chain: &ChainDynamics, threshold: f64) -
         .collect()
 }
 
-/// Why an impact at approach velocity `u`, under the pressing
-/// acceleration `pressing` (s̈, positive toward each other), is taken by
-/// its law: an approach at or below `floor`; the neighbours' reason
-/// (`neighbour`, of the impact's estimated duration); a rebound that would
-/// return within that duration. None: a rigid impact.
-pub(in crate::simulate) fn soft_reason(
-    law: &RigidLaw,
-    (u, pressing): (f64, f64),
-    floor: f64,
-    neighbour: impl FnOnce(f64) -> Option<EpisodeReason>,
-) -> Result<Option<EpisodeReason>, ImpactError> {
-    if u <= floor {
-        return Ok(Some(EpisodeReason::Slow { velocity: u }));
-    }
-    Ok(judged(law.judging(u)?, pressing, neighbour))
-}
-
-/// [`soft_reason`] of an impact above the floor of estimated `duration`
-/// and `rebound` velocity ([`RigidLaw::judging`]), found while its bodies
-/// press together at `pressing` (m/s²).
+/// Why an impact above the floor, of estimated `duration` and `rebound`
+/// velocity ([`judging`](crate::impact::rigid::RigidLaw::judging)), found while its bodies press
+/// together at `pressing` (s̈ in m/s², positive toward each other), is
+/// taken by its law: the neighbours' reason (`neighbour`, of that
+/// duration); a rebound that would return within it. None: a rigid
+/// impact.
 pub(in crate::simulate) fn judged(
     (duration, rebound): (f64, f64),
     pressing: f64,
@@ -205,9 +191,10 @@ pub(in crate::simulate) fn reaches_within(
 
 impl Switches {
     /// Whether rigid contact k's impact, judged at `(t, y)` (`dydt` the
-    /// derivative there), is taken by its law, and why ([`soft_reason`];
-    /// the neighbours' reasons: a contact sharing a body in a soft episode,
-    /// or whose impact began within its estimated duration). None: rigid,
+    /// derivative there), is taken by its law, and why: an approach at or
+    /// below `floor` (the absolute tolerance), else [`judged`] (the
+    /// neighbours' reasons: a contact sharing a body in a soft episode, or
+    /// whose impact began within its estimated duration). None: rigid,
     /// or not approaching.
     pub(in crate::simulate) fn judge(
         &self,
@@ -216,13 +203,26 @@ impl Switches {
         (t, y, dydt): (f64, &[f64], &[f64]),
         floor: f64,
     ) -> Result<Option<EpisodeReason>, IntegrationError> {
-        let (_, u) = chain.approach(k, y);
-        let Some(law) = chain.rigid_law(k) else {
+        let u = chain.approach(k, y).1;
+        let Some(law) = chain.rigid_law(k).filter(|_| u > 0.0) else {
             return Ok(None);
         };
-        if u <= 0.0 {
-            return Ok(None);
+        if u <= floor {
+            return Ok(Some(EpisodeReason::Slow { velocity: u }));
         }
+        let judging = law.judging(u).map_err(|e| failed(t, k, e))?;
+        Ok(self.judged_at(chain, k, (t, y, dydt), judging))
+    }
+
+    /// [`judged`] for contact k at `(t, y)` (`dydt` the derivative
+    /// there), of the impact's estimated `(duration, rebound)`.
+    fn judged_at(
+        &self,
+        chain: &ChainDynamics,
+        k: usize,
+        (t, y, dydt): (f64, &[f64], &[f64]),
+        judging: (f64, f64),
+    ) -> Option<EpisodeReason> {
         let bodies = |j: usize| {
             let [_, vl, _, vr] = chain.contact_indices(j);
             [vl.map(|i| i / 2), vr.map(|i| i / 2)]
@@ -252,20 +252,14 @@ impl Switches {
                     })
                 })
         };
-        let pressing = sdd(k);
-        soft_reason(law, (u, pressing), floor, neighbour).map_err(|e| {
-            IntegrationError::RigidImpact {
-                t,
-                contact: k,
-                reason: e.to_string(),
-            }
-        })
+        judged(judging, sdd(k), neighbour)
     }
 
     /// Rigid contact k's impact at `(t, y)` (`dydt` the derivative just
     /// before it): the velocities' jump applied to `y`, or a soft episode
     /// where the rigid idealisation breaks ([`Switches::judge`], again at
-    /// the touch: a neighbour may have struck since the approach).
+    /// the touch: a neighbour may have struck since the approach). The
+    /// impact at the touch's velocity serves the judging and the jump.
     pub(in crate::simulate) fn rigid_or_soft(
         &mut self,
         chain: &ChainDynamics,
@@ -273,15 +267,24 @@ impl Switches {
         (t, y, dydt): (f64, &mut [f64], &[f64]),
         floor: f64,
     ) -> Result<Jump, IntegrationError> {
-        if chain.approach(k, y).1 <= 0.0 || chain.rigid_law(k).is_none() {
-            return Ok(Jump::Touch);
-        }
-        if let Some(reason) = self.judge(chain, k, (t, y, dydt), floor)? {
-            return Ok(Jump::Soft(reason));
-        }
-        let Some((_, r)) = rigid_jump(chain, k, (t, y), (floor, self.peak_forces))? else {
+        let u = chain.approach(k, y).1;
+        let Some(law) = chain.rigid_law(k).filter(|_| u > 0.0) else {
             return Ok(Jump::Touch);
         };
+        if u <= floor {
+            return Ok(Jump::Soft(EpisodeReason::Slow { velocity: u }));
+        }
+        let r = if self.peak_forces {
+            law.impact(u)
+        } else {
+            law.jump(u)
+        };
+        let r = r.map_err(|e| failed(t, k, e))?;
+        let judging = (r.duration, r.rebound_velocity);
+        if let Some(reason) = self.judged_at(chain, k, (t, y, dydt), judging) {
+            return Ok(Jump::Soft(reason));
+        }
+        apply_jump(chain, k, y, &r);
         self.last_impact[k] = (t, r.duration);
         Ok(Jump::Rigid(r))
     }
@@ -309,11 +312,7 @@ impl Switches {
             return Ok(());
         };
         let u = chain.approach(k, y).1;
-        let r = law.impact(u).map_err(|e| IntegrationError::RigidImpact {
-            t,
-            contact: k,
-            reason: e.to_string(),
-        })?;
+        let r = law.impact(u).map_err(|e| failed(t, k, e))?;
         self.last_impact[k] = (t, r.duration);
         Ok(())
     }
@@ -330,5 +329,14 @@ impl Switches {
                 _ => {}
             }
         }
+    }
+}
+
+/// An impact law's failure at contact k's impact at t.
+fn failed(t: f64, k: usize, e: ImpactError) -> IntegrationError {
+    IntegrationError::RigidImpact {
+        t,
+        contact: k,
+        reason: e.to_string(),
     }
 }

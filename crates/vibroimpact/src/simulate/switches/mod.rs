@@ -550,6 +550,14 @@ fn rigid_jump(
     };
     let r = if peak { law.impact(u) } else { law.jump(u) };
     let r = r.map_err(|e| stop(e.to_string()))?;
+    apply_jump(chain, k, y, &r);
+    Ok(Some((k, r)))
+}
+
+/// Contact k's impact `r` applied to `y`: the bodies' velocities jump by
+/// ∓P/m, and the energy audit's contact dissipation takes the energy
+/// lost.
+fn apply_jump(chain: &ChainDynamics, k: usize, y: &mut [f64], r: &RigidImpact) {
     let [_, vl, _, vr] = chain.contact_indices(k);
     if let Some(i) = vl {
         y[i] -= r.impulse / chain.mass(i / 2);
@@ -560,7 +568,6 @@ fn rigid_jump(
     if chain.audits_energy() {
         y[chain.audit_index() + 2] += r.energy_lost;
     }
-    Ok(Some((k, r)))
 }
 
 #[cfg(test)]
