@@ -551,15 +551,54 @@ fn series_terms(
 }
 
 /// `out = Σ_k τ^k terms_k` over the first `count` terms of `n`
-/// components each (Horner), for the first `out.len()` components.
+/// components each, for the first `out.len()` components: four Horner
+/// chains in τ⁴ (the terms k ≡ r mod 4), joined by Horner in τ. The
+/// chains are independent, so a dense output does not wait on one
+/// dependent chain of a product and a sum a term (Estrin's idea); the
+/// small blocks' sizes unrolled. [`series_at`] is one component of it,
+/// the same operations.
 fn sum_series(terms: &[f64], (n, count): (usize, usize), tau: f64, out: &mut [f64]) {
-    let m = out.len();
-    out.copy_from_slice(&terms[(count - 1) * n..(count - 1) * n + m]);
-    for k in (0..count - 1).rev() {
-        for (x, t) in out.iter_mut().zip(&terms[k * n..k * n + m]) {
-            *x = *x * tau + t;
+    match out.len() {
+        2 => sum_series_of::<2>(terms, (n, count), tau, out),
+        4 => sum_series_of::<4>(terms, (n, count), tau, out),
+        6 => sum_series_of::<6>(terms, (n, count), tau, out),
+        8 => sum_series_of::<8>(terms, (n, count), tau, out),
+        _ => {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = series_at(terms, (n, count), tau, i);
+            }
         }
     }
+}
+
+/// [`sum_series`] of M components.
+fn sum_series_of<const M: usize>(
+    terms: &[f64],
+    (n, count): (usize, usize),
+    tau: f64,
+    out: &mut [f64],
+) {
+    let t4 = (tau * tau) * (tau * tau);
+    let mut c = [[0.0f64; M]; 4];
+    for k in (0..count).rev() {
+        let chain = &mut c[k % 4];
+        for (x, t) in chain.iter_mut().zip(&terms[k * n..k * n + M]) {
+            *x = *x * t4 + t;
+        }
+    }
+    for (i, o) in out[..M].iter_mut().enumerate() {
+        *o = ((c[3][i] * tau + c[2][i]) * tau + c[1][i]) * tau + c[0][i];
+    }
+}
+
+/// Component i of [`sum_series`].
+fn series_at(terms: &[f64], (n, count): (usize, usize), tau: f64, i: usize) -> f64 {
+    let t4 = (tau * tau) * (tau * tau);
+    let mut c = [0.0f64; 4];
+    for k in (0..count).rev() {
+        c[k % 4] = c[k % 4] * t4 + terms[k * n + i];
+    }
+    ((c[3] * tau + c[2]) * tau + c[1]) * tau + c[0]
 }
 
 impl StepMethod for ExactMethod {
@@ -741,10 +780,7 @@ impl StepMethod for ExactMethod {
         if !self.series(h, i + 1) {
             return f64::NAN;
         }
-        let series = (0..self.count)
-            .rev()
-            .fold(0.0, |acc, k| acc * tau + self.terms[k * n + i]);
-        steady + series
+        steady + series_at(&self.terms, (n, self.count), tau, i)
     }
 
     /// At a quarter of the step its matrix on the deviation; elsewhere the

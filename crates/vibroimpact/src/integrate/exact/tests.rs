@@ -2,8 +2,8 @@
 //! a forced pair against DOP853 (and a leading part of either's dense
 //! output against the whole), the dense output between quarters, a step
 //! ended at an event inside it, a leading block alone, a resonance
-//! refused, and a stepper that takes the exact flow where the
-//! form holds.
+//! refused, a stepper that takes the exact flow where the form holds,
+//! and the series summed in four chains against Horner.
 
 use super::*;
 use crate::integrate::{IntegratorOptions, Method, Stepper};
@@ -428,4 +428,48 @@ fn a_stepper_moves_exactly_from_each_reset_where_the_form_holds() {
     assert!((y[0] - x).abs() < 1e-9 * scale, "{} vs {x}", y[0]);
     assert!((y[1] - v).abs() < 1e-9 * scale * w, "{} vs {v}", y[1]);
     assert_eq!(st.stats().steps, steps);
+}
+
+/// The series summed in four chains equals the plain Horner sum to
+/// rounding, and each component alone ([`series_at`]) is the same bits,
+/// for the unrolled sizes and others, and for every term count mod 4.
+#[test]
+fn the_series_in_four_chains_is_horner_to_rounding() {
+    let n = 10;
+    // Terms of e^{x τ} in each component (x_i up to 2, τ up to 1): the
+    // step's series at its largest ‖A‖ τ.
+    let x: Vec<f64> = (0..n).map(|i| 2.0 - 0.37 * i as f64).collect();
+    let mut terms = vec![0.0; (MAX_TERMS + 1) * n];
+    for i in 0..n {
+        let mut t = 1.0 + 0.1 * i as f64;
+        for k in 0..=MAX_TERMS {
+            terms[k * n + i] = t;
+            t *= x[i] / (k + 1) as f64;
+        }
+    }
+    for m in [1, 2, 3, 4, 6, 8, 10] {
+        for count in [1, 2, 5, 26, 27, 28, 29, MAX_TERMS + 1] {
+            for tau in [0.0, 0.013, 0.5, 1.0] {
+                let mut out = vec![0.0; m];
+                sum_series(&terms, (n, count), tau, &mut out);
+                for (i, o) in out.iter().enumerate() {
+                    let horner = (0..count)
+                        .rev()
+                        .fold(0.0, |a, k| a * tau + terms[k * n + i]);
+                    let scale = (0..count).map(|k| terms[k * n + i].abs() * tau.powi(k as i32));
+                    let tol = 4.0 * f64::EPSILON * scale.sum::<f64>();
+                    assert!(
+                        (o - horner).abs() <= tol,
+                        "m {m} count {count} τ {tau} component {i}: {o} against {horner}"
+                    );
+                    let alone = series_at(&terms, (n, count), tau, i);
+                    assert_eq!(alone.to_bits(), o.to_bits(), "m {m} count {count} τ {tau}");
+                }
+            }
+        }
+    }
+    // The closed form where the series is whole: e^{2·1} to rounding.
+    let mut e = [0.0];
+    sum_series(&terms, (n, MAX_TERMS + 1), 1.0, &mut e);
+    assert!((e[0] - 2f64.exp()).abs() <= 4.0 * f64::EPSILON * 2f64.exp());
 }
