@@ -5,7 +5,7 @@
 //! points.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::mpsc::{channel, Receiver, Sender, TryRecvError};
 
 use super::{BranchStep, Continuation, Corrected, Ending, Family};
 
@@ -36,6 +36,25 @@ impl<F: Family + Send> Continuation<F> {
             let _ = hand.send(step);
         }
     }
+}
+
+/// How many times the finisher looks for a handed point, yielding its
+/// core between looks, before it sleeps until one comes.
+const LOOKS: usize = 1000;
+
+/// The next point handed over, None once the corrector has stopped. The
+/// finisher looks ([`LOOKS`] times, yielding between) before it sleeps: a
+/// sleeping finisher costs the corrector a wake-up call at each point it
+/// hands over, 5 % of its thread on the R2 N = 2 rigid branch.
+fn receive(handed: &Receiver<Step>) -> Option<Step> {
+    for _ in 0..LOOKS {
+        match handed.try_recv() {
+            Ok(step) => return Some(step),
+            Err(TryRecvError::Disconnected) => return None,
+            Err(TryRecvError::Empty) => std::thread::yield_now(),
+        }
+    }
+    handed.recv().ok()
 }
 
 impl<F: Family + Send> Iterator for Continuation<F> {
@@ -100,7 +119,8 @@ impl<F: Family + Send> Continuation<F> {
                     return out;
                 }
             }
-            for step in batch.into_iter().chain(handed.into_iter().flatten()) {
+            let handed = std::iter::from_fn(|| handed.and_then(receive));
+            for step in batch.into_iter().chain(handed) {
                 let finished = step.and_then(|s| {
                     finisher.finish(s).map_err(|reason| Ending {
                         reason,
