@@ -2,7 +2,7 @@
 //! soft law, integrated, or in the rigid limit as instantaneous velocity
 //! jumps with the law's e(U) or a Newton coefficient.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use super::{Model, ModelError, ModelErrorKind};
 use crate::field_error::{shown, FieldError};
@@ -22,6 +22,26 @@ impl RigidLimits {
     /// Contact `k`'s rigid limit (None: soft impacts, or no such contact).
     pub fn get(&self, k: usize) -> Option<&RigidLaw> {
         self.of.get(k).copied().flatten().map(|i| &self.laws[i])
+    }
+}
+
+/// The contacts' shared rigid limits ([`Model::rigid_laws`]), built once
+/// for a model and its clones: a reforced model (another base, the same
+/// limits) shares them, so a branch's period maps do not build them
+/// again for each model. Set again wherever the contacts' laws or
+/// impacts change; not part of what a model is (equal whatever it holds).
+#[derive(Clone, Default)]
+pub(super) struct SharedLaws(Arc<OnceLock<Vec<Option<Arc<RigidLaw>>>>>);
+
+impl PartialEq for SharedLaws {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for SharedLaws {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SharedLaws")
     }
 }
 
@@ -118,15 +138,20 @@ impl Model {
         Ok(limits)
     }
 
-    /// [`Model::rigid_limits`] as one shared limit per contact.
+    /// [`Model::rigid_limits`] as one shared limit per contact, built
+    /// once for the model and its clones.
     pub fn rigid_laws(&self) -> Result<Vec<Option<Arc<RigidLaw>>>, ModelError> {
+        if let Some(laws) = self.rigid.0.get() {
+            return Ok(laws.clone());
+        }
         let limits = self.rigid_limits()?;
         let laws: Vec<Arc<RigidLaw>> = limits.laws.into_iter().map(Arc::new).collect();
-        Ok(limits
+        let of: Vec<_> = limits
             .of
             .iter()
             .map(|i| i.map(|i| laws[i].clone()))
-            .collect())
+            .collect();
+        Ok(self.rigid.0.get_or_init(|| of).clone())
     }
 
     /// Contact `k`'s reduced mass (a wall's side infinite).
@@ -164,6 +189,7 @@ impl Model {
     /// contact.
     pub fn with_impacts(mut self, k: usize, impacts: Impacts) -> Result<Self, ModelError> {
         self.impacts[k] = impacts;
+        self.rigid = SharedLaws::default();
         self.rigid_law(k)?;
         Ok(self)
     }

@@ -195,6 +195,8 @@ pub struct Model {
     impacts: Vec<Impacts>,
     /// Gravity along the row (m/s², toward −u; 0 for a horizontal row).
     gravity: f64,
+    /// The contacts' rigid limits, built on first use.
+    rigid: impacts::SharedLaws,
 }
 
 /// `v` must be finite and >= 0; `key` is its path, `what` names it (both
@@ -258,6 +260,7 @@ impl Model {
             forces,
             storeys,
             gravity: 0.0,
+            rigid: Default::default(),
         }
     }
 
@@ -297,6 +300,7 @@ impl Model {
             forces,
             storeys: Vec::new(),
             gravity: 0.0,
+            rigid: Default::default(),
         };
         check_overlaps(&model)?;
         scales::check_rounding(&model)?;
@@ -366,6 +370,7 @@ impl Model {
         for c in &mut self.contacts {
             c.law = law;
         }
+        self.rigid = Default::default();
         self
     }
 

@@ -224,6 +224,8 @@ fn a_hinted_record_value_is_the_value() {
 /// The rigid limits of a row built at once (a copy where a contact is
 /// like the one before) are those built one by one: the walls' reduced
 /// mass is the body's, the pairs' half of it, and a soft contact has none.
+/// They are built once for a model and its clones, again where a clone's
+/// contacts change.
 #[test]
 fn rigid_laws_at_once_equal_those_built_one_by_one() {
     let m = Model::row(
@@ -258,4 +260,63 @@ fn rigid_laws_at_once_equal_those_built_one_by_one() {
             assert_eq!(a.impulse, b.impulse, "contact {k}, U {u}");
         }
     }
+    // Built once for the model and its clones (a reforced model shares
+    // them); a clone whose contacts change builds its own.
+    let same = |a: &Model, b: &Model| {
+        let (a, b) = (a.rigid_laws().unwrap(), b.rigid_laws().unwrap());
+        std::sync::Arc::ptr_eq(a[0].as_ref().unwrap(), b[0].as_ref().unwrap())
+    };
+    let base = BaseExcitation::Harmonic {
+        amplitude: 0.05,
+        frequency: 7.0,
+        phase: 0.0,
+    };
+    assert!(same(&m, &m.reforced(base).unwrap()));
+    let newton = m
+        .clone()
+        .with_impacts(
+            0,
+            Impacts::Rigid {
+                restitution: Some(0.5),
+            },
+        )
+        .unwrap();
+    assert!(!same(&m, &newton));
+    assert_eq!(
+        newton.rigid_laws().unwrap()[0]
+            .as_ref()
+            .unwrap()
+            .impact(0.1)
+            .unwrap()
+            .restitution,
+        0.5
+    );
+    let other = crate::contact::ContactLaw::exponential_from_ratio(
+        0.6,
+        2.6e5,
+        1.0,
+        crate::contact::ForceForm::Published,
+    )
+    .unwrap();
+    let harder = m.clone().with_contact_law(other);
+    let [e, e_harder] = [&m, &harder].map(|m| {
+        m.rigid_laws().unwrap()[0]
+            .as_ref()
+            .unwrap()
+            .impact(0.1)
+            .unwrap()
+            .restitution
+    });
+    assert!(!same(&m, &harder));
+    assert_eq!(
+        e_harder,
+        harder
+            .rigid_law(0)
+            .unwrap()
+            .unwrap()
+            .impact(0.1)
+            .unwrap()
+            .restitution
+    );
+    assert_ne!(e, e_harder);
 }
