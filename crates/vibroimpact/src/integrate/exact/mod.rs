@@ -2,9 +2,9 @@
 //! method: "EXACT" (docs/theory.md §12: the rigid period map between
 //! impacts).
 //!
-//! Files: `mod.rs` (the form and the method), `steady.rs` (the
-//! harmonics' steady states), `tests.rs` (against closed forms and
-//! DOP853).
+//! Files: `mod.rs` (the form and the method), `series.rs` (a step's
+//! motion as a power series), `steady.rs` (the harmonics' steady
+//! states), `tests.rs` (against closed forms and DOP853).
 //!
 //! A system whose right-hand side is `f(t, y) = A y + b(t)`, the state made
 //! of blocks of one dimension d that share the d × d matrix `A`, each with
@@ -37,9 +37,13 @@
 //! * **Dense output**: at a quarter of the step those matrices; elsewhere
 //!   (an event being located) the exponential's series on the deviation,
 //!   `Σ_k τ^k A^k v / k!` to the first term below 1e-17 of the sum, built
-//!   once a step and summed by Horner (at `‖A‖ τ ≤ 2` its terms never
-//!   exceed the sum by more than a factor 3): exact to rounding, so events
-//!   are located on the motion itself.
+//!   once a step and summed by Horner in four chains (at `‖A‖ τ ≤ 2` its
+//!   terms never exceed the sum by more than a factor 3): exact to
+//!   rounding, so events are located on the motion itself. The steady
+//!   state's own series about the step's start is folded into it at the
+//!   first such output, so the sum is the motion and takes no sine
+//!   (unless the forcing is so fast against the step that its terms
+//!   would pass `MAX_TERMS`: then the steady state is added at each).
 //! * `f(t + h, y_new)` is `A y_new + b(t + h)`: no evaluation of the
 //!   system's own right-hand side inside a step.
 //!
@@ -52,8 +56,10 @@ use nalgebra::DMatrix;
 
 use super::driver::{all_finite, Attempt, Driver, Point, StepMethod, Trial, NON_FINITE};
 
+mod series;
 mod steady;
 use super::{OdeSystem, RejectReason, Stats};
+use series::{fold_steady, series_at, series_terms, sum_series};
 use steady::{steady_state, Steady};
 
 /// Most terms of a step's series (at `‖A‖ h ≤ 2` it meets 1e-17 of the
@@ -463,6 +469,9 @@ pub struct ExactMethod {
     terms: Vec<f64>,
     count: usize,
     built: usize,
+    /// Whether `terms` hold the steady state's series too (the motion
+    /// itself, [`fold_steady`]).
+    folded: bool,
     terms_try: Vec<f64>,
     count_try: usize,
     /// Scratch: a steady state; two d × d matrices.
@@ -498,107 +507,33 @@ impl ExactMethod {
         let (n, m) = (self.deviation_acc.len(), m.div_ceil(form.d) * form.d);
         match series_terms(form, (&self.deviation_acc[..m], n), h, &mut self.terms) {
             Some(count) => {
-                (self.count, self.built) = (count, m);
+                (self.count, self.built, self.folded) = (count, m, false);
                 true
             }
             None => false,
         }
     }
-}
 
-/// The series terms `A^k v / k!` of the deviation `v` (whole blocks) into
-/// `terms` (term k at `[k·n..k·n + v.len()]`), as many as reach 1e-17 of
-/// the largest entry of `v` over a step `h`: how many, or None where
-/// `MAX_TERMS` do not.
-fn series_terms(
-    form: &Linear,
-    (v, n): (&[f64], usize),
-    h: f64,
-    terms: &mut [f64],
-) -> Option<usize> {
-    let (m, d) = (v.len(), form.d);
-    let (first, rest) = terms.split_at_mut(n);
-    let first = &mut first[..m];
-    first.copy_from_slice(v);
-    // (Entries measured balanced, `S v`.)
-    let balanced = |x: &[f64]| {
-        x.chunks_exact(d).fold(0.0f64, |m, b| {
-            b.iter()
-                .zip(&form.scale)
-                .fold(m, |m, (x, s)| m.max((x * s).abs()))
-        })
-    };
-    let size = balanced(first);
-    let mut count = 1;
-    let mut previous: &[f64] = first;
-    let mut scale = 1.0;
-    for (k, term) in rest.chunks_exact_mut(n).enumerate() {
-        let term = &mut term[..m];
-        let inv = 1.0 / (k + 1) as f64;
-        for (p, t) in previous.chunks_exact(d).zip(term.chunks_exact_mut(d)) {
-            times(&form.rows, p, t);
-            t.iter_mut().for_each(|x| *x *= inv);
+    /// Folds the steady state about the accepted step's start `t0` into
+    /// its series (built), once: false where it does not fold (the
+    /// steady state is then added at each dense output).
+    fn fold(&mut self, t0: f64, h: f64) -> bool {
+        if self.folded {
+            return true;
         }
-        count += 1;
-        scale *= h;
-        let largest = balanced(term) * scale;
-        if largest <= 1e-17 * size {
-            return Some(count);
-        }
-        previous = term;
-    }
-    None
-}
-
-/// `out = Σ_k τ^k terms_k` over the first `count` terms of `n`
-/// components each, for the first `out.len()` components: four Horner
-/// chains in τ⁴ (the terms k ≡ r mod 4), joined by Horner in τ. The
-/// chains are independent, so a dense output does not wait on one
-/// dependent chain of a product and a sum a term (Estrin's idea); the
-/// small blocks' sizes unrolled. [`series_at`] is one component of it,
-/// the same operations.
-fn sum_series(terms: &[f64], (n, count): (usize, usize), tau: f64, out: &mut [f64]) {
-    match out.len() {
-        2 => sum_series_of::<2>(terms, (n, count), tau, out),
-        4 => sum_series_of::<4>(terms, (n, count), tau, out),
-        6 => sum_series_of::<6>(terms, (n, count), tau, out),
-        8 => sum_series_of::<8>(terms, (n, count), tau, out),
-        _ => {
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = series_at(terms, (n, count), tau, i);
+        let Some(form) = self.form.as_ref() else {
+            return false;
+        };
+        let n = self.deviation_acc.len();
+        let sizes = (n, self.built);
+        match fold_steady(form, (t0, h), sizes, &mut self.terms, self.count) {
+            Some(count) => {
+                (self.count, self.folded) = (count, true);
+                true
             }
+            None => false,
         }
     }
-}
-
-/// [`sum_series`] of M components.
-fn sum_series_of<const M: usize>(
-    terms: &[f64],
-    (n, count): (usize, usize),
-    tau: f64,
-    out: &mut [f64],
-) {
-    let t4 = (tau * tau) * (tau * tau);
-    let mut c = [[0.0f64; M]; 4];
-    for k in (0..count).rev() {
-        let chain = &mut c[k % 4];
-        for (x, t) in chain.iter_mut().zip(&terms[k * n..k * n + M]) {
-            *x = *x * t4 + t;
-        }
-    }
-    for (i, o) in out[..M].iter_mut().enumerate() {
-        *o = ((c[3][i] * tau + c[2][i]) * tau + c[1][i]) * tau + c[0][i];
-    }
-}
-
-/// Component i of [`sum_series`].
-fn series_at(terms: &[f64], (n, count): (usize, usize), tau: f64, i: usize) -> f64 {
-    let t4 = (tau * tau) * (tau * tau);
-    let mut c = [0.0f64; 4];
-    for k in (0..count).rev() {
-        c[k % 4] = c[k % 4] * t4 + terms[k * n + i];
-    }
-    ((c[3] * tau + c[2]) * tau + c[1]) * tau + c[0]
 }
 
 impl StepMethod for ExactMethod {
@@ -622,6 +557,7 @@ impl StepMethod for ExactMethod {
             terms_try: vec![0.0; (MAX_TERMS + 1) * dim],
             count_try: 0,
             built: 0,
+            folded: false,
             steady: vec![0.0; dim],
             scratch: [Vec::new(), Vec::new()],
             end: vec![0.0; dim],
@@ -732,7 +668,7 @@ impl StepMethod for ExactMethod {
     fn accept(&mut self, _at: &Point, _y_new: &[f64], _h: f64) {
         std::mem::swap(&mut self.deviation, &mut self.deviation_acc);
         self.quarters_acc = self.quarters;
-        self.count = 0;
+        (self.count, self.folded) = (0, false);
         if self.quarters.is_none() {
             std::mem::swap(&mut self.terms, &mut self.terms_try);
             (self.count, self.built) = (self.count_try, self.terms.len() / (MAX_TERMS + 1));
@@ -771,8 +707,8 @@ impl StepMethod for ExactMethod {
         let (n, d, h) = (at.dim(), form.d, at.h_last);
         let tau = s * h;
         let (b, r) = (i / d, i % d);
-        let steady = form.steady_at(b, r, at.t_prev + tau);
         if let (Some(j), Some(q)) = (quarter(s), self.quarters_acc) {
+            let steady = form.steady_at(b, r, at.t_prev + tau);
             let row = &self.sizes[q].e[j][r * d..(r + 1) * d];
             let v = &self.deviation_acc[b * d..(b + 1) * d];
             return steady + row.iter().zip(v).map(|(a, x)| a * x).sum::<f64>();
@@ -780,7 +716,15 @@ impl StepMethod for ExactMethod {
         if !self.series(h, i + 1) {
             return f64::NAN;
         }
-        steady + series_at(&self.terms, (n, self.count), tau, i)
+        let series = series_at(&self.terms, (n, self.count), tau, i);
+        if self.fold(at.t_prev, h) {
+            return series;
+        }
+        let steady = self
+            .form
+            .as_ref()
+            .map_or(f64::NAN, |f| f.steady_at(b, r, at.t_prev + tau));
+        steady + series
     }
 
     /// At a quarter of the step its matrix on the deviation; elsewhere the
@@ -799,8 +743,8 @@ impl StepMethod for ExactMethod {
         };
         let (d, h) = (form.d, at.h_last);
         let tau = s * h;
-        form.steady_into(at.t_prev + tau, out);
         if let (Some(j), Some(q)) = (quarter(s), self.quarters_acc) {
+            form.steady_into(at.t_prev + tau, out);
             let e = &self.sizes[q].e[j];
             // (`chunks_mut`: a leading part may end inside a block.)
             for (ob, vb) in out.chunks_mut(d).zip(self.deviation_acc.chunks_exact(d)) {
@@ -815,8 +759,15 @@ impl StepMethod for ExactMethod {
             return;
         }
         let n = self.steady.len();
+        if self.fold(at.t_prev, h) {
+            sum_series(&self.terms, (n, self.count), tau, out);
+            return;
+        }
         let series = &mut self.steady[..out.len()];
         sum_series(&self.terms, (n, self.count), tau, series);
+        if let Some(form) = self.form.as_ref() {
+            form.steady_into(at.t_prev + tau, out);
+        }
         for (o, x) in out.iter_mut().zip(series.iter()) {
             *o += x;
         }

@@ -3,7 +3,8 @@
 //! output against the whole), the dense output between quarters, a step
 //! ended at an event inside it, a leading block alone, a resonance
 //! refused, a stepper that takes the exact flow where the form holds,
-//! and the series summed in four chains against Horner.
+//! the series summed in four chains against Horner, and the steady state
+//! folded into it.
 
 use super::*;
 use crate::integrate::{IntegratorOptions, Method, Stepper};
@@ -472,4 +473,49 @@ fn the_series_in_four_chains_is_horner_to_rounding() {
     let mut e = [0.0];
     sum_series(&terms, (n, MAX_TERMS + 1), 1.0, &mut e);
     assert!((e[0] - 2f64.exp()).abs() <= 4.0 * f64::EPSILON * 2f64.exp());
+}
+
+/// The steady state folded into a step's series sums to the steady state
+/// itself plus the deviation's series (to rounding of the sum's terms),
+/// a constant force's included; a forcing far faster than the step does
+/// not fold, and leaves the terms as they were.
+#[test]
+fn the_steady_state_folds_into_the_series() {
+    let mut sys = Forced::lone((7.4, 0.02, 3.0, 11.1));
+    sys.g = -1.3;
+    sys.p = 0.7;
+    let form = sys.linear_form().and_then(LinearForm::solve).unwrap();
+    let (n, h, t0) = (2, form.step_limit(), 0.37);
+    let v = [2e-3, -0.05];
+    let mut terms = vec![0.0; (MAX_TERMS + 1) * n];
+    let count = series_terms(&form, (&v, n), h, &mut terms).unwrap();
+    let unfolded = terms.clone();
+    let folded = fold_steady(&form, (t0, h), (n, n), &mut terms, count).unwrap();
+    assert!(folded > count, "Ω h = {} needs more terms", 11.1 * h);
+    for s in [0.0, 0.1, 0.377, 0.5, 0.93, 1.0] {
+        let tau = s * h;
+        let mut motion = [0.0; 2];
+        sum_series(&terms, (n, folded), tau, &mut motion);
+        let mut deviation = [0.0; 2];
+        sum_series(&unfolded, (n, count), tau, &mut deviation);
+        let mut steady = [0.0; 2];
+        form.steady_into(t0 + tau, &mut steady);
+        for i in 0..2 {
+            let expected = steady[i] + deviation[i];
+            // (The steady terms reach |X| e^{Ω τ}: a few units of rounding
+            // of that.)
+            let size = steady[i].abs().max(0.1) * (11.1 * tau).exp();
+            assert!(
+                (motion[i] - expected).abs() <= 16.0 * f64::EPSILON * size,
+                "s {s}, row {i}: {} against {expected}",
+                motion[i]
+            );
+        }
+    }
+    // Ω h = 400: the steady terms would need far more than MAX_TERMS.
+    let fast = Forced::lone((7.4, 0.02, 3.0, 400.0 / h));
+    let form = fast.linear_form().and_then(LinearForm::solve).unwrap();
+    let mut terms = unfolded.clone();
+    assert_eq!(fold_steady(&form, (t0, h), (n, n), &mut terms, count), None);
+    assert_eq!(terms, unfolded);
 }
